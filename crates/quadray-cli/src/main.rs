@@ -1,0 +1,33 @@
+//! `quadray`: renders each technique headless, compares it with its CPU ground truth, and runs the
+//! benchmarks. Each subcommand lives in its own module.
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "quadray", version, about = "Reference implementations of three rendering papers")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the GPU adapter quadray would use.
+    Adapter,
+}
+
+fn main() -> anyhow::Result<()> {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match Cli::parse().command {
+        Command::Adapter => {
+            let gpu = quadray_gpu::Gpu::new()?;
+            println!("{}", gpu.describe());
+        }
+    }
+    Ok(())
+}
