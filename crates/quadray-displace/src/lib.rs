@@ -1,0 +1,11 @@
+//! Pyramid inverse displacement mapping (Oh & Ki, 2007): ray casting a height field through a
+//! quadtree of max heights, with node crossing, bilinear refinement, LOD and self-shadowing; the
+//! baselines it is compared against (bump, parallax, POM, relief, a real displaced mesh); and the
+//! exact CPU ground truth every GPU method is measured against.
+//!
+//! Data flows one way: [`heightmap`] (load) -> [`pyramid`] (build) -> [`gpu`] (trace and shade)
+//! -> [`accuracy`] (measure against [`reference`]).
+
+pub mod heightmap;
+pub mod pyramid;
+pub mod reference;
