@@ -4,7 +4,11 @@
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "quadray", version, about = "Reference implementations of three rendering papers")]
+#[command(
+    name = "quadray",
+    version,
+    about = "Reference implementations of three rendering papers"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

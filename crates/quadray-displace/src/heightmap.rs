@@ -165,7 +165,11 @@ impl HeightMap {
     }
 }
 
-fn to_depth(path: &Path, values: &[f32], convention: Convention) -> Result<Vec<f32>, HeightMapError> {
+fn to_depth(
+    path: &Path,
+    values: &[f32],
+    convention: Convention,
+) -> Result<Vec<f32>, HeightMapError> {
     Ok(match convention {
         Convention::Height => values.iter().map(|v| 1.0 - v).collect(),
         Convention::Depth => values.to_vec(),
@@ -191,7 +195,9 @@ fn nearest_power_of_two(n: u32) -> u32 {
 
 /// Bilinear resampling with texel centres aligned (corners map to corners).
 fn resample(src: &[f32], w: u32, h: u32, size: u32) -> Vec<f32> {
-    let at = |x: i64, y: i64| src[(y.clamp(0, h as i64 - 1) * w as i64 + x.clamp(0, w as i64 - 1)) as usize];
+    let at = |x: i64, y: i64| {
+        src[(y.clamp(0, h as i64 - 1) * w as i64 + x.clamp(0, w as i64 - 1)) as usize]
+    };
     let mut out = Vec::with_capacity((size * size) as usize);
     for j in 0..size {
         for i in 0..size {

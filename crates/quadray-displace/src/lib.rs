@@ -6,6 +6,13 @@
 //! Data flows one way: [`heightmap`] (load) -> [`pyramid`] (build) -> [`gpu`] (trace and shade)
 //! -> [`accuracy`] (measure against [`reference`]).
 
+pub mod accuracy;
+pub mod gpu;
 pub mod heightmap;
+pub mod method;
 pub mod pyramid;
 pub mod reference;
+pub mod scene;
+
+pub use gpu::{Frame, Lod, Renderer, Settings};
+pub use method::Method;

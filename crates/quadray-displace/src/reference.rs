@@ -38,7 +38,12 @@ pub struct Hit {
     pub z: f64,
 }
 
-pub fn intersect(map: &HeightMap, addressing: Addressing, surface: Surface, ray: Ray) -> Option<Hit> {
+pub fn intersect(
+    map: &HeightMap,
+    addressing: Addressing,
+    surface: Surface,
+    ray: Ray,
+) -> Option<Hit> {
     match surface {
         Surface::Point => intersect_point(map, addressing, ray),
         Surface::Bilinear => intersect_bilinear(map, addressing, ray),
@@ -122,7 +127,9 @@ fn leave_depth(ray: Ray, addressing: Addressing) -> f64 {
 fn intersect_point(map: &HeightMap, addressing: Addressing, ray: Ray) -> Option<Hit> {
     let n = map.size();
     let leave = leave_depth(ray, addressing);
-    if addressing == Addressing::Clamp && (ray.p0.cmplt(DVec2::ZERO).any() || ray.p0.cmpge(DVec2::ONE).any()) {
+    if addressing == Addressing::Clamp
+        && (ray.p0.cmplt(DVec2::ZERO).any() || ray.p0.cmpge(DVec2::ONE).any())
+    {
         return None;
     }
     walk_cells(ray, n as f64, 0.0, |ix, iy, z_in, z_out| {
@@ -210,7 +217,9 @@ mod tests {
         let mut s = seed;
         let depth = (0..size * size)
             .map(|_| {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 let v = (s >> 40) as f32 / (1u64 << 24) as f32;
                 if sharp { (v * 4.0).floor() / 3.0 } else { v }.min(1.0)
             })
@@ -221,7 +230,9 @@ mod tests {
     fn random_rays(count: usize, seed: u64) -> Vec<Ray> {
         let mut s = seed;
         let mut next = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
         (0..count)
@@ -256,7 +267,9 @@ mod tests {
         let q = p * n as f64 - 0.5;
         let (i, j) = (q.x.floor() as i64, q.y.floor() as i64);
         let (fx, fy) = (q.x - i as f64, q.y - j as f64);
-        let d = |a: i64, b: i64| f64::from(map.at(Addressing::Wrap.texel(a, n), Addressing::Wrap.texel(b, n)));
+        let d = |a: i64, b: i64| {
+            f64::from(map.at(Addressing::Wrap.texel(a, n), Addressing::Wrap.texel(b, n)))
+        };
         let top = d(i, j) * (1.0 - fx) + d(i + 1, j) * fx;
         let bottom = d(i, j + 1) * (1.0 - fx) + d(i + 1, j + 1) * fx;
         top * (1.0 - fy) + bottom * fy
