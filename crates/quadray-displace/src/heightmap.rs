@@ -32,7 +32,7 @@ pub enum HeightMapError {
     #[error("{path}: the image is empty (0 texels)")]
     Empty { path: PathBuf },
     #[error(
-        "{path}: {width}x{height} is not 2^n x 2^n; pass `--fit resample` to resample it to {suggested}x{suggested}"
+        "{path}: {width}x{height} is not 2^n x 2^n; resample it to {suggested}x{suggested} (`--resample` on the command line)"
     )]
     NotPowerOfTwo {
         path: PathBuf,

@@ -7,12 +7,26 @@
 //! -> [`accuracy`] (measure against [`reference`]).
 
 pub mod accuracy;
+pub mod bench;
+pub mod demo;
 pub mod gpu;
 pub mod heightmap;
+pub mod maps;
 pub mod method;
 pub mod pyramid;
 pub mod reference;
 pub mod scene;
+
+/// Anything that can go wrong between a map file and a measured picture.
+#[derive(Debug, thiserror::Error)]
+pub enum DisplaceError {
+    #[error(transparent)]
+    HeightMap(#[from] heightmap::HeightMapError),
+    #[error(transparent)]
+    Gpu(#[from] quadray_gpu::GpuError),
+    #[error(transparent)]
+    File(#[from] quadray_core::FileError),
+}
 
 pub use gpu::{Frame, Lod, Renderer, Settings};
 pub use method::Method;

@@ -29,7 +29,7 @@ impl SurfaceKind {
     /// Camera distance from the surface centre, in tiles.
     fn distance(self) -> f32 {
         match self {
-            SurfaceKind::Wall => 2.5,
+            SurfaceKind::Wall => 1.6,
             SurfaceKind::Terrain | SurfaceKind::Photo => 1.35,
         }
     }
@@ -128,7 +128,7 @@ impl View {
         let theta = view_angle_deg.to_radians();
         let eye = centre + (n * theta.cos() + away * theta.sin()) * kind.distance();
         let forward = (centre - eye).normalize();
-        let up = right.cross(forward);
+        let up = forward.cross(right);
         let view = glam::camera::rh::view::look_at_mat4(eye, centre, up);
         let proj = glam::camera::rh::proj::directx::perspective(
             50f32.to_radians(),
