@@ -5,11 +5,12 @@
 use crate::DisplaceError;
 use crate::accuracy::{Accuracy, Cost};
 use crate::demo::{bevy_pom, threejs_relief};
-use crate::gpu::{Renderer, Settings};
+use crate::gpu::{Lod, Renderer, Settings};
 use crate::heightmap::HeightMap;
 use crate::maps::{BUNDLED, BundledMap, resized};
 use crate::method::Method;
 use crate::pyramid::Addressing;
+use crate::scene::SurfaceKind;
 use quadray_core::bench::{PlotSpec, Series, Table, line_plot, write_json, write_text};
 use quadray_gpu::Gpu;
 use serde::Serialize;
@@ -59,8 +60,14 @@ pub struct Ratios {
     pub pom_layers_to_match: Option<u32>,
     /// POM time at that layer count / pyramid time (target >= 5).
     pub pom_matched_over_pyramid: Option<f64>,
+    /// The last POM layer count tried: (layers, wrong-hit fraction, POM time / pyramid time).
+    pub pom_most_layers: Option<(u32, f64, Option<f64>)>,
     /// Pyramid time with the 4096^2 map / with the 256^2 map (target <= 1.3).
     pub pyramid_4096_over_256: Option<f64>,
+    /// The same with the LOD of section 3.4 chosen from screen-space derivatives.
+    pub pyramid_lod_auto_4096_over_256: Option<f64>,
+    /// Pyramid with LOD from derivatives / POM-16 at 1920x1080 (POM samples level 0 as here).
+    pub pyramid_lod_auto_over_pom16_today: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -91,10 +98,13 @@ impl Bench<'_> {
         s: &Settings,
     ) -> Result<Option<f64>, DisplaceError> {
         let summary = renderer.time(self.gpu, s, self.frames)?;
-        let label = match s.method {
+        let mut label = match s.method {
             Method::Pom | Method::Relief => format!("{}-{}", s.method, s.layers.1),
             m => m.to_string(),
         };
+        if s.lod == Lod::Auto {
+            label += " lod-auto";
+        }
         self.timings.push(TimingRow {
             experiment: experiment.into(),
             map: name.into(),
@@ -186,7 +196,9 @@ pub fn run(
         ],
     );
     let mut f20 = Table::new(
-        format!("Figure 20: real displaced mesh vs pyramid ({paper}x{paper}, 256^2 map)"),
+        format!(
+            "Figure 20: displaced mesh (2 x 256^2 triangles) vs pyramid ({paper}x{paper}, one 256^2 tile)"
+        ),
         &["map", "method", "GPU ms", "memory (MB)"],
     );
     for b in BUNDLED.iter().filter(|b| b.paper_row != "-") {
@@ -244,19 +256,17 @@ pub fn run(
         ]);
         if b.name == "tiles" {
             ratios.pyramid_over_pom16_paper_size = ratio(point, pom);
-            let mesh = bench.time(
-                "figure20",
-                b.name,
-                &map,
-                &mut r,
-                &paper_view(fixed_layers(Method::Mesh, 16)),
-            )?;
-            for (method, t) in [(Method::Pyramid, point), (Method::Mesh, mesh)] {
+            // One copy of the map, as in the paper's figure: 2 * 256^2 triangles for the mesh.
+            let mut one = Renderer::new(gpu, &map, None, SurfaceKind::Terrain);
+            for method in [Method::Pyramid, Method::Mesh] {
+                let s = paper_view(fixed_layers(method, 16));
+                let t = bench.time("figure20", b.name, &map, &mut one, &s)?;
+                let mb = one.memory_bytes(method) as f64 / 1e6;
                 f20.row(vec![
                     b.name.into(),
                     method.to_string(),
                     ms(t),
-                    format!("{:.2}", r.memory_bytes(method) as f64 / 1e6),
+                    format!("{mb:.2}"),
                 ]);
             }
         }
@@ -272,73 +282,72 @@ pub fn run(
         &[256, 512, 1024, 2048, 4096]
     };
     let mut f21 = Table::new(
-        format!("Figure 21: pyramid GPU ms by map size ({paper}x{paper}, tiles, 60 deg)"),
+        format!("Figure 21: GPU ms by map size ({paper}x{paper}, tiles, 60 deg)"),
         &[
             "map size",
             "pyramid",
             "pyramid-ascend",
+            "pyramid lod-auto",
             "pyramid / at 256^2",
+            "lod-auto / at 256^2",
         ],
     );
-    let mut f21_series = vec![
-        Series {
-            name: "pyramid".into(),
-            points: vec![],
-        },
-        Series {
-            name: "pyramid-ascend".into(),
-            points: vec![],
-        },
+    let variants = [
+        ("pyramid", fixed_layers(Method::Pyramid, 16)),
+        ("pyramid-ascend", fixed_layers(Method::PyramidAscend, 16)),
+        (
+            "pyramid lod-auto",
+            Settings {
+                lod: Lod::Auto,
+                ..fixed_layers(Method::Pyramid, 16)
+            },
+        ),
     ];
-    let mut at_256 = None;
+    let mut f21_series: Vec<Series> = variants
+        .iter()
+        .map(|(name, _)| Series {
+            name: name.to_string(),
+            points: vec![],
+        })
+        .collect();
+    let mut at_256 = [None; 3];
     for &size in sizes {
         let map = resized(&tiles, size);
         let mut r = Renderer::new(gpu, &map, None, BUNDLED[0].surface);
-        let p = bench.time(
-            "figure21",
-            "tiles",
-            &map,
-            &mut r,
-            &paper_view(fixed_layers(Method::Pyramid, 16)),
-        )?;
-        let a = bench.time(
-            "figure21",
-            "tiles",
-            &map,
-            &mut r,
-            &paper_view(fixed_layers(Method::PyramidAscend, 16)),
-        )?;
-        if size == 256 {
-            at_256 = p;
-        }
-        if size == 4096 {
-            ratios.pyramid_4096_over_256 = ratio(p, at_256);
-        }
-        for (series, t) in f21_series.iter_mut().zip([p, a]) {
-            if let Some(t) = t {
-                series.points.push((f64::from(size), t));
+        let mut times = [None; 3];
+        for (k, (_, s)) in variants.iter().enumerate() {
+            times[k] = bench.time("figure21", "tiles", &map, &mut r, &paper_view(s.clone()))?;
+            if let Some(t) = times[k] {
+                f21_series[k].points.push((f64::from(size), t));
             }
         }
+        if size == 256 {
+            at_256 = times;
+        }
+        if size == 4096 {
+            ratios.pyramid_4096_over_256 = ratio(times[0], at_256[0]);
+            ratios.pyramid_lod_auto_4096_over_256 = ratio(times[2], at_256[2]);
+        }
+        let r = |k: usize| ratio(times[k], at_256[k]).map_or("n/a".into(), |r| format!("{r:.2}"));
         f21.row(vec![
             format!("{size}^2"),
-            ms(p),
-            ms(a),
-            ratio(p, at_256).map_or("n/a".into(), |r| format!("{r:.2}")),
+            ms(times[0]),
+            ms(times[1]),
+            ms(times[2]),
+            r(0),
+            r(2),
         ]);
     }
     tables.push(f21);
     if f21_series.iter().all(|s| !s.points.is_empty()) {
-        line_plot(
-            &out.join("figure21_map_size.svg"),
-            &PlotSpec {
-                title: "GPU time by map size (figure 21)",
-                x_label: "map side (texels)",
-                y_label: "GPU ms",
-                log_x: true,
-                log_y: false,
-            },
-            &f21_series,
-        )?;
+        let spec = PlotSpec {
+            title: "GPU time by map size (figure 21)",
+            x_label: "map side (texels)",
+            y_label: "GPU ms",
+            log_x: true,
+            log_y: false,
+        };
+        line_plot(&out.join("figure21_map_size.svg"), &spec, &f21_series)?;
     }
 
     // Today's frame: 1920x1080 with a 1024^2 map.
@@ -352,52 +361,39 @@ pub fn run(
             view_angle_deg: 60.0,
             ..s
         };
-        let p = bench.time(
-            "today",
-            "tiles",
-            &tiles,
-            &mut r,
-            &today(fixed_layers(Method::Pyramid, 16)),
-        )?;
-        let pom = bench.time(
-            "today",
-            "tiles",
-            &tiles,
-            &mut r,
-            &today(fixed_layers(Method::Pom, 16)),
-        )?;
-        let a = bench.time(
-            "today",
-            "tiles",
-            &tiles,
-            &mut r,
-            &today(fixed_layers(Method::PyramidAscend, 16)),
-        )?;
-        let b = bench.time(
-            "today",
-            "tiles",
-            &tiles,
-            &mut r,
-            &today(fixed_layers(Method::PyramidBilinear, 16)),
-        )?;
-        ratios.pyramid_over_pom16_today = ratio(p, pom);
+        let columns = [
+            ("pom-16", fixed_layers(Method::Pom, 16)),
+            ("pyramid", fixed_layers(Method::Pyramid, 16)),
+            ("pyramid-ascend", fixed_layers(Method::PyramidAscend, 16)),
+            (
+                "pyramid-bilinear",
+                fixed_layers(Method::PyramidBilinear, 16),
+            ),
+            (
+                "pyramid lod-auto",
+                Settings {
+                    lod: Lod::Auto,
+                    ..fixed_layers(Method::Pyramid, 16)
+                },
+            ),
+        ];
+        let mut times = Vec::new();
+        for (_, s) in &columns {
+            times.push(bench.time("today", "tiles", &tiles, &mut r, &today(s.clone()))?);
+        }
+        ratios.pyramid_over_pom16_today = ratio(times[1], times[0]);
+        ratios.pyramid_lod_auto_over_pom16_today = ratio(times[4], times[0]);
+        let mut header: Vec<&str> = columns.iter().map(|(n, _)| *n).collect();
+        header.extend(["pyramid / pom-16", "lod-auto / pom-16"]);
         let mut t = Table::new(
             format!("Today's frame: {w}x{h}, tiles 1024^2, 60 deg, GPU ms"),
-            &[
-                "pom-16",
-                "pyramid",
-                "pyramid-ascend",
-                "pyramid-bilinear",
-                "pyramid / pom-16",
-            ],
+            &header,
         );
-        t.row(vec![
-            ms(pom),
-            ms(p),
-            ms(a),
-            ms(b),
-            ratio(p, pom).map_or("n/a".into(), |r| format!("{r:.2}")),
-        ]);
+        let mut row: Vec<String> = times.iter().map(|&t| ms(t)).collect();
+        for k in [1, 4] {
+            row.push(ratio(times[k], times[0]).map_or("n/a".into(), |r| format!("{r:.2}")));
+        }
+        t.row(row);
         tables.push(t);
     }
 
@@ -534,7 +530,7 @@ pub fn run(
             ],
         );
         let mut points = Vec::new();
-        for layers in [16, 32, 64, 128, 256, 512, 1024] {
+        for layers in [16, 32, 64, 128, 256, 512, 1024, 2048, 4096] {
             let s = grazing(fixed_layers(Method::Pom, layers));
             let wrong = measure(&mut r, &s)?;
             let time = bench.time("pom-match", "tiles", &map, &mut r, &s)?;
@@ -545,6 +541,7 @@ pub fn run(
                 ms(time),
                 ratio(time, pyramid_time).map_or("n/a".into(), |r| format!("{r:.2}")),
             ]);
+            ratios.pom_most_layers = Some((layers, wrong, ratio(time, pyramid_time)));
             if wrong <= target {
                 ratios.pom_layers_to_match = Some(layers);
                 ratios.pom_matched_over_pyramid = ratio(time, pyramid_time);
