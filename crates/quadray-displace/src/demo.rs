@@ -7,6 +7,7 @@ use crate::gpu::{Lod, Renderer, Settings};
 use crate::maps::BUNDLED;
 use crate::method::Method;
 use crate::pyramid::Addressing;
+use crate::scene::SurfaceKind;
 use quadray_core::image_out::{Rgba8Image, montage};
 use quadray_gpu::Gpu;
 use std::path::{Path, PathBuf};
@@ -114,6 +115,37 @@ pub fn render_demo(
             montage(&tiles, 4).save_png(&path)?;
             written.push(path);
         }
+        // A curved mesh whose tangents MikkTSpace generated.
+        let mut torus = Renderer::new(gpu, &map, color.as_ref(), SurfaceKind::Torus);
+        let at = |s: Settings| Settings {
+            view_angle_deg: 50.0,
+            width: size,
+            height: size,
+            ..s
+        };
+        let mut tiles = Vec::new();
+        for s in [
+            Settings {
+                method: Method::PyramidBilinear,
+                shadows: true,
+                ..Default::default()
+            },
+            bevy_pom(),
+            threejs_relief(),
+        ] {
+            let s = at(s);
+            let frame = torus.render(gpu, &s)?;
+            let acc = Accuracy::measure(&frame, &map, Addressing::Wrap, s.method.truth());
+            let label = format!(
+                "torus {} err {:.1}%",
+                caption(&s),
+                acc.wrong_hit_fraction * 100.0
+            );
+            tiles.push((label, frame.color));
+        }
+        let path = out.join(format!("{}_torus.png", bundled.name));
+        montage(&tiles, 3).save_png(&path)?;
+        written.push(path);
         // Self-shadowing, and the cost of the search per pixel.
         let s = Settings {
             view_angle_deg: 60.0,

@@ -26,6 +26,8 @@ pub enum DisplaceError {
     Gpu(#[from] quadray_gpu::GpuError),
     #[error(transparent)]
     File(#[from] quadray_core::FileError),
+    #[error("invalid parameters: {0}")]
+    Settings(String),
 }
 
 pub use gpu::{Frame, Lod, Renderer, Settings};

@@ -62,7 +62,7 @@ fn gpu_pyramids_are_bit_identical_to_the_cpu_ones() {
 fn pyramid_methods_match_the_ground_truth_at_every_angle_on_every_map() {
     let gpu = Gpu::new().expect("a GPU adapter");
     for (name, map, _) in common::bundled_maps() {
-        for surface in [SurfaceKind::Wall, SurfaceKind::Terrain] {
+        for surface in [SurfaceKind::Wall, SurfaceKind::Terrain, SurfaceKind::Torus] {
             let mut renderer = Renderer::new(&gpu, &map, None, surface);
             for method in [
                 Method::Pyramid,

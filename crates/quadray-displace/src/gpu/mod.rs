@@ -1,6 +1,7 @@
 //! The GPU side: the pyramid builder (compute, `pyramid.wgsl`) and the renderer that runs every
 //! method through one shader (`displace.wgsl`) with one shading model.
 
+use crate::DisplaceError;
 use crate::heightmap::HeightMap;
 use crate::method::Method;
 use crate::pyramid::Addressing;
@@ -322,6 +323,7 @@ pub struct Renderer {
     module: wgpu::ShaderModule,
     params: wgpu::Buffer,
     quad: wgpu::Buffer,
+    vertex_count: u32,
     /// (method, with debug outputs) -> pipeline.
     pipelines: HashMap<(Method, bool), wgpu::RenderPipeline>,
 }
@@ -459,11 +461,12 @@ impl Renderer {
                 bind_group_layouts: &[Some(&bind_layout)],
                 immediate_size: 0,
             });
+        let vertices = surface.vertices();
         let quad = gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("surface quad"),
-                contents: bytemuck::cast_slice(&Plane::of(surface).quad(surface.tiles())),
+                label: Some("surface triangles"),
+                contents: bytemuck::cast_slice(&vertices),
                 usage: wgpu::BufferUsages::VERTEX,
             });
         Self {
@@ -478,6 +481,7 @@ impl Renderer {
                 .create_shader_module(wgpu::include_wgsl!("displace.wgsl")),
             params,
             quad,
+            vertex_count: vertices.len() as u32,
             pipelines: HashMap::new(),
         }
     }
@@ -578,7 +582,7 @@ impl Renderer {
             plane_origin: v4(plane.origin),
             plane_u: v4(plane.u),
             plane_v: v4(plane.v),
-            tile_world: 1.0,
+            tile_world: self.surface.tile_world(),
             depth_scale: s.depth_scale,
             levels: self.map_levels as i32,
             lod: match s.lod {
@@ -697,12 +701,24 @@ impl Renderer {
             pass.draw(0..6 * grid * grid, 0..tiles * tiles);
         } else {
             pass.set_vertex_buffer(0, quad.slice(..));
-            pass.draw(0..6, 0..1);
+            pass.draw(0..self.vertex_count, 0..1);
         }
     }
 
+    fn check(&self, s: &Settings) -> Result<(), DisplaceError> {
+        s.validate().map_err(DisplaceError::Settings)?;
+        if s.method == Method::Mesh && !self.surface.is_planar() {
+            return Err(DisplaceError::Settings(format!(
+                "the mesh baseline displaces a flat grid; the {:?} surface is curved",
+                self.surface
+            )));
+        }
+        Ok(())
+    }
+
     /// Renders one frame with the hit and ray outputs and reads everything back.
-    pub fn render(&mut self, gpu: &Gpu, s: &Settings) -> Result<Frame, GpuError> {
+    pub fn render(&mut self, gpu: &Gpu, s: &Settings) -> Result<Frame, DisplaceError> {
+        self.check(s)?;
         self.write_params(gpu, s);
         let targets = Self::targets(gpu, s, true);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());

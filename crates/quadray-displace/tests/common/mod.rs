@@ -1,4 +1,6 @@
-//! Maps the GPU tests share: the bundled assets, at sizes that keep lavapipe fast.
+//! Maps the tests share: the bundled assets, at sizes that keep lavapipe fast.
+// Each test binary uses its own part of this module.
+#![allow(dead_code)]
 
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use std::path::PathBuf;
