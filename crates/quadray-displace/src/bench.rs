@@ -5,14 +5,16 @@
 use crate::DisplaceError;
 use crate::accuracy::{Accuracy, Cost};
 use crate::demo::{bevy_pom, threejs_relief};
-use crate::gpu::{Lod, Renderer, Settings};
+use crate::gpu::{Lod, PyramidBuilder, Renderer, Settings};
 use crate::heightmap::HeightMap;
 use crate::maps::{BUNDLED, BundledMap, resized};
 use crate::method::Method;
 use crate::pyramid::Addressing;
+use crate::pyramid::Pyramid;
 use crate::scene::SurfaceKind;
 use quadray_core::bench::{PlotSpec, Series, Table, line_plot, write_json, write_text};
-use quadray_gpu::Gpu;
+use quadray_core::stats::time_cpu;
+use quadray_gpu::{Gpu, GpuTimer};
 use serde::Serialize;
 use std::path::Path;
 
@@ -349,6 +351,30 @@ pub fn run(
         };
         line_plot(&out.join("figure21_map_size.svg"), &spec, &f21_series)?;
     }
+
+    // Section 3.1: building the pyramid, on the CPU (the paper: 2.3 ms for 256^2) and on the GPU.
+    progress("pyramid build");
+    let mut build = Table::new(
+        "Pyramid build (section 3.1): CPU ms (median, one thread) and GPU ms (compute, timestamps)",
+        &["map size", "CPU", "GPU"],
+    );
+    let builder = PyramidBuilder::new(gpu);
+    for &size in sizes {
+        let map = resized(&tiles, size);
+        let (_, cpu) = time_cpu(frames, || Pyramid::build(&map));
+        let mut timer = GpuTimer::new(gpu, 1);
+        for _ in 0..frames {
+            builder.build(gpu, &map, None, Some(&timer));
+            timer.collect(gpu)?;
+        }
+        let gpu_ms = timer.summaries()[0].map(|t| t.median_ms);
+        build.row(vec![
+            format!("{size}^2"),
+            format!("{:.3}", cpu.median_ms),
+            ms(gpu_ms),
+        ]);
+    }
+    tables.push(build);
 
     // Today's frame: 1920x1080 with a 1024^2 map.
     progress("1920x1080");

@@ -1,4 +1,5 @@
-//! Bad height maps and parameters get clear errors naming the file and the problem.
+//! Height maps in every supported format load as stored; bad maps and parameters get clear errors
+//! naming the file and the problem.
 
 mod common;
 
@@ -117,4 +118,21 @@ fn absurd_parameters_are_refused() {
     }
     assert!("pyramid-bilinear".parse::<Method>().is_ok());
     assert!("pyramid2".parse::<Method>().unwrap_err().contains("pom"));
+}
+
+#[test]
+fn float_exr_maps_load_as_stored() {
+    let dir = std::env::temp_dir().join(format!("quadray-exr-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("ramp.exr");
+    let img = image::Rgb32FImage::from_fn(8, 8, |x, y| {
+        let v = (x + 8 * y) as f32 / 63.0;
+        image::Rgb([v, v, v])
+    });
+    img.save(&path).unwrap();
+    let map = HeightMap::load(&path, Convention::Depth, Fit::Refuse).unwrap();
+    assert_eq!(map.size(), 8);
+    for (k, d) in map.depth.iter().enumerate() {
+        assert!((d - k as f32 / 63.0).abs() < 1e-6, "texel {k}: {d}");
+    }
 }
