@@ -312,6 +312,13 @@ pub fn read_pyramid(gpu: &Gpu, pyramid: &wgpu::Texture) -> Result<Vec<Vec<f32>>,
         .collect()
 }
 
+/// Where a frame is drawn: `color` Rgba8UnormSrgb and `depth` Depth32Float, of the same size.
+#[derive(Clone, Copy)]
+pub struct Targets<'a> {
+    pub color: &'a wgpu::TextureView,
+    pub depth: &'a wgpu::TextureView,
+}
+
 /// One map on one surface, ready to render with any method.
 pub struct Renderer {
     map_levels: u32,
@@ -571,8 +578,7 @@ impl Renderer {
             })
     }
 
-    fn write_params(&mut self, gpu: &Gpu, s: &Settings) {
-        let view = View::new(self.surface, s.view_angle_deg, s.width, s.height);
+    fn write_params(&mut self, gpu: &Gpu, s: &Settings, view: &View) {
         let plane = Plane::of(self.surface);
         let v4 = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
         let params = Params {
@@ -629,19 +635,19 @@ impl Renderer {
         t
     }
 
+    /// Records the shading pass into `color` (Rgba8UnormSrgb) and `depth` (Depth32Float), and
+    /// into the hit and ray targets (Rgba32Float) when given. The parameters must have been
+    /// written for this frame.
     fn encode(
         &mut self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
-        s: &Settings,
-        targets: &[wgpu::Texture],
+        method: Method,
+        targets: Targets,
+        debug: Option<(&wgpu::TextureView, &wgpu::TextureView)>,
         timer: Option<&GpuTimer>,
     ) {
-        let debug_outputs = targets.len() > 2;
-        let views: Vec<_> = targets
-            .iter()
-            .map(|t| t.create_view(&Default::default()))
-            .collect();
+        let Targets { color, depth } = targets;
         let attachment = |view, clear: wgpu::Color| {
             Some(wgpu::RenderPassColorAttachment {
                 view,
@@ -665,27 +671,29 @@ impl Renderer {
             b: -2.0,
             a: 0.0,
         };
-        let mut color_attachments = vec![attachment(&views[0], sky)];
-        if debug_outputs {
-            color_attachments.push(attachment(&views[2], no_surface));
-            color_attachments.push(attachment(&views[3], no_surface));
-        } else {
-            color_attachments.extend([None, None]);
-        }
-        let bind_group = if s.method.uses_conservative_pyramid() {
+        let color_attachments = match debug {
+            Some((hits, rays)) => [
+                attachment(color, sky),
+                attachment(hits, no_surface),
+                attachment(rays, no_surface),
+            ],
+            None => [attachment(color, sky), None, None],
+        };
+        let bind_group = if method.uses_conservative_pyramid() {
             self.bind_group_conservative.clone()
         } else {
             self.bind_group_point.clone()
         };
         let tiles = self.surface.tiles();
         let grid = self.map_size;
+        let vertex_count = self.vertex_count;
         let quad = self.quad.clone();
-        let pipeline = self.pipeline(gpu, s.method, debug_outputs).clone();
+        let pipeline = self.pipeline(gpu, method, debug.is_some()).clone();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("displace"),
             color_attachments: &color_attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &views[1],
+                view: depth,
                 depth_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Clear(1.0),
                     store: wgpu::StoreOp::Discard,
@@ -697,12 +705,29 @@ impl Renderer {
         });
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        if s.method == Method::Mesh {
+        if method == Method::Mesh {
             pass.draw(0..6 * grid * grid, 0..tiles * tiles);
         } else {
             pass.set_vertex_buffer(0, quad.slice(..));
-            pass.draw(0..self.vertex_count, 0..1);
+            pass.draw(0..vertex_count, 0..1);
         }
+    }
+
+    /// Draws one frame into an application's own targets, seen from `view`. `timer`, when given,
+    /// times the pass as its query 0.
+    pub fn draw(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        s: &Settings,
+        view: &View,
+        targets: Targets,
+        timer: Option<&GpuTimer>,
+    ) -> Result<(), DisplaceError> {
+        self.check(s)?;
+        self.write_params(gpu, s, view);
+        self.encode(gpu, encoder, s.method, targets, None, timer);
+        Ok(())
     }
 
     fn check(&self, s: &Settings) -> Result<(), DisplaceError> {
@@ -719,10 +744,30 @@ impl Renderer {
     /// Renders one frame with the hit and ray outputs and reads everything back.
     pub fn render(&mut self, gpu: &Gpu, s: &Settings) -> Result<Frame, DisplaceError> {
         self.check(s)?;
-        self.write_params(gpu, s);
+        self.write_params(
+            gpu,
+            s,
+            &View::new(self.surface, s.view_angle_deg, s.width, s.height),
+        );
         let targets = Self::targets(gpu, s, true);
+        let views: Vec<_> = targets
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        gpu.checked(|| self.encode(gpu, &mut encoder, s, &targets, None))?;
+        gpu.checked(|| {
+            self.encode(
+                gpu,
+                &mut encoder,
+                s.method,
+                Targets {
+                    color: &views[0],
+                    depth: &views[1],
+                },
+                Some((&views[2], &views[3])),
+                None,
+            )
+        })?;
         gpu.queue.submit([encoder.finish()]);
         let pixels = |v: Vec<f32>| -> Vec<[f32; 4]> {
             v.chunks_exact(4)
@@ -747,13 +792,30 @@ impl Renderer {
         gpu: &Gpu,
         s: &Settings,
         frames: usize,
-    ) -> Result<Option<Summary>, GpuError> {
-        self.write_params(gpu, s);
+    ) -> Result<Option<Summary>, DisplaceError> {
+        self.check(s)?;
+        let view = View::new(self.surface, s.view_angle_deg, s.width, s.height);
         let targets = Self::targets(gpu, s, false);
+        let views: Vec<_> = targets
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
         let mut timer = GpuTimer::new(gpu, 1);
         for frame in 0..frames + 2 {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            gpu.checked(|| self.encode(gpu, &mut encoder, s, &targets, Some(&timer)))?;
+            gpu.checked(|| {
+                self.draw(
+                    gpu,
+                    &mut encoder,
+                    s,
+                    &view,
+                    Targets {
+                        color: &views[0],
+                        depth: &views[1],
+                    },
+                    Some(&timer),
+                )
+            })??;
             timer.resolve(&mut encoder);
             gpu.queue.submit([encoder.finish()]);
             timer.collect(gpu)?;
