@@ -211,9 +211,9 @@ impl Plane {
     }
 }
 
-/// Camera and light. [`View::new`] is the benchmark's camera for a view angle (degrees between
-/// the view direction at the surface centre and the surface normal), looking 30 degrees off the v
-/// axis so both DDA axes work; [`View::orbit`] is the same camera anywhere on its sphere.
+/// Camera and light. By default (the benchmark's camera) the view angle is the angle between the
+/// view direction at the surface centre and the surface normal, looking 30 degrees off the v axis
+/// so both DDA axes work; [`View::orbit`] puts the camera anywhere on its sphere.
 pub struct View {
     pub view_proj: Mat4,
     pub eye: Vec3,
@@ -221,25 +221,22 @@ pub struct View {
 }
 
 impl View {
-    pub fn new(kind: SurfaceKind, view_angle_deg: f32, width: u32, height: u32) -> Self {
+    /// The camera and light a frame's settings ask for.
+    pub fn of(kind: SurfaceKind, s: &crate::Settings) -> Self {
         Self::orbit(
             kind,
-            view_angle_deg,
-            30.0,
-            1.0,
-            width as f32 / height as f32,
+            [s.view_angle_deg, s.azimuth_deg, s.light_azimuth_deg],
+            s.zoom,
+            s.width as f32 / s.height as f32,
         )
     }
 
-    /// A camera at `elevation_deg` from the surface normal (the torus: from its axis) and
-    /// `azimuth_deg` around it, `zoom` times the default distance from the surface centre.
-    pub fn orbit(
-        kind: SurfaceKind,
-        elevation_deg: f32,
-        azimuth_deg: f32,
-        zoom: f32,
-        aspect: f32,
-    ) -> Self {
+    /// A camera at `elevation` degrees from the surface normal (the torus: from its axis) and
+    /// `azimuth` degrees around it, `zoom` times the default distance from the surface centre;
+    /// the light to the side and above at `light_azimuth` degrees. `angles`: [elevation,
+    /// azimuth, light_azimuth].
+    pub fn orbit(kind: SurfaceKind, angles: [f32; 3], zoom: f32, aspect: f32) -> Self {
+        let [elevation_deg, azimuth_deg, light_azimuth_deg] = angles;
         let plane = Plane::of(kind);
         let centre = kind.centre();
         let n = plane.normal();
@@ -255,9 +252,9 @@ impl View {
             glam::camera::rh::proj::directx::perspective(50f32.to_radians(), aspect, 0.01, 100.0);
         // A light to the side and above, low enough to cast visible self-shadows.
         let reach = if kind.is_planar() { 1.0 } else { 3.0 };
-        let default_azimuth = 30f32.to_radians();
-        let light_away = -(plane.v * default_azimuth.cos() + plane.u * default_azimuth.sin());
-        let light_right = plane.u * default_azimuth.cos() - plane.v * default_azimuth.sin();
+        let light_azimuth = light_azimuth_deg.to_radians();
+        let light_away = -(plane.v * light_azimuth.cos() + plane.u * light_azimuth.sin());
+        let light_right = plane.u * light_azimuth.cos() - plane.v * light_azimuth.sin();
         let light = centre + (n * 1.2 + light_right * 1.6 - light_away * 0.4) * reach;
         Self {
             view_proj: proj * view,

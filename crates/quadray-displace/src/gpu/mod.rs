@@ -35,6 +35,13 @@ pub struct Settings {
     pub binary_steps: u32,
     pub lod: Lod,
     pub shadows: bool,
+    /// Camera azimuth around the surface normal (degrees), distance factor, and the light's
+    /// azimuth: the benchmark keeps the defaults; the viewer moves them.
+    pub azimuth_deg: f32,
+    pub zoom: f32,
+    pub light_azimuth_deg: f32,
+    /// Colour each pixel by the iterations its search took (0..64, black to white).
+    pub show_iterations: bool,
 }
 
 impl Default for Settings {
@@ -49,6 +56,10 @@ impl Default for Settings {
             binary_steps: 5,
             lod: Lod::Level(0),
             shadows: false,
+            azimuth_deg: 30.0,
+            zoom: 1.0,
+            light_azimuth_deg: 30.0,
+            show_iterations: false,
         }
     }
 }
@@ -77,6 +88,12 @@ impl Settings {
                 "layers {},{} must satisfy 1 <= min <= max <= 4096",
                 s.layers.0, s.layers.1
             ));
+        }
+        if !(s.azimuth_deg.is_finite() && s.light_azimuth_deg.is_finite()) {
+            return Err("azimuths must be finite".into());
+        }
+        if !(s.zoom.is_finite() && (0.05..=20.0).contains(&s.zoom)) {
+            return Err(format!("zoom {} is outside 0.05..20", s.zoom));
         }
         if s.binary_steps > 64 {
             return Err(format!("{} binary steps is more than 64", s.binary_steps));
@@ -124,7 +141,8 @@ struct Params {
     mesh_grid: u32,
     tiles: u32,
     bilinear_cap: u32,
-    _pad: [u32; 3],
+    show_iterations: u32,
+    _pad: [u32; 2],
 }
 
 /// Builds min-depth pyramids on the GPU (one compute dispatch per level).
@@ -604,7 +622,8 @@ impl Renderer {
             mesh_grid: self.map_size,
             tiles: self.surface.tiles(),
             bilinear_cap: BILINEAR_ROUNDS,
-            _pad: [0; 3],
+            show_iterations: u32::from(s.show_iterations),
+            _pad: [0; 2],
         };
         gpu.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -744,11 +763,7 @@ impl Renderer {
     /// Renders one frame with the hit and ray outputs and reads everything back.
     pub fn render(&mut self, gpu: &Gpu, s: &Settings) -> Result<Frame, DisplaceError> {
         self.check(s)?;
-        self.write_params(
-            gpu,
-            s,
-            &View::new(self.surface, s.view_angle_deg, s.width, s.height),
-        );
+        self.write_params(gpu, s, &View::of(self.surface, s));
         let targets = Self::targets(gpu, s, true);
         let views: Vec<_> = targets
             .iter()
@@ -794,7 +809,7 @@ impl Renderer {
         frames: usize,
     ) -> Result<Option<Summary>, DisplaceError> {
         self.check(s)?;
-        let view = View::new(self.surface, s.view_angle_deg, s.width, s.height);
+        let view = View::of(self.surface, s);
         let targets = Self::targets(gpu, s, false);
         let views: Vec<_> = targets
             .iter()
