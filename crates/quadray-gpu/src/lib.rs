@@ -39,11 +39,24 @@ impl Gpu {
     /// Opens the first high-performance adapter (any backend wgpu was built with; set
     /// `WGPU_BACKEND=vulkan` or `WGPU_ADAPTER_NAME=llvmpipe` to choose).
     pub fn new() -> Result<Self, GpuError> {
+        Self::for_surface(&Self::instance(), None)
+    }
+
+    /// The instance every quadray program uses (backends from `WGPU_BACKEND`, else the primary
+    /// ones).
+    pub fn instance() -> wgpu::Instance {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
-        let instance = wgpu::Instance::new(desc);
+        wgpu::Instance::new(desc)
+    }
+
+    /// Opens an adapter that can present to `surface` (a window), or any adapter without one.
+    pub fn for_surface(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self, GpuError> {
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
-            &instance, None,
+            instance, surface,
         ))
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         Self::from_adapter(adapter)

@@ -1,0 +1,293 @@
+//! The window: winit events, the wgpu surface, egui's panel, and the frame loop.
+
+use crate::Args;
+use crate::displace_view::{DisplaceView, MapChoice};
+use anyhow::{Context, Result};
+use quadray_displace::Settings;
+use quadray_gpu::Gpu;
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::window::{Window, WindowId};
+
+const PANEL_WIDTH: f32 = 260.0;
+
+pub fn run(args: Args, maps: Vec<MapChoice>, start: usize, settings: Settings) -> Result<()> {
+    let event_loop =
+        EventLoop::new().context("no window system (is DISPLAY or WAYLAND_DISPLAY set?)")?;
+    let mut app = App {
+        args,
+        start: Some((maps, start, settings)),
+        state: None,
+        result: Ok(()),
+    };
+    event_loop.run_app(&mut app)?;
+    app.result
+}
+
+struct App {
+    args: Args,
+    start: Option<(Vec<MapChoice>, usize, Settings)>,
+    state: Option<State>,
+    result: Result<()>,
+}
+
+struct State {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    gpu: Gpu,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    displace: DisplaceView,
+    last_frame: Instant,
+    frame_ms: f32,
+    frames_drawn: u32,
+    status: String,
+}
+
+impl State {
+    fn new(
+        event_loop: &ActiveEventLoop,
+        args: &Args,
+        start: (Vec<MapChoice>, usize, Settings),
+    ) -> Result<Self> {
+        let (w, h) = args.view_size;
+        let attributes = Window::default_attributes()
+            .with_title("quadray")
+            .with_inner_size(winit::dpi::LogicalSize::new(
+                w as f64 + PANEL_WIDTH as f64,
+                h.max(560) as f64,
+            ));
+        let window = Arc::new(event_loop.create_window(attributes)?);
+        let instance = Gpu::instance();
+        let surface = instance.create_surface(window.clone())?;
+        let gpu = Gpu::for_surface(&instance, Some(&surface))?;
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
+            .context("the adapter cannot present to this window")?;
+        // egui expects a non-sRGB target only for its own blending; either works, sRGB is the norm.
+        let caps = surface.get_capabilities(&gpu.adapter);
+        if let Some(srgb) = caps.formats.iter().find(|f| f.is_srgb()) {
+            config.format = *srgb;
+        }
+        surface.configure(&gpu.device, &config);
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(gpu.device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer =
+            egui_wgpu::Renderer::new(&gpu.device, config.format, Default::default());
+        let (maps, map, settings) = start;
+        let displace = DisplaceView::new(&gpu, maps, map, settings);
+        Ok(Self {
+            window,
+            surface,
+            config,
+            gpu,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            displace,
+            last_frame: Instant::now(),
+            frame_ms: 0.0,
+            frames_drawn: 0,
+            status: String::new(),
+        })
+    }
+
+    fn resize(&mut self, width: u32, height: u32) {
+        self.config.width = width.max(1);
+        self.config.height = height.max(1);
+        self.surface.configure(&self.gpu.device, &self.config);
+    }
+
+    /// One frame; returns true when a scripted run is over.
+    fn redraw(&mut self, args: &Args) -> Result<bool> {
+        let now = Instant::now();
+        let dt = (now - self.last_frame).as_secs_f32().min(0.1);
+        self.last_frame = now;
+        self.frame_ms = self.frame_ms * 0.9 + dt * 1e3 * 0.1;
+        let scripted = args.frames.is_some();
+        let mut save = false;
+        let raw = self.egui_state.take_egui_input(&self.window);
+        let Self {
+            egui_ctx,
+            displace,
+            gpu,
+            egui_renderer,
+            status,
+            frame_ms,
+            ..
+        } = self;
+        let full = egui_ctx.run_ui(raw, |ui| {
+            egui::Panel::left("controls").exact_size(PANEL_WIDTH).show(ui, |ui| {
+                ui.heading("Displacement");
+                displace.controls(ui);
+                ui.separator();
+                ui.label(format!(
+                    "GPU {}  frame {:.1} ms",
+                    displace.gpu_ms.map_or("n/a".into(), |t| format!("{t:.3} ms")),
+                    frame_ms
+                ));
+                if ui.button("Save screenshot + command (P)").clicked() {
+                    save = true;
+                }
+                if let Some(e) = &displace.error {
+                    ui.colored_label(egui::Color32::LIGHT_RED, e);
+                }
+                ui.label(status.as_str());
+                ui.small("Drag: orbit. Right drag: light. Wheel or Q/E: zoom. W/A/S/D: move. L: animate light. P: screenshot.");
+            });
+            egui::CentralPanel::default().show(ui, |ui| {
+                let points = ui.available_size();
+                let ppp = ui.ctx().pixels_per_point();
+                let pixels = if scripted {
+                    [args.view_size.0, args.view_size.1]
+                } else {
+                    [(points.x * ppp) as u32, (points.y * ppp) as u32]
+                };
+                if let Some(id) = displace.draw(gpu, egui_renderer, pixels, dt) {
+                    let shown = egui::vec2(pixels[0] as f32, pixels[1] as f32) / ppp;
+                    let image = egui::Image::new(egui::load::SizedTexture::new(id, shown))
+                        .sense(egui::Sense::click_and_drag());
+                    let response = ui.add(image);
+                    displace.handle_pointer(&response, ui);
+                }
+                displace.handle_keys(ui, dt);
+                save |= ui.input(|i| i.key_pressed(egui::Key::P));
+            });
+        });
+        self.egui_state
+            .handle_platform_output(&self.window, full.platform_output);
+        self.frames_drawn += 1;
+        let done = args.frames.is_some_and(|n| self.frames_drawn >= n);
+        if save || done {
+            let cmd = self.displace.screenshot(&self.gpu, &args.screenshot)?;
+            self.status = format!("saved {}", args.screenshot.display());
+            println!("{cmd}");
+        }
+        self.paint(full.shapes, full.textures_delta, full.pixels_per_point)?;
+        Ok(done)
+    }
+
+    fn paint(
+        &mut self,
+        shapes: Vec<egui::epaint::ClippedShape>,
+        textures: egui::TexturesDelta,
+        ppp: f32,
+    ) -> Result<()> {
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.gpu.device, &self.config);
+                return Ok(());
+            }
+            // Occluded or timed out: skip this frame.
+            _ => return Ok(()),
+        };
+        let jobs = self.egui_ctx.tessellate(shapes, ppp);
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: ppp,
+        };
+        for (id, deltas) in &textures.set {
+            for delta in deltas {
+                self.egui_renderer
+                    .update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
+            }
+        }
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        let extra = self.egui_renderer.update_buffers(
+            &self.gpu.device,
+            &self.gpu.queue,
+            &mut encoder,
+            &jobs,
+            &screen,
+        );
+        let view = frame.texture.create_view(&Default::default());
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            self.egui_renderer
+                .render(&mut pass.forget_lifetime(), &jobs, &screen);
+        }
+        self.gpu
+            .queue
+            .submit(extra.into_iter().chain([encoder.finish()]));
+        self.window.pre_present_notify();
+        self.gpu.queue.present(frame);
+        for id in &textures.free {
+            self.egui_renderer.free_texture(id);
+        }
+        Ok(())
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if let Some(start) = self.start.take() {
+            match State::new(event_loop, &self.args, start) {
+                Ok(state) => self.state = Some(state),
+                Err(e) => {
+                    self.result = Err(e);
+                    event_loop.exit();
+                }
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(state) = self.state.as_mut() else {
+            return;
+        };
+        let _ = state.egui_state.on_window_event(&state.window, &event);
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::KeyboardInput { event: key, .. }
+                if key.logical_key
+                    == winit::keyboard::Key::Named(winit::keyboard::NamedKey::Escape) =>
+            {
+                event_loop.exit()
+            }
+            WindowEvent::Resized(size) => state.resize(size.width, size.height),
+            WindowEvent::RedrawRequested => match state.redraw(&self.args) {
+                Ok(true) => event_loop.exit(),
+                Ok(false) => {}
+                Err(e) => {
+                    self.result = Err(e);
+                    event_loop.exit();
+                }
+            },
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        // Continuous rendering: the light may be animated and timings are live.
+        if let Some(state) = &self.state {
+            state.window.request_redraw();
+        }
+    }
+}

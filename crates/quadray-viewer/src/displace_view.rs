@@ -1,0 +1,362 @@
+//! The displacement panel: map, surface and method pickers, every parameter, an orbit camera and a
+//! moving light; the frame is drawn by `quadray_displace::Renderer::draw` into an offscreen
+//! texture that egui shows, so what a person sees is exactly what `quadray displace` renders.
+
+use anyhow::Result;
+use quadray_core::image_out::Rgba8Image;
+use quadray_displace::heightmap::{Convention, Fit, HeightMap};
+use quadray_displace::maps::{BUNDLED, assets_dir, load_color};
+use quadray_displace::scene::{SurfaceKind, View};
+use quadray_displace::{Lod, Method, Renderer, Settings, Targets};
+use quadray_gpu::{Gpu, GpuTimer, read_texture_rgba8};
+use std::path::{Path, PathBuf};
+
+/// A height map the viewer can show: a bundled one or one from the command line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapChoice {
+    pub name: String,
+    pub path: PathBuf,
+    pub convention: Convention,
+    pub color: Option<PathBuf>,
+    pub surface: SurfaceKind,
+}
+
+impl MapChoice {
+    pub fn bundled() -> Vec<MapChoice> {
+        BUNDLED
+            .iter()
+            .map(|b| MapChoice {
+                name: b.name.to_string(),
+                path: assets_dir().join(b.file),
+                convention: b.convention,
+                color: b.color.map(|c| assets_dir().join(c)),
+                surface: b.surface,
+            })
+            .collect()
+    }
+
+    fn convention_flag(&self) -> &'static str {
+        match self.convention {
+            Convention::Height => "height",
+            Convention::Depth => "depth",
+            Convention::DepthPhoto => "depth-photo",
+        }
+    }
+}
+
+const SURFACES: [SurfaceKind; 4] = [
+    SurfaceKind::Wall,
+    SurfaceKind::Terrain,
+    SurfaceKind::Photo,
+    SurfaceKind::Torus,
+];
+
+fn surface_flag(s: SurfaceKind) -> &'static str {
+    match s {
+        SurfaceKind::Wall => "wall",
+        SurfaceKind::Terrain => "terrain",
+        SurfaceKind::Photo => "photo",
+        SurfaceKind::Torus => "torus",
+    }
+}
+
+pub struct DisplaceView {
+    pub maps: Vec<MapChoice>,
+    pub map: usize,
+    pub surface: SurfaceKind,
+    pub settings: Settings,
+    pub animate_light: bool,
+    loaded: Option<(usize, SurfaceKind, Renderer)>,
+    target: Option<(
+        wgpu::Texture,
+        wgpu::TextureView,
+        wgpu::TextureView,
+        egui::TextureId,
+    )>,
+    timer: GpuTimer,
+    pub gpu_ms: Option<f64>,
+    pub error: Option<String>,
+}
+
+impl DisplaceView {
+    pub fn new(gpu: &Gpu, maps: Vec<MapChoice>, map: usize, settings: Settings) -> Self {
+        let surface = maps[map].surface;
+        Self {
+            maps,
+            map,
+            surface,
+            settings,
+            animate_light: false,
+            loaded: None,
+            target: None,
+            timer: GpuTimer::new(gpu, 1),
+            gpu_ms: None,
+            error: None,
+        }
+    }
+
+    /// The renderer for the chosen map and surface, loading the map when the choice changed.
+    fn renderer<'a>(
+        loaded: &'a mut Option<(usize, SurfaceKind, Renderer)>,
+        maps: &[MapChoice],
+        map: usize,
+        surface: SurfaceKind,
+        gpu: &Gpu,
+    ) -> Result<&'a mut Renderer> {
+        let stale = !matches!(loaded, Some((m, s, _)) if *m == map && *s == surface);
+        if stale {
+            let choice = &maps[map];
+            let height = HeightMap::load(&choice.path, choice.convention, Fit::Resample)?;
+            let color = choice.color.as_deref().map(load_color).transpose()?;
+            *loaded = Some((
+                map,
+                surface,
+                Renderer::new(gpu, &height, color.as_ref(), surface),
+            ));
+        }
+        Ok(&mut loaded.as_mut().expect("loaded above").2)
+    }
+
+    /// Draws the frame at `size` pixels into the offscreen target and returns its egui texture.
+    pub fn draw(
+        &mut self,
+        gpu: &Gpu,
+        egui_renderer: &mut egui_wgpu::Renderer,
+        size: [u32; 2],
+        dt: f32,
+    ) -> Option<egui::TextureId> {
+        let size = [size[0].clamp(16, 4096), size[1].clamp(16, 4096)];
+        if self.animate_light {
+            self.settings.light_azimuth_deg = (self.settings.light_azimuth_deg + 40.0 * dt) % 360.0;
+        }
+        self.settings.width = size[0];
+        self.settings.height = size[1];
+        let resized =
+            !matches!(&self.target, Some((t, ..)) if t.width() == size[0] && t.height() == size[1]);
+        if resized {
+            let make = |format, usage| {
+                gpu.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("viewer frame"),
+                    size: wgpu::Extent3d {
+                        width: size[0],
+                        height: size[1],
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+            };
+            let color = make(
+                wgpu::TextureFormat::Rgba8UnormSrgb,
+                wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+            );
+            let depth = make(
+                wgpu::TextureFormat::Depth32Float,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            );
+            let color_view = color.create_view(&Default::default());
+            let depth_view = depth.create_view(&Default::default());
+            let id = match self.target.take() {
+                Some((.., id)) => {
+                    egui_renderer.update_egui_texture_from_wgpu_texture(
+                        &gpu.device,
+                        &color_view,
+                        wgpu::FilterMode::Nearest,
+                        id,
+                    );
+                    id
+                }
+                None => egui_renderer.register_native_texture(
+                    &gpu.device,
+                    &color_view,
+                    wgpu::FilterMode::Nearest,
+                ),
+            };
+            self.target = Some((color, color_view, depth_view, id));
+        }
+        let (_, color_view, depth_view, _) = self.target.as_ref().expect("created above");
+        let result = (|| -> Result<()> {
+            let renderer =
+                Self::renderer(&mut self.loaded, &self.maps, self.map, self.surface, gpu)?;
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let view = View::of(self.surface, &self.settings);
+            let targets = Targets {
+                color: color_view,
+                depth: depth_view,
+            };
+            renderer.draw(
+                gpu,
+                &mut encoder,
+                &self.settings,
+                &view,
+                targets,
+                Some(&self.timer),
+            )?;
+            self.timer.resolve(&mut encoder);
+            gpu.queue.submit([encoder.finish()]);
+            self.timer.collect(gpu)?;
+            self.gpu_ms = self.timer.summaries()[0].map(|s| s.median_ms);
+            self.timer.clear();
+            Ok(())
+        })();
+        self.error = result.err().map(|e| e.to_string());
+        self.target.as_ref().map(|(.., id)| *id)
+    }
+
+    /// The `quadray displace` command that renders this view headless.
+    pub fn command_line(&self, out: &Path) -> String {
+        let s = &self.settings;
+        let choice = &self.maps[self.map];
+        let mut cmd = format!(
+            "quadray displace --map {} --convention {} --resample --surface {} --method {} \
+             --view-angle {:.2} --azimuth {:.2} --zoom {:.3} --light-azimuth {:.2} --size {}x{} \
+             --depth-scale {} --layers {},{} --binary-steps {} --lod {}",
+            choice.path.display(),
+            choice.convention_flag(),
+            surface_flag(self.surface),
+            s.method,
+            s.view_angle_deg,
+            s.azimuth_deg,
+            s.zoom,
+            s.light_azimuth_deg,
+            s.width,
+            s.height,
+            s.depth_scale,
+            s.layers.0,
+            s.layers.1,
+            s.binary_steps,
+            match s.lod {
+                Lod::Auto => "auto".to_string(),
+                Lod::Level(l) => l.to_string(),
+            },
+        );
+        if let Some(c) = &choice.color {
+            cmd += &format!(" --color {}", c.display());
+        }
+        if s.shadows {
+            cmd += " --shadows";
+        }
+        if s.show_iterations {
+            cmd += " --show-iterations";
+        }
+        cmd + &format!(" --out {}", out.display())
+    }
+
+    /// Saves the frame as a PNG and the command line that reproduces it beside it (`.txt`).
+    pub fn screenshot(&self, gpu: &Gpu, path: &Path) -> Result<String> {
+        let Some((texture, ..)) = &self.target else {
+            anyhow::bail!("nothing drawn yet");
+        };
+        let bytes = read_texture_rgba8(gpu, texture)?;
+        Rgba8Image::from_bytes(texture.width(), texture.height(), &bytes).save_png(path)?;
+        let cmd = self.command_line(&path.with_extension("headless.png"));
+        std::fs::write(path.with_extension("txt"), format!("{cmd}\n"))?;
+        Ok(cmd)
+    }
+
+    /// The control panel.
+    pub fn controls(&mut self, ui: &mut egui::Ui) {
+        let s = &mut self.settings;
+        egui::ComboBox::from_label("map")
+            .selected_text(self.maps[self.map].name.clone())
+            .show_ui(ui, |ui| {
+                for (i, m) in self.maps.iter().enumerate() {
+                    ui.selectable_value(&mut self.map, i, m.name.clone());
+                }
+            });
+        egui::ComboBox::from_label("surface")
+            .selected_text(surface_flag(self.surface))
+            .show_ui(ui, |ui| {
+                for k in SURFACES {
+                    ui.selectable_value(&mut self.surface, k, surface_flag(k));
+                }
+            });
+        egui::ComboBox::from_label("method")
+            .selected_text(s.method.name())
+            .show_ui(ui, |ui| {
+                for m in Method::ALL {
+                    ui.selectable_value(&mut s.method, m, m.name());
+                }
+            });
+        ui.add(egui::Slider::new(&mut s.view_angle_deg, 0.0..=89.0).text("view angle"));
+        ui.add(egui::Slider::new(&mut s.azimuth_deg, -180.0..=180.0).text("azimuth"));
+        ui.add(egui::Slider::new(&mut s.zoom, 0.2..=4.0).text("zoom"));
+        ui.add(egui::Slider::new(&mut s.depth_scale, 0.01..=0.5).text("depth scale"));
+        ui.add(egui::Slider::new(&mut s.layers.0, 1..=256).text("layers min"));
+        ui.add(egui::Slider::new(&mut s.layers.1, 1..=256).text("layers max"));
+        s.layers.1 = s.layers.1.max(s.layers.0);
+        ui.add(egui::Slider::new(&mut s.binary_steps, 0..=16).text("binary steps"));
+        let mut auto = s.lod == Lod::Auto;
+        ui.checkbox(&mut auto, "LOD from derivatives");
+        if auto {
+            s.lod = Lod::Auto;
+        } else {
+            let mut level = match s.lod {
+                Lod::Level(l) => l,
+                Lod::Auto => 0,
+            };
+            ui.add(egui::Slider::new(&mut level, 0..=12).text("finest level"));
+            s.lod = Lod::Level(level);
+        }
+        ui.checkbox(&mut s.shadows, "self-shadowing");
+        ui.checkbox(&mut s.show_iterations, "iteration heat map");
+        ui.add(egui::Slider::new(&mut s.light_azimuth_deg, 0.0..=360.0).text("light azimuth"));
+        ui.checkbox(&mut self.animate_light, "animate light (L)");
+        if s.method == Method::Mesh && self.surface == SurfaceKind::Torus {
+            ui.colored_label(egui::Color32::YELLOW, "mesh needs a flat surface");
+        }
+    }
+
+    /// Orbit with the left button, move the light with the right, zoom with the wheel.
+    pub fn handle_pointer(&mut self, response: &egui::Response, ui: &egui::Ui) {
+        let s = &mut self.settings;
+        if response.dragged_by(egui::PointerButton::Primary) {
+            let d = response.drag_delta();
+            s.azimuth_deg = (s.azimuth_deg - d.x * 0.3 + 540.0) % 360.0 - 180.0;
+            s.view_angle_deg = (s.view_angle_deg - d.y * 0.3).clamp(0.0, 89.0);
+        }
+        if response.dragged_by(egui::PointerButton::Secondary) {
+            s.light_azimuth_deg =
+                (s.light_azimuth_deg + response.drag_delta().x * 0.5).rem_euclid(360.0);
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            s.zoom = (s.zoom * (1.0 - scroll * 0.002)).clamp(0.2, 4.0);
+        }
+    }
+
+    /// Keyboard: W/S tilt, A/D orbit, Q/E zoom, L animates the light.
+    pub fn handle_keys(&mut self, ui: &egui::Ui, dt: f32) {
+        let s = &mut self.settings;
+        ui.input(|i| {
+            let rate = 60.0 * dt;
+            if i.key_down(egui::Key::W) {
+                s.view_angle_deg = (s.view_angle_deg - rate).max(0.0);
+            }
+            if i.key_down(egui::Key::S) {
+                s.view_angle_deg = (s.view_angle_deg + rate).min(89.0);
+            }
+            if i.key_down(egui::Key::A) {
+                s.azimuth_deg -= rate;
+            }
+            if i.key_down(egui::Key::D) {
+                s.azimuth_deg += rate;
+            }
+            if i.key_down(egui::Key::Q) {
+                s.zoom = (s.zoom * (1.0 - dt)).max(0.2);
+            }
+            if i.key_down(egui::Key::E) {
+                s.zoom = (s.zoom * (1.0 + dt)).min(4.0);
+            }
+            if i.key_pressed(egui::Key::L) {
+                self.animate_light = !self.animate_light;
+            }
+        });
+    }
+}

@@ -1,0 +1,109 @@
+//! `quadray-view` (also started as `quadray view`): fly around the real-time techniques. A window
+//! with an egui control panel; the frame is drawn by the same library code as the headless
+//! commands, and a key saves it with the command line that renders it headless.
+
+mod app;
+mod displace_view;
+
+use anyhow::{Context, Result};
+use clap::Parser;
+use displace_view::MapChoice;
+use quadray_displace::heightmap::Convention;
+use quadray_displace::scene::SurfaceKind;
+use quadray_displace::{Method, Settings};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "quadray-view",
+    version,
+    about = "Interactive viewer for quadray's real-time techniques"
+)]
+pub struct Args {
+    /// A height map of your own (shown beside the bundled ones).
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// How --map stores its values: height, depth or depth-photo.
+    #[arg(long, default_value = "height")]
+    convention: String,
+    /// Start with this bundled map (tiles, bevy-cube, puget-sound, tum-photo).
+    #[arg(long, default_value = "tiles")]
+    bundled: String,
+    #[arg(long)]
+    surface: Option<SurfaceKind>,
+    #[arg(long, default_value = "pyramid")]
+    method: Method,
+    /// Starting camera: view angle, azimuth (degrees) and zoom.
+    #[arg(long, default_value_t = 60.0)]
+    view_angle: f32,
+    #[arg(long, default_value_t = 30.0)]
+    azimuth: f32,
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f32,
+    #[arg(long)]
+    shadows: bool,
+    /// Scripted run: draw this many frames, save --screenshot, and exit.
+    #[arg(long)]
+    frames: Option<u32>,
+    /// Where P (or a scripted run) saves the frame; the command line goes beside it (.txt).
+    #[arg(long, default_value = "quadray-view.png")]
+    screenshot: PathBuf,
+    /// Size of the 3-D view in a scripted run (the window fits it and the panel).
+    #[arg(long, default_value = "512x384", value_parser = parse_size)]
+    view_size: (u32, u32),
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("`{s}` is not WxH"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}` is not WxH"))
+    };
+    Ok((n(w)?, n(h)?))
+}
+
+fn main() -> Result<()> {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let args = Args::parse();
+    let mut maps = MapChoice::bundled();
+    let mut start = maps
+        .iter()
+        .position(|m| m.name == args.bundled)
+        .with_context(|| format!("no bundled map `{}`", args.bundled))?;
+    if let Some(path) = &args.map {
+        let convention = match args.convention.as_str() {
+            "height" => Convention::Height,
+            "depth" => Convention::Depth,
+            "depth-photo" => Convention::DepthPhoto,
+            c => anyhow::bail!("unknown convention `{c}` (height, depth, depth-photo)"),
+        };
+        maps.push(MapChoice {
+            name: path
+                .file_name()
+                .map_or("map".into(), |n| n.to_string_lossy().into_owned()),
+            path: path.clone(),
+            convention,
+            color: None,
+            surface: SurfaceKind::Wall,
+        });
+        start = maps.len() - 1;
+    }
+    let settings = Settings {
+        method: args.method,
+        view_angle_deg: args.view_angle,
+        azimuth_deg: args.azimuth,
+        zoom: args.zoom,
+        shadows: args.shadows,
+        ..Settings::default()
+    };
+    settings.validate().map_err(anyhow::Error::msg)?;
+    app::run(args, maps, start, settings)
+}
