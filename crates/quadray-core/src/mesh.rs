@@ -57,14 +57,16 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     /// Unit normals, one per vertex (generated, area-weighted, when the file has none).
     pub normals: Vec<Vec3>,
-    /// One per vertex when the file has texture coordinates.
+    /// One per vertex when the file has texture coordinates; (0, 0) is the texture's top-left
+    /// corner (glTF's convention; OBJ's v is flipped to match).
     pub uvs: Option<Vec<Vec2>>,
     pub indices: Vec<[u32; 3]>,
     /// Index into [`Model::materials`].
     pub material: usize,
 }
 
-/// Everything loaded from one file: meshes in world space and the materials they refer to.
+/// Everything loaded from one file: meshes in world space and the materials they refer to (the
+/// last material is the default given to faces without one; it may be unused).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Model {
     pub meshes: Vec<Mesh>,
