@@ -1,10 +1,16 @@
 //! `quadray`: renders each technique headless, compares it with its CPU ground truth, and runs the
 //! benchmarks. Each subcommand lives in its own module.
 
+mod raytrace;
+
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "quadray", version, about = "Reference implementations of three rendering papers")]
+#[command(
+    name = "quadray",
+    version,
+    about = "Reference implementations of three rendering papers"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -14,6 +20,8 @@ struct Cli {
 enum Command {
     /// Print the GPU adapter quadray would use.
     Adapter,
+    /// Whitted ray tracing on a uniform grid with hybrid shadow testing.
+    Raytrace(raytrace::RaytraceArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -28,6 +36,7 @@ fn main() -> anyhow::Result<()> {
             let gpu = quadray_gpu::Gpu::new()?;
             println!("{}", gpu.describe());
         }
+        Command::Raytrace(args) => raytrace::run(args)?,
     }
     Ok(())
 }

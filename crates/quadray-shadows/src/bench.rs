@@ -1,0 +1,1 @@
+//! The paper's tables and figure 6 (filled in below).
