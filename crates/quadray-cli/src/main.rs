@@ -6,11 +6,7 @@ mod raytrace;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(
-    name = "quadray",
-    version,
-    about = "Reference implementations of three rendering papers"
-)]
+#[command(name = "quadray", version, about = "Reference implementations of three rendering papers")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
