@@ -22,6 +22,7 @@
 use crate::geom::{Aabb, ConvexPolygon};
 use crate::grid::{CellLists, Grid, Mailbox};
 use crate::scene::{Face, Scene};
+use crate::trace::MAX_LIGHTS;
 use glam::Vec3;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -40,6 +41,9 @@ pub struct LightVolumes {
 /// Shadow polygons for every light.
 pub struct ShadowVolumes {
     pub lights: Vec<LightVolumes>,
+    /// Shadow polygons registered per cell and light, cell-major (saturating), so N_s of every
+    /// light is one pass over a segment's cells.
+    counts: Vec<u16>,
 }
 
 impl ShadowVolumes {
@@ -63,8 +67,14 @@ impl ShadowVolumes {
                     cells,
                 }
             })
-            .collect();
-        Self { lights }
+            .collect::<Vec<LightVolumes>>();
+        let mut counts = vec![0u16; grid.cell_count() * lights.len()];
+        for (l, lv) in lights.iter().enumerate() {
+            for c in 0..grid.cell_count() {
+                counts[c * lights.len() + l] = lv.cells.count(c as u32).min(u16::MAX as u32) as u16;
+            }
+        }
+        Self { lights, counts }
     }
 
     pub fn polygon_count(&self) -> usize {
@@ -79,11 +89,19 @@ impl ShadowVolumes {
             .unwrap_or(0)
     }
 
-    /// N_s: shadow polygons of `light` registered in the cells a segment crossed (with repeats).
+    /// N_s of every light: shadow polygons registered in the cells a segment crossed (with
+    /// repeats).
     #[inline]
-    pub fn registered(&self, light: usize, walked: &[u32]) -> u32 {
-        let cells = &self.lights[light].cells;
-        walked.iter().map(|&c| cells.count(c)).sum()
+    pub fn registered(&self, walked: &[u32]) -> [u32; MAX_LIGHTS] {
+        let n = self.lights.len();
+        let mut ns = [0u32; MAX_LIGHTS];
+        for &c in walked {
+            let row = &self.counts[c as usize * n..c as usize * n + n];
+            for (acc, &k) in ns.iter_mut().zip(row) {
+                *acc += k as u32;
+            }
+        }
+        ns
     }
 
     /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells are

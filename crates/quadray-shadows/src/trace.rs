@@ -304,12 +304,17 @@ impl Tracer<'_> {
         let lights = &prep.scene.lights;
         let mut shadowed = [true; MAX_LIGHTS];
         let shadow_start = Instant::now();
+        let ns = match (&prep.volumes, self.settings.scheme) {
+            (Some(v), Scheme::Hst { .. }) => v.registered(&sc.walked),
+            _ => [0; MAX_LIGHTS],
+        };
         for (l, light) in lights.iter().enumerate() {
             let to_light = light.position - p;
             let self_shadow = to_light.dot(n) <= 0.0;
             shadowed[l] = self.shadowed(
                 sc,
                 l,
+                ns[l],
                 &mut states[l],
                 o,
                 d,
@@ -375,12 +380,14 @@ impl Tracer<'_> {
         colour
     }
 
-    /// The scheme's shadow condition for light `l` at `p` (reached along `o + t d`, `t = t_hit`).
+    /// The scheme's shadow condition for light `l` at `p` (reached along `o + t d`, `t = t_hit`,
+    /// through cells where `ns` shadow polygons of the light are registered).
     #[allow(clippy::too_many_arguments)]
     fn shadowed(
         &self,
         sc: &mut Scratch,
         l: usize,
+        ns: u32,
         state: &mut LightState,
         o: Vec3,
         d: Vec3,
@@ -417,7 +424,6 @@ impl Tracer<'_> {
             }
             Scheme::Hst { nth } => {
                 let v = prep.volumes.as_ref().expect("volumes built");
-                let ns = v.registered(l, &sc.walked);
                 let Scratch {
                     objects,
                     shadows,
