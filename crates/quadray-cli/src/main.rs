@@ -1,6 +1,7 @@
 //! `quadray`: renders each technique headless, compares it with its CPU ground truth, and runs the
 //! benchmarks. Each subcommand lives in its own module.
 
+mod bench;
 mod raytrace;
 
 use clap::{Parser, Subcommand};
@@ -18,6 +19,8 @@ enum Command {
     Adapter,
     /// Whitted ray tracing on a uniform grid with hybrid shadow testing.
     Raytrace(raytrace::RaytraceArgs),
+    /// Benchmarks that reproduce the papers' tables and figures.
+    Bench(bench::BenchArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -33,6 +36,7 @@ fn main() -> anyhow::Result<()> {
             println!("{}", gpu.describe());
         }
         Command::Raytrace(args) => raytrace::run(args)?,
+        Command::Bench(args) => bench::run(args)?,
     }
     Ok(())
 }
