@@ -60,7 +60,8 @@ pub struct Prepared {
     pub cells: CellLists,
     pub volumes: Option<ShadowVolumes>,
     pub bvh: Option<Bvh>,
-    /// Seconds spent building the grid (always) and the shadow polygons or BVH the scheme needs.
+    /// CPU seconds spent building the grid (always) and the shadow polygons or BVH the scheme
+    /// needs.
     pub preprocess_s: f64,
     /// Smallest ray parameter counted as a hit of a ray leaving a surface (scaled to the scene).
     pub eps: f32,
@@ -72,7 +73,7 @@ pub struct Prepared {
 
 impl Prepared {
     pub fn new(scene: Scene, scheme: Scheme) -> Prepared {
-        let start = Instant::now();
+        let start = crate::process_cpu_s();
         let polygons = scene.polygons();
         // The grid holds the eye too, so the eye's depth count describes every eye ray's start.
         let bounds = polygons
@@ -93,7 +94,7 @@ impl Prepared {
             cells,
             volumes,
             bvh,
-            preprocess_s: start.elapsed().as_secs_f64(),
+            preprocess_s: crate::process_cpu_s() - start,
         }
     }
 }
@@ -114,10 +115,13 @@ pub struct RenderStats {
     pub conventional: u64,
     pub shadow_polygon_tests: u64,
     pub shadow_rays: u64,
-    /// Thread time spent deciding shadows, and in the whole render.
-    pub shadow_cpu_s: f64,
-    pub render_cpu_s: f64,
+    /// Clock time the tiles' threads spent deciding shadows, and in the tiles.
+    pub shadow_thread_s: f64,
+    pub tile_thread_s: f64,
     pub render_wall_s: f64,
+    /// CPU time of the render, all threads (what the paper's CPU minutes measure; unlike clock
+    /// time it is not inflated by other processes on a shared machine).
+    pub render_cpu_s: f64,
 }
 
 impl RenderStats {
@@ -132,14 +136,14 @@ impl RenderStats {
         self.conventional += o.conventional;
         self.shadow_polygon_tests += o.shadow_polygon_tests;
         self.shadow_rays += o.shadow_rays;
-        self.shadow_cpu_s += o.shadow_cpu_s;
-        self.render_cpu_s += o.render_cpu_s;
+        self.shadow_thread_s += o.shadow_thread_s;
+        self.tile_thread_s += o.tile_thread_s;
     }
 
-    /// Wall-clock shadow time: the render's wall time split in the threads' proportion.
-    pub fn shadow_wall_s(&self) -> f64 {
-        if self.render_cpu_s > 0.0 {
-            self.render_wall_s * self.shadow_cpu_s / self.render_cpu_s
+    /// CPU time of shadow testing: the render's CPU time split in the threads' proportion.
+    pub fn shadow_cpu_s(&self) -> f64 {
+        if self.tile_thread_s > 0.0 {
+            self.render_cpu_s * self.shadow_thread_s / self.tile_thread_s
         } else {
             0.0
         }
@@ -179,6 +183,7 @@ pub fn render(
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
         .collect();
     let start = Instant::now();
+    let cpu_start = crate::process_cpu_s();
     let done: Vec<(Vec<[u8; 4]>, RenderStats)> = tiles
         .par_iter()
         .map(|&(tx, ty)| {
@@ -189,6 +194,7 @@ pub fn render(
         .collect();
     let mut stats = RenderStats {
         render_wall_s: start.elapsed().as_secs_f64(),
+        render_cpu_s: crate::process_cpu_s() - cpu_start,
         ..Default::default()
     };
     let mut image = Rgba8Image::new(w, h, [0, 0, 0, 255]);
@@ -262,7 +268,7 @@ impl Tracer<'_> {
                 pixels.push([c.x as u8, c.y as u8, c.z as u8, 255]);
             }
         }
-        scratch.stats.render_cpu_s = start.elapsed().as_secs_f64();
+        scratch.stats.tile_thread_s = start.elapsed().as_secs_f64();
         (pixels, scratch.stats)
     }
 
@@ -325,7 +331,7 @@ impl Tracer<'_> {
                 hit.polygon,
             );
         }
-        sc.stats.shadow_cpu_s += shadow_start.elapsed().as_secs_f64();
+        sc.stats.shadow_thread_s += shadow_start.elapsed().as_secs_f64();
         sc.stats.shadow_decisions += lights.len() as u64;
         if self.settings.check {
             let mut differs = 0;
