@@ -1,13 +1,20 @@
 //! `quadray`: renders each technique headless, compares it with its CPU ground truth, and runs the
 //! benchmarks. Each subcommand lives in its own module.
 
-mod bench;
+mod displace;
 mod raytrace;
 
+use anyhow::Result;
 use clap::{Parser, Subcommand};
+use indicatif::ProgressBar;
+use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(name = "quadray", version, about = "Reference implementations of three rendering papers")]
+#[command(
+    name = "quadray",
+    version,
+    about = "Reference implementations of three rendering papers"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -17,13 +24,52 @@ struct Cli {
 enum Command {
     /// Print the GPU adapter quadray would use.
     Adapter,
+    /// Pyramid displacement mapping and its baselines on one height map.
+    Displace(displace::DisplaceArgs),
     /// Whitted ray tracing on a uniform grid with hybrid shadow testing.
     Raytrace(raytrace::RaytraceArgs),
-    /// Benchmarks that reproduce the papers' tables and figures.
-    Bench(bench::BenchArgs),
+    /// Render the side-by-side pictures of every technique from the bundled assets.
+    Demo {
+        #[arg(long, default_value = "out/demo")]
+        out: PathBuf,
+        /// Side of each picture in pixels.
+        #[arg(long, default_value_t = 384)]
+        size: u32,
+    },
+    /// Benchmarks: results.json, results.md and plots.
+    Bench {
+        #[command(subcommand)]
+        what: Bench,
+    },
 }
 
-fn main() -> anyhow::Result<()> {
+#[derive(Subcommand)]
+enum Bench {
+    /// Tables 1-4 and figure 6 of the hybrid shadow testing paper, with SAH BVH shadow rays.
+    Shadows {
+        /// Small images and one render per measurement.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long, default_value = "out/bench/shadows")]
+        out: PathBuf,
+    },
+    /// Tables 1-2, figures 20-21 and accuracy by view angle of the displacement paper.
+    Displace {
+        /// Smaller frames and fewer sizes: minutes on a software rasterizer.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long, default_value = "out/bench/displace")]
+        out: PathBuf,
+    },
+}
+
+fn spinner(what: &str) -> ProgressBar {
+    let bar = ProgressBar::new_spinner().with_message(what.to_string());
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
+fn main() -> Result<()> {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
@@ -35,8 +81,41 @@ fn main() -> anyhow::Result<()> {
             let gpu = quadray_gpu::Gpu::new()?;
             println!("{}", gpu.describe());
         }
+        Command::Displace(args) => displace::run(args)?,
         Command::Raytrace(args) => raytrace::run(args)?,
-        Command::Bench(args) => bench::run(args)?,
+        Command::Bench {
+            what: Bench::Shadows { quick, out },
+        } => raytrace::bench(quick, &out)?,
+        Command::Demo { out, size } => {
+            if !(16..=4096).contains(&size) {
+                anyhow::bail!("--size {size} is outside 16..4096");
+            }
+            let gpu = quadray_gpu::Gpu::new()?;
+            let bar = spinner("displacement");
+            let files =
+                quadray_displace::demo::render_demo(&gpu, &out.join("displace"), size, |m| {
+                    bar.set_message(format!("displacement: {m}"))
+                })?;
+            bar.finish_and_clear();
+            for f in files {
+                println!("{}", f.display());
+            }
+        }
+        Command::Bench {
+            what: Bench::Displace { quick, out },
+        } => {
+            let gpu = quadray_gpu::Gpu::new()?;
+            let bar = spinner("bench displace");
+            let results = quadray_displace::bench::run(
+                &gpu,
+                &out,
+                quadray_displace::bench::BenchOptions { quick },
+                |m| bar.set_message(format!("bench displace: {m}")),
+            )?;
+            bar.finish_and_clear();
+            println!("{}", std::fs::read_to_string(out.join("results.md"))?);
+            println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);
+        }
     }
     Ok(())
 }

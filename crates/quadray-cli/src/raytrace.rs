@@ -4,7 +4,7 @@ use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use quadray_shadows::scene::{BUILTINS, Scene};
 use quadray_shadows::{Nth, RunOptions, SchemeChoice, cost};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct RaytraceArgs {
@@ -141,5 +141,26 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.stats {
         quadray_core::bench::write_json(path, &report)?;
     }
+    Ok(())
+}
+
+/// `quadray bench shadows`: the paper's tables and figure 6 into `out`, the headline ratios printed.
+pub fn bench(quick: bool, out: &Path) -> anyhow::Result<()> {
+    let results = quadray_shadows::bench::bench_shadows(quick, out, &|msg| eprintln!("{msg}"))?;
+    for s in &results.scenes {
+        let (conv, hst, bvh) = (&s.schemes[0], &s.schemes[2], &s.schemes[3]);
+        println!(
+            "{}: shadow hst/conventional {:.2}, total {:.2}, hst/bvh {:.2}; N_th predicted {:.1}, \
+             best {} (shadow at predicted / best {:.2})",
+            s.scene,
+            hst.shadow / conv.shadow,
+            hst.total / conv.total,
+            hst.shadow / bvh.shadow,
+            s.predicted_nth,
+            s.best_nth,
+            s.predicted_over_best
+        );
+    }
+    println!("wrote {}", out.join("shadows.md").display());
     Ok(())
 }

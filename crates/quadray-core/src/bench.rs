@@ -110,7 +110,10 @@ pub fn line_plot(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<(), 
             for (i, s) in series.iter().enumerate() {
                 let color = Palette99::pick(i).to_rgba();
                 chart
-                    .draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(2)))
+                    .draw_series(LineSeries::new(
+                        s.points.iter().copied(),
+                        color.stroke_width(2),
+                    ))
                     .map_err(|e| err(&e))?
                     .label(&s.name)
                     .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], color));
@@ -130,7 +133,9 @@ pub fn line_plot(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<(), 
         (false, false) => draw!(builder.build_cartesian_2d(x0..x1, y0..y1)),
         (true, false) => draw!(builder.build_cartesian_2d((x0..x1).log_scale(), y0..y1)),
         (false, true) => draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())),
-        (true, true) => draw!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())),
+        (true, true) => {
+            draw!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale()))
+        }
     }
     root.present().map_err(|e| err(&e))
 }
@@ -143,7 +148,10 @@ mod tests {
     fn markdown_table_has_header_rule_and_rows() {
         let mut t = Table::new("T", &["a", "b"]);
         t.row(vec!["1".into(), "2".into()]);
-        assert_eq!(t.to_markdown(), "### T\n\n| a | b |\n|---|---|\n| 1 | 2 |\n");
+        assert_eq!(
+            t.to_markdown(),
+            "### T\n\n| a | b |\n|---|---|\n| 1 | 2 |\n"
+        );
     }
 
     #[test]

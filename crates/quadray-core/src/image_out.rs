@@ -152,6 +152,9 @@ mod tests {
         let m = montage(&[("a".into(), red.clone()), ("b".into(), red)], 2);
         assert_eq!(m.width, 2 * (4 + 4) + 4);
         // first pixel of the first tile sits below the 14-pixel caption band
-        assert_eq!(m.pixels[((4 + 14) * m.width + 4) as usize], [255, 0, 0, 255]);
+        assert_eq!(
+            m.pixels[((4 + 14) * m.width + 4) as usize],
+            [255, 0, 0, 255]
+        );
     }
 }

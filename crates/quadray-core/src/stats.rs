@@ -38,7 +38,10 @@ pub fn time_cpu<T>(runs: usize, mut f: impl FnMut() -> T) -> (T, Summary) {
             start.elapsed().as_secs_f64() * 1e3
         })
         .collect();
-    (out, Summary::from_samples(&mut samples).expect("at least one run"))
+    (
+        out,
+        Summary::from_samples(&mut samples).expect("at least one run"),
+    )
 }
 
 #[cfg(test)]

@@ -37,7 +37,8 @@ fn read_texture_bytes(
         .size()
         .mip_level_size(level, wgpu::TextureDimension::D2);
     let row = size.width * texel_bytes;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("texture readback"),
         size: u64::from(padded) * u64::from(size.height),

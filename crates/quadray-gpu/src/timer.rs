@@ -4,7 +4,6 @@
 
 use crate::{Gpu, GpuError};
 
-
 pub use quadray_core::stats::Summary as TimingSummary;
 
 /// A query set with room for `passes` begin/end pairs, resolved once per frame.

@@ -1,0 +1,212 @@
+//! `quadray displace`, and the displacement parts of `quadray demo` and `quadray bench`.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use quadray_displace::accuracy::{Accuracy, Cost};
+use quadray_displace::heightmap::{Convention, Fit, HeightMap};
+use quadray_displace::maps::load_color;
+use quadray_displace::pyramid::Addressing;
+use quadray_displace::scene::SurfaceKind;
+use quadray_displace::{Lod, Method, Renderer, Settings};
+use quadray_gpu::Gpu;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub struct DisplaceArgs {
+    /// Height map: 8/16-bit PNG or float EXR, 2^n x 2^n (see --fit).
+    #[arg(long)]
+    map: PathBuf,
+    /// pyramid, pyramid-ascend, pyramid-bilinear, bump, parallax, pom, relief or mesh.
+    #[arg(long, default_value = "pyramid")]
+    method: Method,
+    /// Angle between the view direction at the surface centre and the normal (0..89).
+    #[arg(long, default_value_t = 45.0)]
+    view_angle: f32,
+    /// Image size WxH.
+    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Texture units per unit of depth (Bevy's default 0.1).
+    #[arg(long, default_value_t = 0.1)]
+    depth_scale: f32,
+    /// POM / relief layers MIN,MAX (head-on .. grazing). Bevy: 1,16; Godot: 8,32; three.js: 20,25.
+    #[arg(long, default_value = "8,32", value_parser = parse_layers)]
+    layers: (u32, u32),
+    /// Relief mapping's binary search steps (three.js: 5).
+    #[arg(long, default_value_t = 5)]
+    binary_steps: u32,
+    /// Finest pyramid level: `auto` (from screen-space derivatives) or a level number.
+    #[arg(long, default_value = "0", value_parser = parse_lod)]
+    lod: Lod,
+    /// Self-shadowing by tracing from the light.
+    #[arg(long)]
+    shadows: bool,
+    /// Compare every pixel with the CPU ground truth; writes an error heat map beside --out.
+    #[arg(long)]
+    reference: bool,
+    /// wall (tiled, rays wrap), terrain (one copy, rays leaving it are discarded) or photo.
+    #[arg(long, default_value = "wall")]
+    surface: SurfaceKind,
+    /// How the map stores its values: height (white = high), depth (white = deep) or depth-photo
+    /// (a Kinect/TUM depth image: 0 = no measurement).
+    #[arg(long, default_value = "height", value_parser = parse_convention)]
+    convention: Convention,
+    /// Resample maps that are not 2^n x 2^n to the nearest power of two instead of refusing them.
+    #[arg(long)]
+    resample: bool,
+    /// Albedo image (default: tinted by depth).
+    #[arg(long)]
+    color: Option<PathBuf>,
+    /// Frames to time (median).
+    #[arg(long, default_value_t = 30)]
+    frames: usize,
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long)]
+    stats: Option<PathBuf>,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("`{s}` is not WxH"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}` is not WxH"))
+    };
+    Ok((n(w)?, n(h)?))
+}
+
+fn parse_layers(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s
+        .split_once(',')
+        .ok_or_else(|| format!("`{s}` is not MIN,MAX"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}` is not MIN,MAX"))
+    };
+    Ok((n(a)?, n(b)?))
+}
+
+fn parse_lod(s: &str) -> Result<Lod, String> {
+    match s {
+        "auto" => Ok(Lod::Auto),
+        n => n
+            .parse()
+            .map(Lod::Level)
+            .map_err(|_| format!("`{s}` is not `auto` or a level")),
+    }
+}
+
+fn parse_convention(s: &str) -> Result<Convention, String> {
+    match s {
+        "height" => Ok(Convention::Height),
+        "depth" => Ok(Convention::Depth),
+        "depth-photo" => Ok(Convention::DepthPhoto),
+        _ => Err(format!(
+            "unknown convention `{s}` (height, depth, depth-photo)"
+        )),
+    }
+}
+
+#[derive(Serialize)]
+struct Stats<'a> {
+    method: Method,
+    width: u32,
+    height: u32,
+    map: &'a Path,
+    map_size: u32,
+    surface: SurfaceKind,
+    view_angle_deg: f32,
+    depth_scale: f32,
+    adapter: String,
+    gpu_time_ms: Option<f64>,
+    frames: usize,
+    iteration_cap_hits: usize,
+    mean_iterations: f64,
+    max_iterations: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    wrong_hit_fraction: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    accuracy: Option<Accuracy>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error_map: Option<PathBuf>,
+}
+
+pub fn run(args: DisplaceArgs) -> Result<()> {
+    let settings = Settings {
+        method: args.method,
+        view_angle_deg: args.view_angle,
+        width: args.size.0,
+        height: args.size.1,
+        depth_scale: args.depth_scale,
+        layers: args.layers,
+        binary_steps: args.binary_steps,
+        lod: args.lod,
+        shadows: args.shadows,
+    };
+    if let Err(e) = settings.validate() {
+        bail!("{e}");
+    }
+    if args.frames == 0 || args.frames > 100_000 {
+        bail!("--frames {} is outside 1..100000", args.frames);
+    }
+    let fit = if args.resample {
+        Fit::Resample
+    } else {
+        Fit::Refuse
+    };
+    let map = HeightMap::load(&args.map, args.convention, fit)?;
+    let color = args.color.as_deref().map(load_color).transpose()?;
+    let gpu = Gpu::new()?;
+    let mut renderer = Renderer::new(&gpu, &map, color.as_ref(), args.surface);
+    let frame = renderer.render(&gpu, &settings)?;
+    frame.color.save_png(&args.out)?;
+    let timing = renderer.time(&gpu, &settings, args.frames)?;
+    let cost = Cost::of(&frame);
+    let (accuracy, error_map) = if args.reference && settings.method.traces_rays() {
+        let addressing = if args.surface.wraps() {
+            Addressing::Wrap
+        } else {
+            Addressing::Clamp
+        };
+        let acc = Accuracy::measure(&frame, &map, addressing, settings.method.truth());
+        let path = args.out.with_extension("error.png");
+        acc.heat_map().save_png(&path)?;
+        (Some(acc), Some(path))
+    } else {
+        if args.reference {
+            eprintln!("note: --reference compares traced rays; the mesh baseline is rasterised");
+        }
+        (None, None)
+    };
+    let stats = Stats {
+        method: settings.method,
+        width: settings.width,
+        height: settings.height,
+        map: &args.map,
+        map_size: map.size(),
+        surface: args.surface,
+        view_angle_deg: settings.view_angle_deg,
+        depth_scale: settings.depth_scale,
+        adapter: gpu.describe(),
+        gpu_time_ms: timing.map(|t| t.median_ms),
+        frames: args.frames,
+        iteration_cap_hits: cost.iteration_cap_hits,
+        mean_iterations: cost.mean_iterations,
+        max_iterations: cost.max_iterations,
+        wrong_hit_fraction: accuracy.as_ref().map(|a| a.wrong_hit_fraction),
+        accuracy,
+        error_map,
+    };
+    let json = serde_json::to_string_pretty(&stats)?;
+    match &args.stats {
+        Some(path) => {
+            std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?
+        }
+        None => println!("{json}"),
+    }
+    Ok(())
+}

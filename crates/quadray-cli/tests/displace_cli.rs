@@ -1,0 +1,148 @@
+//! The `quadray displace` contract other tools rely on: option names, the stats JSON fields, the
+//! heat map beside the output, and clear errors (never a panic) on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
+}
+
+fn quadray(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_quadray"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("run quadray")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("quadray-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn displace_writes_the_picture_the_stats_and_the_error_map() {
+    let dir = scratch("ok");
+    let map = assets().join("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
+    let out = dir.join("tiles.png");
+    let stats = dir.join("tiles.json");
+    let run = quadray(&[
+        "displace",
+        "--map",
+        map.to_str().unwrap(),
+        "--method",
+        "pom",
+        "--layers",
+        "1,16",
+        "--view-angle",
+        "80",
+        "--size",
+        "96x64",
+        "--frames",
+        "3",
+        "--reference",
+        "--out",
+        out.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for field in [
+        "method",
+        "width",
+        "height",
+        "map",
+        "view_angle_deg",
+        "gpu_time_ms",
+        "frames",
+        "iteration_cap_hits",
+        "wrong_hit_fraction",
+    ] {
+        assert!(json.get(field).is_some(), "stats lack `{field}`: {json}");
+    }
+    assert_eq!(json["method"], "pom");
+    assert_eq!(
+        (json["width"].as_u64(), json["height"].as_u64()),
+        (Some(96), Some(64))
+    );
+    // Bevy's POM at 80 degrees on the sharp tile map is wrong on a large share of pixels.
+    assert!(
+        json["wrong_hit_fraction"].as_f64().unwrap() > 0.05,
+        "{json}"
+    );
+    let picture = image::open(&out).unwrap();
+    assert_eq!((picture.width(), picture.height()), (96, 64));
+    assert!(dir.join("tiles.error.png").exists());
+}
+
+#[test]
+fn bad_input_gets_a_clear_error_and_no_panic() {
+    let dir = scratch("bad");
+    let out = dir.join("x.png");
+    let tiles = assets().join("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
+    let bevy = assets().join("heightmaps/bevy_parallax/cube_depth.png");
+    let text = assets().join("SOURCES.md");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--map", bevy.to_str().unwrap()], "348x348"),
+        (vec!["--map", text.to_str().unwrap()], "SOURCES.md"),
+        (vec!["--map", "/nonexistent/map.png"], "map.png"),
+        (
+            vec!["--map", tiles.to_str().unwrap(), "--view-angle", "95"],
+            "view angle",
+        ),
+        (
+            vec!["--map", tiles.to_str().unwrap(), "--depth-scale", "NaN"],
+            "depth scale",
+        ),
+        (
+            vec!["--map", tiles.to_str().unwrap(), "--size", "0x10"],
+            "size",
+        ),
+        (
+            vec!["--map", tiles.to_str().unwrap(), "--layers", "9,3"],
+            "layers",
+        ),
+        (
+            vec!["--map", tiles.to_str().unwrap(), "--method", "steep"],
+            "unknown method",
+        ),
+        (
+            vec![
+                "--map",
+                tiles.to_str().unwrap(),
+                "--surface",
+                "torus",
+                "--method",
+                "mesh",
+            ],
+            "curved",
+        ),
+    ];
+    for (args, expected) in cases {
+        let mut all = vec!["displace", "--out", out.to_str().unwrap(), "--frames", "1"];
+        if !args.contains(&"--size") {
+            all.extend(["--size", "32x32"]);
+        }
+        all.extend(args.iter().copied());
+        let run = quadray(&all);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(
+            run.status.code(),
+            Some(if expected == "unknown method" { 2 } else { 1 }),
+            "{args:?}: {stderr}"
+        );
+        assert!(
+            stderr.contains(expected),
+            "{args:?}: `{expected}` not in {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}

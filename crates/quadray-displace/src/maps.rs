@@ -1,0 +1,112 @@
+//! The bundled maps the demo and the benchmark use, with the convention each is stored in.
+
+use crate::heightmap::{Convention, Fit, HeightMap, HeightMapError};
+use crate::scene::SurfaceKind;
+use quadray_core::image_out::Rgba8Image;
+use std::path::{Path, PathBuf};
+
+pub struct BundledMap {
+    pub name: &'static str,
+    /// Relative to the assets folder.
+    pub file: &'static str,
+    pub convention: Convention,
+    pub color: Option<&'static str>,
+    /// Sharp maps (steep walls) are where searches by fixed steps fail.
+    pub sharp: bool,
+    pub surface: SurfaceKind,
+    /// The paper's row this map stands in for (tables 1 and 2).
+    pub paper_row: &'static str,
+}
+
+pub const BUNDLED: [BundledMap; 4] = [
+    BundledMap {
+        name: "tiles",
+        file: "heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png",
+        convention: Convention::Height,
+        color: None,
+        sharp: true,
+        surface: SurfaceKind::Wall,
+        paper_row: "gravel wall",
+    },
+    BundledMap {
+        name: "bevy-cube",
+        file: "heightmaps/bevy_parallax/cube_depth.png",
+        convention: Convention::Depth,
+        color: Some("heightmaps/bevy_parallax/cube_color.png"),
+        sharp: true,
+        surface: SurfaceKind::Wall,
+        paper_row: "-",
+    },
+    BundledMap {
+        name: "puget-sound",
+        file: "heightmaps/puget_sound/ps_height_1k.png",
+        convention: Convention::Height,
+        color: None,
+        sharp: false,
+        surface: SurfaceKind::Terrain,
+        paper_row: "terrain",
+    },
+    BundledMap {
+        name: "tum-photo",
+        file: "heightmaps/depth_tum_rgbd/TUM_depth.png",
+        convention: Convention::DepthPhoto,
+        color: Some("heightmaps/depth_tum_rgbd/TUM_color.png"),
+        sharp: true,
+        surface: SurfaceKind::Photo,
+        paper_row: "face",
+    },
+];
+
+/// The repository's `assets/` folder (the binary may run from anywhere inside the clone).
+pub fn assets_dir() -> PathBuf {
+    let compiled = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+    if compiled.exists() {
+        compiled
+    } else {
+        PathBuf::from("assets")
+    }
+}
+
+impl BundledMap {
+    pub fn load(&self) -> Result<HeightMap, HeightMapError> {
+        HeightMap::load(
+            &assets_dir().join(self.file),
+            self.convention,
+            Fit::Resample,
+        )
+    }
+
+    pub fn load_color(&self) -> Result<Option<Rgba8Image>, HeightMapError> {
+        self.color
+            .map(|rel| load_color(&assets_dir().join(rel)))
+            .transpose()
+    }
+}
+
+/// Loads an albedo image as 8-bit RGBA.
+pub fn load_color(path: &Path) -> Result<Rgba8Image, HeightMapError> {
+    let img = image::open(path)
+        .map_err(|e| HeightMapError::Unreadable {
+            path: path.into(),
+            reason: e.to_string(),
+        })?
+        .to_rgba8();
+    Ok(Rgba8Image::from_bytes(
+        img.width(),
+        img.height(),
+        img.as_raw(),
+    ))
+}
+
+/// Resamples a map to `size` x `size` (figure 21's map-size sweep).
+pub fn resized(map: &HeightMap, size: u32) -> HeightMap {
+    let src = map.size();
+    let depth = (0..size * size)
+        .map(|k| {
+            let (i, j) = (k % size, k / size);
+            // Nearest texel: keeps the map's sharpness at every size.
+            map.at(i * src / size, j * src / size)
+        })
+        .collect();
+    HeightMap::from_depths(Path::new("resized"), size, depth).expect("power-of-two size")
+}

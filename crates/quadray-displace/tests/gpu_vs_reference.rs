@@ -1,0 +1,223 @@
+//! Every GPU method against the CPU ground truth on the bundled maps, on lavapipe in CI: small
+//! frames, every view angle the spec names.
+
+mod common;
+
+use quadray_displace::accuracy::{Accuracy, Cost};
+use quadray_displace::gpu::{PyramidBuilder, read_pyramid};
+use quadray_displace::pyramid::{Addressing, Pyramid};
+use quadray_displace::scene::SurfaceKind;
+use quadray_displace::{Lod, Method, Renderer, Settings};
+use quadray_gpu::Gpu;
+
+const ANGLES: [f32; 6] = [0.0, 30.0, 60.0, 70.0, 80.0, 85.0];
+
+fn addressing(surface: SurfaceKind) -> Addressing {
+    if surface.wraps() {
+        Addressing::Wrap
+    } else {
+        Addressing::Clamp
+    }
+}
+
+fn settings(method: Method, angle: f32) -> Settings {
+    Settings {
+        method,
+        view_angle_deg: angle,
+        width: 64,
+        height: 64,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn gpu_pyramids_are_bit_identical_to_the_cpu_ones() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    let builder = PyramidBuilder::new(&gpu);
+    for (name, map, _) in common::bundled_maps() {
+        let cases = [
+            (None, Pyramid::build(&map)),
+            (
+                Some(Addressing::Wrap),
+                Pyramid::build_conservative(&map, Addressing::Wrap),
+            ),
+            (
+                Some(Addressing::Clamp),
+                Pyramid::build_conservative(&map, Addressing::Clamp),
+            ),
+        ];
+        for (conservative, cpu) in cases {
+            let (_, texture) = builder.build(&gpu, &map, conservative, None);
+            let levels = read_pyramid(&gpu, &texture).unwrap();
+            assert_eq!(levels.len(), cpu.levels.len(), "{name}");
+            for (k, (g, c)) in levels.iter().zip(&cpu.levels).enumerate() {
+                let same = g.iter().zip(c).all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "{name} {conservative:?}: level {k} differs");
+            }
+        }
+    }
+}
+
+#[test]
+fn pyramid_methods_match_the_ground_truth_at_every_angle_on_every_map() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    for (name, map, _) in common::bundled_maps() {
+        for surface in [SurfaceKind::Wall, SurfaceKind::Terrain, SurfaceKind::Torus] {
+            let mut renderer = Renderer::new(&gpu, &map, None, surface);
+            for method in [
+                Method::Pyramid,
+                Method::PyramidAscend,
+                Method::PyramidBilinear,
+            ] {
+                let limit = if method == Method::PyramidBilinear {
+                    0.005
+                } else {
+                    0.001
+                };
+                for angle in ANGLES {
+                    let frame = renderer.render(&gpu, &settings(method, angle)).unwrap();
+                    let acc = Accuracy::measure(&frame, &map, addressing(surface), method.truth());
+                    let cost = Cost::of(&frame);
+                    let at = format!("{name} {surface:?} {method} {angle} deg");
+                    assert!(
+                        acc.covered > 200,
+                        "{at}: only {} pixels show the surface",
+                        acc.covered
+                    );
+                    assert!(
+                        acc.wrong_hit_fraction <= limit,
+                        "{at}: wrong_hit_fraction {} > {limit}",
+                        acc.wrong_hit_fraction
+                    );
+                    assert_eq!(cost.iteration_cap_hits, 0, "{at}: iteration cap hit");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn pom_and_relief_at_engine_defaults_miss_where_the_pyramid_does_not() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    let (_, map, _) = common::bundled_maps().remove(0); // tiles105: sharp grout
+    let mut renderer = Renderer::new(&gpu, &map, None, SurfaceKind::Wall);
+    let measure = |renderer: &mut Renderer, s: Settings| {
+        let frame = renderer.render(&gpu, &s).unwrap();
+        Accuracy::measure(&frame, &map, Addressing::Wrap, s.method.truth()).wrong_hit_fraction
+    };
+    let bevy_pom = Settings {
+        layers: (1, 16),
+        ..settings(Method::Pom, 80.0)
+    };
+    let three_relief = Settings {
+        layers: (20, 25),
+        binary_steps: 5,
+        ..settings(Method::Relief, 80.0)
+    };
+    let pom = measure(&mut renderer, bevy_pom);
+    let relief = measure(&mut renderer, three_relief);
+    let pyramid = measure(&mut renderer, settings(Method::Pyramid, 80.0));
+    assert!(
+        pom > 0.05 && pom > 20.0 * pyramid,
+        "pom {pom} vs pyramid {pyramid}"
+    );
+    assert!(
+        relief > 0.01 && relief > 5.0 * pyramid,
+        "relief {relief} vs pyramid {pyramid}"
+    );
+}
+
+#[test]
+fn coarser_lod_levels_cost_fewer_iterations() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    let (_, map, _) = common::bundled_maps().remove(2); // puget sound
+    let mut renderer = Renderer::new(&gpu, &map, None, SurfaceKind::Wall);
+    let cost = |renderer: &mut Renderer, lod| {
+        let s = Settings {
+            lod,
+            ..settings(Method::Pyramid, 70.0)
+        };
+        Cost::of(&renderer.render(&gpu, &s).unwrap()).mean_iterations
+    };
+    let per_level: Vec<f64> = (0..=map.levels)
+        .map(|l| cost(&mut renderer, Lod::Level(l)))
+        .collect();
+    for pair in per_level.windows(2) {
+        assert!(
+            pair[1] <= pair[0],
+            "cost by level not monotone: {per_level:?}"
+        );
+    }
+    assert!(
+        per_level[map.levels as usize] < 0.5 * per_level[0],
+        "{per_level:?}"
+    );
+    let auto = cost(&mut renderer, Lod::Auto);
+    assert!(
+        auto < per_level[0],
+        "auto LOD {auto} vs level 0 {}",
+        per_level[0]
+    );
+}
+
+#[test]
+fn the_displaced_mesh_and_the_ray_cast_surface_agree_pixel_by_pixel() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    let (_, map, _) = common::bundled_maps().remove(1); // bevy cube, 256^2
+    let mut renderer = Renderer::new(&gpu, &map, None, SurfaceKind::Terrain);
+    for angle in [0.0, 45.0] {
+        let mesh = renderer
+            .render(&gpu, &settings(Method::Mesh, angle))
+            .unwrap();
+        let cast = renderer
+            .render(&gpu, &settings(Method::PyramidBilinear, angle))
+            .unwrap();
+        let texel = 1.0 / map.size() as f32;
+        let (mut both, mut close) = (0, 0);
+        for (m, c) in mesh.hits.iter().zip(&cast.hits) {
+            if m[2] >= 0.0 && c[2] >= 0.0 {
+                both += 1;
+                let d = ((m[0] - c[0]).powi(2) + (m[1] - c[1]).powi(2)).sqrt();
+                close += usize::from(d <= 2.0 * texel);
+            }
+        }
+        assert!(both > 1000, "{angle}: only {both} pixels in both");
+        let agree = close as f64 / both as f64;
+        assert!(
+            agree > 0.97,
+            "{angle} deg: mesh and ray casting agree on {agree} of pixels"
+        );
+    }
+}
+
+#[test]
+fn self_shadows_darken_a_sharp_map_and_leave_a_flat_one_alone() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    let (_, map, _) = common::bundled_maps().remove(0);
+    let flat = quadray_displace::heightmap::HeightMap::from_depths(
+        std::path::Path::new("flat"),
+        64,
+        vec![0.3; 64 * 64],
+    )
+    .unwrap();
+    let darker = |map| {
+        let mut r = Renderer::new(&gpu, map, None, SurfaceKind::Wall);
+        let lit = r.render(&gpu, &settings(Method::Pyramid, 50.0)).unwrap();
+        let s = Settings {
+            shadows: true,
+            ..settings(Method::Pyramid, 50.0)
+        };
+        let shadowed = r.render(&gpu, &s).unwrap();
+        let n = lit
+            .color
+            .pixels
+            .iter()
+            .zip(&shadowed.color.pixels)
+            .filter(|(a, b)| a != b)
+            .count();
+        n as f64 / lit.color.pixels.len() as f64
+    };
+    assert_eq!(darker(&flat), 0.0);
+    let sharp = darker(&map);
+    assert!(sharp > 0.02, "only {sharp} of pixels in shadow");
+}

@@ -1,0 +1,138 @@
+//! Height maps in every supported format load as stored; bad maps and parameters get clear errors
+//! naming the file and the problem.
+
+mod common;
+
+use quadray_displace::heightmap::{Convention, Fit, HeightMap, HeightMapError};
+use quadray_displace::{Method, Settings};
+
+#[test]
+fn odd_sizes_are_refused_or_resampled_on_request() {
+    let bevy = common::asset("heightmaps/bevy_parallax/cube_depth.png");
+    let err = HeightMap::load(&bevy, Convention::Depth, Fit::Refuse).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("cube_depth.png") && msg.contains("348x348") && msg.contains("256x256"),
+        "{msg}"
+    );
+    let map = HeightMap::load(&bevy, Convention::Depth, Fit::Resample).unwrap();
+    assert_eq!(map.size(), 256);
+    let puget = common::asset("heightmaps/puget_sound/ps_height_1k.png");
+    assert_eq!(
+        HeightMap::load(&puget, Convention::Height, Fit::Resample)
+            .unwrap()
+            .size(),
+        1024
+    );
+}
+
+#[test]
+fn sixteen_bit_maps_keep_their_precision() {
+    let tiles = common::asset("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
+    let map = HeightMap::load(&tiles, Convention::Height, Fit::Refuse).unwrap();
+    let mut levels: Vec<u32> = map
+        .depth
+        .iter()
+        .map(|d| (d * 65535.0).round() as u32)
+        .collect();
+    levels.sort_unstable();
+    levels.dedup();
+    assert!(
+        levels.len() > 256,
+        "only {} distinct depths: quantised to 8 bits?",
+        levels.len()
+    );
+    // SOURCES.md: values 7623..65336, so depth spans (1 - 65336/65535) .. (1 - 7623/65535).
+    let max = map.depth.iter().copied().fold(0.0, f32::max);
+    assert!((max - (1.0 - 7623.0 / 65535.0)).abs() < 1e-4, "{max}");
+}
+
+#[test]
+fn nan_empty_and_broken_files_are_refused_with_their_name() {
+    let dir = std::env::temp_dir().join(format!("quadray-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let nan = dir.join("nan.exr");
+    let mut img = image::Rgb32FImage::new(4, 4);
+    img.put_pixel(2, 1, image::Rgb([f32::NAN, 0.0, 0.0]));
+    img.save(&nan).unwrap();
+    let err = HeightMap::load(&nan, Convention::Height, Fit::Refuse).unwrap_err();
+    assert!(
+        matches!(err, HeightMapError::NotFinite { x: 2, y: 1, .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("nan.exr"));
+
+    let empty = dir.join("empty.png");
+    std::fs::write(&empty, b"").unwrap();
+    let truncated = dir.join("truncated.png");
+    let bytes = std::fs::read(common::asset("heightmaps/bevy_parallax/cube_depth.png")).unwrap();
+    std::fs::write(&truncated, &bytes[..bytes.len() / 3]).unwrap();
+    let text = common::asset("SOURCES.md");
+    for path in [empty, truncated, text, dir.join("missing.png")] {
+        let err = HeightMap::load(&path, Convention::Height, Fit::Refuse).unwrap_err();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(err.to_string().contains(&name), "{err}");
+    }
+}
+
+#[test]
+fn absurd_parameters_are_refused() {
+    let ok = Settings::default();
+    assert!(ok.validate().is_ok());
+    let bad = [
+        Settings {
+            view_angle_deg: 90.0,
+            ..ok.clone()
+        },
+        Settings {
+            view_angle_deg: f32::NAN,
+            ..ok.clone()
+        },
+        Settings {
+            depth_scale: -1.0,
+            ..ok.clone()
+        },
+        Settings {
+            depth_scale: f32::INFINITY,
+            ..ok.clone()
+        },
+        Settings {
+            width: 0,
+            ..ok.clone()
+        },
+        Settings {
+            layers: (32, 8),
+            ..ok.clone()
+        },
+        Settings {
+            layers: (1, 1_000_000),
+            ..ok.clone()
+        },
+        Settings {
+            binary_steps: 1000,
+            ..ok.clone()
+        },
+    ];
+    for s in bad {
+        assert!(s.validate().is_err(), "{s:?} accepted");
+    }
+    assert!("pyramid-bilinear".parse::<Method>().is_ok());
+    assert!("pyramid2".parse::<Method>().unwrap_err().contains("pom"));
+}
+
+#[test]
+fn float_exr_maps_load_as_stored() {
+    let dir = std::env::temp_dir().join(format!("quadray-exr-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("ramp.exr");
+    let img = image::Rgb32FImage::from_fn(8, 8, |x, y| {
+        let v = (x + 8 * y) as f32 / 63.0;
+        image::Rgb([v, v, v])
+    });
+    img.save(&path).unwrap();
+    let map = HeightMap::load(&path, Convention::Depth, Fit::Refuse).unwrap();
+    assert_eq!(map.size(), 8);
+    for (k, d) in map.depth.iter().enumerate() {
+        assert!((d - k as f32 / 63.0).abs() < 1e-6, "texel {k}: {d}");
+    }
+}
