@@ -14,7 +14,7 @@ pub struct RaytraceArgs {
     /// A builtin look-alike of the paper's scenes: glasses, desk, stars, kaist.
     #[arg(long)]
     builtin: Option<String>,
-    /// Shadow scheme: hst, volume, conventional or bvh.
+    /// Shadow scheme: hst, volume, conventional, bvh, or embree (built with --features embree).
     #[arg(long, default_value = "hst")]
     shadows: SchemeChoice,
     /// HST threshold: auto (the cost model's prediction) or a number.

@@ -137,12 +137,16 @@ pub fn bench_shadows(
         let scene = Scene::builtin(name).expect("builtin");
         let mut rows = Vec::new();
         let mut hst_prep = None;
-        for scheme in [
+        let mut schemes = vec![
             SchemeChoice::Conventional,
             SchemeChoice::Volume,
             SchemeChoice::Hst,
             SchemeChoice::Bvh,
-        ] {
+        ];
+        if cfg!(feature = "embree") {
+            schemes.push(SchemeChoice::Embree);
+        }
+        for scheme in schemes {
             let (row, prep) = time_scheme(
                 &scene,
                 RunOptions { scheme, ..base },
@@ -225,7 +229,7 @@ fn figure6(path: &Path, s: &SceneResult) -> Result<(), FileError> {
         .map(|p| p.shadow)
         .chain(s.schemes.iter().map(|r| r.shadow))
         .fold(0.0, f64::max);
-    let series = [
+    let mut series = vec![
         Series {
             name: "HST".into(),
             points: s.sweep.iter().map(|p| (p.nth, ms(p.shadow))).collect(),
@@ -241,6 +245,9 @@ fn figure6(path: &Path, s: &SceneResult) -> Result<(), FileError> {
             ],
         },
     ];
+    if let Some(embree) = s.schemes.get(4) {
+        series.push(flat("Embree shadow rays", embree.shadow));
+    }
     let title = format!("{}: shadow testing time against N_th", s.scene);
     let spec = PlotSpec {
         title: &title,
@@ -257,7 +264,7 @@ fn markdown(r: &BenchResults) -> String {
     let ms = |x: f64| format!("{:.1}", x * 1e3);
     let mut md = format!(
         "## Hybrid shadow testing (`quadray bench shadows{}`)\n\n{}x{}, recursion depth {}, 1 sample per pixel, median of {} render(s), {} threads. \
-         Times in milliseconds; ratios from one run.\n\n",
+         Times are CPU milliseconds of all threads (the paper reports CPU minutes); ratios from one run.\n\n",
         if r.quick { " --quick" } else { "" },
         r.width,
         r.height,
@@ -382,6 +389,7 @@ fn markdown(r: &BenchResults) -> String {
             "hst/conventional shadow",
             "hst/conventional total",
             "hst/bvh shadow",
+            "hst/embree shadow",
             "shadow at predicted / best N_th",
             "disagreements volume",
             "disagreements hst",
@@ -398,6 +406,9 @@ fn markdown(r: &BenchResults) -> String {
             format!("{:.2}", hst.shadow / conv.shadow),
             format!("{:.2}", hst.total / conv.total),
             format!("{:.2}", hst.shadow / bvh.shadow),
+            s.schemes
+                .get(4)
+                .map_or("-".into(), |e| format!("{:.2}", hst.shadow / e.shadow)),
             format!("{:.2}", s.predicted_over_best),
             format!(
                 "{} ({:.1e})",
@@ -417,6 +428,7 @@ fn markdown(r: &BenchResults) -> String {
         "mean".into(),
         format!("{:.2}", shadow_sum / n),
         format!("{:.2}", total_sum / n),
+        String::new(),
         String::new(),
         String::new(),
         String::new(),

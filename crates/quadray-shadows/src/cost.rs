@@ -43,6 +43,9 @@ pub struct SceneStats {
     pub n_c: f64,
     /// N_o = alpha N_c (eq. 10).
     pub n_o: f64,
+    /// C_s measured per registered shadow polygon on this scene (ns), when it has shadow polygons;
+    /// equation 12 uses it in place of the per-test C_s.
+    pub c_s_per_entry: Option<f64>,
 }
 
 /// Equation 11: expected cost of a conventional shadow test.
@@ -51,9 +54,10 @@ pub fn conventional_cost(c: &MachineCosts, s: &SceneStats) -> f64 {
     c.c_i + (1.0 - q.powf(s.n_o)) * (c.c_c / (1.0 - q.powf(s.alpha)) + c.c_o / s.p)
 }
 
-/// Equation 12: the N_s where the shadow-volume test (C_s N_s, eq. 1) costs as much.
+/// Equation 12: the N_s where the shadow-volume test (C_s N_s, eq. 1) costs as much, with C_s
+/// per registered shadow polygon when the scene's was measured.
 pub fn predicted_nth(c: &MachineCosts, s: &SceneStats) -> f64 {
-    conventional_cost(c, s) / c.c_s
+    conventional_cost(c, s) / s.c_s_per_entry.unwrap_or(c.c_s)
 }
 
 /// Scene statistics from the polygons and the grid.
@@ -78,6 +82,7 @@ pub fn scene_stats(prep: &Prepared) -> SceneStats {
     let (a, l, h) = (mean_area, mean_perimeter, cell_edge);
     let p =
         (2.0 * a / (2.0 * a + 6.0 * h * h + 0.75 * std::f64::consts::PI * l * h)).clamp(1e-6, 1.0);
+    let c_s_per_entry = shadow_entry_cost(prep, &live);
     let n_c = mean_shadow_ray_cells(
         &live,
         g,
@@ -99,7 +104,35 @@ pub fn scene_stats(prep: &Prepared) -> SceneStats {
         p,
         n_c,
         n_o: alpha * n_c,
+        c_s_per_entry,
     }
+}
+
+/// Mean number of cells walked from area-weighted random points on the polygons to each light.
+/// `count` area-weighted random points on the polygons.
+fn surface_points(polygons: &[&ConvexPolygon], count: usize, rng: &mut SplitMix) -> Vec<Vec3> {
+    let mut cumulative = Vec::with_capacity(polygons.len());
+    let mut total = 0.0;
+    for p in polygons {
+        total += p.area() as f64;
+        cumulative.push(total);
+    }
+    (0..count)
+        .map(|_| {
+            let pick = cumulative
+                .partition_point(|&c| c < rng.unit() as f64 * total)
+                .min(polygons.len() - 1);
+            let poly = polygons[pick];
+            // A point inside the convex polygon: random convex weights of its vertices.
+            let w: Vec<f32> = poly.vertices.iter().map(|_| rng.unit() + 1e-3).collect();
+            let ws: f32 = w.iter().sum();
+            poly.vertices
+                .iter()
+                .zip(&w)
+                .map(|(v, w)| *v * (w / ws))
+                .sum::<Vec3>()
+        })
+        .collect()
 }
 
 /// Mean number of cells walked from area-weighted random points on the polygons to each light.
@@ -107,29 +140,9 @@ fn mean_shadow_ray_cells(polygons: &[&ConvexPolygon], grid: &Grid, lights: &[Vec
     if polygons.is_empty() || lights.is_empty() {
         return 0.0;
     }
-    let mut cumulative = Vec::with_capacity(polygons.len());
-    let mut total = 0.0;
-    for p in polygons {
-        total += p.area() as f64;
-        cumulative.push(total);
-    }
-    let mut rng = SplitMix(7);
-    let samples = 2000;
+    let points = surface_points(polygons, 2000, &mut SplitMix(7));
     let mut cells = 0u64;
-    for _ in 0..samples {
-        let pick = cumulative
-            .partition_point(|&c| c < rng.unit() as f64 * total)
-            .min(polygons.len() - 1);
-        let poly = polygons[pick];
-        // A point inside the convex polygon: random convex weights of its vertices.
-        let w: Vec<f32> = poly.vertices.iter().map(|_| rng.unit() + 1e-3).collect();
-        let ws: f32 = w.iter().sum();
-        let point = poly
-            .vertices
-            .iter()
-            .zip(&w)
-            .map(|(v, w)| *v * (w / ws))
-            .sum::<Vec3>();
+    for &point in &points {
         for &light in lights {
             let to = light - point;
             let dist = to.length();
@@ -139,7 +152,54 @@ fn mean_shadow_ray_cells(polygons: &[&ConvexPolygon], grid: &Grid, lights: &[Vec
             });
         }
     }
-    cells as f64 / (samples * lights.len()) as f64
+    cells as f64 / (points.len() * lights.len()) as f64
+}
+
+/// C_s as equation 1 uses it, measured on the scene's own shadow polygons: CPU time per shadow
+/// polygon registered in a crossed cell. N_s counts a polygon once per cell it is registered in,
+/// and the bucket (mailbox) tests it only once per segment, so most entries cost a mailbox check
+/// rather than a ray test. Timed on segments between random points on the polygons (None without
+/// shadow polygons).
+fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64> {
+    let volumes = prep.volumes.as_ref()?;
+    let points = surface_points(polygons, 2000, &mut SplitMix(9));
+    let segments: Vec<(Vec3, Vec3, f32, Vec<u32>)> = points
+        .chunks_exact(2)
+        .map(|ab| {
+            let to = ab[1] - ab[0];
+            let dist = to.length().max(1e-6);
+            let mut walked = Vec::new();
+            prep.grid.walk(ab[0], to / dist, 0.0, dist, |c, _, _| {
+                walked.push(c);
+                false
+            });
+            (ab[0], to / dist, dist, walked)
+        })
+        .collect();
+    let entries: u64 = segments
+        .iter()
+        .map(|s| {
+            volumes
+                .registered(&s.3)
+                .iter()
+                .map(|&n| n as u64)
+                .sum::<u64>()
+        })
+        .sum();
+    if entries == 0 {
+        return None;
+    }
+    let mut mailbox = Mailbox::new(volumes.max_per_light());
+    let mut tests = 0;
+    Some(median_ns(entries as usize, || {
+        let mut change = 0;
+        for (o, d, t, walked) in &segments {
+            for l in 0..volumes.lights.len() {
+                change += volumes.crossings(l, walked, *o, *d, 0.0, *t, &mut mailbox, &mut tests);
+            }
+        }
+        black_box(change);
+    }))
 }
 
 /// Measures the machine constants with micro-benchmarks on synthetic polygons and grids; each is

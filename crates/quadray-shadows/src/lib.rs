@@ -9,6 +9,8 @@
 pub mod bench;
 pub mod bvh;
 pub mod cost;
+#[cfg(feature = "embree")]
+pub mod embree;
 pub mod geom;
 pub mod grid;
 pub mod scene;
@@ -39,6 +41,8 @@ pub enum SchemeChoice {
     Volume,
     Hst,
     Bvh,
+    /// Embree occlusion rays; needs the `embree` feature.
+    Embree,
 }
 
 impl std::str::FromStr for SchemeChoice {
@@ -143,6 +147,7 @@ pub fn prepare(scene: Scene, scheme: SchemeChoice) -> Prepared {
         SchemeChoice::Volume => Scheme::Volume,
         SchemeChoice::Hst => Scheme::Hst { nth: 0.0 },
         SchemeChoice::Bvh => Scheme::Bvh,
+        SchemeChoice::Embree => Scheme::Embree,
     };
     Prepared::new(scene, s)
 }
@@ -165,6 +170,7 @@ pub fn render_prepared(
         SchemeChoice::Volume => Scheme::Volume,
         SchemeChoice::Hst => Scheme::Hst { nth: used as f32 },
         SchemeChoice::Bvh => Scheme::Bvh,
+        SchemeChoice::Embree => Scheme::Embree,
     };
     let settings = Settings {
         width: opts.width,

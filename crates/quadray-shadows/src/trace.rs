@@ -28,6 +28,8 @@ pub enum Scheme {
     Hst { nth: f32 },
     /// A shadow ray through the SAH BVH.
     Bvh,
+    /// A shadow ray as an Embree occlusion query (`embree` feature).
+    Embree,
 }
 
 impl Scheme {
@@ -37,6 +39,7 @@ impl Scheme {
             Scheme::Volume => "volume",
             Scheme::Hst { .. } => "hst",
             Scheme::Bvh => "bvh",
+            Scheme::Embree => "embree",
         }
     }
 }
@@ -60,6 +63,8 @@ pub struct Prepared {
     pub cells: CellLists,
     pub volumes: Option<ShadowVolumes>,
     pub bvh: Option<Bvh>,
+    #[cfg(feature = "embree")]
+    pub embree: Option<crate::embree::EmbreeScene>,
     /// CPU seconds spent building the grid (always) and the shadow polygons or BVH the scheme
     /// needs.
     pub preprocess_s: f64,
@@ -85,6 +90,9 @@ impl Prepared {
         let volumes = matches!(scheme, Scheme::Volume | Scheme::Hst { .. })
             .then(|| ShadowVolumes::build(&scene, &polygons, &grid));
         let bvh = (scheme == Scheme::Bvh).then(|| Bvh::build(&polygons));
+        #[cfg(feature = "embree")]
+        let embree =
+            (scheme == Scheme::Embree).then(|| crate::embree::EmbreeScene::build(&polygons));
         Prepared {
             eps: bounds.extent().length() * 1e-5,
             shadow_eps: bounds.extent().length() * 1e-7,
@@ -94,6 +102,8 @@ impl Prepared {
             cells,
             volumes,
             bvh,
+            #[cfg(feature = "embree")]
+            embree,
             preprocess_s: crate::process_cpu_s() - start,
         }
     }
@@ -405,7 +415,7 @@ impl Tracer<'_> {
     ) -> bool {
         let prep = self.prep;
         match self.settings.scheme {
-            Scheme::Conventional | Scheme::Bvh => {
+            Scheme::Conventional | Scheme::Bvh | Scheme::Embree => {
                 sc.stats.conventional += 1;
                 if self_shadow {
                     return true;
@@ -472,19 +482,22 @@ impl Tracer<'_> {
     }
 
     fn shadow_ray_with(&self, sc: &mut Scratch, p: Vec3, to_light: Vec3, polygon: u32) -> bool {
-        match &self.prep.bvh {
-            Some(bvh) if self.settings.scheme == Scheme::Bvh => {
-                let dist = to_light.length();
-                bvh.occluded(
-                    &self.prep.polygons,
-                    p,
-                    to_light / dist,
-                    self.prep.shadow_eps,
-                    dist,
-                    Some(polygon),
-                )
-            }
-            _ => occluded_grid(self.prep, &mut sc.objects, p, to_light, polygon),
+        let prep = self.prep;
+        let dist = to_light.length();
+        #[cfg(feature = "embree")]
+        if let Some(embree) = &prep.embree {
+            return embree.occluded(p, to_light / dist, prep.eps, dist);
+        }
+        match &prep.bvh {
+            Some(bvh) => bvh.occluded(
+                &prep.polygons,
+                p,
+                to_light / dist,
+                prep.shadow_eps,
+                dist,
+                Some(polygon),
+            ),
+            None => occluded_grid(prep, &mut sc.objects, p, to_light, polygon),
         }
     }
 }
