@@ -53,8 +53,12 @@ impl std::str::FromStr for SchemeChoice {
             "volume" => Ok(Self::Volume),
             "hst" => Ok(Self::Hst),
             "bvh" => Ok(Self::Bvh),
+            "embree" if cfg!(feature = "embree") => Ok(Self::Embree),
+            "embree" => {
+                Err("this quadray was built without Embree (cargo build --features embree)".into())
+            }
             _ => Err(format!(
-                "unknown shadow scheme {s:?} (conventional, volume, hst, bvh)"
+                "unknown shadow scheme {s:?} (conventional, volume, hst, bvh, embree)"
             )),
         }
     }
