@@ -160,7 +160,7 @@ pub fn bench_shadows(
             }
         }
         let prep = hst_prep.expect("hst prepared");
-        let stats = cost::scene_stats(&prep);
+        let stats = *prep.stats();
         let predicted = cost::predicted_nth(&costs, &stats);
         let sweep: Vec<SweepPoint> = sweep_values
             .iter()

@@ -9,7 +9,6 @@ use crate::trace::Prepared;
 use glam::Vec3;
 use serde::Serialize;
 use std::hint::black_box;
-use std::time::Instant;
 
 /// Machine constants in nanoseconds (the paper's table 1 has milliseconds on a SUN 3/75).
 #[derive(Clone, Copy, Debug, Serialize, PartialEq)]
@@ -289,13 +288,15 @@ pub fn calibrate() -> MachineCosts {
 }
 
 /// Median over batches of the time per operation of `f`, which performs `ops` operations.
+/// Timed in this thread's CPU time, so neither other processes nor idle-spinning worker threads
+/// sharing the cores inflate it.
 fn median_ns(ops: usize, mut f: impl FnMut()) -> f64 {
     f();
     let mut samples: Vec<f64> = (0..15)
         .map(|_| {
-            let start = Instant::now();
+            let start = crate::thread_cpu_s();
             f();
-            start.elapsed().as_secs_f64() * 1e9 / ops as f64
+            (crate::thread_cpu_s() - start) * 1e9 / ops as f64
         })
         .collect();
     samples.sort_by(f64::total_cmp);

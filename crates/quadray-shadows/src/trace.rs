@@ -70,6 +70,8 @@ pub struct Prepared {
     pub preprocess_s: f64,
     /// Smallest ray parameter counted as a hit of a ray leaving a surface (scaled to the scene).
     pub eps: f32,
+    /// Scene statistics of the cost model, computed once on first use.
+    stats: std::sync::OnceLock<crate::cost::SceneStats>,
     /// The same for shadow rays: much smaller, so a polygon that a shadow ray crosses right next to
     /// its start (a concave corner) counts, as it does for the depth count. Depth counts take
     /// every crossing after the segment's start.
@@ -105,7 +107,16 @@ impl Prepared {
             #[cfg(feature = "embree")]
             embree,
             preprocess_s: crate::process_cpu_s() - start,
+            stats: std::sync::OnceLock::new(),
         }
+    }
+}
+
+impl Prepared {
+    /// The cost model's scene statistics (measured once, so every render of this preparation
+    /// predicts the same N_th).
+    pub fn stats(&self) -> &crate::cost::SceneStats {
+        self.stats.get_or_init(|| crate::cost::scene_stats(self))
     }
 }
 
