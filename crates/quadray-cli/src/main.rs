@@ -2,6 +2,7 @@
 //! benchmarks. Each subcommand lives in its own module.
 
 mod displace;
+mod raytrace;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ enum Command {
     Adapter,
     /// Pyramid displacement mapping and its baselines on one height map.
     Displace(displace::DisplaceArgs),
+    /// Whitted ray tracing on a uniform grid with hybrid shadow testing.
+    Raytrace(raytrace::RaytraceArgs),
     /// Render the side-by-side pictures of every technique from the bundled assets.
     Demo {
         #[arg(long, default_value = "out/demo")]
@@ -42,6 +45,14 @@ enum Command {
 
 #[derive(Subcommand)]
 enum Bench {
+    /// Tables 1-4 and figure 6 of the hybrid shadow testing paper, with SAH BVH shadow rays.
+    Shadows {
+        /// Small images and one render per measurement.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long, default_value = "out/bench/shadows")]
+        out: PathBuf,
+    },
     /// Tables 1-2, figures 20-21 and accuracy by view angle of the displacement paper.
     Displace {
         /// Smaller frames and fewer sizes: minutes on a software rasterizer.
@@ -71,6 +82,10 @@ fn main() -> Result<()> {
             println!("{}", gpu.describe());
         }
         Command::Displace(args) => displace::run(args)?,
+        Command::Raytrace(args) => raytrace::run(args)?,
+        Command::Bench {
+            what: Bench::Shadows { quick, out },
+        } => raytrace::bench(quick, &out)?,
         Command::Demo { out, size } => {
             if !(16..=4096).contains(&size) {
                 anyhow::bail!("--size {size} is outside 16..4096");

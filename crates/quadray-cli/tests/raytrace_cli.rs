@@ -1,0 +1,152 @@
+//! The `quadray raytrace` contract: option names, the stats JSON fields of issue 4, the demo scene
+//! file from the assets, and clear errors (never a panic) on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
+}
+
+fn quadray(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_quadray"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("run quadray")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("quadray-raytrace-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn raytrace_writes_the_picture_and_the_stats() {
+    let dir = scratch("ok");
+    let (out, stats) = (dir.join("demo.png"), dir.join("demo.json"));
+    let scene = assets().join("scenes/shadows-demo.toml");
+    let run = quadray(&[
+        "raytrace",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--shadows",
+        "hst",
+        "--nth",
+        "6",
+        "--size",
+        "64x48",
+        "--depth",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
+        "--check",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let img = image::open(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (64, 48));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in [
+        "scheme",
+        "width",
+        "height",
+        "polygons",
+        "lights",
+        "shadow_polygons",
+        "grid",
+        "times_s",
+        "subschemes",
+        "nth",
+        "p",
+        "alpha",
+        "disagreements",
+        "shading_points",
+    ] {
+        assert!(json.get(key).is_some(), "stats lack {key}");
+    }
+    for key in ["preprocess", "shadow", "other", "total"] {
+        assert!(json["times_s"][key].as_f64().unwrap() >= 0.0);
+    }
+    for key in ["sustain", "self_shadow", "shadow_volume", "conventional"] {
+        assert!(json["subschemes"][key].as_u64().is_some());
+    }
+    assert_eq!(json["nth"]["used"].as_f64(), Some(6.0));
+    assert_eq!(json["grid"].as_array().unwrap().len(), 3);
+    assert_eq!(json["disagreements"].as_u64(), Some(0));
+}
+
+#[test]
+fn raytrace_bad_input_is_a_clear_error() {
+    let dir = scratch("bad");
+    let bad_scene = dir.join("bad.toml");
+    std::fs::write(&bad_scene, "[camera]\neye = [0, 0, 0]\n").unwrap();
+    let out = dir.join("x.png");
+    let out = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["raytrace", "--builtin", "nope", "--out", out],
+            "unknown builtin",
+        ),
+        (
+            &[
+                "raytrace",
+                "--builtin",
+                "stars",
+                "--size",
+                "0x5",
+                "--out",
+                out,
+            ],
+            "--size",
+        ),
+        (
+            &[
+                "raytrace",
+                "--builtin",
+                "stars",
+                "--nth=-3",
+                "--out",
+                out,
+            ],
+            "--nth",
+        ),
+        (
+            &[
+                "raytrace",
+                "--builtin",
+                "stars",
+                "--shadows",
+                "raster",
+                "--out",
+                out,
+            ],
+            "unknown shadow scheme",
+        ),
+        (
+            &[
+                "raytrace",
+                "--scene",
+                bad_scene.to_str().unwrap(),
+                "--out",
+                out,
+            ],
+            "bad.toml",
+        ),
+    ];
+    for (args, why) in cases {
+        let run = quadray(args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            !run.status.success() && err.contains(why) && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}

@@ -1,0 +1,457 @@
+//! `quadray bench shadows`: the paper's tables 1-4 and figure 6 on the four look-alike scenes,
+//! with the SAH BVH as today's baseline. Every time is the median of several renders; methods are
+//! compared as ratios within one run.
+
+use crate::cost::{self, MachineCosts, SceneStats};
+use crate::scene::{BUILTINS, Scene};
+use crate::trace::Prepared;
+use crate::{Nth, RunOptions, RunReport, SchemeChoice, prepare, render_prepared};
+use quadray_core::FileError;
+use quadray_core::bench::{PlotSpec, Series, Table, line_plot, write_json, write_text};
+use serde::Serialize;
+use std::path::Path;
+
+/// Timings of one scheme on one scene (medians, seconds).
+#[derive(Clone, Debug, Serialize)]
+pub struct SchemeRow {
+    pub scheme: String,
+    pub nth: Option<f64>,
+    pub preprocess: f64,
+    pub shadow: f64,
+    pub other: f64,
+    pub total: f64,
+    pub disagreements: u64,
+    pub shading_points: u64,
+    pub report: RunReport,
+}
+
+/// One point of figure 6.
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepPoint {
+    pub nth: f64,
+    pub shadow: f64,
+    pub conventional_share: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneResult {
+    pub scene: String,
+    pub stats: SceneStats,
+    pub predicted_nth: f64,
+    pub schemes: Vec<SchemeRow>,
+    pub sweep: Vec<SweepPoint>,
+    pub best_nth: f64,
+    /// Shadow time at the predicted N_th over the best shadow time of the sweep.
+    pub predicted_over_best: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchResults {
+    pub quick: bool,
+    pub width: u32,
+    pub height: u32,
+    pub depth: u32,
+    pub runs: usize,
+    pub threads: usize,
+    pub costs_ns: MachineCosts,
+    pub scenes: Vec<SceneResult>,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Renders `runs` times (after one checked render that counts disagreements) and keeps the medians.
+fn time_scheme(
+    scene: &Scene,
+    opts: RunOptions,
+    costs: &MachineCosts,
+    runs: usize,
+    progress: &dyn Fn(&str),
+) -> (SchemeRow, Prepared) {
+    let mut preprocess = Vec::new();
+    let mut prep = None;
+    for _ in 0..runs {
+        let p = prepare(scene.clone(), opts.scheme);
+        preprocess.push(p.preprocess_s);
+        prep = Some(p);
+    }
+    let prep = prep.expect("at least one run");
+    let checked = RunOptions {
+        check: true,
+        ..opts
+    };
+    let (_, check) = render_prepared(&prep, &checked, costs, &|| {});
+    let reports: Vec<RunReport> = (0..runs)
+        .map(|_| render_prepared(&prep, &opts, costs, &|| {}).1)
+        .collect();
+    progress(&format!("{} {}", scene.name, check.scheme));
+    let pre = median(preprocess);
+    let shadow = median(reports.iter().map(|r| r.times_s.shadow).collect());
+    let other = median(reports.iter().map(|r| r.times_s.other).collect());
+    let row = SchemeRow {
+        scheme: check.scheme.clone(),
+        nth: check.nth.used,
+        preprocess: pre,
+        shadow,
+        other,
+        total: pre + shadow + other,
+        disagreements: check.disagreements.unwrap_or(0),
+        shading_points: check.shading_points,
+        report: reports[0].clone(),
+    };
+    (row, prep)
+}
+
+/// Runs the whole benchmark and writes `results.json`, `shadows.md` and one figure-6 SVG per scene
+/// into `out`.
+pub fn bench_shadows(
+    quick: bool,
+    out: &Path,
+    progress: &dyn Fn(&str),
+) -> Result<BenchResults, FileError> {
+    let (width, height, runs) = if quick { (128, 120, 1) } else { (512, 480, 3) };
+    let depth = 5;
+    let sweep_values: Vec<f64> = if quick {
+        vec![0.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0]
+    } else {
+        vec![
+            0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0, 32.0, 48.0, 64.0, 96.0, 128.0,
+        ]
+    };
+    let costs = cost::calibrate();
+    progress(&format!("machine constants (ns): {costs:?}"));
+    let base = RunOptions {
+        scheme: SchemeChoice::Conventional,
+        nth: Nth::Auto,
+        width,
+        height,
+        spp: 1,
+        depth,
+        check: false,
+        costs: Some(costs),
+    };
+    let mut scenes = Vec::new();
+    for (name, ..) in BUILTINS {
+        let scene = Scene::builtin(name).expect("builtin");
+        let mut rows = Vec::new();
+        let mut hst_prep = None;
+        let mut schemes = vec![
+            SchemeChoice::Conventional,
+            SchemeChoice::Volume,
+            SchemeChoice::Hst,
+            SchemeChoice::Bvh,
+        ];
+        if cfg!(feature = "embree") {
+            schemes.push(SchemeChoice::Embree);
+        }
+        for scheme in schemes {
+            let (row, prep) = time_scheme(
+                &scene,
+                RunOptions { scheme, ..base },
+                &costs,
+                runs,
+                progress,
+            );
+            rows.push(row);
+            if scheme == SchemeChoice::Hst {
+                hst_prep = Some(prep);
+            }
+        }
+        let prep = hst_prep.expect("hst prepared");
+        let stats = *prep.stats();
+        let predicted = cost::predicted_nth(&costs, &stats);
+        let sweep: Vec<SweepPoint> = sweep_values
+            .iter()
+            .map(|&nth| {
+                let opts = RunOptions {
+                    scheme: SchemeChoice::Hst,
+                    nth: Nth::Fixed(nth as f32),
+                    ..base
+                };
+                let reports: Vec<RunReport> = (0..runs)
+                    .map(|_| render_prepared(&prep, &opts, &costs, &|| {}).1)
+                    .collect();
+                let r = &reports[0];
+                SweepPoint {
+                    nth,
+                    shadow: median(reports.iter().map(|r| r.times_s.shadow).collect()),
+                    conventional_share: r.subschemes.conventional as f64
+                        / r.shadow_decisions.max(1) as f64,
+                }
+            })
+            .collect();
+        progress(&format!("{name} sweep"));
+        let best = sweep
+            .iter()
+            .min_by(|a, b| a.shadow.total_cmp(&b.shadow))
+            .expect("sweep");
+        let hst = &rows[2];
+        scenes.push(SceneResult {
+            scene: name.into(),
+            stats,
+            predicted_nth: predicted,
+            best_nth: best.nth,
+            predicted_over_best: hst.shadow / best.shadow,
+            schemes: rows,
+            sweep,
+        });
+    }
+    let results = BenchResults {
+        quick,
+        width,
+        height,
+        depth,
+        runs,
+        threads: rayon::current_num_threads(),
+        costs_ns: costs,
+        scenes,
+    };
+    write_json(&out.join("results.json"), &results)?;
+    for s in &results.scenes {
+        figure6(&out.join(format!("fig6-{}.svg", s.scene)), s)?;
+    }
+    write_text(&out.join("shadows.md"), &markdown(&results))?;
+    Ok(results)
+}
+
+fn figure6(path: &Path, s: &SceneResult) -> Result<(), FileError> {
+    let ms = |x: f64| x * 1e3;
+    let xmax = s.sweep.last().map_or(1.0, |p| p.nth);
+    let flat = |name: &str, y: f64| Series {
+        name: name.into(),
+        points: vec![(0.0, ms(y)), (xmax, ms(y))],
+    };
+    let top = s
+        .sweep
+        .iter()
+        .map(|p| p.shadow)
+        .chain(s.schemes.iter().map(|r| r.shadow))
+        .fold(0.0, f64::max);
+    let mut series = vec![
+        Series {
+            name: "HST".into(),
+            points: s.sweep.iter().map(|p| (p.nth, ms(p.shadow))).collect(),
+        },
+        flat("conventional", s.schemes[0].shadow),
+        flat("shadow volume", s.schemes[1].shadow),
+        flat("BVH shadow rays", s.schemes[3].shadow),
+        Series {
+            name: format!("predicted N_th = {:.1}", s.predicted_nth),
+            points: vec![
+                (s.predicted_nth.min(xmax), 0.0),
+                (s.predicted_nth.min(xmax), ms(top)),
+            ],
+        },
+    ];
+    if let Some(embree) = s.schemes.get(4) {
+        series.push(flat("Embree shadow rays", embree.shadow));
+    }
+    let title = format!("{}: shadow testing time against N_th", s.scene);
+    let spec = PlotSpec {
+        title: &title,
+        x_label: "N_th",
+        y_label: "shadow testing (ms)",
+        log_x: false,
+        log_y: false,
+    };
+    line_plot(path, &spec, &series)
+}
+
+fn markdown(r: &BenchResults) -> String {
+    let pct = |x: f64, of: f64| format!("{:.0}%", 100.0 * x / of.max(1e-12));
+    let ms = |x: f64| format!("{:.1}", x * 1e3);
+    let mut md = format!(
+        "## Hybrid shadow testing (`quadray bench shadows{}`)\n\n{}x{}, recursion depth {}, 1 sample per pixel, median of {} render(s), {} threads. \
+         Times are CPU milliseconds of all threads (the paper reports CPU minutes); ratios from one run.\n\n",
+        if r.quick { " --quick" } else { "" },
+        r.width,
+        r.height,
+        r.depth,
+        r.runs,
+        r.threads
+    );
+    let c = &r.costs_ns;
+    let mut t1 = Table::new(
+        "Table 1: machine constants (ns; the paper: 2.00, 2.54, 0.23, 1.88 ms)",
+        &["C_s", "C_i", "C_c", "C_o"],
+    );
+    t1.row(vec![
+        format!("{:.1}", c.c_s),
+        format!("{:.1}", c.c_i),
+        format!("{:.1}", c.c_c),
+        format!("{:.1}", c.c_o),
+    ]);
+    md += &t1.to_markdown();
+    let mut t2 = Table::new(
+        "Table 2: scene statistics and predicted N_th",
+        &[
+            "scene",
+            "A_avg",
+            "L_avg",
+            "n_or",
+            "N_ot",
+            "grid",
+            "alpha",
+            "p",
+            "N_c",
+            "N_th predicted",
+            "N_th best (sweep)",
+        ],
+    );
+    for s in &r.scenes {
+        let st = &s.stats;
+        t2.row(vec![
+            s.scene.clone(),
+            format!("{:.4}", st.mean_area),
+            format!("{:.3}", st.mean_perimeter),
+            format!("{:.3}", st.n_or),
+            st.polygons.to_string(),
+            format!("{}x{}x{}", st.grid[0], st.grid[1], st.grid[2]),
+            format!("{:.3}", st.alpha),
+            format!("{:.3}", st.p),
+            format!("{:.1}", st.n_c),
+            format!("{:.2}", s.predicted_nth),
+            format!("{}", s.best_nth),
+        ]);
+    }
+    md += "\n";
+    md += &t2.to_markdown();
+    let mut t3 = Table::new(
+        "Table 3: HST sub-schemes at the predicted N_th (per light and shading point)",
+        &[
+            "scene",
+            "sustain",
+            "self-shadow",
+            "shadow volume",
+            "conventional",
+            "total",
+        ],
+    );
+    for s in &r.scenes {
+        let sub = &s.schemes[2].report.subschemes;
+        let total = (sub.sustain + sub.self_shadow + sub.shadow_volume + sub.conventional) as f64;
+        let cell = |n: u64| format!("{n} ({})", pct(n as f64, total));
+        t3.row(vec![
+            s.scene.clone(),
+            cell(sub.sustain),
+            cell(sub.self_shadow),
+            cell(sub.shadow_volume),
+            cell(sub.conventional),
+            format!("{total}"),
+        ]);
+    }
+    md += "\n";
+    md += &t3.to_markdown();
+    let mut t4 = Table::new(
+        "Table 4: preprocessing / shadow testing / other / total (ms)",
+        &[
+            "scene",
+            "scheme",
+            "preprocess",
+            "shadow",
+            "other",
+            "total",
+            "shadow / conventional",
+            "total / conventional",
+        ],
+    );
+    for s in &r.scenes {
+        let conv = &s.schemes[0];
+        for row in &s.schemes {
+            let name = match row.nth {
+                Some(n) => format!("{} (N_th={:.1})", row.scheme, n),
+                None => row.scheme.clone(),
+            };
+            t4.row(vec![
+                s.scene.clone(),
+                name,
+                format!(
+                    "{} ({})",
+                    ms(row.preprocess),
+                    pct(row.preprocess, row.total)
+                ),
+                format!("{} ({})", ms(row.shadow), pct(row.shadow, row.total)),
+                format!("{} ({})", ms(row.other), pct(row.other, row.total)),
+                ms(row.total),
+                format!("{:.2}", row.shadow / conv.shadow),
+                format!("{:.2}", row.total / conv.total),
+            ]);
+        }
+    }
+    md += "\n";
+    md += &t4.to_markdown();
+    let mut summary = Table::new(
+        "Summary: HST against the conventional grid test and the SAH BVH; sameness",
+        &[
+            "scene",
+            "hst/conventional shadow",
+            "hst/conventional total",
+            "hst/bvh shadow",
+            "hst/embree shadow",
+            "shadow at predicted / best N_th",
+            "disagreements volume",
+            "disagreements hst",
+            "shading points",
+        ],
+    );
+    let (mut shadow_sum, mut total_sum) = (0.0, 0.0);
+    for s in &r.scenes {
+        let (conv, vol, hst, bvh) = (&s.schemes[0], &s.schemes[1], &s.schemes[2], &s.schemes[3]);
+        shadow_sum += hst.shadow / conv.shadow;
+        total_sum += hst.total / conv.total;
+        summary.row(vec![
+            s.scene.clone(),
+            format!("{:.2}", hst.shadow / conv.shadow),
+            format!("{:.2}", hst.total / conv.total),
+            format!("{:.2}", hst.shadow / bvh.shadow),
+            s.schemes
+                .get(4)
+                .map_or("-".into(), |e| format!("{:.2}", hst.shadow / e.shadow)),
+            format!("{:.2}", s.predicted_over_best),
+            format!(
+                "{} ({:.1e})",
+                vol.disagreements,
+                vol.disagreements as f64 / vol.shading_points as f64
+            ),
+            format!(
+                "{} ({:.1e})",
+                hst.disagreements,
+                hst.disagreements as f64 / hst.shading_points as f64
+            ),
+            hst.shading_points.to_string(),
+        ]);
+    }
+    let n = r.scenes.len() as f64;
+    summary.row(vec![
+        "mean".into(),
+        format!("{:.2}", shadow_sum / n),
+        format!("{:.2}", total_sum / n),
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+    ]);
+    md += "\n";
+    md += &summary.to_markdown();
+    let mut sweep = Table::new(
+        "Figure 6 data: HST shadow time (ms) against N_th (fig6-SCENE.svg)",
+        &["N_th"],
+    );
+    sweep
+        .columns
+        .extend(r.scenes.iter().map(|s| s.scene.clone()));
+    if let Some(first) = r.scenes.first() {
+        for (i, p) in first.sweep.iter().enumerate() {
+            let mut row = vec![format!("{}", p.nth)];
+            row.extend(r.scenes.iter().map(|s| ms(s.sweep[i].shadow)));
+            sweep.row(row);
+        }
+    }
+    md += "\n";
+    md += &sweep.to_markdown();
+    md
+}

@@ -1,0 +1,304 @@
+//! The paper's cost model (section II, equations 1-12): the cost of a conventional shadow test
+//! against the cost of N_s shadow-polygon tests, the threshold N_th where they meet, the machine
+//! constants measured by micro-benchmarks and the scene statistics p and alpha.
+
+use crate::SplitMix;
+use crate::geom::{Aabb, ConvexPolygon};
+use crate::grid::{Grid, Mailbox};
+use crate::trace::Prepared;
+use glam::Vec3;
+use serde::Serialize;
+use std::hint::black_box;
+
+/// Machine constants in nanoseconds (the paper's table 1 has milliseconds on a SUN 3/75).
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct MachineCosts {
+    /// One ray / shadow-polygon test.
+    pub c_s: f64,
+    /// Starting a shadow ray's 3DDDA.
+    pub c_i: f64,
+    /// One 3DDDA step to the next cell.
+    pub c_c: f64,
+    /// One ray / object-polygon test.
+    pub c_o: f64,
+}
+
+/// The scene statistics of the paper's table 2 and what the model derives from them.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct SceneStats {
+    pub polygons: usize,
+    pub mean_area: f64,
+    pub mean_perimeter: f64,
+    pub grid: [u32; 3],
+    /// Edge of a cube of the cell's volume.
+    pub cell_edge: f64,
+    /// Mean polygons registered per cell (n_or).
+    pub n_or: f64,
+    /// New polygons per cell a ray meets: n_or / 2, the relation all four rows of table 2 obey.
+    pub alpha: f64,
+    /// Chance that a polygon met in a crossed cell blocks the ray.
+    pub p: f64,
+    /// Mean cells a shadow ray crosses (sampled from points on the polygons to every light).
+    pub n_c: f64,
+    /// N_o = alpha N_c (eq. 10).
+    pub n_o: f64,
+    /// C_s measured per registered shadow polygon on this scene (ns), when it has shadow polygons;
+    /// equation 12 uses it in place of the per-test C_s.
+    pub c_s_per_entry: Option<f64>,
+}
+
+/// Equation 11: expected cost of a conventional shadow test.
+pub fn conventional_cost(c: &MachineCosts, s: &SceneStats) -> f64 {
+    let q = 1.0 - s.p;
+    c.c_i + (1.0 - q.powf(s.n_o)) * (c.c_c / (1.0 - q.powf(s.alpha)) + c.c_o / s.p)
+}
+
+/// Equation 12: the N_s where the shadow-volume test (C_s N_s, eq. 1) costs as much, with C_s
+/// per registered shadow polygon when the scene's was measured.
+pub fn predicted_nth(c: &MachineCosts, s: &SceneStats) -> f64 {
+    conventional_cost(c, s) / s.c_s_per_entry.unwrap_or(c.c_s)
+}
+
+/// Scene statistics from the polygons and the grid.
+///
+/// p comes from integral geometry: among random lines that meet a polygon's neighbourhood of
+/// cells (the polygon swept by a cell, K + C), the share that meets the polygon is the ratio of mean
+/// projected areas, (2A/4) / (S(K+C)/4), and for a flat polygon of area A and perimeter L and a cube
+/// cell of edge h the mean surface of K + C is 2A + 6h^2 + (3 pi / 4) L h.
+pub fn scene_stats(prep: &Prepared) -> SceneStats {
+    let live: Vec<&ConvexPolygon> = prep
+        .polygons
+        .iter()
+        .filter(|p| !p.is_degenerate())
+        .collect();
+    let n = live.len().max(1) as f64;
+    let mean_area = live.iter().map(|p| p.area() as f64).sum::<f64>() / n;
+    let mean_perimeter = live.iter().map(|p| p.perimeter() as f64).sum::<f64>() / n;
+    let g = &prep.grid;
+    let cell_edge = (g.cell_size.x as f64 * g.cell_size.y as f64 * g.cell_size.z as f64).cbrt();
+    let n_or = prep.cells.registrations() as f64 / g.cell_count() as f64;
+    let alpha = n_or / 2.0;
+    let (a, l, h) = (mean_area, mean_perimeter, cell_edge);
+    let p =
+        (2.0 * a / (2.0 * a + 6.0 * h * h + 0.75 * std::f64::consts::PI * l * h)).clamp(1e-6, 1.0);
+    let c_s_per_entry = shadow_entry_cost(prep, &live);
+    let n_c = mean_shadow_ray_cells(
+        &live,
+        g,
+        &prep
+            .scene
+            .lights
+            .iter()
+            .map(|l| l.position)
+            .collect::<Vec<_>>(),
+    );
+    SceneStats {
+        polygons: prep.polygons.len(),
+        mean_area,
+        mean_perimeter,
+        grid: g.res,
+        cell_edge,
+        n_or,
+        alpha,
+        p,
+        n_c,
+        n_o: alpha * n_c,
+        c_s_per_entry,
+    }
+}
+
+/// Mean number of cells walked from area-weighted random points on the polygons to each light.
+/// `count` area-weighted random points on the polygons.
+fn surface_points(polygons: &[&ConvexPolygon], count: usize, rng: &mut SplitMix) -> Vec<Vec3> {
+    let mut cumulative = Vec::with_capacity(polygons.len());
+    let mut total = 0.0;
+    for p in polygons {
+        total += p.area() as f64;
+        cumulative.push(total);
+    }
+    (0..count)
+        .map(|_| {
+            let pick = cumulative
+                .partition_point(|&c| c < rng.unit() as f64 * total)
+                .min(polygons.len() - 1);
+            let poly = polygons[pick];
+            // A point inside the convex polygon: random convex weights of its vertices.
+            let w: Vec<f32> = poly.vertices.iter().map(|_| rng.unit() + 1e-3).collect();
+            let ws: f32 = w.iter().sum();
+            poly.vertices
+                .iter()
+                .zip(&w)
+                .map(|(v, w)| *v * (w / ws))
+                .sum::<Vec3>()
+        })
+        .collect()
+}
+
+/// Mean number of cells walked from area-weighted random points on the polygons to each light.
+fn mean_shadow_ray_cells(polygons: &[&ConvexPolygon], grid: &Grid, lights: &[Vec3]) -> f64 {
+    if polygons.is_empty() || lights.is_empty() {
+        return 0.0;
+    }
+    let points = surface_points(polygons, 2000, &mut SplitMix(7));
+    let mut cells = 0u64;
+    for &point in &points {
+        for &light in lights {
+            let to = light - point;
+            let dist = to.length();
+            grid.walk(point, to / dist, 0.0, dist, |_, _, _| {
+                cells += 1;
+                false
+            });
+        }
+    }
+    cells as f64 / (points.len() * lights.len()) as f64
+}
+
+/// C_s as equation 1 uses it, measured on the scene's own shadow polygons: CPU time per shadow
+/// polygon registered in a crossed cell. N_s counts a polygon once per cell it is registered in,
+/// and the bucket (mailbox) tests it only once per segment, so most entries cost a mailbox check
+/// rather than a ray test. Timed on segments between random points on the polygons (None without
+/// shadow polygons).
+fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64> {
+    let volumes = prep.volumes.as_ref()?;
+    let points = surface_points(polygons, 2000, &mut SplitMix(9));
+    let segments: Vec<(Vec3, Vec3, f32, Vec<u32>)> = points
+        .chunks_exact(2)
+        .map(|ab| {
+            let to = ab[1] - ab[0];
+            let dist = to.length().max(1e-6);
+            let mut walked = Vec::new();
+            prep.grid.walk(ab[0], to / dist, 0.0, dist, |c, _, _| {
+                walked.push(c);
+                false
+            });
+            (ab[0], to / dist, dist, walked)
+        })
+        .collect();
+    let entries: u64 = segments
+        .iter()
+        .map(|s| {
+            volumes
+                .registered(&s.3)
+                .iter()
+                .map(|&n| n as u64)
+                .sum::<u64>()
+        })
+        .sum();
+    if entries == 0 {
+        return None;
+    }
+    let mut mailbox = Mailbox::new(volumes.max_per_light());
+    let mut tests = 0;
+    Some(median_ns(entries as usize, || {
+        let mut change = 0;
+        for (o, d, t, walked) in &segments {
+            for l in 0..volumes.lights.len() {
+                change += volumes.crossings(l, walked, *o, *d, 0.0, *t, &mut mailbox, &mut tests);
+            }
+        }
+        black_box(change);
+    }))
+}
+
+/// Measures the machine constants with micro-benchmarks on synthetic polygons and grids; each is
+/// the median of several timed batches.
+pub fn calibrate() -> MachineCosts {
+    let mut rng = SplitMix(1);
+    let mut random_polygon = |sides: usize| {
+        let c = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 4.0 - 2.0;
+        let (u, v) = (
+            Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5).normalize(),
+            Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5),
+        );
+        let v = u.cross(v).normalize();
+        let r = 0.3 + rng.unit();
+        ConvexPolygon::new(
+            (0..sides)
+                .map(|i| {
+                    let a = i as f32 / sides as f32 * std::f32::consts::TAU;
+                    c + (u * a.cos() + v * a.sin()) * r
+                })
+                .collect(),
+        )
+    };
+    // Objects are triangles and quads; shadow polygons are the extruded pentagons.
+    let objects: Vec<ConvexPolygon> = (0..256).map(|i| random_polygon(3 + i % 2)).collect();
+    let shadows: Vec<ConvexPolygon> = (0..256).map(|_| random_polygon(5)).collect();
+    let rays: Vec<(Vec3, Vec3)> = (0..256)
+        .map(|_| {
+            let o = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 6.0 - 3.0;
+            let d = Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5).normalize();
+            (o, d)
+        })
+        .collect();
+    let per_test = |polys: &[ConvexPolygon]| {
+        let mut mailbox = Mailbox::new(polys.len());
+        median_ns(polys.len() * rays.len(), || {
+            let mut hits = 0u32;
+            for &(o, d) in &rays {
+                mailbox.next_ray();
+                for (i, p) in polys.iter().enumerate() {
+                    if mailbox.first_visit(i as u32) {
+                        hits += p.intersect(o, d, 0.0, 10.0).is_some() as u32;
+                    }
+                }
+            }
+            black_box(hits);
+        })
+    };
+    let c_o = per_test(&objects);
+    let c_s = per_test(&shadows);
+    let grid = Grid::with_resolution(
+        Aabb {
+            min: Vec3::splat(-3.0),
+            max: Vec3::splat(3.0),
+        },
+        [48, 48, 48],
+    );
+    let c_i = median_ns(rays.len(), || {
+        for &(o, d) in &rays {
+            grid.walk(o, d, 0.0, 100.0, |c, _, _| black_box(c) != u32::MAX);
+        }
+    });
+    let mut steps = 0usize;
+    grid.walk(
+        Vec3::splat(-2.99),
+        Vec3::ONE.normalize(),
+        0.0,
+        100.0,
+        |_, _, _| {
+            steps += 1;
+            false
+        },
+    );
+    let walk_all = median_ns(rays.len(), || {
+        for _ in 0..rays.len() {
+            grid.walk(
+                Vec3::splat(-2.99),
+                Vec3::ONE.normalize(),
+                0.0,
+                100.0,
+                |c, _, _| black_box(c) == u32::MAX,
+            );
+        }
+    });
+    let c_c = ((walk_all - c_i) / steps.max(1) as f64).max(0.01);
+    MachineCosts { c_s, c_i, c_c, c_o }
+}
+
+/// Median over batches of the time per operation of `f`, which performs `ops` operations.
+/// Timed in this thread's CPU time, so neither other processes nor idle-spinning worker threads
+/// sharing the cores inflate it.
+fn median_ns(ops: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    let mut samples: Vec<f64> = (0..15)
+        .map(|_| {
+            let start = crate::thread_cpu_s();
+            f();
+            (crate::thread_cpu_s() - start) * 1e9 / ops as f64
+        })
+        .collect();
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}

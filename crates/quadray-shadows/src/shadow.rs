@@ -1,0 +1,329 @@
+//! Shadow volumes in the grid and the hybrid switch (HST) of Eo & Kyung's figure 4.
+//!
+//! **Depth count.** For light L, a polygon P's shadow volume is every point X whose open segment
+//! (L, X) crosses P; the depth count D(X) is the number of polygons whose volume holds X, so X is
+//! shadowed exactly when D(X) > 0 (every polygon, transparent or not, blocks a shadow ray, as in the
+//! conventional test). Along a ray D changes only where the ray crosses a volume's side (an edge
+//! extruded away from L) or a polygon itself. Sides of one edge from its polygons add up: a polygon
+//! on the positive side of the extruded plane contributes +1, one on the negative side -1, so the
+//! weight of an extruded edge is 0 between two polygons that face L alike and +-2 between two that
+//! face it differently, +-1 on a boundary edge: the non-zero ones are exactly Bergeron's silhouette
+//! edges. A ray crossing a shadow polygon along its normal changes D by its weight, against it by
+//! minus its weight. Ray segments end at every polygon they meet (every hit is a reflection point),
+//! so a polygon is only crossed where a ray is refracted through it: D then grows by one going from
+//! L's side to the far side and drops by one coming back ([`LightState::transmit`]).
+//!
+//! **HST.** The four-way switch of the paper's pseudo code, per light and reflection point, with the
+//! shadow condition SC and the shadow depth flag SDF carried along the ray. The paper leaves open
+//! what a refraction does to them; here a ray refracted through a surface whose far side faces the
+//! light starts with an unknown condition (it may have left the shadow), which the next reflection
+//! point resolves with a conventional test instead of sustaining it.
+
+use crate::geom::{Aabb, ConvexPolygon};
+use crate::grid::{CellLists, Grid, Mailbox};
+use crate::scene::{Face, Scene};
+use crate::trace::MAX_LIGHTS;
+use glam::Vec3;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// The shadow polygons of one light, registered in the grid.
+pub struct LightVolumes {
+    pub polygons: Vec<ConvexPolygon>,
+    /// Signed weight of each shadow polygon (its change of depth count along its normal).
+    pub weights: Vec<i8>,
+    pub cells: CellLists,
+    /// D at the eye.
+    pub eye_depth: i32,
+}
+
+/// Shadow polygons for every light.
+pub struct ShadowVolumes {
+    pub lights: Vec<LightVolumes>,
+    /// Shadow polygons registered per cell and light, cell-major (saturating), so N_s of every
+    /// light is one pass over a segment's cells.
+    counts: Vec<u16>,
+}
+
+impl ShadowVolumes {
+    /// Finds the silhouette edges of every light, extrudes them to beyond the grid's box,
+    /// registers them in the grid and counts the eye's depth.
+    pub fn build(scene: &Scene, polygons: &[ConvexPolygon], grid: &Grid) -> Self {
+        let (vertices, eye) = (&scene.vertices, scene.camera.eye);
+        let edges = edge_map(polygons, &scene.faces);
+        let lights = scene
+            .lights
+            .iter()
+            .map(|l| {
+                let light = l.position;
+                let (polys, weights) =
+                    silhouette_polygons(polygons, vertices, &edges, light, &grid.bounds);
+                let cells = grid.register(polys.par_iter().map(|p| p.vertices.as_slice()));
+                LightVolumes {
+                    eye_depth: depth_at(polygons, light, eye),
+                    polygons: polys,
+                    weights,
+                    cells,
+                }
+            })
+            .collect::<Vec<LightVolumes>>();
+        let mut counts = vec![0u16; grid.cell_count() * lights.len()];
+        for (l, lv) in lights.iter().enumerate() {
+            for c in 0..grid.cell_count() {
+                counts[c * lights.len() + l] = lv.cells.count(c as u32).min(u16::MAX as u32) as u16;
+            }
+        }
+        Self { lights, counts }
+    }
+
+    pub fn polygon_count(&self) -> usize {
+        self.lights.iter().map(|l| l.polygons.len()).sum()
+    }
+
+    pub fn max_per_light(&self) -> usize {
+        self.lights
+            .iter()
+            .map(|l| l.polygons.len())
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// N_s of every light: shadow polygons registered in the cells a segment crossed (with
+    /// repeats).
+    #[inline]
+    pub fn registered(&self, walked: &[u32]) -> [u32; MAX_LIGHTS] {
+        let n = self.lights.len();
+        let mut ns = [0u32; MAX_LIGHTS];
+        for &c in walked {
+            let row = &self.counts[c as usize * n..c as usize * n + n];
+            for (acc, &k) in ns.iter_mut().zip(row) {
+                *acc += k as u32;
+            }
+        }
+        ns
+    }
+
+    /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells are
+    /// `walked`; `tests` counts the ray/shadow-polygon tests.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn crossings(
+        &self,
+        light: usize,
+        walked: &[u32],
+        o: Vec3,
+        d: Vec3,
+        t0: f32,
+        t1: f32,
+        mailbox: &mut Mailbox,
+        tests: &mut u64,
+    ) -> i32 {
+        let lv = &self.lights[light];
+        mailbox.next_ray();
+        let mut change = 0;
+        for &c in walked {
+            for &id in lv.cells.cell(c) {
+                if mailbox.first_visit(id) {
+                    *tests += 1;
+                    let p = &lv.polygons[id as usize];
+                    if p.intersect(o, d, t0, t1).is_some() {
+                        let w = lv.weights[id as usize] as i32;
+                        change += if p.normal.dot(d) > 0.0 { w } else { -w };
+                    }
+                }
+            }
+        }
+        change
+    }
+}
+
+type EdgeMap = HashMap<(u32, u32), Vec<u32>>;
+
+/// Faces around each edge (by shared vertex indices), degenerate faces left out.
+fn edge_map(polygons: &[ConvexPolygon], faces: &[Face]) -> EdgeMap {
+    let mut edges: EdgeMap = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        if polygons[f].is_degenerate() {
+            continue;
+        }
+        let v = &face.vertices;
+        for i in 0..v.len() {
+            let (a, b) = (v[i], v[(i + 1) % v.len()]);
+            edges
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(f as u32);
+        }
+    }
+    edges
+}
+
+/// Shadow polygons of one light: each silhouette edge extruded away from the light to beyond `bounds`.
+fn silhouette_polygons(
+    polygons: &[ConvexPolygon],
+    vertices: &[Vec3],
+    edges: &EdgeMap,
+    light: Vec3,
+    bounds: &Aabb,
+) -> (Vec<ConvexPolygon>, Vec<i8>) {
+    let corners = (0..8).map(|i| {
+        Vec3::new(
+            if i & 1 == 0 {
+                bounds.min.x
+            } else {
+                bounds.max.x
+            },
+            if i & 2 == 0 {
+                bounds.min.y
+            } else {
+                bounds.max.y
+            },
+            if i & 4 == 0 {
+                bounds.min.z
+            } else {
+                bounds.max.z
+            },
+        )
+    });
+    // Far points at 4x the farthest corner: chords between them (at most 90 degrees apart) stay
+    // outside the box.
+    let reach = 4.0 * corners.map(|c| (c - light).length()).fold(0.0, f32::max);
+    let far = |v: Vec3| light + (v - light) * (reach / (v - light).length());
+    let mut keys: Vec<&(u32, u32)> = edges.keys().collect();
+    keys.sort_unstable();
+    let mut out = (Vec::new(), Vec::new());
+    for key in keys {
+        let faces = &edges[key];
+        let (a, b) = (vertices[key.0 as usize], vertices[key.1 as usize]);
+        if (a - light).length() < 1e-6 || (b - light).length() < 1e-6 {
+            continue;
+        }
+        let (fa, fb) = (far(a), far(b));
+        let fm = far((a + b) * 0.5);
+        let quad = ConvexPolygon::new(vec![a, b, fb, fm, fa]);
+        if quad.is_degenerate() {
+            continue;
+        }
+        let weight: i32 = faces
+            .iter()
+            .map(|&f| {
+                let poly = &polygons[f as usize];
+                // A polygon seen edge-on from the light has an empty shadow volume; rounding must
+                // not give it a side.
+                let to_light = light - poly.vertices[0];
+                if poly.normal.dot(to_light).abs() <= 1e-5 * to_light.length() {
+                    return 0;
+                }
+                let side = quad.normal.dot(poly.centroid() - a);
+                if side > 0.0 {
+                    1
+                } else if side < 0.0 {
+                    -1
+                } else {
+                    0
+                }
+            })
+            .sum();
+        if weight != 0 {
+            out.0.push(quad);
+            out.1.push(weight.clamp(-127, 127) as i8);
+        }
+    }
+    out
+}
+
+/// D at `p` for `light`: the polygons the open segment (light, p) crosses.
+pub fn depth_at(polygons: &[ConvexPolygon], light: Vec3, p: Vec3) -> i32 {
+    polygons
+        .iter()
+        .filter(|poly| poly.intersect(light, p - light, 0.0, 1.0).is_some())
+        .count() as i32
+}
+
+/// The paper's sub-schemes (table 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Subscheme {
+    Sustain,
+    SelfShadow,
+    ShadowVolume,
+    Conventional,
+}
+
+/// What a ray carries for one light: the shadow condition SC of where it starts (None: unknown),
+/// the shadow depth flag SDF, and the depth count DC (meaningful when SDF is set).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightState {
+    pub sc: Option<bool>,
+    pub sdf: bool,
+    pub dc: i32,
+}
+
+impl LightState {
+    /// The eye's state: its depth count is known.
+    pub fn at_eye(depth: i32) -> Self {
+        Self {
+            sc: Some(depth > 0),
+            sdf: true,
+            dc: depth,
+        }
+    }
+
+    /// The pure shadow-volume scheme: D is carried exactly along every segment.
+    pub fn volume_step(&mut self, crossings: i32, self_shadow: bool) -> bool {
+        self.dc += crossings;
+        self.sc = Some(self.dc > 0);
+        self.sdf = true;
+        self_shadow || self.dc > 0
+    }
+
+    /// One step of the paper's pseudo code at a reflection point. `ns` is N_s of the incoming
+    /// segment, `crossings` its change of D (only evaluated in the shadow-volume mode), and
+    /// `conventional` a shadow ray. Returns the shadow condition and the sub-scheme used.
+    pub fn hst_step(
+        &mut self,
+        ns: u32,
+        nth: f32,
+        self_shadow: bool,
+        crossings: impl FnOnce() -> i32,
+        conventional: impl FnOnce() -> bool,
+    ) -> (bool, Subscheme) {
+        match self.sc {
+            Some(sc) if ns == 0 => (sc, Subscheme::Sustain),
+            _ if self_shadow => {
+                self.sc = Some(true);
+                self.sdf = false;
+                (true, Subscheme::SelfShadow)
+            }
+            Some(sc) if (ns as f32) <= nth && (!sc || self.sdf) => {
+                // Lit means D = 0, so a lit start is a valid count too.
+                let start = if self.sdf { self.dc } else { 0 };
+                self.dc = start + crossings();
+                self.sc = Some(self.dc > 0);
+                self.sdf = true;
+                (self.dc > 0, Subscheme::ShadowVolume)
+            }
+            _ => {
+                let shadowed = conventional();
+                self.sc = Some(shadowed);
+                self.sdf = false;
+                self.dc = 0;
+                (shadowed, Subscheme::Conventional)
+            }
+        }
+    }
+
+    /// The state of a ray refracted through the surface: `towards_far_side` when it leaves the
+    /// light's side of the polygon (D + 1), false when it comes back to it (D - 1).
+    pub fn transmit(&mut self, towards_far_side: bool) {
+        let delta = if towards_far_side { 1 } else { -1 };
+        let known = self.sdf || self.sc == Some(false);
+        if known {
+            self.dc = if self.sdf { self.dc } else { 0 } + delta;
+            self.sc = Some(self.dc > 0);
+            self.sdf = true;
+        } else if !(towards_far_side && self.sc == Some(true)) {
+            self.sc = None;
+        }
+    }
+}

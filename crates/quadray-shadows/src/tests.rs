@@ -1,0 +1,469 @@
+//! Tests against ground truth: brute force over all polygons for the grid and the BVH, the
+//! depth count against counting the polygons between a point and the light, and every scheme's
+//! shadow condition against the conventional test at every shading point.
+
+use crate::cost::{self, MachineCosts};
+use crate::geom::ConvexPolygon;
+use crate::grid::Mailbox;
+use crate::scene::{BUILTINS, Face, Scene};
+use crate::shadow::{LightState, ShadowVolumes, depth_at};
+use crate::trace::{Prepared, Scheme};
+use crate::{Nth, RunOptions, SchemeChoice, SplitMix, run};
+use glam::Vec3;
+use std::path::Path;
+
+fn brute_closest(polys: &[ConvexPolygon], o: Vec3, d: Vec3, t_min: f32) -> Option<(f32, u32)> {
+    polys
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            p.intersect(o, d, t_min, f32::INFINITY)
+                .map(|t| (t, i as u32))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// A builtin scene plus degenerate polygons (collinear, repeated vertices) sharing its vertices.
+fn scene_with_degenerates(name: &str) -> Scene {
+    let mut s = Scene::builtin(name).unwrap();
+    let n = s.vertices.len() as u32;
+    let (a, b) = (s.vertices[0], s.vertices[1]);
+    s.vertices.push(a + (b - a) * 0.5);
+    s.faces.push(Face {
+        vertices: vec![0, n, 1],
+        material: 0,
+    });
+    s.faces.push(Face {
+        vertices: vec![2, 2, 2],
+        material: 0,
+    });
+    s
+}
+
+/// Random rays, and rays lying on cell boundary planes along the grid axes.
+fn test_rays(prep: &Prepared, count: usize) -> Vec<(Vec3, Vec3)> {
+    let mut rng = SplitMix(11);
+    let b = prep.grid.bounds;
+    let point =
+        |rng: &mut SplitMix| b.min + b.extent() * Vec3::new(rng.unit(), rng.unit(), rng.unit());
+    let mut rays = Vec::new();
+    for i in 0..count {
+        let o = point(&mut rng);
+        if i % 2 == 0 {
+            let d = Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5).normalize();
+            rays.push((o, d));
+        } else {
+            // Snap two coordinates onto cell boundaries, walk along the third axis.
+            let axis = i % 3;
+            let mut o = o;
+            for a in (0..3).filter(|&a| a != axis) {
+                let k = ((o[a] - b.min[a]) / prep.grid.cell_size[a]).round();
+                o[a] = b.min[a] + k * prep.grid.cell_size[a];
+            }
+            let mut d = Vec3::ZERO;
+            d[axis] = if i % 4 == 1 { 1.0 } else { -1.0 };
+            rays.push((o, d));
+        }
+    }
+    rays
+}
+
+#[test]
+fn builtin_scenes_have_the_papers_polygon_and_light_counts() {
+    for (name, polygons, lights) in BUILTINS {
+        let s = Scene::builtin(name).unwrap();
+        assert_eq!(
+            (s.faces.len(), s.lights.len()),
+            (polygons, lights),
+            "{name}"
+        );
+        for (i, p) in s.polygons().iter().enumerate() {
+            assert!(!p.is_degenerate(), "{name}: face {i} degenerate");
+            let size = p.bounds().extent().max_element();
+            for v in &p.vertices {
+                assert!(
+                    (p.normal.dot(*v) - p.offset).abs() < 1e-4 * size,
+                    "{name}: face {i} not planar"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn grid_closest_hit_equals_brute_force() {
+    for name in ["stars", "desk", "kaist"] {
+        let prep = Prepared::new(scene_with_degenerates(name), Scheme::Conventional);
+        let mut mailbox = Mailbox::new(prep.polygons.len());
+        let mut walked = Vec::new();
+        for (o, d) in test_rays(&prep, 4000) {
+            let grid = prep.grid.closest_hit(
+                &prep.cells,
+                &prep.polygons,
+                o,
+                d,
+                0.0,
+                f32::INFINITY,
+                None,
+                &mut mailbox,
+                &mut walked,
+            );
+            let brute = brute_closest(&prep.polygons, o, d, 0.0);
+            match (grid, brute) {
+                (None, None) => {}
+                (Some(g), Some((t, id))) => assert!(
+                    g.polygon == id || (g.t - t).abs() <= 1e-5 * t.max(1.0),
+                    "{name}: {g:?} vs {t} {id} for {o} {d}"
+                ),
+                _ => panic!("{name}: grid {grid:?} vs brute force {brute:?} for ray {o} {d}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn bvh_and_grid_occlusion_equal_brute_force() {
+    let prep = Prepared::new(scene_with_degenerates("kaist"), Scheme::Bvh);
+    let bvh = prep.bvh.as_ref().unwrap();
+    let mut mailbox = Mailbox::new(prep.polygons.len());
+    for (o, d) in test_rays(&prep, 3000) {
+        let t_max = 3.0;
+        let brute = prep
+            .polygons
+            .iter()
+            .any(|p| p.intersect(o, d, 0.0, t_max).is_some());
+        assert_eq!(
+            bvh.occluded(&prep.polygons, o, d, 0.0, t_max, None),
+            brute,
+            "bvh {o} {d}"
+        );
+        assert_eq!(
+            prep.grid.occluded(
+                &prep.cells,
+                &prep.polygons,
+                o,
+                d,
+                0.0,
+                t_max,
+                None,
+                &mut mailbox
+            ),
+            brute,
+            "grid {o} {d}"
+        );
+    }
+}
+
+/// D at `p`, unless nudging `p` by a ten-thousandth of the scene changes it.
+fn stable_depth(prep: &Prepared, light: Vec3, p: Vec3) -> Option<i32> {
+    let nudge = prep.grid.bounds.extent().length() * 1e-4;
+    let d = depth_at(&prep.polygons, light, p);
+    let same = (0..3).all(|a| {
+        let mut e = Vec3::ZERO;
+        e[a] = nudge;
+        depth_at(&prep.polygons, light, p + e) == d && depth_at(&prep.polygons, light, p - e) == d
+    });
+    same.then_some(d)
+}
+
+/// D(end) = D(start) + the signed shadow-polygon crossings between, on segments that meet no
+/// object polygon, for every light (including the desk lamp's light inside the grid), random and
+/// along cell boundaries, with degenerate polygons in the scene.
+#[test]
+fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
+    // The desk again with its lamp's light on the lamp's axis: inside the stem and exactly in the
+    // planes of the flare's faces (edge-on polygons).
+    let mut on_axis = scene_with_degenerates("desk");
+    on_axis.lights[0].position = Vec3::new(-1.5, 2.25, -0.3);
+    on_axis.name = "desk, light on the lamp's axis".into();
+    let scenes = [
+        on_axis,
+        scene_with_degenerates("desk"),
+        scene_with_degenerates("stars"),
+        scene_with_degenerates("kaist"),
+    ];
+    for scene in scenes {
+        let name = scene.name.clone();
+        let prep = Prepared::new(scene, Scheme::Volume);
+        let volumes = prep.volumes.as_ref().unwrap();
+        let mut objects = Mailbox::new(prep.polygons.len());
+        let mut shadows = Mailbox::new(volumes.max_per_light());
+        let (mut walked, mut tests, mut checked) = (Vec::new(), 0, 0);
+        for (o, d) in test_rays(&prep, 1500) {
+            walked.clear();
+            let t1 = prep
+                .grid
+                .closest_hit(
+                    &prep.cells,
+                    &prep.polygons,
+                    o,
+                    d,
+                    0.0,
+                    2.0,
+                    None,
+                    &mut objects,
+                    &mut walked,
+                )
+                .map_or(2.0, |h| h.t * 0.5);
+            let end = o + d * t1;
+            if !prep.grid.bounds.grow(end).eq(&prep.grid.bounds) {
+                continue;
+            }
+            for (l, light) in prep.scene.lights.iter().enumerate() {
+                // Points within rounding of a polygon have no well-defined count: skip them.
+                let (Some(d0), Some(d1)) = (
+                    stable_depth(&prep, light.position, o),
+                    stable_depth(&prep, light.position, end),
+                ) else {
+                    continue;
+                };
+                let change = volumes.crossings(l, &walked, o, d, 0.0, t1, &mut shadows, &mut tests);
+                assert_eq!(
+                    d0 + change,
+                    d1,
+                    "{name}: light {l}, segment {o} -> {end}, d0 {d0} change {change}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 1000, "{name}: only {checked} segments checked");
+    }
+}
+
+fn options(scheme: SchemeChoice, nth: Nth) -> RunOptions {
+    RunOptions {
+        scheme,
+        nth,
+        width: 96,
+        height: 72,
+        spp: 1,
+        depth: 4,
+        check: true,
+        costs: Some(MachineCosts {
+            c_s: 5.0,
+            c_i: 20.0,
+            c_c: 3.0,
+            c_o: 5.0,
+        }),
+    }
+}
+
+/// The issue's bar, at most 1e-4 of the shading points, rounded up to whole points on these small
+/// test images (grazing light can still flip a rare point in the pure shadow-volume mode).
+fn assert_same_as_conventional(scene: &Scene, what: &str) {
+    for (scheme, nth) in [
+        (SchemeChoice::Volume, Nth::Auto),
+        (SchemeChoice::Hst, Nth::Auto),
+        (SchemeChoice::Hst, Nth::Fixed(0.0)),
+        (SchemeChoice::Hst, Nth::Fixed(1e9)),
+        (SchemeChoice::Bvh, Nth::Auto),
+    ] {
+        let (_, r) = run(scene.clone(), &options(scheme, nth), &|| {});
+        let bad = r.disagreements.unwrap();
+        assert!(
+            r.shading_points > 1000,
+            "{what}: {} shading points",
+            r.shading_points
+        );
+        assert!(
+            bad as f64 <= (1e-4 * r.shading_points as f64).ceil(),
+            "{what} {scheme:?} {nth:?}: {bad} of {} shading points disagree",
+            r.shading_points
+        );
+    }
+}
+
+#[test]
+fn volume_hst_and_bvh_decide_like_the_conventional_test_on_every_builtin() {
+    for (name, ..) in BUILTINS {
+        assert_same_as_conventional(&Scene::builtin(name).unwrap(), name);
+    }
+}
+
+const GLASS_BOX: &str = r#"
+name = "glass box"
+[camera]
+eye = [0.3, 1.2, 4.0]
+look_at = [0.0, 0.8, 0.0]
+fov_y_deg = 50
+[[lights]]
+position = [0.41, 3.03, -0.29]
+intensity = [1, 1, 1]
+[[lights]]
+position = [0.1, 0.9, 0.2]
+intensity = [0.5, 0.5, 0.5]
+[materials.glass]
+diffuse = [0.1, 0.1, 0.1]
+transmit = 0.9
+reflect = 0.1
+ior = 1.3
+[materials.floor]
+diffuse = [0.8, 0.8, 0.8]
+[[objects]]
+material = "glass"
+box = { min = [-0.5, 0.6, -0.6], max = [0.6, 1.4, 0.5] }
+[[objects]]
+material = "glass"
+box = { min = [-1.4, 0.2, -0.77], max = [-0.9, 0.5, 0.9] }
+[[objects]]
+material = "floor"
+polygons = [
+  [[-3, 0, -3], [-3, 0, 3], [3, 0, 3], [3, 0, -3]],
+  [[-3, 0, -3], [3, 0, -3], [3, 3, -3], [-3, 3, -3]],
+  [[1, 0.5, 0], [1.5, 0.5, 0], [2, 0.5, 0]],
+]
+"#;
+
+/// Rays refracted through a transparent box, the second light inside the grid (under the box),
+/// a degenerate polygon: a depth count that ignores what refraction crosses disagrees here.
+#[test]
+fn refraction_through_glass_and_a_light_inside_the_grid_keep_the_depth_count() {
+    let scene = Scene::parse(GLASS_BOX, Path::new("glass-box.toml")).unwrap();
+    assert_same_as_conventional(&scene, "glass box");
+}
+
+#[test]
+fn transmission_updates_the_carried_state() {
+    let mut s = LightState::at_eye(0);
+    s.transmit(true);
+    assert_eq!((s.sc, s.sdf, s.dc), (Some(true), true, 1));
+    s.transmit(false);
+    assert_eq!((s.sc, s.dc), (Some(false), 0));
+    // Shadowed with an unknown count: coming back to the light's side leaves it unknown.
+    let mut u = LightState {
+        sc: Some(true),
+        sdf: false,
+        dc: 0,
+    };
+    u.transmit(true);
+    assert_eq!(u.sc, Some(true));
+    u.transmit(false);
+    assert_eq!(u.sc, None);
+    // An unknown condition is never sustained: the next point takes a shadow ray.
+    let (shadowed, sub) = u.hst_step(0, 10.0, false, || unreachable!(), || false);
+    assert_eq!(
+        (shadowed, sub),
+        (false, crate::shadow::Subscheme::Conventional)
+    );
+}
+
+#[test]
+fn renders_are_deterministic_and_not_empty() {
+    let opts = RunOptions {
+        check: false,
+        ..options(SchemeChoice::Hst, Nth::Fixed(8.0))
+    };
+    let (a, r) = run(Scene::builtin("stars").unwrap(), &opts, &|| {});
+    let (b, _) = run(Scene::builtin("stars").unwrap(), &opts, &|| {});
+    assert_eq!(a, b);
+    assert!(
+        a.pixels
+            .iter()
+            .collect::<std::collections::HashSet<_>>()
+            .len()
+            > 50
+    );
+    let s = &r.subschemes;
+    assert_eq!(
+        s.sustain + s.self_shadow + s.shadow_volume + s.conventional,
+        r.shadow_decisions
+    );
+}
+
+#[test]
+fn cost_model_limits() {
+    let c = MachineCosts {
+        c_s: 2.00,
+        c_i: 2.54,
+        c_c: 0.23,
+        c_o: 1.88,
+    };
+    let prep = Prepared::new(Scene::builtin("stars").unwrap(), Scheme::Conventional);
+    let mut s = cost::scene_stats(&prep);
+    assert!(s.p > 0.0 && s.p < 1.0 && s.alpha > 0.0 && s.n_c >= 1.0);
+    s.n_o = 0.0;
+    assert!((cost::conventional_cost(&c, &s) - c.c_i).abs() < 1e-9);
+    // The paper's Glasses row (table 2): p 0.276, alpha 0.115 with its table-1 constants gives
+    // N_th 7.04 when a shadow ray meets N_o = 6.55 new polygons.
+    (s.p, s.alpha, s.n_o) = (0.276, 0.115, 6.55);
+    assert!((cost::predicted_nth(&c, &s) - 7.04).abs() < 0.02);
+    s.n_o = 1e6;
+    let limit = c.c_i + c.c_c / (1.0 - (1.0_f64 - 0.276).powf(0.115)) + c.c_o / 0.276;
+    assert!((cost::conventional_cost(&c, &s) - limit).abs() < 1e-6);
+}
+
+#[test]
+fn calibration_measures_positive_constants() {
+    let c = cost::calibrate();
+    assert!(
+        c.c_s > 0.0 && c.c_i > 0.0 && c.c_c > 0.0 && c.c_o > 0.0,
+        "{c:?}"
+    );
+}
+
+#[test]
+fn shadow_polygons_are_silhouettes_only() {
+    // A closed box under one light: only edges between lit and unlit faces are extruded.
+    let s = Scene::parse(GLASS_BOX, Path::new("glass-box.toml")).unwrap();
+    let prep = Prepared::new(s, Scheme::Volume);
+    let v: &ShadowVolumes = prep.volumes.as_ref().unwrap();
+    // Light 0 is above the boxes: each box shows 1 or 2 side faces plus its top: 4-6 silhouette
+    // edges each, weight 2; the floor and wall quads add their open boundary edges, weight 1.
+    let w = &v.lights[0].weights;
+    let doubles = w.iter().filter(|&&x| x.abs() == 2).count();
+    assert!(
+        (8..=12).contains(&doubles),
+        "{doubles} silhouette edges of weight 2"
+    );
+    assert!(w.iter().all(|&x| x.abs() == 1 || x.abs() == 2));
+}
+
+#[test]
+fn malformed_scene_files_are_clear_errors() {
+    let cases = [
+        ("not toml", "expected"),
+        (
+            &GLASS_BOX.replace("fov_y_deg = 50", "fov_y_deg = 500"),
+            "fov_y_deg",
+        ),
+        (
+            &GLASS_BOX.replace("material = \"floor\"", "material = \"wood\""),
+            "unknown material",
+        ),
+        (
+            &GLASS_BOX.replace(
+                "[1, 0.5, 0], [1.5, 0.5, 0], [2, 0.5, 0]",
+                "[0, 0, 0], [1, 0, 0], [1, 1, 0.5], [0, 1, 0]",
+            ),
+            "not planar",
+        ),
+        (
+            &GLASS_BOX.replace(
+                "[1, 0.5, 0], [1.5, 0.5, 0], [2, 0.5, 0]",
+                "[0, 0, 0], [2, 0, 0], [1, 0.2, 0], [1, 2, 0]",
+            ),
+            "not convex",
+        ),
+        (
+            &GLASS_BOX.replace(
+                "[1, 0.5, 0], [1.5, 0.5, 0], [2, 0.5, 0]",
+                "[0, 0, 0], [1, 0, 0]",
+            ),
+            "at least 3",
+        ),
+        (
+            &GLASS_BOX.replace(
+                "position = [0.41, 3.03, -0.29]",
+                "position = [nan, 3.0, -0.3]",
+            ),
+            "not finite",
+        ),
+    ];
+    for (text, why) in cases {
+        let e = Scene::parse(text, Path::new("bad.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("bad.toml: ") && e.contains(why), "{e}");
+    }
+    assert!(Scene::load(Path::new("/nonexistent/scene.toml")).is_err());
+}
