@@ -1,0 +1,399 @@
+//! The GPU side. Raster passes (`raster.wgsl`): the RSM from the spot and the camera's G-buffer.
+//! Compute passes (`cluster.wgsl`): pack the RSM into the quadtree, reduce it level by level, mark
+//! valid clusters, compact the cut. Shading (`shade.wgsl`, and the baselines' `baselines.wgsl`):
+//! indirect from the cut or the per-level passes, sub-sampled with upsampling, direct light.
+
+mod resources;
+
+use crate::IndirectError;
+use crate::baselines;
+use crate::scene::Scene;
+use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
+use resources::{Buffers, Pipelines, Targets};
+use serde::Serialize;
+
+/// How the indirect term is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Light quadtree, cut compacted once per light update and looped over per pixel.
+    Quadtree,
+    /// Light quadtree, the paper's one pass per level.
+    QuadtreePasses,
+    /// RSM sampling with N Poisson-disk samples (baseline).
+    Rsm,
+    /// Every VPL (brute force on the GPU).
+    Reference,
+}
+
+impl Method {
+    pub fn uses_quadtree(self) -> bool {
+        matches!(self, Method::Quadtree | Method::QuadtreePasses)
+    }
+}
+
+/// Which clusters count as valid (see the spec).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Validity {
+    /// The paper's: the 4 children against their mean.
+    Local,
+    /// Also every child valid.
+    Recursive,
+}
+
+/// The light quadtree's parameters. Levels are mip levels: 0 is the RSM itself (one VPL per
+/// node), each level halves the side.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ClusterSettings {
+    pub start_level: u32,
+    pub limit_level: u32,
+    pub depth_threshold: f32,
+    pub normal_threshold: f32,
+    pub validity: Validity,
+    /// Means weighted by flux luminance (else by texel count).
+    pub flux_weighted: bool,
+}
+
+impl ClusterSettings {
+    /// The paper's defaults for a given RSM: start at 8x8, limit at 32x32, depth 0.05, normal 0.9.
+    pub fn paper(rsm_size: u32) -> Self {
+        let top = rsm_size.ilog2();
+        Self {
+            start_level: top.saturating_sub(3),
+            limit_level: top.saturating_sub(5),
+            depth_threshold: 0.05,
+            normal_threshold: 0.9,
+            validity: Validity::Local,
+            flux_weighted: true,
+        }
+    }
+
+    /// Every cluster a single VPL: the cut is the whole RSM.
+    pub fn every_vpl(rsm_size: u32) -> Self {
+        Self {
+            limit_level: 0,
+            depth_threshold: 0.0,
+            ..Self::paper(rsm_size)
+        }
+    }
+}
+
+/// Sizes and the parameters of every method.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Settings {
+    pub width: u32,
+    pub height: u32,
+    pub rsm_size: u32,
+    pub cluster: ClusterSettings,
+    /// RSM-sampling samples per pixel.
+    pub samples: u32,
+    /// Sampling radius as a fraction of the RSM's diagonal.
+    pub rsm_radius: f32,
+    /// Indirect at one sample per `subsample`^2 pixels (1: full resolution).
+    pub subsample: u32,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+            rsm_size: 512,
+            cluster: ClusterSettings::paper(512),
+            samples: 256,
+            rsm_radius: 1.0,
+            subsample: 1,
+        }
+    }
+}
+
+impl Settings {
+    /// Refuses sizes and parameters that would make no picture or an absurd amount of work.
+    pub fn validate(&self) -> Result<(), String> {
+        let s = self;
+        if !(1..=8192).contains(&s.width) || !(1..=8192).contains(&s.height) {
+            return Err(format!("size {}x{} is outside 1..8192", s.width, s.height));
+        }
+        if !s.rsm_size.is_power_of_two() || !(4..=2048).contains(&s.rsm_size) {
+            return Err(format!(
+                "RSM size {} must be a power of two in 4..2048",
+                s.rsm_size
+            ));
+        }
+        let top = s.rsm_size.ilog2();
+        let c = &s.cluster;
+        if c.start_level > top || c.limit_level > c.start_level {
+            return Err(format!(
+                "levels must satisfy limit ({}) <= start ({}) <= {top} (the 1x1 level of a {} RSM)",
+                c.limit_level, c.start_level, s.rsm_size
+            ));
+        }
+        if !(c.depth_threshold.is_finite() && c.depth_threshold >= 0.0) {
+            return Err(format!(
+                "depth threshold {} must be >= 0",
+                c.depth_threshold
+            ));
+        }
+        if !(c.normal_threshold.is_finite() && (-1.0..=1.0).contains(&c.normal_threshold)) {
+            return Err(format!(
+                "normal threshold {} is outside [-1, 1]",
+                c.normal_threshold
+            ));
+        }
+        if !(1..=65536).contains(&s.samples) {
+            return Err(format!("{} samples is outside 1..65536", s.samples));
+        }
+        if !(s.rsm_radius.is_finite() && s.rsm_radius > 0.0 && s.rsm_radius <= 1.0) {
+            return Err(format!("RSM radius {} is outside (0, 1]", s.rsm_radius));
+        }
+        if !(1..=64).contains(&s.subsample) {
+            return Err(format!("subsample {} is outside 1..64", s.subsample));
+        }
+        Ok(())
+    }
+}
+
+/// The timed passes, in `GpuTimer` order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Pass {
+    Rsm,
+    Pyramid,
+    Validity,
+    Cut,
+    GBuffer,
+    Indirect,
+    Upsample,
+    Direct,
+}
+
+impl Pass {
+    pub const ALL: [Pass; 8] = [
+        Pass::Rsm,
+        Pass::Pyramid,
+        Pass::Validity,
+        Pass::Cut,
+        Pass::GBuffer,
+        Pass::Indirect,
+        Pass::Upsample,
+        Pass::Direct,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass::Rsm => "rsm",
+            Pass::Pyramid => "pyramid",
+            Pass::Validity => "validity",
+            Pass::Cut => "cut",
+            Pass::GBuffer => "gbuffer",
+            Pass::Indirect => "indirect",
+            Pass::Upsample => "upsample",
+            Pass::Direct => "direct",
+        }
+    }
+}
+
+/// One frame read back: linear radiance per pixel, row-major, top row first.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub indirect: Vec<[f32; 3]>,
+    pub direct: Vec<[f32; 3]>,
+    /// Pixels the upsampler recomputed at full resolution.
+    pub recomputed: u32,
+}
+
+/// A VPL as the RSM stores it (the CPU reference's input).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vpl {
+    pub flux: [f32; 3],
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+}
+
+/// A G-buffer texel (the CPU reference's receivers); `None` where the camera sees nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Receiver {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub albedo: [f32; 3],
+}
+
+/// Everything one scene needs on the GPU at one set of sizes.
+pub struct Renderer<'g> {
+    gpu: &'g Gpu,
+    settings: Settings,
+    pipelines: Pipelines,
+    targets: Targets,
+    buffers: Buffers,
+    vertex_count: u32,
+    /// A timer for all passes; `None` when the adapter has no timestamp queries.
+    timer: GpuTimer,
+}
+
+impl<'g> Renderer<'g> {
+    pub fn new(gpu: &'g Gpu, scene: &Scene, settings: Settings) -> Result<Self, IndirectError> {
+        settings.validate().map_err(IndirectError::Settings)?;
+        let pipelines = gpu.checked(|| Pipelines::new(gpu))?;
+        let targets = gpu.checked(|| Targets::new(gpu, &settings))?;
+        let samples = baselines::rsm_samples(
+            settings.samples,
+            settings.rsm_radius * settings.rsm_size as f32 * std::f32::consts::SQRT_2,
+            0x5eed,
+        );
+        let buffers =
+            gpu.checked(|| Buffers::new(gpu, scene, &settings, &samples, &pipelines, &targets))?;
+        let mut renderer = Self {
+            gpu,
+            vertex_count: (scene.triangles.len() * 3) as u32,
+            timer: GpuTimer::new(gpu, Pass::ALL.len() as u32),
+            settings,
+            pipelines,
+            targets,
+            buffers,
+        };
+        renderer.write_uniforms(scene);
+        Ok(renderer)
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Changes the quadtree's parameters; the next frame with `rebuild` uses them.
+    pub fn set_cluster(&mut self, cluster: ClusterSettings) -> Result<(), IndirectError> {
+        let settings = Settings {
+            cluster,
+            ..self.settings.clone()
+        };
+        settings.validate().map_err(IndirectError::Settings)?;
+        self.settings = settings;
+        self.buffers.write_cluster(self.gpu, &self.settings);
+        Ok(())
+    }
+
+    /// Moves the light (and refreshes everything that depends on it on the next rebuild).
+    pub fn set_scene_light(&mut self, scene: &Scene) {
+        self.write_uniforms(scene);
+    }
+
+    fn write_uniforms(&mut self, scene: &Scene) {
+        self.buffers.write_scene(self.gpu, scene, &self.settings);
+    }
+
+    /// Renders one frame of `method`. With `rebuild` the light-dependent work (RSM, pyramid,
+    /// validity, cut) is redone, as when the light moves; without it those buffers are reused.
+    /// With `timed` the passes' GPU times are recorded.
+    pub fn render(
+        &mut self,
+        method: Method,
+        rebuild: bool,
+        timed: bool,
+    ) -> Result<(), IndirectError> {
+        let gpu = self.gpu;
+        gpu.checked(|| {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let timer = timed.then_some(&self.timer);
+            let p = &self.pipelines;
+            let t = &self.targets;
+            let b = &self.buffers;
+            if rebuild {
+                p.raster_rsm(&mut encoder, t, b, self.vertex_count, timer);
+                if method.uses_quadtree() {
+                    p.build_quadtree(&mut encoder, b, &self.settings, timer);
+                    if method == Method::Quadtree {
+                        p.select_cut(&mut encoder, b, &self.settings, timer);
+                    }
+                }
+            }
+            p.raster_gbuffer(&mut encoder, t, b, self.vertex_count, timer);
+            p.shade_indirect(&mut encoder, b, &self.settings, method, timer);
+            p.shade_direct(&mut encoder, b, &self.settings, timer);
+            if let Some(timer) = timer {
+                timer.resolve(&mut encoder);
+            }
+            gpu.queue.submit([encoder.finish()]);
+        })?;
+        if timed {
+            self.timer.collect(gpu)?;
+        }
+        Ok(())
+    }
+
+    /// Median GPU time per pass over the timed frames so far (ms); `None` for passes not run or
+    /// without timestamp queries.
+    pub fn pass_times(&self) -> Vec<(Pass, Option<quadray_core::stats::Summary>)> {
+        Pass::ALL.into_iter().zip(self.timer.summaries()).collect()
+    }
+
+    pub fn clear_times(&mut self) {
+        self.timer.clear();
+    }
+
+    pub fn has_timestamps(&self) -> bool {
+        self.timer.enabled()
+    }
+
+    /// The last frame's indirect and direct light.
+    pub fn read_frame(&self) -> Result<Frame, IndirectError> {
+        let indirect = self.buffers.read_vec4(self.gpu, &self.buffers.indirect)?;
+        let direct = self.buffers.read_vec4(self.gpu, &self.buffers.direct)?;
+        let rgb = |v: &[[f32; 4]]| v.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        Ok(Frame {
+            width: self.settings.width,
+            height: self.settings.height,
+            recomputed: indirect.iter().filter(|p| p[3] > 0.5).count() as u32,
+            indirect: rgb(&indirect),
+            direct: rgb(&direct),
+        })
+    }
+
+    /// Number of clusters in the compacted cut (after a `Quadtree` frame with rebuild).
+    pub fn clusters_in_cut(&self) -> Result<u32, IndirectError> {
+        let count = self.buffers.read_u32(self.gpu, &self.buffers.cut_count)?;
+        Ok(count[0])
+    }
+
+    /// The quadtree as built: per node (flux rgb + texel count, position + depth, normal +
+    /// validity), finest level first.
+    pub fn read_nodes(&self) -> Result<Vec<[[f32; 4]; 3]>, IndirectError> {
+        let flat = self.buffers.read_vec4(self.gpu, &self.buffers.nodes)?;
+        Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    }
+
+    /// The RSM's VPLs (texels that see geometry), for the CPU reference.
+    pub fn read_vpls(&self) -> Result<Vec<Vpl>, IndirectError> {
+        let read = |tex: &wgpu::Texture| read_texture_f32(self.gpu, tex, 0, 4);
+        let flux = read(&self.targets.rsm[0])?;
+        let pos = read(&self.targets.rsm[1])?;
+        let normal = read(&self.targets.rsm[2])?;
+        Ok((0..flux.len() / 4)
+            .filter(|i| normal[i * 4 + 3] > 0.5)
+            .map(|i| Vpl {
+                flux: [flux[i * 4], flux[i * 4 + 1], flux[i * 4 + 2]],
+                position: [pos[i * 4], pos[i * 4 + 1], pos[i * 4 + 2]],
+                normal: [normal[i * 4], normal[i * 4 + 1], normal[i * 4 + 2]],
+            })
+            .collect())
+    }
+
+    /// The G-buffer, for the CPU reference.
+    pub fn read_receivers(&self) -> Result<Vec<Option<Receiver>>, IndirectError> {
+        let read = |tex: &wgpu::Texture| read_texture_f32(self.gpu, tex, 0, 4);
+        let pos = read(&self.targets.gbuffer[0])?;
+        let normal = read(&self.targets.gbuffer[1])?;
+        let albedo = read(&self.targets.gbuffer[2])?;
+        let v3 = |v: &[f32], i: usize| [v[i * 4], v[i * 4 + 1], v[i * 4 + 2]];
+        Ok((0..pos.len() / 4)
+            .map(|i| {
+                (pos[i * 4 + 3] > 0.5).then(|| Receiver {
+                    position: v3(&pos, i),
+                    normal: v3(&normal, i),
+                    albedo: v3(&albedo, i),
+                })
+            })
+            .collect())
+    }
+}

@@ -1,0 +1,415 @@
+//! Scenes: a TOML file naming meshes (built-in procedural ones for now), their transforms and
+//! colours, the camera and one spot light. Everything is flattened into one triangle list with a
+//! per-vertex albedo, which is all the RSM and G-buffer passes need.
+
+use glam::{Mat4, Vec3};
+use quadray_core::FileError;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// One vertex as the raster passes read it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub albedo: [f32; 3],
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    pub position: [f32; 3],
+    pub target: [f32; 3],
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    /// Vertical field of view.
+    pub fov_deg: f32,
+}
+
+/// A spot light: full intensity inside `cone_deg - falloff_deg` of its axis, fading smoothly to
+/// zero at `cone_deg`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpotLight {
+    pub position: [f32; 3],
+    pub direction: [f32; 3],
+    /// Half-angle of the cone; also half the field of view of the RSM.
+    pub cone_deg: f32,
+    #[serde(default)]
+    pub falloff_deg: f32,
+    /// Radiant intensity on the axis (W/sr per channel).
+    pub intensity: [f32; 3],
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshEntry {
+    /// A procedural mesh: `cornell` (the box with two blocks) or `blocks` (the two blocks alone).
+    pub builtin: Option<String>,
+    #[serde(default = "default_translate")]
+    pub translate: [f32; 3],
+    #[serde(default = "default_scale")]
+    pub scale: f32,
+    #[serde(default)]
+    pub rotate_y_deg: f32,
+    /// Replaces the mesh's own colours.
+    pub albedo: Option<[f32; 3]>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    /// Clamp of the VPL kernel's 1/r^4 (world units); shared by every method.
+    #[serde(default = "default_r_min")]
+    r_min: f32,
+    camera: Camera,
+    light: SpotLight,
+    mesh: Vec<MeshEntry>,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn default_translate() -> [f32; 3] {
+    [0.0; 3]
+}
+fn default_scale() -> f32 {
+    1.0
+}
+fn default_r_min() -> f32 {
+    0.05
+}
+
+/// A loaded scene, checked and flattened.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub camera: Camera,
+    pub light: SpotLight,
+    pub r_min: f32,
+    pub triangles: Vec<[Vertex; 3]>,
+}
+
+impl Scene {
+    pub fn load(path: &Path) -> Result<Self, FileError> {
+        let text = std::fs::read_to_string(path).map_err(|e| FileError::new(path, e))?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into());
+        Self::parse(&text, &name).map_err(|reason| FileError::new(path, reason))
+    }
+
+    /// Parses scene text; the error says what is wrong (the caller adds the file name).
+    pub fn parse(text: &str, name: &str) -> Result<Self, String> {
+        let file: SceneFile = toml::from_str(text).map_err(|e| e.to_string())?;
+        if file.mesh.is_empty() {
+            return Err("the scene has no [[mesh]]".into());
+        }
+        let mut triangles = Vec::new();
+        for (i, entry) in file.mesh.iter().enumerate() {
+            let tris = mesh_triangles(entry).map_err(|e| format!("mesh {}: {e}", i + 1))?;
+            triangles.extend(tris);
+        }
+        let scene = Self {
+            name: name.to_string(),
+            camera: file.camera,
+            light: file.light,
+            r_min: file.r_min,
+            triangles,
+        };
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// The bundled Cornell box with a spot light (no file needed).
+    pub fn cornell() -> Self {
+        Self::parse(CORNELL_TOML, "cornell").expect("the built-in Cornell scene is valid")
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        let c = &self.camera;
+        let l = &self.light;
+        if !finite(&c.position) || !finite(&c.target) || !finite(&c.up) {
+            return Err("camera has a non-finite coordinate".into());
+        }
+        if Vec3::from(c.position).distance(Vec3::from(c.target)) < 1e-6 {
+            return Err("camera position equals its target".into());
+        }
+        if !(c.fov_deg > 1.0 && c.fov_deg < 179.0) {
+            return Err(format!("camera fov_deg {} is outside (1, 179)", c.fov_deg));
+        }
+        if !finite(&l.position) || !finite(&l.direction) || !finite(&l.intensity) {
+            return Err("light has a non-finite value".into());
+        }
+        if Vec3::from(l.direction).length() < 1e-6 {
+            return Err("light direction is zero".into());
+        }
+        if !(l.cone_deg > 0.5 && l.cone_deg < 89.0) {
+            return Err(format!(
+                "light cone_deg {} is outside (0.5, 89)",
+                l.cone_deg
+            ));
+        }
+        if !(l.falloff_deg >= 0.0 && l.falloff_deg <= l.cone_deg) {
+            return Err(format!(
+                "light falloff_deg {} is outside [0, cone_deg]",
+                l.falloff_deg
+            ));
+        }
+        if l.intensity.iter().any(|&x| x < 0.0) {
+            return Err("light intensity is negative".into());
+        }
+        if !(self.r_min.is_finite() && self.r_min > 0.0) {
+            return Err(format!("r_min {} must be positive", self.r_min));
+        }
+        Ok(())
+    }
+
+    /// Axis-aligned bounds of the geometry.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::MAX);
+        let mut hi = Vec3::splat(f32::MIN);
+        for v in self.triangles.iter().flatten() {
+            lo = lo.min(v.position.into());
+            hi = hi.max(v.position.into());
+        }
+        (lo, hi)
+    }
+
+    /// Length of the bounds' diagonal: the unit of RSM depth (validity thresholds are fractions of
+    /// it) and the far plane of every projection.
+    pub fn extent(&self) -> f32 {
+        let (lo, hi) = self.bounds();
+        (hi - lo).length().max(1e-3)
+    }
+
+    /// World -> light view.
+    pub fn light_view(&self) -> Mat4 {
+        let dir = Vec3::from(self.light.direction).normalize();
+        let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+        glam::camera::rh::view::look_to_mat4(self.light.position.into(), dir, up)
+    }
+
+    /// World -> light clip space (the RSM and shadow map projection).
+    pub fn light_view_proj(&self) -> Mat4 {
+        let far = self.light_far();
+        glam::camera::rh::proj::directx::perspective(
+            (2.0 * self.light.cone_deg).to_radians(),
+            1.0,
+            far * 1e-3,
+            far,
+        ) * self.light_view()
+    }
+
+    /// Far plane of the light: everything in the scene is closer.
+    pub fn light_far(&self) -> f32 {
+        let (lo, hi) = self.bounds();
+        let p = Vec3::from(self.light.position);
+        let centre = (lo + hi) * 0.5;
+        p.distance(centre) + self.extent()
+    }
+
+    pub fn camera_view_proj(&self, aspect: f32) -> Mat4 {
+        let c = &self.camera;
+        let far = Vec3::from(c.position).distance(self.bounds().0.midpoint(self.bounds().1))
+            + self.extent();
+        glam::camera::rh::proj::directx::perspective(
+            c.fov_deg.to_radians(),
+            aspect,
+            far * 1e-3,
+            far,
+        ) * glam::camera::rh::view::look_at_mat4(c.position.into(), c.target.into(), c.up.into())
+    }
+}
+
+/// The scene `quadray indirect` uses without `--scene`, also `assets/scenes/cornell.toml`.
+pub const CORNELL_TOML: &str = include_str!("../../../assets/scenes/cornell.toml");
+
+/// Directory of the bundled scene files.
+pub fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes")
+}
+
+const WHITE: [f32; 3] = [0.73, 0.73, 0.73];
+const RED: [f32; 3] = [0.63, 0.065, 0.05];
+const GREEN: [f32; 3] = [0.14, 0.45, 0.091];
+
+fn mesh_triangles(entry: &MeshEntry) -> Result<Vec<[Vertex; 3]>, String> {
+    let Some(builtin) = &entry.builtin else {
+        return Err("needs `builtin` (mesh files are not supported yet)".into());
+    };
+    let mut tris = match builtin.as_str() {
+        "cornell" => {
+            let mut t = cornell_room();
+            t.extend(cornell_blocks());
+            t
+        }
+        "room" => cornell_room(),
+        "blocks" => cornell_blocks(),
+        other => {
+            return Err(format!(
+                "unknown builtin `{other}` (known: cornell, room, blocks)"
+            ));
+        }
+    };
+    if !(entry.scale.is_finite() && entry.scale > 0.0) {
+        return Err(format!("scale {} must be positive", entry.scale));
+    }
+    if !entry.translate.iter().all(|x| x.is_finite()) || !entry.rotate_y_deg.is_finite() {
+        return Err("transform has a non-finite value".into());
+    }
+    if let Some(a) = entry.albedo
+        && !a.iter().all(|x| (0.0..=1.0).contains(x))
+    {
+        return Err(format!("albedo {a:?} is outside [0, 1]"));
+    }
+    let rotation = Mat4::from_rotation_y(entry.rotate_y_deg.to_radians());
+    let model = Mat4::from_translation(entry.translate.into())
+        * rotation
+        * Mat4::from_scale(Vec3::splat(entry.scale));
+    for v in tris.iter_mut().flatten() {
+        v.position = model.transform_point3(v.position.into()).into();
+        v.normal = rotation.transform_vector3(v.normal.into()).into();
+        if let Some(a) = entry.albedo {
+            v.albedo = a;
+        }
+    }
+    Ok(tris)
+}
+
+/// Two triangles of the quad a, b, c, d (counter-clockwise seen from the side `normal` faces).
+fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2] {
+    let normal = (b - a).cross(d - a).normalize();
+    let v = |p: Vec3| Vertex {
+        position: p.into(),
+        normal: normal.into(),
+        albedo,
+    };
+    [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
+}
+
+/// The unit room [0,1]^3 open towards +z: red wall at x = 0, green at x = 1.
+fn cornell_room() -> Vec<[Vertex; 3]> {
+    let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    [
+        quad(
+            p(0., 0., 1.),
+            p(1., 0., 1.),
+            p(1., 0., 0.),
+            p(0., 0., 0.),
+            WHITE,
+        ), // floor
+        quad(
+            p(0., 1., 0.),
+            p(1., 1., 0.),
+            p(1., 1., 1.),
+            p(0., 1., 1.),
+            WHITE,
+        ), // ceiling
+        quad(
+            p(0., 0., 0.),
+            p(1., 0., 0.),
+            p(1., 1., 0.),
+            p(0., 1., 0.),
+            WHITE,
+        ), // back
+        quad(
+            p(0., 0., 1.),
+            p(0., 0., 0.),
+            p(0., 1., 0.),
+            p(0., 1., 1.),
+            RED,
+        ), // left
+        quad(
+            p(1., 0., 0.),
+            p(1., 0., 1.),
+            p(1., 1., 1.),
+            p(1., 1., 0.),
+            GREEN,
+        ), // right
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// The short and the tall block of the Cornell box, turned as in the original.
+fn cornell_blocks() -> Vec<[Vertex; 3]> {
+    let mut out = block(Vec3::new(0.66, 0.0, 0.62), 0.3, 0.3, -17.0);
+    out.extend(block(Vec3::new(0.32, 0.0, 0.33), 0.3, 0.6, 17.0));
+    out
+}
+
+/// An upright box of footprint `side` and `height` standing on y = 0 at `centre`.
+fn block(centre: Vec3, side: f32, height: f32, turn_deg: f32) -> Vec<[Vertex; 3]> {
+    let r = Mat4::from_translation(centre) * Mat4::from_rotation_y(turn_deg.to_radians());
+    let h = side * 0.5;
+    let p = |x: f32, y: f32, z: f32| r.transform_point3(Vec3::new(x, y, z));
+    let (b0, b1, b2, b3) = (p(-h, 0., h), p(h, 0., h), p(h, 0., -h), p(-h, 0., -h));
+    let (t0, t1, t2, t3) = (
+        p(-h, height, h),
+        p(h, height, h),
+        p(h, height, -h),
+        p(-h, height, -h),
+    );
+    [
+        quad(t0, t1, t2, t3, WHITE),
+        quad(b0, b1, t1, t0, WHITE),
+        quad(b1, b2, t2, t1, WHITE),
+        quad(b2, b3, t3, t2, WHITE),
+        quad(b3, b0, t0, t3, WHITE),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cornell_room_normals_face_inwards_and_blocks_outwards() {
+        let scene = Scene::cornell();
+        let centre = Vec3::new(0.5, 0.5, 0.5);
+        for t in cornell_room() {
+            let n = Vec3::from(t[0].normal);
+            assert!(n.dot(centre - Vec3::from(t[0].position)) > 0.0);
+        }
+        let centre = Vec3::new(0.4, 0.0, 0.3);
+        for t in block(centre, 0.3, 0.6, 17.0) {
+            let mid =
+                (Vec3::from(t[0].position) + Vec3::from(t[1].position) + Vec3::from(t[2].position))
+                    / 3.0;
+            let inside = centre + Vec3::new(0.0, 0.3, 0.0);
+            assert!(Vec3::from(t[0].normal).dot(mid - inside) > 0.0);
+        }
+        assert_eq!(scene.triangles.len(), 10 + 20);
+        assert!((scene.extent() - 3f32.sqrt()).abs() < 1e-4);
+    }
+
+    #[test]
+    fn bad_scenes_are_refused_with_the_reason() {
+        let good = CORNELL_TOML;
+        let cases = [
+            (
+                good.replace("cone_deg = 55.0", "cone_deg = 95.0"),
+                "cone_deg",
+            ),
+            (
+                good.replace("builtin = \"cornell\"", "builtin = \"sponza\""),
+                "unknown builtin",
+            ),
+            (good.replace("fov_deg = 39.0", "fov_deg = nan"), "fov_deg"),
+            (good.replace("[light]", "[lamp]"), "light"),
+            ("r_min = 0.1".to_string(), "camera"),
+        ];
+        for (text, needle) in cases {
+            let err = Scene::parse(&text, "bad").unwrap_err();
+            assert!(err.contains(needle), "{err} should mention {needle}");
+        }
+    }
+}

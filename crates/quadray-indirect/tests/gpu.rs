@@ -1,0 +1,213 @@
+//! The GPU paths against ground truth on whatever adapter the machine has (lavapipe in CI), at
+//! tiny sizes: the GPU brute force against the CPU one, the quadtree with every cluster a single
+//! VPL against the brute force, the per-level passes against the compacted cut, and the error of
+//! the default thresholds.
+
+use quadray_gpu::Gpu;
+use quadray_indirect::reference::{self, compare};
+use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings, Validity};
+
+fn settings(rsm_size: u32) -> Settings {
+    Settings {
+        width: 64,
+        height: 64,
+        rsm_size,
+        cluster: ClusterSettings::paper(rsm_size),
+        samples: 64,
+        ..Settings::default()
+    }
+}
+
+fn gpu() -> Gpu {
+    Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)")
+}
+
+fn render(r: &mut Renderer, method: Method) -> Vec<[f32; 3]> {
+    r.render(method, true, false).unwrap();
+    r.read_frame().unwrap().indirect
+}
+
+#[test]
+fn gpu_brute_force_matches_the_cpu_reference() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(32)).unwrap();
+    let gpu_image = render(&mut r, Method::Reference);
+    let vpls = r.read_vpls().unwrap();
+    let receivers = r.read_receivers().unwrap();
+    assert!(
+        vpls.len() > 500,
+        "the spot sees the room: {} VPLs",
+        vpls.len()
+    );
+    assert!(receivers.iter().filter(|r| r.is_some()).count() > 2000);
+    let cpu_image = reference::brute_force(&vpls, &receivers, scene.r_min);
+    let lit = cpu_image
+        .iter()
+        .filter(|p| p.iter().sum::<f32>() > 0.0)
+        .count();
+    assert!(lit > 2000, "indirect light reaches most pixels ({lit})");
+    let e = compare(&gpu_image, &cpu_image);
+    println!("GPU vs CPU brute force: {e:?}");
+    assert!(e.rel_l1 < 1e-5 && e.rel_max < 1e-4, "{e:?}");
+}
+
+#[test]
+fn quadtree_with_every_cluster_one_vpl_equals_the_brute_force() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut s = settings(32);
+    s.cluster = ClusterSettings::every_vpl(32);
+    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    let brute = render(&mut r, Method::Reference);
+    for validity in [Validity::Local, Validity::Recursive] {
+        r.set_cluster(ClusterSettings {
+            validity,
+            ..ClusterSettings::every_vpl(32)
+        })
+        .unwrap();
+        let cut = render(&mut r, Method::Quadtree);
+        assert_eq!(
+            r.clusters_in_cut().unwrap() as usize,
+            r.read_vpls().unwrap().len(),
+            "the cut is every VPL"
+        );
+        let passes = render(&mut r, Method::QuadtreePasses);
+        for (name, image) in [("cut", cut), ("passes", passes)] {
+            let e = compare(&image, &brute);
+            println!("{validity:?} {name} with every VPL vs brute force: {e:?}");
+            assert!(e.rel_max < 1e-5, "{name}: {e:?}");
+        }
+    }
+}
+
+#[test]
+fn per_level_passes_give_the_compacted_cut_image() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(64)).unwrap();
+    for (validity, depth, normal) in [
+        (Validity::Local, 0.05, 0.9),
+        (Validity::Recursive, 0.05, 0.9),
+        (Validity::Local, 0.45, 0.3),
+    ] {
+        r.set_cluster(ClusterSettings {
+            validity,
+            depth_threshold: depth,
+            normal_threshold: normal,
+            ..ClusterSettings::paper(64)
+        })
+        .unwrap();
+        let cut = render(&mut r, Method::Quadtree);
+        let clusters = r.clusters_in_cut().unwrap();
+        let passes = render(&mut r, Method::QuadtreePasses);
+        let e = compare(&passes, &cut);
+        println!("{validity:?} {depth}/{normal}: {clusters} clusters, passes vs cut {e:?}");
+        assert!(clusters > 16 && clusters < 64 * 64 / 4, "{clusters}");
+        assert!(e.rel_max < 1e-5, "{e:?}");
+    }
+}
+
+#[test]
+fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(64)).unwrap();
+    let brute = render(&mut r, Method::Reference);
+    for validity in [Validity::Local, Validity::Recursive] {
+        r.set_cluster(ClusterSettings {
+            validity,
+            ..ClusterSettings::paper(64)
+        })
+        .unwrap();
+        let image = render(&mut r, Method::Quadtree);
+        let e = compare(&image, &brute);
+        println!(
+            "{validity:?} default thresholds, {} clusters: {e:?}",
+            r.clusters_in_cut().unwrap()
+        );
+        assert!(e.rel_l1 < 0.05, "{e:?}");
+    }
+}
+
+#[test]
+fn rsm_sampling_converges_to_the_brute_force() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut errors = Vec::new();
+    for samples in [16, 256] {
+        let mut r = Renderer::new(
+            &gpu,
+            &scene,
+            Settings {
+                samples,
+                ..settings(32)
+            },
+        )
+        .unwrap();
+        let brute = render(&mut r, Method::Reference);
+        let image = render(&mut r, Method::Rsm);
+        errors.push(compare(&image, &brute).rel_l1);
+    }
+    println!("RSM sampling rel_l1 at 16 and 256 samples: {errors:?}");
+    assert!(errors[1] < errors[0] && errors[1] < 0.25, "{errors:?}");
+}
+
+#[test]
+fn subsampled_indirect_stays_close_to_full_resolution() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(32)).unwrap();
+    let full = render(&mut r, Method::Quadtree);
+    let mut r = Renderer::new(
+        &gpu,
+        &scene,
+        Settings {
+            subsample: 4,
+            ..settings(32)
+        },
+    )
+    .unwrap();
+    r.render(Method::Quadtree, true, false).unwrap();
+    let frame = r.read_frame().unwrap();
+    let e = compare(&frame.indirect, &full);
+    println!(
+        "subsample 4 vs full: {e:?}, {} pixels recomputed",
+        frame.recomputed
+    );
+    assert!(frame.recomputed > 0 && frame.recomputed < 64 * 64 / 2);
+    assert!(e.rel_l1 < 0.05, "{e:?}");
+}
+
+#[test]
+fn absurd_settings_are_refused() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    for bad in [
+        Settings {
+            rsm_size: 48,
+            ..settings(32)
+        },
+        Settings {
+            cluster: ClusterSettings {
+                limit_level: 4,
+                start_level: 2,
+                ..ClusterSettings::paper(32)
+            },
+            ..settings(32)
+        },
+        Settings {
+            cluster: ClusterSettings {
+                depth_threshold: f32::NAN,
+                ..ClusterSettings::paper(32)
+            },
+            ..settings(32)
+        },
+        Settings {
+            width: 0,
+            ..settings(32)
+        },
+    ] {
+        assert!(Renderer::new(&gpu, &scene, bad).is_err());
+    }
+}
