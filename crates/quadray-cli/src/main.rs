@@ -2,6 +2,7 @@
 //! benchmarks. Each subcommand lives in its own module.
 
 mod displace;
+mod indirect;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ enum Command {
     Adapter,
     /// Pyramid displacement mapping and its baselines on one height map.
     Displace(displace::DisplaceArgs),
+    /// One-bounce indirect light from a light quadtree, its baselines and reference.
+    Indirect(indirect::IndirectArgs),
     /// Render the side-by-side pictures of every technique from the bundled assets.
     Demo {
         #[arg(long, default_value = "out/demo")]
@@ -71,6 +74,7 @@ fn main() -> Result<()> {
             println!("{}", gpu.describe());
         }
         Command::Displace(args) => displace::run(args)?,
+        Command::Indirect(args) => indirect::run_indirect(args)?,
         Command::Demo { out, size } => {
             if !(16..=4096).contains(&size) {
                 anyhow::bail!("--size {size} is outside 16..4096");

@@ -8,6 +8,7 @@
 pub mod baselines;
 pub mod gpu;
 pub mod reference;
+pub mod report;
 pub mod scene;
 
 /// Anything that can go wrong between a scene file and a measured picture.
@@ -21,5 +22,5 @@ pub enum IndirectError {
     Settings(String),
 }
 
-pub use gpu::{ClusterSettings, Frame, Method, Pass, Renderer, Settings, Validity};
+pub use gpu::{ClusterSettings, Frame, FrameTiming, Method, Pass, Renderer, Settings, Validity};
 pub use scene::Scene;

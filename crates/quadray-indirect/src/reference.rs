@@ -4,7 +4,8 @@
 use crate::gpu::{Receiver, Vpl};
 use rayon::prelude::*;
 
-/// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none).
+/// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none), with
+/// E_p = flux_p / pi * cos_p * cos / max(r^2, r_min^2) (the spec's kernel with a diffuse VPL's 1/pi).
 pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> Vec<[f32; 3]> {
     let r_min2 = f64::from(r_min).powi(2);
     receivers
@@ -22,7 +23,7 @@ pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> 
                 let d2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(r_min2);
                 let emit = (np[0] * d[0] + np[1] * d[1] + np[2] * d[2]).max(0.0);
                 let receive = -(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
-                let g = emit * receive.max(0.0) / (d2 * d2);
+                let g = emit * receive.max(0.0) / (std::f64::consts::PI * d2 * d2);
                 for c in 0..3 {
                     e[c] += f64::from(p.flux[c]) * g;
                 }
@@ -82,7 +83,8 @@ mod tests {
 
     #[test]
     fn one_vpl_facing_a_receiver_gives_the_inverse_square_law() {
-        // VPL at the origin facing +z, receiver at distance 2 facing back: cosines 1, E = flux / 4
+        // VPL at the origin facing +z, receiver at distance 2 facing back: cosines 1,
+        // E = flux / (4 pi), radiance = albedo / pi * E
         let vpl = Vpl {
             flux: [4.0, 8.0, 0.0],
             position: [0.0; 3],
@@ -95,8 +97,8 @@ mod tests {
         };
         let out = brute_force(&[vpl], &[Some(receiver), None], 0.1);
         let pi = std::f32::consts::PI;
-        assert!((out[0][0] - 1.0 / pi).abs() < 1e-6);
-        assert!((out[0][1] - 1.0 / pi).abs() < 1e-6);
+        assert!((out[0][0] - 1.0 / (pi * pi)).abs() < 1e-6);
+        assert!((out[0][1] - 1.0 / (pi * pi)).abs() < 1e-6);
         assert_eq!(out[1], [0.0; 3]);
         // closer than r_min the 1/r^4 is clamped: d = 0.05, r_min = 0.1 -> d^2 / r_min^4 = 0.25
         let near = Receiver {
@@ -104,7 +106,7 @@ mod tests {
             ..receiver
         };
         let out = brute_force(&[vpl], &[Some(near)], 0.1);
-        assert!((out[0][0] - 4.0 * 0.0025 / 1e-4 / pi).abs() < 1e-3);
+        assert!((out[0][0] - 4.0 * 0.0025 / 1e-4 / (pi * pi)).abs() < 1e-3);
     }
 
     #[test]

@@ -46,9 +46,11 @@ fn node_index(p: ClusterParams, level: u32, xy: vec2<u32>) -> u32 {
 }
 
 // Irradiance at x (normal n) from a VPL or cluster of flux `flux` at xp (normal np), with the
-// 1/r^4 clamped at r_min (the spec's kernel; the reference uses the same).
+// 1/r^4 clamped at r_min (the spec's kernel; the reference uses the same). A diffuse VPL radiates
+// flux / pi * cos: the 1/pi the spec's formula (after the RSM paper) leaves out is put back so
+// that indirect and direct light are on the same scale; errors are ratios and do not change.
 fn vpl_irradiance(flux: vec3<f32>, xp: vec3<f32>, np: vec3<f32>, x: vec3<f32>, n: vec3<f32>, r_min: f32) -> vec3<f32> {
     let d = x - xp;
     let d2 = max(dot(d, d), r_min * r_min);
-    return flux * (max(0.0, dot(np, d)) * max(0.0, dot(n, -d)) / (d2 * d2));
+    return flux * (max(0.0, dot(np, d)) * max(0.0, dot(n, -d)) / (PI * d2 * d2));
 }

@@ -11,6 +11,7 @@ use crate::scene::Scene;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use resources::{Buffers, Pipelines, Targets};
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// How the indirect term is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -27,8 +28,36 @@ pub enum Method {
 }
 
 impl Method {
+    pub const ALL: [Method; 4] = [
+        Method::Quadtree,
+        Method::QuadtreePasses,
+        Method::Rsm,
+        Method::Reference,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Quadtree => "quadtree",
+            Method::QuadtreePasses => "quadtree-passes",
+            Method::Rsm => "rsm",
+            Method::Reference => "reference",
+        }
+    }
+
     pub fn uses_quadtree(self) -> bool {
         matches!(self, Method::Quadtree | Method::QuadtreePasses)
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                format!("unknown method `{s}` (quadtree, quadtree-passes, rsm, reference)")
+            })
     }
 }
 
@@ -40,6 +69,17 @@ pub enum Validity {
     Local,
     /// Also every child valid.
     Recursive,
+}
+
+impl std::str::FromStr for Validity {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "local" => Ok(Validity::Local),
+            "recursive" => Ok(Validity::Recursive),
+            _ => Err(format!("unknown validity rule `{s}` (local, recursive)")),
+        }
+    }
 }
 
 /// The light quadtree's parameters. Levels are mip levels: 0 is the RSM itself (one VPL per
@@ -201,6 +241,14 @@ impl Pass {
     }
 }
 
+/// Median GPU time per pass (ms) over some frames; `total_ms` is the sum of the medians.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FrameTiming {
+    pub passes: BTreeMap<&'static str, f64>,
+    pub total_ms: f64,
+    pub frames: u32,
+}
+
 /// One frame read back: linear radiance per pixel, row-major, top row first.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -300,20 +348,21 @@ impl<'g> Renderer<'g> {
         timed: bool,
     ) -> Result<(), IndirectError> {
         let gpu = self.gpu;
+        let run = self.passes_run(method, rebuild);
         gpu.checked(|| {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let timer = timed.then_some(&self.timer);
             let p = &self.pipelines;
             let t = &self.targets;
             let b = &self.buffers;
-            if rebuild {
+            if run.contains(&Pass::Rsm) {
                 p.raster_rsm(&mut encoder, t, b, self.vertex_count, timer);
-                if method.uses_quadtree() {
-                    p.build_quadtree(&mut encoder, b, &self.settings, timer);
-                    if method == Method::Quadtree {
-                        p.select_cut(&mut encoder, b, &self.settings, timer);
-                    }
-                }
+            }
+            if run.contains(&Pass::Pyramid) {
+                p.build_quadtree(&mut encoder, b, &self.settings, timer);
+            }
+            if run.contains(&Pass::Cut) {
+                p.select_cut(&mut encoder, b, &self.settings, timer);
             }
             p.raster_gbuffer(&mut encoder, t, b, self.vertex_count, timer);
             p.shade_indirect(&mut encoder, b, &self.settings, method, timer);
@@ -329,14 +378,52 @@ impl<'g> Renderer<'g> {
         Ok(())
     }
 
-    /// Median GPU time per pass over the timed frames so far (ms); `None` for passes not run or
-    /// without timestamp queries.
-    pub fn pass_times(&self) -> Vec<(Pass, Option<quadray_core::stats::Summary>)> {
-        Pass::ALL.into_iter().zip(self.timer.summaries()).collect()
+    /// The passes a frame of `method` records (the timer's slots of the others hold stale times).
+    pub fn passes_run(&self, method: Method, rebuild: bool) -> Vec<Pass> {
+        let mut passes = Vec::new();
+        if rebuild {
+            passes.push(Pass::Rsm);
+            if method.uses_quadtree() {
+                passes.extend([Pass::Pyramid, Pass::Validity]);
+            }
+            if method == Method::Quadtree {
+                passes.push(Pass::Cut);
+            }
+        }
+        passes.extend([Pass::GBuffer, Pass::Indirect, Pass::Direct]);
+        if method == Method::Quadtree && self.settings.subsample > 1 {
+            passes.push(Pass::Upsample);
+        }
+        passes
     }
 
-    pub fn clear_times(&mut self) {
+    /// Renders `frames` timed frames of `method` (rebuilding the light's buffers each frame with
+    /// `rebuild`) and returns the median GPU time of each pass; `None` without timestamp queries.
+    pub fn time(
+        &mut self,
+        method: Method,
+        rebuild: bool,
+        frames: u32,
+    ) -> Result<Option<FrameTiming>, IndirectError> {
         self.timer.clear();
+        for _ in 0..frames {
+            self.render(method, rebuild, true)?;
+        }
+        if !self.timer.enabled() || frames == 0 {
+            return Ok(None);
+        }
+        let run = self.passes_run(method, rebuild);
+        let passes: BTreeMap<&'static str, f64> = Pass::ALL
+            .into_iter()
+            .zip(self.timer.summaries())
+            .filter(|(p, _)| run.contains(p))
+            .filter_map(|(p, s)| s.map(|s| (p.name(), s.median_ms)))
+            .collect();
+        Ok(Some(FrameTiming {
+            total_ms: passes.values().sum(),
+            passes,
+            frames,
+        }))
     }
 
     pub fn has_timestamps(&self) -> bool {
