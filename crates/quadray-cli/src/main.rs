@@ -53,6 +53,14 @@ enum Bench {
         #[arg(long, default_value = "out/bench/displace")]
         out: PathBuf,
     },
+    /// Tables 1-3 and the error-vs-time plot of the light-quadtree paper.
+    Indirect {
+        /// 64x64 image and RSM, 3 frames per median: seconds on a software rasterizer.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long, default_value = "out/bench/indirect")]
+        out: PathBuf,
+    },
 }
 
 fn spinner(what: &str) -> ProgressBar {
@@ -105,6 +113,9 @@ fn main() -> Result<()> {
             println!("{}", std::fs::read_to_string(out.join("results.md"))?);
             println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);
         }
+        Command::Bench {
+            what: Bench::Indirect { quick, out },
+        } => indirect::bench(quick, &out)?,
     }
     Ok(())
 }

@@ -6,6 +6,7 @@
 //! against [`reference`] (CPU brute force) and the GPU brute force of [`baselines`].
 
 pub mod baselines;
+pub mod bench;
 pub mod gpu;
 pub mod reference;
 pub mod report;
