@@ -215,3 +215,64 @@ fn absurd_settings_are_refused() {
         assert!(Renderer::new(&gpu, &scene, bad).is_err());
     }
 }
+
+/// The pyramid and validity maps as built on the GPU, checked node by node on the CPU: sums of
+/// flux and texel counts, weighted means, and both validity rules.
+#[test]
+fn quadtree_nodes_match_a_cpu_rebuild() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let size = 32u32;
+    let mut r = Renderer::new(&gpu, &scene, settings(size)).unwrap();
+    for validity in [Validity::Local, Validity::Recursive] {
+        let cluster = ClusterSettings {
+            validity,
+            ..ClusterSettings::defaults(size)
+        };
+        r.set_cluster(cluster).unwrap();
+        r.render(Method::Quadtree, true, false).unwrap();
+        let nodes = r.read_nodes().unwrap();
+        let mut offset = 0usize;
+        let mut valid_above_zero = 0;
+        for level in 1..=size.ilog2() {
+            let child_side = (size >> (level - 1)) as usize;
+            let side = child_side / 2;
+            let child_offset = offset;
+            offset += child_side * child_side;
+            for y in 0..side {
+                for x in 0..side {
+                    let node = nodes[offset + y * side + x];
+                    let children: Vec<_> = (0..4)
+                        .map(|c| nodes[child_offset + (2 * y + c / 2) * child_side + 2 * x + c % 2])
+                        .collect();
+                    let count: f32 = children.iter().map(|c| c[0][3]).sum();
+                    let flux: f32 = children.iter().map(|c| c[0][0]).sum();
+                    assert_eq!(node[0][3], count);
+                    assert!((node[0][0] - flux).abs() <= 1e-5 * flux.abs() + 1e-12);
+                    let lum =
+                        |c: &[[f32; 4]; 3]| 0.2126 * c[0][0] + 0.7152 * c[0][1] + 0.0722 * c[0][2];
+                    let weight: f32 = children.iter().map(lum).sum();
+                    if weight > 0.0 {
+                        let depth: f32 =
+                            children.iter().map(|c| lum(c) * c[1][3]).sum::<f32>() / weight;
+                        assert!(
+                            (node[1][3] - depth).abs() < 1e-4,
+                            "{} vs {depth}",
+                            node[1][3]
+                        );
+                    }
+                    let mut valid = true;
+                    for c in children.iter().filter(|c| c[0][3] > 0.5) {
+                        let dot: f32 = (0..3).map(|i| c[2][i] * node[2][i]).sum();
+                        valid &= (c[1][3] - node[1][3]).abs() < cluster.depth_threshold
+                            && dot > cluster.normal_threshold
+                            && (validity == Validity::Local || c[2][3] > 0.5);
+                    }
+                    assert_eq!(node[2][3] > 0.5, valid, "level {level} node {x},{y}");
+                    valid_above_zero += usize::from(valid && count > 0.0);
+                }
+            }
+        }
+        assert!(valid_above_zero > 10, "some clusters are valid");
+    }
+}
