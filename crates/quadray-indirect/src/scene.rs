@@ -45,7 +45,8 @@ pub struct SpotLight {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshEntry {
-    /// A procedural mesh: `cornell` (the box with two blocks) or `blocks` (the two blocks alone).
+    /// A procedural mesh: `cornell` (the box with two blocks), `room` (the box alone), `blocks`
+    /// (the two blocks alone) or `atrium` (a Sponza-like courtyard, about 25k triangles).
     pub builtin: Option<String>,
     #[serde(default = "default_translate")]
     pub translate: [f32; 3],
@@ -249,9 +250,10 @@ fn mesh_triangles(entry: &MeshEntry) -> Result<Vec<[Vertex; 3]>, String> {
         }
         "room" => cornell_room(),
         "blocks" => cornell_blocks(),
+        "atrium" => atrium(),
         other => {
             return Err(format!(
-                "unknown builtin `{other}` (known: cornell, room, blocks)"
+                "unknown builtin `{other}` (known: cornell, room, blocks, atrium)"
             ));
         }
     };
@@ -367,6 +369,150 @@ fn block(centre: Vec3, side: f32, height: f32, turn_deg: f32) -> Vec<[Vertex; 3]
     .collect()
 }
 
+/// An axis-aligned box, faces outwards.
+fn cuboid(lo: Vec3, hi: Vec3, albedo: [f32; 3]) -> Vec<[Vertex; 3]> {
+    let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    let (a, b) = (lo, hi);
+    [
+        quad(
+            p(a.x, b.y, b.z),
+            p(b.x, b.y, b.z),
+            p(b.x, b.y, a.z),
+            p(a.x, b.y, a.z),
+            albedo,
+        ),
+        quad(
+            p(a.x, a.y, a.z),
+            p(b.x, a.y, a.z),
+            p(b.x, a.y, b.z),
+            p(a.x, a.y, b.z),
+            albedo,
+        ),
+        quad(
+            p(a.x, a.y, b.z),
+            p(b.x, a.y, b.z),
+            p(b.x, b.y, b.z),
+            p(a.x, b.y, b.z),
+            albedo,
+        ),
+        quad(
+            p(b.x, a.y, a.z),
+            p(a.x, a.y, a.z),
+            p(a.x, b.y, a.z),
+            p(b.x, b.y, a.z),
+            albedo,
+        ),
+        quad(
+            p(a.x, a.y, a.z),
+            p(a.x, a.y, b.z),
+            p(a.x, b.y, b.z),
+            p(a.x, b.y, a.z),
+            albedo,
+        ),
+        quad(
+            p(b.x, a.y, b.z),
+            p(b.x, a.y, a.z),
+            p(b.x, b.y, a.z),
+            p(b.x, b.y, b.z),
+            albedo,
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// A vertical cylinder (no caps) with smooth normals, `segments` around and `rings` high.
+fn column(base: Vec3, radius: f32, height: f32, segments: u32, rings: u32) -> Vec<[Vertex; 3]> {
+    let albedo = [0.75, 0.72, 0.66];
+    let at = |i: u32, j: u32| {
+        let a = std::f32::consts::TAU * i as f32 / segments as f32;
+        let n = Vec3::new(a.cos(), 0.0, a.sin());
+        Vertex {
+            position: (base + n * radius + Vec3::Y * height * j as f32 / rings as f32).into(),
+            normal: n.into(),
+            albedo,
+        }
+    };
+    (0..segments)
+        .flat_map(|i| (0..rings).map(move |j| (i, j)))
+        .flat_map(|(i, j)| {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            [[a, c, b], [a, d, c]]
+        })
+        .collect()
+}
+
+/// A Sponza-like courtyard, 30 x 15 x 13 m, open to the sky: stone floor, two storeys of
+/// galleries on columns along both long sides, coloured banners hanging between the columns.
+fn atrium() -> Vec<[Vertex; 3]> {
+    const STONE: [f32; 3] = [0.62, 0.57, 0.48];
+    const PLASTER: [f32; 3] = [0.74, 0.68, 0.58];
+    const BANNERS: [[f32; 3]; 3] = [[0.7, 0.08, 0.06], [0.08, 0.15, 0.6], [0.1, 0.5, 0.12]];
+    let (length, width, height) = (30.0, 13.0, 15.0);
+    let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    let mut out: Vec<[Vertex; 3]> = Vec::new();
+    out.extend(quad(
+        p(0., 0., width),
+        p(length, 0., width),
+        p(length, 0., 0.),
+        p(0., 0., 0.),
+        STONE,
+    ));
+    out.extend(quad(
+        p(0., 0., 0.),
+        p(length, 0., 0.),
+        p(length, height, 0.),
+        p(0., height, 0.),
+        PLASTER,
+    ));
+    out.extend(quad(
+        p(length, 0., width),
+        p(0., 0., width),
+        p(0., height, width),
+        p(length, height, width),
+        PLASTER,
+    ));
+    out.extend(quad(
+        p(0., 0., width),
+        p(0., 0., 0.),
+        p(0., height, 0.),
+        p(0., height, width),
+        PLASTER,
+    ));
+    out.extend(quad(
+        p(length, 0., 0.),
+        p(length, 0., width),
+        p(length, height, width),
+        p(length, height, 0.),
+        PLASTER,
+    ));
+    for (side, z) in [(0.0f32, 3.0f32), (1.0, width - 3.0)] {
+        let (z0, z1) = if side == 0.0 { (0.0, z) } else { (z, width) };
+        for storey in 0..2 {
+            let floor = 5.0 * (storey as f32 + 1.0);
+            out.extend(cuboid(p(0.0, floor - 0.4, z0), p(length, floor, z1), STONE));
+            for i in 0..12 {
+                let x = 1.5 + 2.45 * i as f32;
+                out.extend(column(p(x, floor - 5.0, z), 0.35, 4.6, 32, 8));
+                if storey == 1 && i < 11 {
+                    let banner = BANNERS[i % 3];
+                    let (bz, x0, x1) =
+                        (z + if side == 0.0 { 0.2 } else { -0.2 }, x + 0.5, x + 1.95);
+                    out.extend(quad(
+                        p(x0, 5.0, bz),
+                        p(x1, 5.0, bz),
+                        p(x1, 9.0, bz),
+                        p(x0, 9.0, bz),
+                        banner,
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -389,6 +535,21 @@ mod tests {
         }
         assert_eq!(scene.triangles.len(), 10 + 20);
         assert!((scene.extent() - 3f32.sqrt()).abs() < 1e-4);
+    }
+
+    #[test]
+    fn the_atrium_is_large_and_its_scene_file_loads() {
+        let scene = Scene::load(&scenes_dir().join("atrium.toml")).unwrap();
+        assert!(scene.triangles.len() > 20_000, "{}", scene.triangles.len());
+        let (lo, hi) = scene.bounds();
+        assert!(lo.min_element() >= 0.0 && hi.x <= 30.0 && hi.y <= 15.0);
+        for t in &scene.triangles {
+            let [a, b, c] = t.map(|v| Vec3::from(v.position));
+            assert!(
+                (b - a).cross(c - a).length() > 1e-6,
+                "no degenerate triangles"
+            );
+        }
     }
 
     #[test]
