@@ -137,3 +137,13 @@ pub fn bench(quick: bool, out: &Path) -> Result<()> {
     println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);
     Ok(())
 }
+
+/// The indirect-light pictures of `quadray demo`.
+pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
+    let bar = crate::spinner("indirect light");
+    let files = quadray_indirect::demo::render_demo(gpu, &out.join("indirect"), size, |m| {
+        bar.set_message(format!("indirect light: {m}"))
+    })?;
+    bar.finish_and_clear();
+    Ok(files)
+}

@@ -94,7 +94,7 @@ fn main() -> Result<()> {
                     bar.set_message(format!("displacement: {m}"))
                 })?;
             bar.finish_and_clear();
-            for f in files {
+            for f in files.into_iter().chain(indirect::demo(&gpu, &out, size)?) {
                 println!("{}", f.display());
             }
         }

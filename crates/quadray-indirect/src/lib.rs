@@ -7,6 +7,7 @@
 
 pub mod baselines;
 pub mod bench;
+pub mod demo;
 pub mod gpu;
 pub mod reference;
 pub mod report;

@@ -24,8 +24,8 @@ pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> 
                 let emit = (np[0] * d[0] + np[1] * d[1] + np[2] * d[2]).max(0.0);
                 let receive = -(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
                 let g = emit * receive.max(0.0) / (std::f64::consts::PI * d2 * d2);
-                for c in 0..3 {
-                    e[c] += f64::from(p.flux[c]) * g;
+                for (e, flux) in e.iter_mut().zip(p.flux) {
+                    *e += f64::from(flux) * g;
                 }
             }
             std::array::from_fn(|c| (f64::from(r.albedo[c]) / std::f64::consts::PI * e[c]) as f32)

@@ -100,12 +100,7 @@ pub fn run(
     let frame = renderer.read_frame()?;
     let s = renderer.settings().clone();
     let (w, h) = (s.width, s.height);
-    let combined: Vec<[f32; 3]> = frame
-        .direct
-        .iter()
-        .zip(&frame.indirect)
-        .map(|(d, i)| [d[0] + i[0], d[1] + i[1], d[2] + i[2]])
-        .collect();
+    let combined = frame.combined();
     let error = reference
         .as_ref()
         .map(|r| reference::compare(&frame.indirect, r));

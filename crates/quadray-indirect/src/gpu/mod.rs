@@ -260,6 +260,17 @@ pub struct Frame {
     pub recomputed: u32,
 }
 
+impl Frame {
+    /// Direct plus indirect radiance.
+    pub fn combined(&self) -> Vec<[f32; 3]> {
+        self.direct
+            .iter()
+            .zip(&self.indirect)
+            .map(|(d, i)| std::array::from_fn(|c| d[c] + i[c]))
+            .collect()
+    }
+}
+
 /// A VPL as the RSM stores it (the CPU reference's input).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vpl {
