@@ -41,6 +41,18 @@ pub struct DisplaceArgs {
     /// Self-shadowing by tracing from the light.
     #[arg(long)]
     shadows: bool,
+    /// Camera azimuth around the surface normal, degrees.
+    #[arg(long, default_value_t = 30.0)]
+    azimuth: f32,
+    /// Camera distance as a multiple of the default.
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f32,
+    /// Light azimuth around the surface normal, degrees.
+    #[arg(long, default_value_t = 30.0)]
+    light_azimuth: f32,
+    /// Colour pixels by the iterations their search took (0..64: black, red, yellow, white).
+    #[arg(long)]
+    show_iterations: bool,
     /// Compare every pixel with the CPU ground truth; writes an error heat map beside --out.
     #[arg(long)]
     reference: bool,
@@ -146,6 +158,10 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
         binary_steps: args.binary_steps,
         lod: args.lod,
         shadows: args.shadows,
+        azimuth_deg: args.azimuth,
+        zoom: args.zoom,
+        light_azimuth_deg: args.light_azimuth,
+        show_iterations: args.show_iterations,
     };
     if let Err(e) = settings.validate() {
         bail!("{e}");

@@ -30,5 +30,5 @@ pub enum DisplaceError {
     Settings(String),
 }
 
-pub use gpu::{Frame, Lod, Renderer, Settings};
+pub use gpu::{Frame, Lod, Renderer, Settings, Targets};
 pub use method::Method;

@@ -42,6 +42,16 @@ impl SurfaceKind {
         }
     }
 
+    /// Where the camera looks: the middle of the surface.
+    pub fn centre(self) -> Vec3 {
+        if self.is_planar() {
+            let plane = Plane::of(self);
+            plane.origin + (plane.u + plane.v) * self.tiles() as f32 / 2.0
+        } else {
+            Vec3::ZERO
+        }
+    }
+
     /// Camera distance from the surface centre.
     fn distance(self) -> f32 {
         match self {
@@ -201,8 +211,9 @@ impl Plane {
     }
 }
 
-/// Camera and light for a view angle (degrees between the view direction at the surface centre
-/// and the surface normal). The camera looks 30 degrees off the v axis so both DDA axes work.
+/// Camera and light. By default (the benchmark's camera) the view angle is the angle between the
+/// view direction at the surface centre and the surface normal, looking 30 degrees off the v axis
+/// so both DDA axes work; [`View::orbit`] puts the camera anywhere on its sphere.
 pub struct View {
     pub view_proj: Mat4,
     pub eye: Vec3,
@@ -210,33 +221,41 @@ pub struct View {
 }
 
 impl View {
-    pub fn new(kind: SurfaceKind, view_angle_deg: f32, width: u32, height: u32) -> Self {
+    /// The camera and light a frame's settings ask for.
+    pub fn of(kind: SurfaceKind, s: &crate::Settings) -> Self {
+        Self::orbit(
+            kind,
+            [s.view_angle_deg, s.azimuth_deg, s.light_azimuth_deg],
+            s.zoom,
+            s.width as f32 / s.height as f32,
+        )
+    }
+
+    /// A camera at `elevation` degrees from the surface normal (the torus: from its axis) and
+    /// `azimuth` degrees around it, `zoom` times the default distance from the surface centre;
+    /// the light to the side and above at `light_azimuth` degrees. `angles`: [elevation,
+    /// azimuth, light_azimuth].
+    pub fn orbit(kind: SurfaceKind, angles: [f32; 3], zoom: f32, aspect: f32) -> Self {
+        let [elevation_deg, azimuth_deg, light_azimuth_deg] = angles;
         let plane = Plane::of(kind);
-        let tiles = kind.tiles() as f32;
-        // The torus sits at the origin around +y: the angle is taken from its axis.
-        let centre = if kind.is_planar() {
-            plane.origin + (plane.u + plane.v) * tiles / 2.0
-        } else {
-            Vec3::ZERO
-        };
+        let centre = kind.centre();
         let n = plane.normal();
-        let azimuth = 30f32.to_radians();
+        let azimuth = azimuth_deg.to_radians();
         let away = -(plane.v * azimuth.cos() + plane.u * azimuth.sin());
         let right = plane.u * azimuth.cos() - plane.v * azimuth.sin();
-        let theta = view_angle_deg.to_radians();
-        let eye = centre + (n * theta.cos() + away * theta.sin()) * kind.distance();
+        let theta = elevation_deg.to_radians();
+        let eye = centre + (n * theta.cos() + away * theta.sin()) * kind.distance() * zoom;
         let forward = (centre - eye).normalize();
         let up = forward.cross(right);
         let view = glam::camera::rh::view::look_at_mat4(eye, centre, up);
-        let proj = glam::camera::rh::proj::directx::perspective(
-            50f32.to_radians(),
-            width as f32 / height as f32,
-            0.01,
-            100.0,
-        );
+        let proj =
+            glam::camera::rh::proj::directx::perspective(50f32.to_radians(), aspect, 0.01, 100.0);
         // A light to the side and above, low enough to cast visible self-shadows.
         let reach = if kind.is_planar() { 1.0 } else { 3.0 };
-        let light = centre + (n * 1.2 + right * 1.6 - away * 0.4) * reach;
+        let light_azimuth = light_azimuth_deg.to_radians();
+        let light_away = -(plane.v * light_azimuth.cos() + plane.u * light_azimuth.sin());
+        let light_right = plane.u * light_azimuth.cos() - plane.v * light_azimuth.sin();
+        let light = centre + (n * 1.2 + light_right * 1.6 - light_away * 0.4) * reach;
         Self {
             view_proj: proj * view,
             eye,

@@ -37,7 +37,7 @@ struct Params {
     mesh_grid: u32,      // mesh baseline: quads per side per tile
     tiles: u32,          // texture repeats per side of the surface
     bilinear_cap: u32,   // refinement rounds of section 3.3
-    _pad0: u32,
+    show_iterations: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -462,6 +462,11 @@ fn fs_surface(in: VertexOut) -> FragmentOut {
         lit = light_reaches(hit_uv, t.z, world, t_axis, b_axis, n_axis, finest);
     }
     out.color = vec4f(shade(hit_uv, world, t_axis, b_axis, n_axis, lit), 1.0);
+    if params.show_iterations == 1u {
+        // Black through red and yellow to white at 64 iterations, as the CPU heat maps.
+        let k = clamp(f32(t.iterations) / 64.0, 0.0, 1.0) * 3.0;
+        out.color = vec4f(clamp(vec3f(k, k - 1.0, k - 2.0), vec3f(0.0), vec3f(1.0)), 1.0);
+    }
     return out;
 }
 

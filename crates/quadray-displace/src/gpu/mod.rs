@@ -35,6 +35,13 @@ pub struct Settings {
     pub binary_steps: u32,
     pub lod: Lod,
     pub shadows: bool,
+    /// Camera azimuth around the surface normal (degrees), distance factor, and the light's
+    /// azimuth: the benchmark keeps the defaults; the viewer moves them.
+    pub azimuth_deg: f32,
+    pub zoom: f32,
+    pub light_azimuth_deg: f32,
+    /// Colour each pixel by the iterations its search took (0..64, black to white).
+    pub show_iterations: bool,
 }
 
 impl Default for Settings {
@@ -49,6 +56,10 @@ impl Default for Settings {
             binary_steps: 5,
             lod: Lod::Level(0),
             shadows: false,
+            azimuth_deg: 30.0,
+            zoom: 1.0,
+            light_azimuth_deg: 30.0,
+            show_iterations: false,
         }
     }
 }
@@ -77,6 +88,12 @@ impl Settings {
                 "layers {},{} must satisfy 1 <= min <= max <= 4096",
                 s.layers.0, s.layers.1
             ));
+        }
+        if !(s.azimuth_deg.is_finite() && s.light_azimuth_deg.is_finite()) {
+            return Err("azimuths must be finite".into());
+        }
+        if !(s.zoom.is_finite() && (0.05..=20.0).contains(&s.zoom)) {
+            return Err(format!("zoom {} is outside 0.05..20", s.zoom));
         }
         if s.binary_steps > 64 {
             return Err(format!("{} binary steps is more than 64", s.binary_steps));
@@ -124,7 +141,8 @@ struct Params {
     mesh_grid: u32,
     tiles: u32,
     bilinear_cap: u32,
-    _pad: [u32; 3],
+    show_iterations: u32,
+    _pad: [u32; 2],
 }
 
 /// Builds min-depth pyramids on the GPU (one compute dispatch per level).
@@ -310,6 +328,13 @@ pub fn read_pyramid(gpu: &Gpu, pyramid: &wgpu::Texture) -> Result<Vec<Vec<f32>>,
     (0..pyramid.mip_level_count())
         .map(|level| read_texture_f32(gpu, pyramid, level, 1))
         .collect()
+}
+
+/// Where a frame is drawn: `color` Rgba8UnormSrgb and `depth` Depth32Float, of the same size.
+#[derive(Clone, Copy)]
+pub struct Targets<'a> {
+    pub color: &'a wgpu::TextureView,
+    pub depth: &'a wgpu::TextureView,
 }
 
 /// One map on one surface, ready to render with any method.
@@ -571,8 +596,7 @@ impl Renderer {
             })
     }
 
-    fn write_params(&mut self, gpu: &Gpu, s: &Settings) {
-        let view = View::new(self.surface, s.view_angle_deg, s.width, s.height);
+    fn write_params(&mut self, gpu: &Gpu, s: &Settings, view: &View) {
         let plane = Plane::of(self.surface);
         let v4 = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
         let params = Params {
@@ -598,7 +622,8 @@ impl Renderer {
             mesh_grid: self.map_size,
             tiles: self.surface.tiles(),
             bilinear_cap: BILINEAR_ROUNDS,
-            _pad: [0; 3],
+            show_iterations: u32::from(s.show_iterations),
+            _pad: [0; 2],
         };
         gpu.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -629,19 +654,19 @@ impl Renderer {
         t
     }
 
+    /// Records the shading pass into `color` (Rgba8UnormSrgb) and `depth` (Depth32Float), and
+    /// into the hit and ray targets (Rgba32Float) when given. The parameters must have been
+    /// written for this frame.
     fn encode(
         &mut self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
-        s: &Settings,
-        targets: &[wgpu::Texture],
+        method: Method,
+        targets: Targets,
+        debug: Option<(&wgpu::TextureView, &wgpu::TextureView)>,
         timer: Option<&GpuTimer>,
     ) {
-        let debug_outputs = targets.len() > 2;
-        let views: Vec<_> = targets
-            .iter()
-            .map(|t| t.create_view(&Default::default()))
-            .collect();
+        let Targets { color, depth } = targets;
         let attachment = |view, clear: wgpu::Color| {
             Some(wgpu::RenderPassColorAttachment {
                 view,
@@ -665,27 +690,29 @@ impl Renderer {
             b: -2.0,
             a: 0.0,
         };
-        let mut color_attachments = vec![attachment(&views[0], sky)];
-        if debug_outputs {
-            color_attachments.push(attachment(&views[2], no_surface));
-            color_attachments.push(attachment(&views[3], no_surface));
-        } else {
-            color_attachments.extend([None, None]);
-        }
-        let bind_group = if s.method.uses_conservative_pyramid() {
+        let color_attachments = match debug {
+            Some((hits, rays)) => [
+                attachment(color, sky),
+                attachment(hits, no_surface),
+                attachment(rays, no_surface),
+            ],
+            None => [attachment(color, sky), None, None],
+        };
+        let bind_group = if method.uses_conservative_pyramid() {
             self.bind_group_conservative.clone()
         } else {
             self.bind_group_point.clone()
         };
         let tiles = self.surface.tiles();
         let grid = self.map_size;
+        let vertex_count = self.vertex_count;
         let quad = self.quad.clone();
-        let pipeline = self.pipeline(gpu, s.method, debug_outputs).clone();
+        let pipeline = self.pipeline(gpu, method, debug.is_some()).clone();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("displace"),
             color_attachments: &color_attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &views[1],
+                view: depth,
                 depth_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Clear(1.0),
                     store: wgpu::StoreOp::Discard,
@@ -697,12 +724,29 @@ impl Renderer {
         });
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        if s.method == Method::Mesh {
+        if method == Method::Mesh {
             pass.draw(0..6 * grid * grid, 0..tiles * tiles);
         } else {
             pass.set_vertex_buffer(0, quad.slice(..));
-            pass.draw(0..self.vertex_count, 0..1);
+            pass.draw(0..vertex_count, 0..1);
         }
+    }
+
+    /// Draws one frame into an application's own targets, seen from `view`. `timer`, when given,
+    /// times the pass as its query 0.
+    pub fn draw(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        s: &Settings,
+        view: &View,
+        targets: Targets,
+        timer: Option<&GpuTimer>,
+    ) -> Result<(), DisplaceError> {
+        self.check(s)?;
+        self.write_params(gpu, s, view);
+        self.encode(gpu, encoder, s.method, targets, None, timer);
+        Ok(())
     }
 
     fn check(&self, s: &Settings) -> Result<(), DisplaceError> {
@@ -719,10 +763,26 @@ impl Renderer {
     /// Renders one frame with the hit and ray outputs and reads everything back.
     pub fn render(&mut self, gpu: &Gpu, s: &Settings) -> Result<Frame, DisplaceError> {
         self.check(s)?;
-        self.write_params(gpu, s);
+        self.write_params(gpu, s, &View::of(self.surface, s));
         let targets = Self::targets(gpu, s, true);
+        let views: Vec<_> = targets
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        gpu.checked(|| self.encode(gpu, &mut encoder, s, &targets, None))?;
+        gpu.checked(|| {
+            self.encode(
+                gpu,
+                &mut encoder,
+                s.method,
+                Targets {
+                    color: &views[0],
+                    depth: &views[1],
+                },
+                Some((&views[2], &views[3])),
+                None,
+            )
+        })?;
         gpu.queue.submit([encoder.finish()]);
         let pixels = |v: Vec<f32>| -> Vec<[f32; 4]> {
             v.chunks_exact(4)
@@ -747,13 +807,30 @@ impl Renderer {
         gpu: &Gpu,
         s: &Settings,
         frames: usize,
-    ) -> Result<Option<Summary>, GpuError> {
-        self.write_params(gpu, s);
+    ) -> Result<Option<Summary>, DisplaceError> {
+        self.check(s)?;
+        let view = View::of(self.surface, s);
         let targets = Self::targets(gpu, s, false);
+        let views: Vec<_> = targets
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
         let mut timer = GpuTimer::new(gpu, 1);
         for frame in 0..frames + 2 {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            gpu.checked(|| self.encode(gpu, &mut encoder, s, &targets, Some(&timer)))?;
+            gpu.checked(|| {
+                self.draw(
+                    gpu,
+                    &mut encoder,
+                    s,
+                    &view,
+                    Targets {
+                        color: &views[0],
+                        depth: &views[1],
+                    },
+                    Some(&timer),
+                )
+            })??;
             timer.resolve(&mut encoder);
             gpu.queue.submit([encoder.finish()]);
             timer.collect(gpu)?;
