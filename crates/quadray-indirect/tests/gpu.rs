@@ -276,3 +276,54 @@ fn quadtree_nodes_match_a_cpu_rebuild() {
         assert!(valid_above_zero > 10, "some clusters are valid");
     }
 }
+
+/// The RSM's VPLs carry the flux the spot sends into its cone: with every ray of the cone landing
+/// on the floor, sum(flux / albedo) = integral of I(w) over the sphere (texel solid angles
+/// shrink as cos^3 off the axis).
+#[test]
+fn rsm_flux_adds_up_to_the_light_sent_into_the_cone() {
+    let gpu = gpu();
+    let scene = Scene::parse(
+        r#"
+        [camera]
+        position = [2.0, 2.0, 6.0]
+        target = [2.0, 1.0, 2.0]
+        fov_deg = 40.0
+        [light]
+        position = [2.0, 1.0, 2.0]
+        direction = [0.0, -1.0, 0.0]
+        cone_deg = 30.0
+        falloff_deg = 10.0
+        intensity = [3.0, 3.0, 3.0]
+        [[mesh]]
+        builtin = "room"
+        scale = 4.0
+        albedo = [0.5, 0.5, 0.5]
+        "#,
+        "floor",
+    )
+    .unwrap();
+    let mut r = Renderer::new(&gpu, &scene, settings(64)).unwrap();
+    r.render(Method::Reference, true, false).unwrap();
+    let sent: f64 = r
+        .read_vpls()
+        .unwrap()
+        .iter()
+        .map(|v| f64::from(v.flux[0]) / 0.5)
+        .sum();
+    // 2 pi * integral over theta of I(theta) sin(theta), smoothstep edge from 30 to 20 degrees
+    let (outer, inner) = (30f64.to_radians().cos(), 20f64.to_radians().cos());
+    let steps = 100_000;
+    let expected: f64 = (0..steps)
+        .map(|i| {
+            let theta = (i as f64 + 0.5) / steps as f64 * std::f64::consts::FRAC_PI_2;
+            let t = ((theta.cos() - outer) / (inner - outer)).clamp(0.0, 1.0);
+            3.0 * t * t * (3.0 - 2.0 * t) * theta.sin()
+        })
+        .sum::<f64>()
+        * std::f64::consts::FRAC_PI_2
+        / steps as f64
+        * std::f64::consts::TAU;
+    println!("RSM flux {sent} vs emitted {expected}");
+    assert!((sent / expected - 1.0).abs() < 1e-3, "{sent} vs {expected}");
+}
