@@ -162,9 +162,10 @@ impl Settings {
         if !(1..=8192).contains(&s.width) || !(1..=8192).contains(&s.height) {
             return Err(format!("size {}x{} is outside 1..8192", s.width, s.height));
         }
-        if !s.rsm_size.is_power_of_two() || !(4..=2048).contains(&s.rsm_size) {
+        // 1024^2 VPLs make a 67 MB quadtree, within every adapter's storage-buffer limit
+        if !s.rsm_size.is_power_of_two() || !(4..=1024).contains(&s.rsm_size) {
             return Err(format!(
-                "RSM size {} must be a power of two in 4..2048",
+                "RSM size {} must be a power of two in 4..1024",
                 s.rsm_size
             ));
         }
@@ -311,7 +312,7 @@ impl<'g> Renderer<'g> {
         );
         let buffers =
             gpu.checked(|| Buffers::new(gpu, scene, &settings, &samples, &pipelines, &targets))?;
-        let mut renderer = Self {
+        Ok(Self {
             gpu,
             vertex_count: (scene.triangles.len() * 3) as u32,
             timer: GpuTimer::new(gpu, Pass::ALL.len() as u32),
@@ -319,9 +320,7 @@ impl<'g> Renderer<'g> {
             pipelines,
             targets,
             buffers,
-        };
-        renderer.write_uniforms(scene);
-        Ok(renderer)
+        })
     }
 
     pub fn settings(&self) -> &Settings {
@@ -338,15 +337,6 @@ impl<'g> Renderer<'g> {
         self.settings = settings;
         self.buffers.write_cluster(self.gpu, &self.settings);
         Ok(())
-    }
-
-    /// Moves the light (and refreshes everything that depends on it on the next rebuild).
-    pub fn set_scene_light(&mut self, scene: &Scene) {
-        self.write_uniforms(scene);
-    }
-
-    fn write_uniforms(&mut self, scene: &Scene) {
-        self.buffers.write_scene(self.gpu, scene, &self.settings);
     }
 
     /// Renders one frame of `method`. With `rebuild` the light-dependent work (RSM, pyramid,

@@ -10,7 +10,7 @@ use wgpu::util::DeviceExt;
 
 const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Deepest pyramid (a 2048^2 RSM has 12 levels); bounds the per-level uniform slots.
+/// Bound on the pyramid's levels (a 1024^2 RSM has 11); the per-level uniform slots.
 const MAX_LEVELS: u32 = 16;
 
 const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
