@@ -64,6 +64,8 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
     let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
     assert!(rel_l1 > 0.0 && rel_l1 < 0.1, "{rel_l1}");
     assert!(json["error"]["rmse"].as_f64().is_some());
+    let flip = json["flip"].as_f64().unwrap();
+    assert!(flip > 0.0 && flip < 0.2, "{flip}");
     if !json["gpu_time_ms_moving"].is_null() {
         assert!(json["gpu_time_ms_moving"]["total_ms"].as_f64().unwrap() > 0.0);
         assert!(json["gpu_time_ms_static"]["passes"]["pyramid"].is_null());

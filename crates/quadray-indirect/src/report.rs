@@ -2,7 +2,7 @@
 //! error heat map) and the stats (GPU time per pass with a moving and a static light, clusters in
 //! the cut, error against the brute force).
 
-use crate::gpu::{FrameTiming, Method, Renderer, Settings};
+use crate::gpu::{Frame, FrameTiming, Method, Renderer, Settings};
 use crate::reference::{self, ImageError};
 use crate::{IndirectError, Scene};
 use quadray_core::image_out::{Rgba8Image, heat_map};
@@ -40,6 +40,8 @@ pub struct Stats {
     pub gpu_time_ms_static: Option<FrameTiming>,
     /// Error of the indirect term against the GPU brute force (with `--reference`).
     pub error: Option<ImageError>,
+    /// Mean FLIP of the tone-mapped combined picture against direct + brute-force indirect.
+    pub flip: Option<f32>,
 }
 
 pub struct Outcome {
@@ -70,6 +72,21 @@ pub fn tone_map(width: u32, height: u32, radiance: &[[f32; 3]], exposure: f32) -
             .map(|p| [encode(p[0]), encode(p[1]), encode(p[2]), 255])
             .collect(),
     }
+}
+
+/// Mean FLIP (NVIDIA's perceptual difference, 0 = identical) of `test` against `reference`.
+pub fn mean_flip(reference: &Rgba8Image, test: &Rgba8Image) -> f32 {
+    let rgb = |img: &Rgba8Image| -> Vec<u8> {
+        img.pixels.iter().flat_map(|p| [p[0], p[1], p[2]]).collect()
+    };
+    let flip_image =
+        |img: &Rgba8Image| nv_flip::FlipImageRgb8::with_data(img.width, img.height, &rgb(img));
+    let map = nv_flip::flip(
+        flip_image(reference),
+        flip_image(test),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    nv_flip::FlipPool::from_image(&map).mean()
 }
 
 /// Renders `options.method` on `scene`, times it and measures it.
@@ -107,6 +124,17 @@ pub fn run(
     let error_map = reference
         .as_ref()
         .map(|r| heat_map(w, h, &reference::error_map(&frame.indirect, r), 0.5));
+    let combined_image = tone_map(w, h, &combined, options.exposure);
+    let flip = reference.as_ref().map(|r| {
+        let truth = Frame {
+            indirect: r.clone(),
+            ..frame.clone()
+        };
+        mean_flip(
+            &tone_map(w, h, &truth.combined(), options.exposure),
+            &combined_image,
+        )
+    });
     Ok(Outcome {
         stats: Stats {
             scene: scene.name.clone(),
@@ -120,11 +148,12 @@ pub fn run(
             gpu_time_ms_moving: moving,
             gpu_time_ms_static: still,
             error,
+            flip,
             settings: s,
         },
         direct: tone_map(w, h, &frame.direct, options.exposure),
         indirect: tone_map(w, h, &frame.indirect, options.exposure),
-        combined: tone_map(w, h, &combined, options.exposure),
+        combined: combined_image,
         error_map,
     })
 }
