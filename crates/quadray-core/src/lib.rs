@@ -1,8 +1,10 @@
 //! What quadray's techniques share: image output and error heat maps, medians of timings, and the
-//! results files (JSON, markdown, SVG plots) every benchmark writes.
+//! results files (JSON, markdown, SVG plots) every benchmark writes, and the mesh loader (OBJ, glTF,
+//! PLY) the renderers share.
 
 pub mod bench;
 pub mod image_out;
+pub mod mesh;
 pub mod stats;
 
 use std::path::PathBuf;
