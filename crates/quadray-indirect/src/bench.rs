@@ -161,6 +161,26 @@ pub fn run(
             rows.push(m.row(&mut r, "2", Method::Quadtree, label)?);
         }
     }
+    // Table 2's second scene: the Buddha (100k triangles) in the Cornell room.
+    let buddha = Scene::load(&crate::scene::scenes_dir().join("cornell_buddha.toml"))?;
+    let mut rb = Renderer::new(gpu, &buddha, base.clone())?;
+    progress("table 2: Buddha brute force");
+    rb.render(Method::Reference, true, false)?;
+    let buddha_brute = rb.read_frame()?.indirect;
+    let mb = Measure {
+        brute: &buddha_brute,
+        frames,
+    };
+    for (depth, normal) in THRESHOLDS {
+        progress(&format!("table 2: Buddha {depth}/{normal}"));
+        rb.set_cluster(ClusterSettings {
+            depth_threshold: depth,
+            normal_threshold: normal,
+            ..ClusterSettings::with_limit_side(rsm_size, 32)
+        })?;
+        let label = format!("Buddha: depth {depth} normal {normal} Local, limit 32^2");
+        rows.push(mb.row(&mut rb, "2", Method::Quadtree, label)?);
+    }
     for side in [16, 32] {
         r.set_cluster(ClusterSettings::with_limit_side(rsm_size, side))?;
         progress(&format!("table 3: quadtree limit {side}^2"));
@@ -257,7 +277,10 @@ fn write_outputs(out: &Path, results: &BenchResults) -> Result<(), IndirectError
             "1",
             "Table 1: limit level (depth 0.05, normal 0.9, local rule)",
         ),
-        ("2", "Table 2: thresholds (limit 32^2)"),
+        (
+            "2",
+            "Table 2: thresholds (limit 32^2; Cornell box, then the Buddha)",
+        ),
         ("3", "Table 3: quadtree vs RSM sampling"),
     ];
     let mut md = format!(
@@ -313,7 +336,9 @@ fn write_outputs(out: &Path, results: &BenchResults) -> Result<(), IndirectError
         series("quadtree-passes, limit levels", &|r| {
             r.table == "1" && r.method == Method::QuadtreePasses
         }),
-        series("quadtree, thresholds", &|r| r.table == "2"),
+        series("quadtree, thresholds (Cornell)", &|r| {
+            r.table == "2" && !r.label.starts_with("Buddha")
+        }),
         series("RSM sampling", &|r| r.method == Method::Rsm),
     ];
     let plotted: Vec<Series> = all.into_iter().filter(|s| !s.points.is_empty()).collect();

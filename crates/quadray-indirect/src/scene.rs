@@ -4,6 +4,7 @@
 
 use glam::{Mat4, Vec3};
 use quadray_core::FileError;
+use quadray_core::mesh::load_model;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -48,6 +49,8 @@ pub struct MeshEntry {
     /// A procedural mesh: `cornell` (the box with two blocks), `room` (the box alone), `blocks`
     /// (the two blocks alone) or `atrium` (a Sponza-like courtyard, about 25k triangles).
     pub builtin: Option<String>,
+    /// Or a mesh file (OBJ + MTL, glTF 2.0, PLY), relative to the scene file.
+    pub path: Option<PathBuf>,
     #[serde(default = "default_translate")]
     pub translate: [f32; 3],
     #[serde(default = "default_scale")]
@@ -99,18 +102,24 @@ impl Scene {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "scene".into());
-        Self::parse(&text, &name).map_err(|reason| FileError::new(path, reason))
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Self::parse_in(&text, &name, dir).map_err(|reason| FileError::new(path, reason))
     }
 
-    /// Parses scene text; the error says what is wrong (the caller adds the file name).
+    /// Parses scene text without mesh files; the error says what is wrong.
     pub fn parse(text: &str, name: &str) -> Result<Self, String> {
+        Self::parse_in(text, name, Path::new("."))
+    }
+
+    /// Parses scene text whose mesh paths are relative to `dir`.
+    pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Self, String> {
         let file: SceneFile = toml::from_str(text).map_err(|e| e.to_string())?;
         if file.mesh.is_empty() {
             return Err("the scene has no [[mesh]]".into());
         }
         let mut triangles = Vec::new();
         for (i, entry) in file.mesh.iter().enumerate() {
-            let tris = mesh_triangles(entry).map_err(|e| format!("mesh {}: {e}", i + 1))?;
+            let tris = mesh_triangles(entry, dir).map_err(|e| format!("mesh {}: {e}", i + 1))?;
             triangles.extend(tris);
         }
         let scene = Self {
@@ -238,11 +247,52 @@ const WHITE: [f32; 3] = [0.73, 0.73, 0.73];
 const RED: [f32; 3] = [0.63, 0.065, 0.05];
 const GREEN: [f32; 3] = [0.14, 0.45, 0.091];
 
-fn mesh_triangles(entry: &MeshEntry) -> Result<Vec<[Vertex; 3]>, String> {
-    let Some(builtin) = &entry.builtin else {
-        return Err("needs `builtin` (mesh files are not supported yet)".into());
+/// Triangles of a mesh file with per-vertex albedo: the material's base colour times its texture
+/// sampled at the vertex (the RSM and G-buffer carry albedo per vertex, not per texel).
+fn file_triangles(path: &Path) -> Result<Vec<[Vertex; 3]>, String> {
+    let model = load_model(path).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    for mesh in &model.meshes {
+        let material = model.materials.get(mesh.material);
+        let base = material.map_or(Vec3::ONE, |m| m.base_color);
+        let albedo = |i: usize| -> [f32; 3] {
+            let texel = material
+                .and_then(|m| m.base_color_texture.as_ref())
+                .zip(mesh.uvs.as_ref())
+                .map_or(Vec3::ONE, |(tex, uvs)| texture_at(tex, uvs[i]));
+            (base * texel).clamp(Vec3::ZERO, Vec3::ONE).into()
+        };
+        for tri in &mesh.indices {
+            out.push(tri.map(|i| {
+                let i = i as usize;
+                Vertex {
+                    position: mesh.positions[i].into(),
+                    normal: mesh.normals[i].into(),
+                    albedo: albedo(i),
+                }
+            }));
+        }
+    }
+    Ok(out)
+}
+
+/// Nearest texel at `uv` (wrapping; (0, 0) is the top-left corner), decoded from sRGB.
+fn texture_at(tex: &quadray_core::image_out::Rgba8Image, uv: glam::Vec2) -> Vec3 {
+    let wrap = |t: f32, n: u32| ((t - t.floor()) * n as f32).min(n as f32 - 1.0) as u32;
+    let p = tex.pixels[(wrap(uv.y, tex.height) * tex.width + wrap(uv.x, tex.width)) as usize];
+    let linear = |c: u8| {
+        let c = f32::from(c) / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
     };
-    let mut tris = match builtin.as_str() {
+    Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))
+}
+
+fn builtin_triangles(name: &str) -> Result<Vec<[Vertex; 3]>, String> {
+    Ok(match name {
         "cornell" => {
             let mut t = cornell_room();
             t.extend(cornell_blocks());
@@ -256,6 +306,15 @@ fn mesh_triangles(entry: &MeshEntry) -> Result<Vec<[Vertex; 3]>, String> {
                 "unknown builtin `{other}` (known: cornell, room, blocks, atrium)"
             ));
         }
+    })
+}
+
+fn mesh_triangles(entry: &MeshEntry, dir: &Path) -> Result<Vec<[Vertex; 3]>, String> {
+    let mut tris = match (&entry.builtin, &entry.path) {
+        (Some(_), Some(_)) => return Err("has both `builtin` and `path`".into()),
+        (None, None) => return Err("needs `builtin` or `path`".into()),
+        (None, Some(path)) => file_triangles(&dir.join(path))?,
+        (Some(builtin), None) => builtin_triangles(builtin)?,
     };
     if !(entry.scale.is_finite() && entry.scale > 0.0) {
         return Err(format!("scale {} must be positive", entry.scale));
@@ -550,6 +609,36 @@ mod tests {
                 "no degenerate triangles"
             );
         }
+    }
+
+    #[test]
+    fn scenes_with_mesh_files_load_in_the_unit_room() {
+        for (file, min_triangles) in [
+            ("cornell_obj.toml", 30),
+            ("cornell_bunny.toml", 60_000),
+            ("cornell_buddha.toml", 90_000),
+        ] {
+            let scene = Scene::load(&scenes_dir().join(file)).unwrap();
+            assert!(scene.triangles.len() >= min_triangles, "{file}");
+            let (lo, hi) = scene.bounds();
+            assert!(
+                lo.min_element() > -0.01 && hi.max_element() < 1.01,
+                "{file}: {lo} {hi}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_malformed_mesh_file_is_named_in_the_error() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/malformed/obj");
+        let text = CORNELL_TOML.replace("builtin = \"cornell\"", "path = \"empty.obj\"");
+        let err = Scene::parse_in(&text, "bad", &dir).unwrap_err();
+        assert!(err.contains("empty.obj"), "{err}");
+        let both = CORNELL_TOML.replace(
+            "builtin = \"cornell\"",
+            "builtin = \"room\"\npath = \"x.obj\"",
+        );
+        assert!(Scene::parse(&both, "bad").unwrap_err().contains("both"));
     }
 
     #[test]
