@@ -78,7 +78,7 @@ pub struct DisplaceArgs {
     stats: Option<PathBuf>,
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once('x')
         .ok_or_else(|| format!("`{s}` is not WxH"))?;

@@ -2,6 +2,7 @@
 //! benchmarks. Each subcommand lives in its own module.
 
 mod displace;
+mod indirect;
 mod raytrace;
 
 use anyhow::Result;
@@ -28,6 +29,8 @@ enum Command {
     Displace(displace::DisplaceArgs),
     /// Whitted ray tracing on a uniform grid with hybrid shadow testing.
     Raytrace(raytrace::RaytraceArgs),
+    /// One-bounce indirect light from a light quadtree, its baselines and reference.
+    Indirect(indirect::IndirectArgs),
     /// Render the side-by-side pictures of every technique from the bundled assets.
     Demo {
         #[arg(long, default_value = "out/demo")]
@@ -61,6 +64,14 @@ enum Bench {
         #[arg(long, default_value = "out/bench/displace")]
         out: PathBuf,
     },
+    /// Tables 1-3 and the error-vs-time plot of the light-quadtree paper.
+    Indirect {
+        /// 64x64 image and RSM, 3 frames per median: seconds on a software rasterizer.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long, default_value = "out/bench/indirect")]
+        out: PathBuf,
+    },
 }
 
 fn spinner(what: &str) -> ProgressBar {
@@ -86,6 +97,7 @@ fn main() -> Result<()> {
         Command::Bench {
             what: Bench::Shadows { quick, out },
         } => raytrace::bench(quick, &out)?,
+        Command::Indirect(args) => indirect::run_indirect(args)?,
         Command::Demo { out, size } => {
             if !(16..=4096).contains(&size) {
                 anyhow::bail!("--size {size} is outside 16..4096");
@@ -97,7 +109,7 @@ fn main() -> Result<()> {
                     bar.set_message(format!("displacement: {m}"))
                 })?;
             bar.finish_and_clear();
-            for f in files {
+            for f in files.into_iter().chain(indirect::demo(&gpu, &out, size)?) {
                 println!("{}", f.display());
             }
         }
@@ -116,6 +128,9 @@ fn main() -> Result<()> {
             println!("{}", std::fs::read_to_string(out.join("results.md"))?);
             println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);
         }
+        Command::Bench {
+            what: Bench::Indirect { quick, out },
+        } => indirect::bench(quick, &out)?,
     }
     Ok(())
 }

@@ -108,14 +108,7 @@ fn raytrace_bad_input_is_a_clear_error() {
             "--size",
         ),
         (
-            &[
-                "raytrace",
-                "--builtin",
-                "stars",
-                "--nth=-3",
-                "--out",
-                out,
-            ],
+            &["raytrace", "--builtin", "stars", "--nth=-3", "--out", out],
             "--nth",
         ),
         (

@@ -1,0 +1,149 @@
+//! `quadray indirect`: one scene, one method, pictures and stats (and the error against the brute
+//! force with `--reference`).
+
+use anyhow::{Context, Result};
+use clap::Args;
+use quadray_core::bench::write_json;
+use quadray_gpu::Gpu;
+use quadray_indirect::report::{RunOptions, run};
+use quadray_indirect::{ClusterSettings, Method, Scene, Settings, Validity};
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub struct IndirectArgs {
+    /// Scene file (TOML); default: the bundled Cornell box.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// quadtree (compacted cut), quadtree-passes (the paper's per-level passes), rsm (RSM
+    /// sampling) or reference (every VPL).
+    #[arg(long, default_value = "quadtree")]
+    method: Method,
+    /// Side of the reflective shadow map (power of two).
+    #[arg(long, default_value_t = 512)]
+    rsm_size: u32,
+    /// Level where every cluster is accepted (mip level: 0 = the RSM, each level halves the
+    /// side); default: the level of 64x64 nodes.
+    #[arg(long)]
+    limit_level: Option<u32>,
+    /// Level the traversal starts at; default: the level of 8x8 nodes.
+    #[arg(long)]
+    start_level: Option<u32>,
+    /// Max |child depth - mean depth| of a valid cluster (depth in units of the scene's extent).
+    #[arg(long, default_value_t = 0.05)]
+    depth_threshold: f32,
+    /// Min dot(child normal, mean normal) of a valid cluster.
+    #[arg(long, default_value_t = 0.9)]
+    normal_threshold: f32,
+    /// local (the paper's) or recursive (every child valid too).
+    #[arg(long, default_value = "local")]
+    validity: Validity,
+    /// Cluster means weighted by texel count instead of flux.
+    #[arg(long)]
+    unweighted_means: bool,
+    /// RSM-sampling samples per pixel.
+    #[arg(long, default_value_t = 256)]
+    samples: u32,
+    /// Indirect at one sample per KxK pixels, upsampled where the geometry agrees (quadtree).
+    #[arg(long, default_value_t = 1)]
+    subsample: u32,
+    /// Image size WxH.
+    #[arg(long, default_value = "512x512", value_parser = crate::displace::parse_size)]
+    size: (u32, u32),
+    /// Also render the brute force; adds rmse / rel_l1 to the stats and an error heat map
+    /// beside --out.
+    #[arg(long)]
+    reference: bool,
+    /// Frames timed per light mode (median).
+    #[arg(long, default_value_t = 20)]
+    frames: u32,
+    /// Radiance scale before tone mapping.
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long)]
+    stats: Option<PathBuf>,
+}
+
+/// `picture.png` -> `picture.SUFFIX.png`.
+fn beside(out: &Path, suffix: &str) -> PathBuf {
+    let stem = out.file_stem().unwrap_or_default().to_string_lossy();
+    out.with_file_name(format!("{stem}.{suffix}.png"))
+}
+
+pub fn run_indirect(args: IndirectArgs) -> Result<()> {
+    let scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::cornell(),
+    };
+    let defaults = ClusterSettings::defaults(args.rsm_size.max(1));
+    let settings = Settings {
+        width: args.size.0,
+        height: args.size.1,
+        rsm_size: args.rsm_size,
+        cluster: ClusterSettings {
+            start_level: args.start_level.unwrap_or(defaults.start_level),
+            limit_level: args.limit_level.unwrap_or(defaults.limit_level),
+            depth_threshold: args.depth_threshold,
+            normal_threshold: args.normal_threshold,
+            validity: args.validity,
+            flux_weighted: !args.unweighted_means,
+        },
+        samples: args.samples,
+        subsample: args.subsample,
+        ..Settings::default()
+    };
+    if !(args.exposure.is_finite() && args.exposure > 0.0) {
+        anyhow::bail!("--exposure {} must be positive", args.exposure);
+    }
+    let gpu = Gpu::new()?;
+    let outcome = run(
+        &gpu,
+        &scene,
+        settings,
+        &RunOptions {
+            method: args.method,
+            frames: args.frames,
+            reference: args.reference,
+            exposure: args.exposure,
+        },
+    )
+    .context("rendering")?;
+    outcome.combined.save_png(&args.out)?;
+    outcome.direct.save_png(&beside(&args.out, "direct"))?;
+    outcome.indirect.save_png(&beside(&args.out, "indirect"))?;
+    if let Some(map) = &outcome.error_map {
+        map.save_png(&beside(&args.out, "error"))?;
+    }
+    if let Some(path) = &args.stats {
+        write_json(path, &outcome.stats)?;
+    }
+    println!("{}", serde_json::to_string_pretty(&outcome.stats)?);
+    Ok(())
+}
+
+/// `quadray bench indirect`.
+pub fn bench(quick: bool, out: &Path) -> Result<()> {
+    let gpu = Gpu::new()?;
+    let bar = crate::spinner("bench indirect");
+    let results = quadray_indirect::bench::run(
+        &gpu,
+        out,
+        quadray_indirect::bench::BenchOptions { quick },
+        |m| bar.set_message(format!("bench indirect: {m}")),
+    )?;
+    bar.finish_and_clear();
+    println!("{}", std::fs::read_to_string(out.join("results.md"))?);
+    println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);
+    Ok(())
+}
+
+/// The indirect-light pictures of `quadray demo`.
+pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
+    let bar = crate::spinner("indirect light");
+    let files = quadray_indirect::demo::render_demo(gpu, &out.join("indirect"), size, |m| {
+        bar.set_message(format!("indirect light: {m}"))
+    })?;
+    bar.finish_and_clear();
+    Ok(files)
+}

@@ -1,0 +1,102 @@
+//! The `quadray indirect` contract: option names, the stats JSON fields, the pictures and the
+//! error heat map beside the output, and clear errors on bad scenes and parameters.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn quadray(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_quadray"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("run quadray")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("quadray-indirect-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn indirect_writes_pictures_stats_and_the_error_map() {
+    let dir = scratch("ok");
+    let out = dir.join("cornell.png");
+    let stats = dir.join("cornell.json");
+    let run = quadray(&[
+        "indirect",
+        "--method",
+        "quadtree-passes",
+        "--rsm-size",
+        "32",
+        "--size",
+        "48x32",
+        "--validity",
+        "recursive",
+        "--frames",
+        "2",
+        "--reference",
+        "--out",
+        out.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for name in [
+        "cornell.png",
+        "cornell.direct.png",
+        "cornell.indirect.png",
+        "cornell.error.png",
+    ] {
+        assert!(dir.join(name).exists(), "{name}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(json["method"], "quadtree-passes");
+    assert_eq!(json["width"], 48);
+    assert_eq!(json["height"], 32);
+    assert_eq!(json["rsm_size"], 32);
+    assert!(json["clusters_in_cut"].as_u64().unwrap() > 0);
+    let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
+    assert!(rel_l1 > 0.0 && rel_l1 < 0.1, "{rel_l1}");
+    assert!(json["error"]["rmse"].as_f64().is_some());
+    let flip = json["flip"].as_f64().unwrap();
+    assert!(flip > 0.0 && flip < 0.2, "{flip}");
+    if !json["gpu_time_ms_moving"].is_null() {
+        assert!(json["gpu_time_ms_moving"]["total_ms"].as_f64().unwrap() > 0.0);
+        assert!(json["gpu_time_ms_static"]["passes"]["pyramid"].is_null());
+    }
+}
+
+#[test]
+fn bad_scenes_and_parameters_are_refused_with_a_reason() {
+    let dir = scratch("bad");
+    let out = dir.join("x.png");
+    let scene = dir.join("bad.toml");
+    std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();
+    let cases: [(Vec<&str>, &str); 4] = [
+        (vec!["--scene", scene.to_str().unwrap()], "bad.toml"),
+        (vec!["--scene", "/nonexistent/scene.toml"], "scene.toml"),
+        (vec!["--rsm-size", "100"], "power of two"),
+        (vec!["--method", "photon"], "photon"),
+    ];
+    for (extra, needle) in cases {
+        let mut args = vec![
+            "indirect",
+            "--out",
+            out.to_str().unwrap(),
+            "--size",
+            "16x16",
+        ];
+        args.extend(extra);
+        let run = quadray(&args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success());
+        assert!(err.contains(needle), "{err} should mention {needle}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}

@@ -1,0 +1,137 @@
+//! The pictures of `quadray demo`: direct, indirect and combined light on the Cornell box with the
+//! brute force and the error heat map beside them; the paper's figure 9 (quadtree against RSM
+//! sampling at equal time and at 2040 samples); the atrium.
+
+use crate::gpu::{ClusterSettings, Method, Renderer, Settings};
+use crate::reference::{compare, error_map};
+use crate::report::tone_map;
+use crate::{IndirectError, Scene};
+use quadray_core::image_out::{Rgba8Image, heat_map, montage};
+use quadray_gpu::Gpu;
+use std::path::{Path, PathBuf};
+
+const EXPOSURE: f32 = 1.0;
+const FRAMES: u32 = 5;
+
+fn settings(gpu: &Gpu, width: u32, height: u32, samples: u32) -> Settings {
+    // the brute force beside every picture costs pixels x VPLs: small RSMs on a CPU rasterizer
+    let rsm_size = if gpu.is_software() { 32 } else { 512 };
+    Settings {
+        width,
+        height,
+        rsm_size,
+        cluster: ClusterSettings::defaults(rsm_size),
+        samples,
+        ..Settings::default()
+    }
+}
+
+fn caption_ms(ms: Option<f64>) -> String {
+    ms.map_or(String::new(), |t| format!(" {t:.2}ms"))
+}
+
+/// Renders every demo picture into `out` and returns the files written.
+pub fn render_demo(
+    gpu: &Gpu,
+    out: &Path,
+    size: u32,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<PathBuf>, IndirectError> {
+    let mut files = Vec::new();
+    let scene = Scene::cornell();
+    progress("cornell: quadtree and brute force");
+    let mut r = Renderer::new(gpu, &scene, settings(gpu, size, size, 256))?;
+    r.render(Method::Reference, true, false)?;
+    let brute = r.read_frame()?.indirect;
+    r.render(Method::Quadtree, true, false)?;
+    let quadtree_ms = r.time(Method::Quadtree, false, FRAMES)?.map(|t| t.total_ms);
+    r.render(Method::Quadtree, true, false)?;
+    let frame = r.read_frame()?;
+    let clusters = r.clusters_in_cut()?;
+    let combined = frame.combined();
+    let e = compare(&frame.indirect, &brute);
+    let tile = |v: &[[f32; 3]]| tone_map(size, size, v, EXPOSURE);
+    let picture = montage(
+        &[
+            ("direct".into(), tile(&frame.direct)),
+            (
+                format!("indirect, {clusters} clusters"),
+                tile(&frame.indirect),
+            ),
+            ("combined".into(), tile(&combined)),
+            ("brute force indirect".into(), tile(&brute)),
+            (
+                format!("error (white 50%), L1 {:.3}", e.rel_l1),
+                heat_map(size, size, &error_map(&frame.indirect, &brute), 0.5),
+            ),
+        ],
+        3,
+    );
+    files.push(save(&picture, &out.join("cornell.png"))?);
+
+    progress("figure 9: RSM sampling at equal time");
+    let mut tiles: Vec<(String, Rgba8Image)> = vec![(
+        format!("quadtree{} L1 {:.3}", caption_ms(quadtree_ms), e.rel_l1),
+        tile(&frame.indirect),
+    )];
+    let mut rsm_runs = Vec::new();
+    for samples in [16, 64, 216, 2040] {
+        let mut rs = Renderer::new(gpu, &scene, settings(gpu, size, size, samples))?;
+        rs.render(Method::Rsm, true, false)?;
+        let ms = rs.time(Method::Rsm, false, FRAMES)?.map(|t| t.total_ms);
+        let image = rs.read_frame()?.indirect;
+        rsm_runs.push((samples, ms, image));
+    }
+    // the sample count whose time is closest to the quadtree's (216 without timestamps)
+    let equal_time = rsm_runs
+        .iter()
+        .filter(|(s, _, _)| *s != 2040)
+        .min_by(|a, b| {
+            let gap = |ms: Option<f64>| match (ms, quadtree_ms) {
+                (Some(a), Some(b)) => (a - b).abs(),
+                _ => f64::MAX,
+            };
+            gap(a.1).total_cmp(&gap(b.1))
+        })
+        .filter(|_| quadtree_ms.is_some())
+        .or_else(|| rsm_runs.iter().find(|(s, _, _)| *s == 216));
+    for (samples, ms, image) in rsm_runs
+        .iter()
+        .filter(|run| equal_time.is_some_and(|e| e.0 == run.0) || run.0 == 2040)
+    {
+        let err = compare(image, &brute).rel_l1;
+        tiles.push((
+            format!("RSM {samples}{} L1 {err:.3}", caption_ms(*ms)),
+            tile(image),
+        ));
+    }
+    files.push(save(
+        &montage(&tiles, 3),
+        &out.join("figure9_equal_time.png"),
+    )?);
+
+    progress("atrium");
+    let atrium = Scene::load(&crate::scene::scenes_dir().join("atrium.toml"))?;
+    let (w, h) = (size * 16 / 9, size);
+    let mut r = Renderer::new(gpu, &atrium, settings(gpu, w, h, 256))?;
+    r.render(Method::Quadtree, true, false)?;
+    let frame = r.read_frame()?;
+    let combined = frame.combined();
+    let pictures = montage(
+        &[
+            ("direct".into(), tone_map(w, h, &frame.direct, EXPOSURE)),
+            (
+                "direct + indirect".into(),
+                tone_map(w, h, &combined, EXPOSURE),
+            ),
+        ],
+        2,
+    );
+    files.push(save(&pictures, &out.join("atrium.png"))?);
+    Ok(files)
+}
+
+fn save(image: &Rgba8Image, path: &Path) -> Result<PathBuf, IndirectError> {
+    image.save_png(path)?;
+    Ok(path.to_path_buf())
+}

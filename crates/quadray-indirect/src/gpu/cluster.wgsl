@@ -1,0 +1,116 @@
+// The light quadtree: pack the RSM into level 0, reduce level by level (summed flux, means),
+// mark valid clusters (local or recursive rule), and compact the cut into a list.
+
+struct Level {
+    level: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: ClusterParams;
+@group(0) @binding(1) var<uniform> current: Level;
+@group(0) @binding(2) var rsm_flux: texture_2d<f32>;
+@group(0) @binding(3) var rsm_pos: texture_2d<f32>;
+@group(0) @binding(4) var rsm_normal: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read_write> nodes: array<Node>;
+@group(0) @binding(6) var<storage, read_write> cut: array<u32>;
+@group(0) @binding(7) var<storage, read_write> cut_count: atomic<u32>;
+
+@compute @workgroup_size(8, 8)
+fn pack(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= params.rsm_size || id.y >= params.rsm_size) {
+        return;
+    }
+    let t = vec2<i32>(id.xy);
+    let n = textureLoad(rsm_normal, t, 0);
+    var node: Node;
+    node.flux = vec4<f32>(textureLoad(rsm_flux, t, 0).rgb, n.w);
+    node.pos = textureLoad(rsm_pos, t, 0);
+    node.normal = vec4<f32>(n.xyz, 1.0);
+    nodes[node_index(params, 0u, id.xy)] = node;
+}
+
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// One level from the one below: sums of flux and texel counts, weighted means of position, depth
+// and normal over the non-empty children (weights: flux luminance, or texel counts).
+@compute @workgroup_size(8, 8)
+fn reduce(@builtin(global_invocation_id) id: vec3<u32>) {
+    let level = current.level;
+    let size = level_size(params, level);
+    if (id.x >= size || id.y >= size) {
+        return;
+    }
+    var flux = vec4<f32>(0.0);
+    var pos = vec4<f32>(0.0);
+    var normal = vec3<f32>(0.0);
+    var weight = 0.0;
+    var count_pos = vec4<f32>(0.0);
+    var count_normal = vec3<f32>(0.0);
+    for (var c = 0u; c < 4u; c++) {
+        let child = nodes[node_index(params, level - 1u, id.xy * 2u + vec2<u32>(c & 1u, c >> 1u))];
+        flux += child.flux;
+        let w = select(child.flux.w, luminance(child.flux.rgb), params.flux_weighted != 0u);
+        pos += w * child.pos;
+        normal += w * child.normal.xyz;
+        weight += w;
+        count_pos += child.flux.w * child.pos;
+        count_normal += child.flux.w * child.normal.xyz;
+    }
+    // Black surfaces carry no flux: fall back to texel counts so their means stay defined.
+    if (weight <= 0.0) {
+        pos = count_pos;
+        normal = count_normal;
+        weight = flux.w;
+    }
+    var node: Node;
+    node.flux = flux;
+    node.pos = select(vec4<f32>(0.0), pos / weight, weight > 0.0);
+    let len = length(normal);
+    node.normal = vec4<f32>(select(vec3<f32>(0.0), normal / len, len > 0.0), 0.0);
+    nodes[node_index(params, level, id.xy)] = node;
+}
+
+// Valid when every non-empty child is close to the mean in depth and direction (the paper's local
+// rule); the recursive rule also wants every child valid. Empty nodes are valid (they add nothing).
+@compute @workgroup_size(8, 8)
+fn validity(@builtin(global_invocation_id) id: vec3<u32>) {
+    let level = current.level;
+    let size = level_size(params, level);
+    if (id.x >= size || id.y >= size) {
+        return;
+    }
+    let index = node_index(params, level, id.xy);
+    let mean = nodes[index];
+    var valid = true;
+    for (var c = 0u; c < 4u; c++) {
+        let child = nodes[node_index(params, level - 1u, id.xy * 2u + vec2<u32>(c & 1u, c >> 1u))];
+        if (child.flux.w > 0.5) {
+            let close = abs(child.pos.w - mean.pos.w) < params.depth_threshold
+                && dot(child.normal.xyz, mean.normal.xyz) > params.normal_threshold;
+            let child_ok = params.recursive == 0u || child.normal.w > 0.5;
+            valid = valid && close && child_ok;
+        }
+    }
+    nodes[index].normal.w = select(0.0, 1.0, valid);
+}
+
+// One thread per node of the levels limit..start (stored contiguously); appends the cut's nodes.
+@compute @workgroup_size(256)
+fn select_cut(@builtin(global_invocation_id) id: vec3<u32>) {
+    let first = level_offset(params, params.limit_level);
+    let end = level_offset(params, params.start_level + 1u);
+    let index = first + id.x;
+    if (index >= end) {
+        return;
+    }
+    var level = params.limit_level;
+    while (level < params.start_level && index >= level_offset(params, level + 1u)) {
+        level++;
+    }
+    let local = index - level_offset(params, level);
+    let size = level_size(params, level);
+    if (in_cut(params, level, vec2<u32>(local % size, local / size))) {
+        cut[atomicAdd(&cut_count, 1u)] = index;
+    }
+}

@@ -1,0 +1,56 @@
+// Shared by every pass that reads clusters: the node layout, pyramid addressing, the VPL kernel
+// and the top-down cut rule. Concatenated in front of cluster.wgsl, shade.wgsl and baselines.wgsl.
+
+// One light cluster (a level-0 node is one RSM texel = one VPL).
+//   flux.rgb: summed flux, flux.w: number of texels that see geometry
+//   pos.xyz: mean position, pos.w: mean RSM depth (light-axis distance / scene extent)
+//   normal.xyz: renormalised mean normal, normal.w: 1 when the cluster is valid
+struct Node {
+    flux: vec4<f32>,
+    pos: vec4<f32>,
+    normal: vec4<f32>,
+}
+
+struct ClusterParams {
+    rsm_size: u32,
+    // number of levels: log2(rsm_size) + 1
+    levels: u32,
+    start_level: u32,
+    limit_level: u32,
+    recursive: u32,
+    flux_weighted: u32,
+    depth_threshold: f32,
+    normal_threshold: f32,
+}
+
+// Hard cap of every per-pixel loop (the longest legitimate one is the 512^2 brute force).
+const LOOP_CAP: u32 = 4194304u;
+const PI: f32 = 3.14159265358979;
+
+fn level_size(p: ClusterParams, level: u32) -> u32 {
+    return p.rsm_size >> level;
+}
+
+// Index of the first node of `level` (levels are stored finest first).
+fn level_offset(p: ClusterParams, level: u32) -> u32 {
+    var offset = 0u;
+    for (var l = 0u; l < min(level, 16u); l++) {
+        let s = p.rsm_size >> l;
+        offset += s * s;
+    }
+    return offset;
+}
+
+fn node_index(p: ClusterParams, level: u32, xy: vec2<u32>) -> u32 {
+    return level_offset(p, level) + xy.y * level_size(p, level) + xy.x;
+}
+
+// Irradiance at x (normal n) from a VPL or cluster of flux `flux` at xp (normal np), with the
+// 1/r^4 clamped at r_min (the spec's kernel; the reference uses the same). A diffuse VPL radiates
+// flux / pi * cos: the 1/pi the spec's formula (after the RSM paper) leaves out is put back so
+// that indirect and direct light are on the same scale; errors are ratios and do not change.
+fn vpl_irradiance(flux: vec3<f32>, xp: vec3<f32>, np: vec3<f32>, x: vec3<f32>, n: vec3<f32>, r_min: f32) -> vec3<f32> {
+    let d = x - xp;
+    let d2 = max(dot(d, d), r_min * r_min);
+    return flux * (max(0.0, dot(np, d)) * max(0.0, dot(n, -d)) / (PI * d2 * d2));
+}

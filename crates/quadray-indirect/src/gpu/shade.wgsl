@@ -1,0 +1,134 @@
+// Indirect light from the light quadtree: from the compacted cut, or the paper's way with one
+// pass per level; optionally at low resolution with geometry-aware upsampling. Direct light from
+// the spot with the RSM depth as shadow map.
+
+fn cut_irradiance(r: Receiver) -> vec3<f32> {
+    var e = vec3<f32>(0.0);
+    let count = min(min(cut_count, arrayLength(&cut)), LOOP_CAP);
+    for (var i = 0u; i < count; i++) {
+        e += node_irradiance(nodes[cut[i]], r);
+    }
+    return e;
+}
+
+@compute @workgroup_size(8, 8)
+fn indirect_cut(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= shade.width || id.y >= shade.height) {
+        return;
+    }
+    let r = receiver(id.xy);
+    var e = vec3<f32>(0.0);
+    if (r.covered) {
+        e = cut_irradiance(r);
+    }
+    indirect[pixel_index(id.xy)] = vec4<f32>(r.albedo / PI * e, 0.0);
+}
+
+// One level of the paper's traversal: every node of the level, used when the top-down rule says
+// so; adds to what the coarser levels' passes left (the buffer is cleared before the first).
+@compute @workgroup_size(8, 8)
+fn indirect_level(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= shade.width || id.y >= shade.height) {
+        return;
+    }
+    let r = receiver(id.xy);
+    if (!r.covered) {
+        return;
+    }
+    let level = current.level;
+    let size = level_size(params, level);
+    var e = vec3<f32>(0.0);
+    for (var i = 0u; i < min(size * size, LOOP_CAP); i++) {
+        let xy = vec2<u32>(i % size, i / size);
+        if (in_cut(params, level, xy)) {
+            e += node_irradiance(nodes[level_offset(params, level) + i], r);
+        }
+    }
+    let index = pixel_index(id.xy);
+    indirect[index] += vec4<f32>(r.albedo / PI * e, 0.0);
+}
+
+// The full-resolution pixel a low-resolution sample stands for.
+fn low_pixel(low_xy: vec2<u32>) -> vec2<u32> {
+    let p = low_xy * shade.subsample + vec2<u32>(shade.subsample / 2u);
+    return min(p, vec2<u32>(shade.width - 1u, shade.height - 1u));
+}
+
+@compute @workgroup_size(8, 8)
+fn indirect_low(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= shade.low_width || id.y >= shade.low_height) {
+        return;
+    }
+    let r = receiver(low_pixel(id.xy));
+    var e = vec3<f32>(0.0);
+    if (r.covered) {
+        e = cut_irradiance(r);
+    }
+    low[id.y * shade.low_width + id.x] = vec4<f32>(e, select(0.0, 1.0, r.covered));
+}
+
+// Bilinear over the four nearest low-resolution samples that lie on the same surface (normals
+// and planes agree); where none does, the pixel is recomputed from the cut.
+@compute @workgroup_size(8, 8)
+fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= shade.width || id.y >= shade.height) {
+        return;
+    }
+    let r = receiver(id.xy);
+    let index = pixel_index(id.xy);
+    if (!r.covered) {
+        indirect[index] = vec4<f32>(0.0);
+        return;
+    }
+    let k = f32(shade.subsample);
+    let f = (vec2<f32>(id.xy) + 0.5 - vec2<f32>(f32(shade.subsample / 2u) + 0.5)) / k;
+    let base = vec2<i32>(floor(f));
+    let t = f - vec2<f32>(base);
+    var e = vec3<f32>(0.0);
+    var weight = 0.0;
+    for (var c = 0u; c < 4u; c++) {
+        let o = vec2<i32>(i32(c & 1u), i32(c >> 1u));
+        let s = clamp(base + o, vec2<i32>(0), vec2<i32>(i32(shade.low_width) - 1, i32(shade.low_height) - 1));
+        let q = receiver(low_pixel(vec2<u32>(s)));
+        let agree = q.covered && dot(q.n, r.n) > shade.normal_agreement
+            && abs(dot(q.x - r.x, r.n)) < shade.plane_agreement;
+        let w = select(1.0 - t.x, t.x, o.x == 1) * select(1.0 - t.y, t.y, o.y == 1);
+        if (agree && w > 0.0) {
+            e += w * low[u32(s.y) * shade.low_width + u32(s.x)].rgb;
+            weight += w;
+        }
+    }
+    if (weight > 1e-3) {
+        indirect[index] = vec4<f32>(r.albedo / PI * e / weight, 0.0);
+    } else {
+        indirect[index] = vec4<f32>(r.albedo / PI * cut_irradiance(r), 1.0);
+    }
+}
+
+// Direct light from the spot, shadowed by the RSM depth.
+@compute @workgroup_size(8, 8)
+fn direct_light(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= shade.width || id.y >= shade.height) {
+        return;
+    }
+    let r = receiver(id.xy);
+    var l = vec3<f32>(0.0);
+    if (r.covered) {
+        let clip = light.view_proj * vec4<f32>(r.x, 1.0);
+        let ndc = clip.xyz / clip.w;
+        let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+        let size = i32(params.rsm_size);
+        let texel = clamp(vec2<i32>(floor(uv * f32(size))), vec2<i32>(0), vec2<i32>(size - 1));
+        let occluder = textureLoad(rsm_pos, texel, 0);
+        let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && clip.w > 0.0;
+        let lit = textureLoad(rsm_normal, texel, 0).w < 0.5
+            || light_depth(light, r.x) <= occluder.w + shade.depth_bias;
+        if (inside && lit) {
+            let to_light = light.position.xyz - r.x;
+            let d2 = dot(to_light, to_light);
+            let w = to_light / sqrt(d2);
+            l = r.albedo / PI * spot_intensity(light, -w) * max(0.0, dot(r.n, w)) / d2;
+        }
+    }
+    direct[pixel_index(id.xy)] = vec4<f32>(l, 1.0);
+}

@@ -1,0 +1,69 @@
+// What every per-pixel shading pass sees (the quadtree's, the baselines' and the reference's).
+
+struct Shade {
+    width: u32,
+    height: u32,
+    r_min: f32,
+    sample_count: u32,
+    // sub-sampled indirect: one sample per `subsample` x `subsample` pixels
+    subsample: u32,
+    low_width: u32,
+    low_height: u32,
+    // shadow-map bias in RSM depth units
+    depth_bias: f32,
+    // geometry agreement for upsampling: normals' dot and plane distance (world units)
+    normal_agreement: f32,
+    plane_agreement: f32,
+    pad0: u32,
+    pad1: u32,
+}
+
+struct Level {
+    level: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: ClusterParams;
+@group(0) @binding(1) var<uniform> shade: Shade;
+@group(0) @binding(2) var<uniform> current: Level;
+@group(0) @binding(3) var<uniform> light: Light;
+@group(0) @binding(4) var g_pos: texture_2d<f32>;
+@group(0) @binding(5) var g_normal: texture_2d<f32>;
+@group(0) @binding(6) var g_albedo: texture_2d<f32>;
+@group(0) @binding(7) var rsm_flux: texture_2d<f32>;
+@group(0) @binding(8) var rsm_pos: texture_2d<f32>;
+@group(0) @binding(9) var rsm_normal: texture_2d<f32>;
+@group(0) @binding(10) var<storage, read> nodes: array<Node>;
+@group(0) @binding(11) var<storage, read> cut: array<u32>;
+@group(0) @binding(12) var<storage, read> cut_count: u32;
+// rgb: indirect radiance (or irradiance for the low-resolution pass), w: 1 when recomputed
+@group(0) @binding(13) var<storage, read_write> indirect: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read_write> direct: array<vec4<f32>>;
+@group(0) @binding(15) var<storage, read_write> low: array<vec4<f32>>;
+// xy: offset in RSM texels, z: weight
+@group(0) @binding(16) var<storage, read> samples: array<vec4<f32>>;
+
+struct Receiver {
+    x: vec3<f32>,
+    n: vec3<f32>,
+    albedo: vec3<f32>,
+    covered: bool,
+}
+
+fn receiver(pixel: vec2<u32>) -> Receiver {
+    let t = vec2<i32>(pixel);
+    let p = textureLoad(g_pos, t, 0);
+    var r: Receiver;
+    r.x = p.xyz;
+    r.n = textureLoad(g_normal, t, 0).xyz;
+    r.albedo = textureLoad(g_albedo, t, 0).rgb;
+    r.covered = p.w > 0.5;
+    return r;
+}
+
+fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
+    return vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, shade.r_min);
+}
+
+fn pixel_index(pixel: vec2<u32>) -> u32 {
+    return pixel.y * shade.width + pixel.x;
+}

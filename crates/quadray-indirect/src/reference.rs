@@ -1,0 +1,121 @@
+//! Ground truth on the CPU: the indirect radiance of every receiver from every VPL, with the same
+//! kernel (including the r_min clamp) as the GPU, summed in f64. For small RSMs and images only.
+
+use crate::gpu::{Receiver, Vpl};
+use rayon::prelude::*;
+
+/// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none), with
+/// E_p = flux_p / pi * cos_p * cos / max(r^2, r_min^2) (the spec's kernel with a diffuse VPL's 1/pi).
+pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> Vec<[f32; 3]> {
+    let r_min2 = f64::from(r_min).powi(2);
+    receivers
+        .par_iter()
+        .map(|r| {
+            let Some(r) = r else {
+                return [0.0; 3];
+            };
+            let v = |a: [f32; 3]| a.map(f64::from);
+            let (x, n) = (v(r.position), v(r.normal));
+            let mut e = [0.0f64; 3];
+            for p in vpls {
+                let (xp, np) = (v(p.position), v(p.normal));
+                let d = [x[0] - xp[0], x[1] - xp[1], x[2] - xp[2]];
+                let d2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(r_min2);
+                let emit = (np[0] * d[0] + np[1] * d[1] + np[2] * d[2]).max(0.0);
+                let receive = -(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
+                let g = emit * receive.max(0.0) / (std::f64::consts::PI * d2 * d2);
+                for (e, flux) in e.iter_mut().zip(p.flux) {
+                    *e += f64::from(flux) * g;
+                }
+            }
+            std::array::from_fn(|c| (f64::from(r.albedo[c]) / std::f64::consts::PI * e[c]) as f32)
+        })
+        .collect()
+}
+
+/// Error of an image against a reference (both linear RGB, same size).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ImageError {
+    pub rmse: f64,
+    /// sum |a - b| / sum |b| over every pixel and channel.
+    pub rel_l1: f64,
+    /// max |a - b| / max |b|.
+    pub rel_max: f64,
+}
+
+pub fn compare(image: &[[f32; 3]], reference: &[[f32; 3]]) -> ImageError {
+    assert_eq!(image.len(), reference.len(), "images of different sizes");
+    let (mut sq, mut abs, mut norm, mut max_diff, mut max_ref) = (0.0, 0.0, 0.0, 0.0f64, 0.0f64);
+    for (a, b) in image.iter().flatten().zip(reference.iter().flatten()) {
+        let (a, b) = (f64::from(*a), f64::from(*b));
+        sq += (a - b).powi(2);
+        abs += (a - b).abs();
+        norm += b.abs();
+        max_diff = max_diff.max((a - b).abs());
+        max_ref = max_ref.max(b.abs());
+    }
+    let count = (image.len() * 3).max(1) as f64;
+    ImageError {
+        rmse: (sq / count).sqrt(),
+        rel_l1: if norm > 0.0 { abs / norm } else { abs },
+        rel_max: if max_ref > 0.0 {
+            max_diff / max_ref
+        } else {
+            max_diff
+        },
+    }
+}
+
+/// Per-pixel relative error |a - b| summed over channels / (mean |b| per pixel), for heat maps.
+pub fn error_map(image: &[[f32; 3]], reference: &[[f32; 3]]) -> Vec<f32> {
+    let mean: f32 =
+        reference.iter().flatten().map(|v| v.abs()).sum::<f32>() / reference.len().max(1) as f32;
+    image
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).sum::<f32>() / mean.max(1e-20))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_vpl_facing_a_receiver_gives_the_inverse_square_law() {
+        // VPL at the origin facing +z, receiver at distance 2 facing back: cosines 1,
+        // E = flux / (4 pi), radiance = albedo / pi * E
+        let vpl = Vpl {
+            flux: [4.0, 8.0, 0.0],
+            position: [0.0; 3],
+            normal: [0.0, 0.0, 1.0],
+        };
+        let receiver = Receiver {
+            position: [0.0, 0.0, 2.0],
+            normal: [0.0, 0.0, -1.0],
+            albedo: [1.0, 0.5, 1.0],
+        };
+        let out = brute_force(&[vpl], &[Some(receiver), None], 0.1);
+        let pi = std::f32::consts::PI;
+        assert!((out[0][0] - 1.0 / (pi * pi)).abs() < 1e-6);
+        assert!((out[0][1] - 1.0 / (pi * pi)).abs() < 1e-6);
+        assert_eq!(out[1], [0.0; 3]);
+        // closer than r_min the 1/r^4 is clamped: d = 0.05, r_min = 0.1 -> d^2 / r_min^4 = 0.25
+        let near = Receiver {
+            position: [0.0, 0.0, 0.05],
+            ..receiver
+        };
+        let out = brute_force(&[vpl], &[Some(near)], 0.1);
+        assert!((out[0][0] - 4.0 * 0.0025 / 1e-4 / (pi * pi)).abs() < 1e-3);
+    }
+
+    #[test]
+    fn errors_of_a_scaled_image() {
+        let reference = vec![[1.0, 2.0, 3.0]; 4];
+        let scaled: Vec<_> = reference.iter().map(|p| p.map(|v| v * 1.1)).collect();
+        let e = compare(&scaled, &reference);
+        assert!((e.rel_l1 - 0.1).abs() < 1e-6);
+        assert!((e.rel_max - 0.1).abs() < 1e-6);
+        assert_eq!(compare(&reference, &reference).rmse, 0.0);
+    }
+}

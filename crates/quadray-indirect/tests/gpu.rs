@@ -1,0 +1,329 @@
+//! The GPU paths against ground truth on whatever adapter the machine has (lavapipe in CI), at
+//! tiny sizes: the GPU brute force against the CPU one, the quadtree with every cluster a single
+//! VPL against the brute force, the per-level passes against the compacted cut, and the error of
+//! the default thresholds.
+
+use quadray_gpu::Gpu;
+use quadray_indirect::reference::{self, compare};
+use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings, Validity};
+
+fn settings(rsm_size: u32) -> Settings {
+    Settings {
+        width: 64,
+        height: 64,
+        rsm_size,
+        cluster: ClusterSettings::defaults(rsm_size),
+        samples: 64,
+        ..Settings::default()
+    }
+}
+
+fn gpu() -> Gpu {
+    Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)")
+}
+
+fn render(r: &mut Renderer, method: Method) -> Vec<[f32; 3]> {
+    r.render(method, true, false).unwrap();
+    r.read_frame().unwrap().indirect
+}
+
+#[test]
+fn gpu_brute_force_matches_the_cpu_reference() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(32)).unwrap();
+    let gpu_image = render(&mut r, Method::Reference);
+    let vpls = r.read_vpls().unwrap();
+    let receivers = r.read_receivers().unwrap();
+    assert!(
+        vpls.len() > 500,
+        "the spot sees the room: {} VPLs",
+        vpls.len()
+    );
+    assert!(receivers.iter().filter(|r| r.is_some()).count() > 2000);
+    let cpu_image = reference::brute_force(&vpls, &receivers, scene.r_min);
+    let lit = cpu_image
+        .iter()
+        .filter(|p| p.iter().sum::<f32>() > 0.0)
+        .count();
+    assert!(lit > 2000, "indirect light reaches most pixels ({lit})");
+    let e = compare(&gpu_image, &cpu_image);
+    println!("GPU vs CPU brute force: {e:?}");
+    assert!(e.rel_l1 < 1e-5 && e.rel_max < 1e-4, "{e:?}");
+}
+
+#[test]
+fn quadtree_with_every_cluster_one_vpl_equals_the_brute_force() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut s = settings(32);
+    s.cluster = ClusterSettings::every_vpl(32);
+    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    let brute = render(&mut r, Method::Reference);
+    for validity in [Validity::Local, Validity::Recursive] {
+        r.set_cluster(ClusterSettings {
+            validity,
+            ..ClusterSettings::every_vpl(32)
+        })
+        .unwrap();
+        let cut = render(&mut r, Method::Quadtree);
+        assert_eq!(
+            r.clusters_in_cut().unwrap() as usize,
+            r.read_vpls().unwrap().len(),
+            "the cut is every VPL"
+        );
+        let passes = render(&mut r, Method::QuadtreePasses);
+        for (name, image) in [("cut", cut), ("passes", passes)] {
+            let e = compare(&image, &brute);
+            println!("{validity:?} {name} with every VPL vs brute force: {e:?}");
+            assert!(e.rel_max < 1e-5, "{name}: {e:?}");
+        }
+    }
+}
+
+#[test]
+fn per_level_passes_give_the_compacted_cut_image() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(64)).unwrap();
+    for (validity, depth, normal) in [
+        (Validity::Local, 0.05, 0.9),
+        (Validity::Recursive, 0.05, 0.9),
+        (Validity::Local, 0.45, 0.3),
+    ] {
+        r.set_cluster(ClusterSettings {
+            validity,
+            depth_threshold: depth,
+            normal_threshold: normal,
+            ..ClusterSettings::with_limit_side(64, 32)
+        })
+        .unwrap();
+        let cut = render(&mut r, Method::Quadtree);
+        let clusters = r.clusters_in_cut().unwrap();
+        let passes = render(&mut r, Method::QuadtreePasses);
+        let e = compare(&passes, &cut);
+        println!("{validity:?} {depth}/{normal}: {clusters} clusters, passes vs cut {e:?}");
+        assert!(clusters > 16 && clusters < 64 * 64 / 4, "{clusters}");
+        assert!(e.rel_max < 1e-5, "{e:?}");
+    }
+}
+
+#[test]
+fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(128)).unwrap();
+    let brute = render(&mut r, Method::Reference);
+    for validity in [Validity::Local, Validity::Recursive] {
+        for limit_side in [32, 64] {
+            r.set_cluster(ClusterSettings {
+                validity,
+                ..ClusterSettings::with_limit_side(128, limit_side)
+            })
+            .unwrap();
+            let image = render(&mut r, Method::Quadtree);
+            let e = compare(&image, &brute);
+            println!(
+                "{validity:?}, limit {limit_side}^2, {} clusters: {e:?}",
+                r.clusters_in_cut().unwrap()
+            );
+            // the default limit (64^2) meets the target; 32^2 is the paper's faster setting
+            let bound = if limit_side == 64 { 0.05 } else { 0.10 };
+            assert!(e.rel_l1 < bound, "{e:?}");
+        }
+    }
+}
+
+#[test]
+fn rsm_sampling_converges_to_the_brute_force() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut errors = Vec::new();
+    for samples in [16, 256] {
+        let mut r = Renderer::new(
+            &gpu,
+            &scene,
+            Settings {
+                samples,
+                ..settings(32)
+            },
+        )
+        .unwrap();
+        let brute = render(&mut r, Method::Reference);
+        let image = render(&mut r, Method::Rsm);
+        errors.push(compare(&image, &brute).rel_l1);
+    }
+    println!("RSM sampling rel_l1 at 16 and 256 samples: {errors:?}");
+    assert!(errors[1] < 0.7 * errors[0], "{errors:?}");
+}
+
+#[test]
+fn subsampled_indirect_stays_close_to_full_resolution() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let mut r = Renderer::new(&gpu, &scene, settings(32)).unwrap();
+    let full = render(&mut r, Method::Quadtree);
+    let mut r = Renderer::new(
+        &gpu,
+        &scene,
+        Settings {
+            subsample: 4,
+            ..settings(32)
+        },
+    )
+    .unwrap();
+    r.render(Method::Quadtree, true, false).unwrap();
+    let frame = r.read_frame().unwrap();
+    let e = compare(&frame.indirect, &full);
+    println!(
+        "subsample 4 vs full: {e:?}, {} pixels recomputed",
+        frame.recomputed
+    );
+    assert!(frame.recomputed > 0 && frame.recomputed < 64 * 64 / 2);
+    assert!(e.rel_l1 < 0.10, "{e:?}");
+}
+
+#[test]
+fn absurd_settings_are_refused() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    for bad in [
+        Settings {
+            rsm_size: 48,
+            ..settings(32)
+        },
+        Settings {
+            cluster: ClusterSettings {
+                limit_level: 4,
+                start_level: 2,
+                ..ClusterSettings::defaults(32)
+            },
+            ..settings(32)
+        },
+        Settings {
+            cluster: ClusterSettings {
+                depth_threshold: f32::NAN,
+                ..ClusterSettings::defaults(32)
+            },
+            ..settings(32)
+        },
+        Settings {
+            width: 0,
+            ..settings(32)
+        },
+    ] {
+        assert!(Renderer::new(&gpu, &scene, bad).is_err());
+    }
+}
+
+/// The pyramid and validity maps as built on the GPU, checked node by node on the CPU: sums of
+/// flux and texel counts, weighted means, and both validity rules.
+#[test]
+fn quadtree_nodes_match_a_cpu_rebuild() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let size = 32u32;
+    let mut r = Renderer::new(&gpu, &scene, settings(size)).unwrap();
+    for validity in [Validity::Local, Validity::Recursive] {
+        let cluster = ClusterSettings {
+            validity,
+            ..ClusterSettings::defaults(size)
+        };
+        r.set_cluster(cluster).unwrap();
+        r.render(Method::Quadtree, true, false).unwrap();
+        let nodes = r.read_nodes().unwrap();
+        let mut offset = 0usize;
+        let mut valid_above_zero = 0;
+        for level in 1..=size.ilog2() {
+            let child_side = (size >> (level - 1)) as usize;
+            let side = child_side / 2;
+            let child_offset = offset;
+            offset += child_side * child_side;
+            for y in 0..side {
+                for x in 0..side {
+                    let node = nodes[offset + y * side + x];
+                    let children: Vec<_> = (0..4)
+                        .map(|c| nodes[child_offset + (2 * y + c / 2) * child_side + 2 * x + c % 2])
+                        .collect();
+                    let count: f32 = children.iter().map(|c| c[0][3]).sum();
+                    let flux: f32 = children.iter().map(|c| c[0][0]).sum();
+                    assert_eq!(node[0][3], count);
+                    assert!((node[0][0] - flux).abs() <= 1e-5 * flux.abs() + 1e-12);
+                    let lum =
+                        |c: &[[f32; 4]; 3]| 0.2126 * c[0][0] + 0.7152 * c[0][1] + 0.0722 * c[0][2];
+                    let weight: f32 = children.iter().map(lum).sum();
+                    if weight > 0.0 {
+                        let depth: f32 =
+                            children.iter().map(|c| lum(c) * c[1][3]).sum::<f32>() / weight;
+                        assert!(
+                            (node[1][3] - depth).abs() < 1e-4,
+                            "{} vs {depth}",
+                            node[1][3]
+                        );
+                    }
+                    let mut valid = true;
+                    for c in children.iter().filter(|c| c[0][3] > 0.5) {
+                        let dot: f32 = (0..3).map(|i| c[2][i] * node[2][i]).sum();
+                        valid &= (c[1][3] - node[1][3]).abs() < cluster.depth_threshold
+                            && dot > cluster.normal_threshold
+                            && (validity == Validity::Local || c[2][3] > 0.5);
+                    }
+                    assert_eq!(node[2][3] > 0.5, valid, "level {level} node {x},{y}");
+                    valid_above_zero += usize::from(valid && count > 0.0);
+                }
+            }
+        }
+        assert!(valid_above_zero > 10, "some clusters are valid");
+    }
+}
+
+/// The RSM's VPLs carry the flux the spot sends into its cone: with every ray of the cone landing
+/// on the floor, sum(flux / albedo) = integral of I(w) over the sphere (texel solid angles
+/// shrink as cos^3 off the axis).
+#[test]
+fn rsm_flux_adds_up_to_the_light_sent_into_the_cone() {
+    let gpu = gpu();
+    let scene = Scene::parse(
+        r#"
+        [camera]
+        position = [2.0, 2.0, 6.0]
+        target = [2.0, 1.0, 2.0]
+        fov_deg = 40.0
+        [light]
+        position = [2.0, 1.0, 2.0]
+        direction = [0.0, -1.0, 0.0]
+        cone_deg = 30.0
+        falloff_deg = 10.0
+        intensity = [3.0, 3.0, 3.0]
+        [[mesh]]
+        builtin = "room"
+        scale = 4.0
+        albedo = [0.5, 0.5, 0.5]
+        "#,
+        "floor",
+    )
+    .unwrap();
+    let mut r = Renderer::new(&gpu, &scene, settings(64)).unwrap();
+    r.render(Method::Reference, true, false).unwrap();
+    let sent: f64 = r
+        .read_vpls()
+        .unwrap()
+        .iter()
+        .map(|v| f64::from(v.flux[0]) / 0.5)
+        .sum();
+    // 2 pi * integral over theta of I(theta) sin(theta), smoothstep edge from 30 to 20 degrees
+    let (outer, inner) = (30f64.to_radians().cos(), 20f64.to_radians().cos());
+    let steps = 100_000;
+    let expected: f64 = (0..steps)
+        .map(|i| {
+            let theta = (i as f64 + 0.5) / steps as f64 * std::f64::consts::FRAC_PI_2;
+            let t = ((theta.cos() - outer) / (inner - outer)).clamp(0.0, 1.0);
+            3.0 * t * t * (3.0 - 2.0 * t) * theta.sin()
+        })
+        .sum::<f64>()
+        * std::f64::consts::FRAC_PI_2
+        / steps as f64
+        * std::f64::consts::TAU;
+    println!("RSM flux {sent} vs emitted {expected}");
+    assert!((sent / expected - 1.0).abs() < 1e-3, "{sent} vs {expected}");
+}
