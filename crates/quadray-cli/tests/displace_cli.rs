@@ -1,30 +1,13 @@
 //! The `quadray displace` contract other tools rely on: option names, the stats JSON fields, the
 //! heat map beside the output, and clear errors (never a panic) on bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
-}
-
-fn quadray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_quadray"))
-        .args(args)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .expect("run quadray")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("quadray-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{assets, quadray, scratch};
 
 #[test]
 fn displace_writes_the_picture_the_stats_and_the_error_map() {
-    let dir = scratch("ok");
+    let dir = scratch("displace-ok");
     let map = assets().join("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
     let out = dir.join("tiles.png");
     let stats = dir.join("tiles.json");
@@ -85,7 +68,7 @@ fn displace_writes_the_picture_the_stats_and_the_error_map() {
 
 #[test]
 fn bad_input_gets_a_clear_error_and_no_panic() {
-    let dir = scratch("bad");
+    let dir = scratch("displace-bad");
     let out = dir.join("x.png");
     let tiles = assets().join("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
     let bevy = assets().join("heightmaps/bevy_parallax/cube_depth.png");

@@ -1,26 +1,13 @@
 //! The `quadray indirect` contract: option names, the stats JSON fields, the pictures and the
 //! error heat map beside the output, and clear errors on bad scenes and parameters.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn quadray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_quadray"))
-        .args(args)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .expect("run quadray")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("quadray-indirect-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{quadray, scratch};
 
 #[test]
 fn indirect_writes_pictures_stats_and_the_error_map() {
-    let dir = scratch("ok");
+    let dir = scratch("indirect-ok");
     let out = dir.join("cornell.png");
     let stats = dir.join("cornell.json");
     let run = quadray(&[
@@ -74,7 +61,7 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
 
 #[test]
 fn bad_scenes_and_parameters_are_refused_with_a_reason() {
-    let dir = scratch("bad");
+    let dir = scratch("indirect-bad");
     let out = dir.join("x.png");
     let scene = dir.join("bad.toml");
     std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();

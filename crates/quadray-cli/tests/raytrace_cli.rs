@@ -1,30 +1,13 @@
 //! The `quadray raytrace` contract: option names, the stats JSON fields of issue 4, the demo scene
 //! file from the assets, and clear errors (never a panic) on bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
-}
-
-fn quadray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_quadray"))
-        .args(args)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .expect("run quadray")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("quadray-raytrace-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{assets, quadray, scratch};
 
 #[test]
 fn raytrace_writes_the_picture_and_the_stats() {
-    let dir = scratch("ok");
+    let dir = scratch("raytrace-ok");
     let (out, stats) = (dir.join("demo.png"), dir.join("demo.json"));
     let scene = assets().join("scenes/shadows-demo.toml");
     let run = quadray(&[
@@ -85,7 +68,7 @@ fn raytrace_writes_the_picture_and_the_stats() {
 
 #[test]
 fn raytrace_bad_input_is_a_clear_error() {
-    let dir = scratch("bad");
+    let dir = scratch("raytrace-bad");
     let bad_scene = dir.join("bad.toml");
     std::fs::write(&bad_scene, "[camera]\neye = [0, 0, 0]\n").unwrap();
     let out = dir.join("x.png");
