@@ -24,7 +24,7 @@ pub struct DisplaceArgs {
     #[arg(long, default_value_t = 45.0)]
     view_angle: f32,
     /// Image size WxH.
-    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
     size: (u32, u32),
     /// Texture units per unit of depth (Bevy's default 0.1).
     #[arg(long, default_value_t = 0.1)]
@@ -76,18 +76,6 @@ pub struct DisplaceArgs {
     out: PathBuf,
     #[arg(long)]
     stats: Option<PathBuf>,
-}
-
-pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once('x')
-        .ok_or_else(|| format!("`{s}` is not WxH"))?;
-    let n = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("`{s}` is not WxH"))
-    };
-    Ok((n(w)?, n(h)?))
 }
 
 fn parse_layers(s: &str) -> Result<(u32, u32), String> {

@@ -47,7 +47,7 @@ pub struct IndirectArgs {
     #[arg(long, default_value_t = 1)]
     subsample: u32,
     /// Image size WxH.
-    #[arg(long, default_value = "512x512", value_parser = crate::displace::parse_size)]
+    #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
     size: (u32, u32),
     /// Also render the brute force; adds rmse / rel_l1 to the stats and an error heat map
     /// beside --out.

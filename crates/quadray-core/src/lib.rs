@@ -26,3 +26,16 @@ impl FileError {
         }
     }
 }
+
+/// Parses an image size written `WxH` (command lines).
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("`{s}` is not WxH"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}` is not WxH"))
+    };
+    Ok((n(w)?, n(h)?))
+}

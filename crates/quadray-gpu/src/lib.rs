@@ -7,7 +7,7 @@
 mod readback;
 mod timer;
 
-pub use readback::{read_texture_f32, read_texture_rgba8};
+pub use readback::{read_buffer, read_texture_f32, read_texture_rgba8};
 pub use timer::{GpuTimer, TimingSummary};
 
 use thiserror::Error;

@@ -49,20 +49,8 @@ pub struct Args {
     #[arg(long, default_value = "quadray-view.png")]
     screenshot: PathBuf,
     /// Size of the 3-D view in a scripted run (the window fits it and the panel).
-    #[arg(long, default_value = "512x384", value_parser = parse_size)]
+    #[arg(long, default_value = "512x384", value_parser = quadray_core::parse_size)]
     view_size: (u32, u32),
-}
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once('x')
-        .ok_or_else(|| format!("`{s}` is not WxH"))?;
-    let n = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("`{s}` is not WxH"))
-    };
-    Ok((n(w)?, n(h)?))
 }
 
 fn main() -> Result<()> {

@@ -5,7 +5,7 @@ use crate::IndirectError;
 use crate::baselines;
 use crate::scene::{Scene, Vertex};
 use glam::Vec3;
-use quadray_gpu::{Gpu, GpuError, GpuTimer};
+use quadray_gpu::{Gpu, GpuTimer};
 use wgpu::util::DeviceExt;
 
 const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -406,30 +406,7 @@ impl Buffers {
     }
 
     fn read_bytes(&self, gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, IndirectError> {
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: buffer.size(),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-        gpu.queue.submit([encoder.finish()]);
-        let slice = staging.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        gpu.wait()?;
-        rx.recv()
-            .map_err(|e| GpuError::Readback(e.to_string()))?
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let bytes = slice
-            .get_mapped_range()
-            .map_err(|e| GpuError::Readback(e.to_string()))?
-            .to_vec();
-        staging.unmap();
-        Ok(bytes)
+        Ok(quadray_gpu::read_buffer(gpu, buffer)?)
     }
 
     pub fn read_vec4(
