@@ -59,6 +59,18 @@ pub struct IndirectArgs {
     /// Radiance scale before tone mapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
+    /// Camera position X,Y,Z instead of the scene file's.
+    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
+    camera_position: Option<[f32; 3]>,
+    /// Camera target X,Y,Z instead of the scene file's.
+    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
+    camera_target: Option<[f32; 3]>,
+    /// Spot light position X,Y,Z instead of the scene file's.
+    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
+    light_position: Option<[f32; 3]>,
+    /// Spot light direction X,Y,Z instead of the scene file's.
+    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
+    light_direction: Option<[f32; 3]>,
     #[arg(long)]
     out: PathBuf,
     #[arg(long)]
@@ -72,10 +84,24 @@ fn beside(out: &Path, suffix: &str) -> PathBuf {
 }
 
 pub fn run_indirect(args: IndirectArgs) -> Result<()> {
-    let scene = match &args.scene {
+    let mut scene = match &args.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::cornell(),
     };
+    let overrides = [
+        (&mut scene.camera.position, args.camera_position),
+        (&mut scene.camera.target, args.camera_target),
+        (&mut scene.light.position, args.light_position),
+        (&mut scene.light.direction, args.light_direction),
+    ];
+    for (value, given) in overrides {
+        if let Some(v) = given {
+            *value = v;
+        }
+    }
+    scene
+        .validate()
+        .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;
     let defaults = ClusterSettings::defaults(args.rsm_size.max(1));
     let settings = Settings {
         width: args.size.0,
@@ -114,6 +140,9 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     outcome.indirect.save_png(&beside(&args.out, "indirect"))?;
     if let Some(map) = &outcome.error_map {
         map.save_png(&beside(&args.out, "error"))?;
+    }
+    if let Some(cut) = &outcome.cut_view {
+        cut.save_png(&beside(&args.out, "cut"))?;
     }
     if let Some(path) = &args.stats {
         write_json(path, &outcome.stats)?;

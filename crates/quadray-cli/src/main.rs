@@ -5,7 +5,7 @@ mod displace;
 mod indirect;
 mod raytrace;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::ProgressBar;
 use std::path::PathBuf;
@@ -31,6 +31,12 @@ enum Command {
     Raytrace(raytrace::RaytraceArgs),
     /// One-bounce indirect light from a light quadtree, its baselines and reference.
     Indirect(indirect::IndirectArgs),
+    /// Open the interactive viewer: runs the `quadray-view` program installed beside this one
+    /// (its own crate, so quadray builds without windowing); every argument is passed on.
+    View {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
     /// Render the side-by-side pictures of every technique from the bundled assets.
     Demo {
         #[arg(long, default_value = "out/demo")]
@@ -88,6 +94,20 @@ fn main() -> Result<()> {
         .with_writer(std::io::stderr)
         .init();
     match Cli::parse().command {
+        Command::View { args } => {
+            let viewer = std::env::current_exe()?
+                .with_file_name(format!("quadray-view{}", std::env::consts::EXE_SUFFIX));
+            let status = std::process::Command::new(&viewer)
+                .args(args)
+                .status()
+                .with_context(|| {
+                    format!(
+                        "cannot start the viewer {} (build it: cargo build --release -p quadray-viewer)",
+                        viewer.display()
+                    )
+                })?;
+            std::process::exit(status.code().unwrap_or(1));
+        }
         Command::Adapter => {
             let gpu = quadray_gpu::Gpu::new()?;
             println!("{}", gpu.describe());

@@ -65,11 +65,17 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
     let out = dir.join("x.png");
     let scene = dir.join("bad.toml");
     std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();
-    let cases: [(Vec<&str>, &str); 4] = [
+    let cases: [(Vec<&str>, &str); 7] = [
         (vec!["--scene", scene.to_str().unwrap()], "bad.toml"),
         (vec!["--scene", "/nonexistent/scene.toml"], "scene.toml"),
         (vec!["--rsm-size", "100"], "power of two"),
         (vec!["--method", "photon"], "photon"),
+        (vec!["--camera-position", "1,2"], "X,Y,Z"),
+        (vec!["--light-direction", "0,NaN,0"], "finite"),
+        (
+            vec!["--light-direction", "0,0,0"],
+            "light direction is zero",
+        ),
     ];
     for (extra, needle) in cases {
         let mut args = vec![
@@ -86,4 +92,49 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         assert!(err.contains(needle), "{err} should mention {needle}");
         assert!(!err.contains("panicked"), "{err}");
     }
+}
+
+#[test]
+fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
+    let dir = scratch("indirect-view");
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec![
+            "indirect",
+            "--rsm-size",
+            "32",
+            "--size",
+            "48x48",
+            "--frames",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let run = quadray(&args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        image::open(&out).unwrap().to_rgb8().into_raw()
+    };
+    let base = render("base.png", &[]);
+    // the scene file's own camera given explicitly: the same picture
+    let same = render(
+        "same.png",
+        &[
+            "--camera-position",
+            "0.5,0.5,2.4",
+            "--camera-target",
+            "0.5,0.5,0",
+        ],
+    );
+    assert_eq!(base, same);
+    let turned = render("turned.png", &["--light-direction=0.3,-1,0.2"]);
+    assert_ne!(base, turned);
+    let moved = render("moved.png", &["--camera-position", "0.2,0.6,2.0"]);
+    assert_ne!(base, moved);
+    let cut = image::open(dir.join("base.cut.png")).unwrap();
+    assert_eq!((cut.width(), cut.height()), (512, 512));
 }

@@ -28,6 +28,19 @@ impl FileError {
 }
 
 /// Parses an image size written `WxH` (command lines).
+/// Parses `X,Y,Z` (a point or direction on a command line); every coordinate must be finite.
+pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<f32> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("`{s}` is not X,Y,Z"))?;
+    match parts[..] {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
+        _ => Err(format!("`{s}` is not X,Y,Z with finite numbers")),
+    }
+}
+
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once('x')

@@ -4,7 +4,7 @@
 
 use crate::gpu::{ClusterSettings, Method, Renderer, Settings};
 use crate::reference::{compare, error_map};
-use crate::report::tone_map;
+use crate::report::{cut_view, tone_map};
 use crate::{IndirectError, Scene};
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
@@ -68,6 +68,12 @@ pub fn render_demo(
         3,
     );
     files.push(save(&picture, &out.join("cornell.png"))?);
+    let cut = cut_view(r.settings().rsm_size, &r.read_rsm_flux()?, &r.read_cut()?);
+    let cut_picture = montage(
+        &[(format!("the cut over the RSM: {clusters} clusters"), cut)],
+        1,
+    );
+    files.push(save(&cut_picture, &out.join("cornell_cut.png"))?);
 
     progress("figure 9: RSM sampling at equal time");
     let mut tiles: Vec<(String, Rgba8Image)> = vec![(

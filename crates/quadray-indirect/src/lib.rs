@@ -24,5 +24,7 @@ pub enum IndirectError {
     Settings(String),
 }
 
-pub use gpu::{ClusterSettings, Frame, FrameTiming, Method, Pass, Renderer, Settings, Validity};
+pub use gpu::{
+    ClusterSettings, CutNode, Frame, FrameTiming, Method, Pass, Renderer, Settings, Validity,
+};
 pub use scene::Scene;

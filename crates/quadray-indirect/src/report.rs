@@ -2,7 +2,7 @@
 //! error heat map) and the stats (GPU time per pass with a moving and a static light, clusters in
 //! the cut, error against the brute force).
 
-use crate::gpu::{Frame, FrameTiming, Method, Renderer, Settings};
+use crate::gpu::{CutNode, Frame, FrameTiming, Method, Renderer, Settings};
 use crate::reference::{self, ImageError};
 use crate::{IndirectError, Scene};
 use quadray_core::image_out::{Rgba8Image, heat_map};
@@ -51,6 +51,8 @@ pub struct Outcome {
     pub combined: Rgba8Image,
     /// Per-pixel |error| / mean reference radiance, black 0 to white 0.5.
     pub error_map: Option<Rgba8Image>,
+    /// The cut over the RSM (quadtree methods), see [`cut_view`].
+    pub cut_view: Option<Rgba8Image>,
 }
 
 /// Exposure, then 1 - exp(-x) and the sRGB curve.
@@ -72,6 +74,52 @@ pub fn tone_map(width: u32, height: u32, radiance: &[[f32; 3]], exposure: f32) -
             .map(|p| [encode(p[0]), encode(p[1]), encode(p[2]), 255])
             .collect(),
     }
+}
+
+/// Outline colours of the cut's clusters by level (0 = single VPLs).
+const LEVEL_COLOURS: [[u8; 4]; 6] = [
+    [255, 255, 255, 255],
+    [255, 64, 64, 255],
+    [255, 200, 0, 255],
+    [64, 220, 64, 255],
+    [64, 160, 255, 255],
+    [230, 90, 255, 255],
+];
+
+/// The selected clusters over the RSM that they cluster: the RSM's flux (exposed by its mean over
+/// lit texels), magnified to at least 512 pixels, with every cluster of the cut outlined in a
+/// colour by its level (white single VPLs, then red, yellow, green, blue, violet going up).
+pub fn cut_view(rsm_size: u32, flux: &[[f32; 3]], cut: &[CutNode]) -> Rgba8Image {
+    let zoom = (512 / rsm_size).max(1);
+    let side = rsm_size * zoom;
+    let luminance = |p: &[f32; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let (sum, lit) = flux
+        .iter()
+        .map(luminance)
+        .filter(|&l| l > 0.0)
+        .fold((0.0, 0u32), |(s, n), l| (s + l, n + 1));
+    let exposure = if sum > 0.0 { lit as f32 / sum } else { 1.0 };
+    let rsm = tone_map(rsm_size, rsm_size, flux, exposure);
+    let mut image = Rgba8Image {
+        width: side,
+        height: side,
+        pixels: (0..side * side)
+            .map(|i| rsm.pixels[((i / side / zoom) * rsm_size + i % side / zoom) as usize])
+            .collect(),
+    };
+    for node in cut {
+        let colour = LEVEL_COLOURS[node.level as usize % LEVEL_COLOURS.len()];
+        let n = (1 << node.level) * zoom;
+        let (x0, y0) = (node.x * n, node.y * n);
+        // top and left edges: neighbours draw the others, so every boundary is drawn once
+        for i in 0..n.min(side - x0) {
+            image.pixels[(y0 * side + x0 + i) as usize] = colour;
+        }
+        for i in 0..n.min(side - y0) {
+            image.pixels[((y0 + i) * side + x0) as usize] = colour;
+        }
+    }
+    image
 }
 
 /// Mean FLIP (NVIDIA's perceptual difference, 0 = identical) of `test` against `reference`.
@@ -105,11 +153,14 @@ pub fn run(
         None
     };
     // The compacted cut's size is the size of the set both quadtree methods use.
-    let clusters_in_cut = if method.uses_quadtree() {
+    let (clusters_in_cut, cut) = if method.uses_quadtree() {
         renderer.render(Method::Quadtree, true, false)?;
-        Some(renderer.clusters_in_cut()?)
+        let cut = renderer.read_cut()?;
+        let rsm_size = renderer.settings().rsm_size;
+        let picture = cut_view(rsm_size, &renderer.read_rsm_flux()?, &cut);
+        (Some(cut.len() as u32), Some(picture))
     } else {
-        None
+        (None, None)
     };
     let moving = renderer.time(method, true, options.frames)?;
     let still = renderer.time(method, false, options.frames)?;
@@ -155,5 +206,6 @@ pub fn run(
         indirect: tone_map(w, h, &frame.indirect, options.exposure),
         combined: combined_image,
         error_map,
+        cut_view: cut,
     })
 }

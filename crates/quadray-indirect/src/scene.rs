@@ -138,7 +138,8 @@ impl Scene {
         Self::parse(CORNELL_TOML, "cornell").expect("the built-in Cornell scene is valid")
     }
 
-    fn validate(&self) -> Result<(), String> {
+    /// Checks the camera, the light and `r_min` (after loading, or after changing them).
+    pub fn validate(&self) -> Result<(), String> {
         let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
         let c = &self.camera;
         let l = &self.light;
@@ -237,6 +238,15 @@ impl Scene {
 
 /// The scene `quadray indirect` uses without `--scene`, also `assets/scenes/cornell.toml`.
 pub const CORNELL_TOML: &str = include_str!("../../../assets/scenes/cornell.toml");
+
+/// The bundled scene files of this technique, in `scenes_dir()`.
+pub const BUNDLED_SCENES: [&str; 5] = [
+    "cornell.toml",
+    "cornell_obj.toml",
+    "cornell_bunny.toml",
+    "cornell_buddha.toml",
+    "atrium.toml",
+];
 
 /// Directory of the bundled scene files.
 pub fn scenes_dir() -> PathBuf {

@@ -5,7 +5,7 @@
 
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::{self, compare};
-use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings, Validity};
+use quadray_indirect::{ClusterSettings, CutNode, Method, Renderer, Scene, Settings, Validity};
 
 fn settings(rsm_size: u32) -> Settings {
     Settings {
@@ -106,6 +106,43 @@ fn per_level_passes_give_the_compacted_cut_image() {
         assert!(clusters > 16 && clusters < 64 * 64 / 4, "{clusters}");
         assert!(e.rel_max < 1e-5, "{e:?}");
     }
+}
+
+#[test]
+fn the_cut_covers_every_lit_rsm_texel_exactly_once() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let size = 64;
+    let mut r = Renderer::new(&gpu, &scene, settings(size)).unwrap();
+    r.render(Method::Quadtree, true, false).unwrap();
+    let cut = r.read_cut().unwrap();
+    assert_eq!(cut.len() as u32, r.clusters_in_cut().unwrap());
+    let c = r.settings().cluster;
+    let mut cover = vec![0u32; (size * size) as usize];
+    for &CutNode { level, x, y } in &cut {
+        assert!((c.limit_level..=c.start_level).contains(&level), "{level}");
+        let side = 1 << level;
+        for ty in y * side..(y + 1) * side {
+            for tx in x * side..(x + 1) * side {
+                cover[(ty * size + tx) as usize] += 1;
+            }
+        }
+    }
+    let flux = r.read_rsm_flux().unwrap();
+    let lit = |i: usize| flux[i].iter().any(|&v| v > 0.0);
+    let levels: std::collections::BTreeSet<u32> = cut.iter().map(|n| n.level).collect();
+    println!("{} clusters on levels {levels:?}", cut.len());
+    assert!(
+        levels.len() > 1,
+        "a cut on one level is no quadtree: {levels:?}"
+    );
+    for (i, &n) in cover.iter().enumerate() {
+        assert!(n <= 1, "texel {i} is in {n} clusters");
+        assert!(n == 1 || !lit(i), "lit texel {i} is in no cluster");
+    }
+    // the picture of it: the RSM magnified to 512 pixels with the clusters outlined
+    let picture = quadray_indirect::report::cut_view(size, &flux, &cut);
+    assert_eq!((picture.width, picture.height), (512, 512));
 }
 
 #[test]

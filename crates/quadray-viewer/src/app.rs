@@ -2,6 +2,7 @@
 
 use crate::Args;
 use crate::displace_view::{DisplaceView, MapChoice};
+use crate::indirect_view::IndirectView;
 use anyhow::{Context, Result};
 use quadray_displace::Settings;
 use quadray_gpu::Gpu;
@@ -12,7 +13,14 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
-const PANEL_WIDTH: f32 = 260.0;
+const PANEL_WIDTH: f32 = 300.0;
+
+/// The technique on screen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Technique {
+    Displace,
+    Indirect,
+}
 
 pub fn run(args: Args, maps: Vec<MapChoice>, start: usize, settings: Settings) -> Result<()> {
     let event_loop =
@@ -38,11 +46,15 @@ struct State {
     window: Arc<Window>,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
-    gpu: Gpu,
+    /// Lives as long as the program: the indirect renderer borrows it.
+    gpu: &'static Gpu,
     egui_ctx: egui::Context,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
+    technique: Technique,
     displace: DisplaceView,
+    /// Made when first shown.
+    indirect: Option<IndirectView>,
     last_frame: Instant,
     frame_ms: f32,
     frames_drawn: u32,
@@ -65,15 +77,16 @@ impl State {
         let window = Arc::new(event_loop.create_window(attributes)?);
         let instance = Gpu::instance();
         let surface = instance.create_surface(window.clone())?;
-        let gpu = Gpu::for_surface(&instance, Some(&surface))?;
+        let gpu: &'static Gpu = Box::leak(Box::new(Gpu::for_surface(&instance, Some(&surface))?));
         let size = window.inner_size();
         let mut config = surface
             .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
             .context("the adapter cannot present to this window")?;
-        // egui expects a non-sRGB target only for its own blending; either works, sRGB is the norm.
+        // egui blends in gamma space and wants a non-sRGB target; the 3-D view is an sRGB
+        // texture, so it is decoded on sampling and encoded again by egui's shader.
         let caps = surface.get_capabilities(&gpu.adapter);
-        if let Some(srgb) = caps.formats.iter().find(|f| f.is_srgb()) {
-            config.format = *srgb;
+        if let Some(plain) = caps.formats.iter().find(|f| !f.is_srgb()) {
+            config.format = *plain;
         }
         surface.configure(&gpu.device, &config);
         let egui_ctx = egui::Context::default();
@@ -88,7 +101,7 @@ impl State {
         let egui_renderer =
             egui_wgpu::Renderer::new(&gpu.device, config.format, Default::default());
         let (maps, map, settings) = start;
-        let displace = DisplaceView::new(&gpu, maps, map, settings);
+        let displace = DisplaceView::new(gpu, maps, map, settings);
         Ok(Self {
             window,
             surface,
@@ -97,7 +110,9 @@ impl State {
             egui_ctx,
             egui_state,
             egui_renderer,
+            technique: args.technique,
             displace,
+            indirect: None,
             last_frame: Instant::now(),
             frame_ms: 0.0,
             frames_drawn: 0,
@@ -119,34 +134,79 @@ impl State {
         self.frame_ms = self.frame_ms * 0.9 + dt * 1e3 * 0.1;
         let scripted = args.frames.is_some();
         let mut save = false;
+        if self.technique == Technique::Indirect && self.indirect.is_none() {
+            self.indirect = Some(IndirectView::new(
+                self.gpu,
+                args.scene.clone(),
+                args.indirect_method,
+                args.show,
+                args.rsm_size,
+            ));
+        }
+        if scripted && self.frames_drawn > 0 {
+            match (self.technique, &mut self.indirect) {
+                (Technique::Indirect, Some(view)) => view.spin(args.spin),
+                _ => self.displace.settings.azimuth_deg += args.spin,
+            }
+        }
         let raw = self.egui_state.take_egui_input(&self.window);
         let Self {
             egui_ctx,
+            technique,
             displace,
+            indirect,
             gpu,
             egui_renderer,
             status,
             frame_ms,
             ..
         } = self;
+        let gpu: &'static Gpu = gpu;
         let full = egui_ctx.run_ui(raw, |ui| {
             egui::Panel::left("controls").exact_size(PANEL_WIDTH).show(ui, |ui| {
-                ui.heading("Displacement");
-                displace.controls(ui);
+                ui.horizontal(|ui| {
+                    ui.selectable_value(technique, Technique::Displace, "Displacement");
+                    ui.selectable_value(technique, Technique::Indirect, "Indirect light");
+                });
                 ui.separator();
-                ui.label(format!(
-                    "GPU {}  frame {:.1} ms",
-                    displace.gpu_ms.map_or("n/a".into(), |t| format!("{t:.3} ms")),
-                    frame_ms
-                ));
+                if let Some(view) = indirect.as_mut().filter(|_| *technique == Technique::Indirect) {
+                    view.controls(ui);
+                    ui.separator();
+                    if let Some(t) = &view.timing {
+                        // in the order the frame runs them
+                        for pass in quadray_indirect::Pass::ALL {
+                            if let Some(ms) = t.passes.get(pass.name()) {
+                                ui.monospace(format!("{:<9}{ms:9.3} ms", pass.name()));
+                            }
+                        }
+                        ui.label(format!("GPU {:.3} ms  frame {frame_ms:.1} ms", t.total_ms));
+                    } else {
+                        ui.label(format!("GPU n/a  frame {frame_ms:.1} ms"));
+                    }
+                    if let Some(n) = view.clusters {
+                        ui.label(format!("{n} clusters in the cut"));
+                    }
+                    if let Some(e) = &view.error {
+                        ui.colored_label(egui::Color32::LIGHT_RED, e);
+                    }
+                    ui.small("Drag: look. Right drag: aim the light. W/A/S/D, Q/E, wheel: move. L: animate light. P: screenshot.");
+                } else {
+                    displace.controls(ui);
+                    ui.separator();
+                    ui.label(format!(
+                        "GPU {}  frame {:.1} ms",
+                        displace.gpu_ms.map_or("n/a".into(), |t| format!("{t:.3} ms")),
+                        frame_ms
+                    ));
+                    if let Some(e) = &displace.error {
+                        ui.colored_label(egui::Color32::LIGHT_RED, e);
+                    }
+                    ui.small("Drag: orbit. Right drag: light. Wheel or Q/E: zoom. W/A/S/D: move. L: animate light. P: screenshot.");
+                }
                 if ui.button("Save screenshot + command (P)").clicked() {
                     save = true;
                 }
-                if let Some(e) = &displace.error {
-                    ui.colored_label(egui::Color32::LIGHT_RED, e);
-                }
                 ui.label(status.as_str());
-                ui.small("Drag: orbit. Right drag: light. Wheel or Q/E: zoom. W/A/S/D: move. L: animate light. P: screenshot.");
             });
             egui::CentralPanel::default().show(ui, |ui| {
                 let points = ui.available_size();
@@ -156,14 +216,30 @@ impl State {
                 } else {
                     [(points.x * ppp) as u32, (points.y * ppp) as u32]
                 };
-                if let Some(id) = displace.draw(gpu, egui_renderer, pixels, dt) {
-                    let shown = egui::vec2(pixels[0] as f32, pixels[1] as f32) / ppp;
-                    let image = egui::Image::new(egui::load::SizedTexture::new(id, shown))
-                        .sense(egui::Sense::click_and_drag());
-                    let response = ui.add(image);
-                    displace.handle_pointer(&response, ui);
+                let shown = |size: [u32; 2]| {
+                    let full = egui::vec2(size[0] as f32, size[1] as f32) / ppp;
+                    // the cut view is larger than the frame: fit it
+                    full * (points.x / full.x).min(points.y / full.y).min(1.0)
+                };
+                let sense = egui::Sense::click_and_drag();
+                match indirect.as_mut().filter(|_| *technique == Technique::Indirect) {
+                    Some(view) => {
+                        if let Some((id, size)) = view.draw(ui.ctx(), pixels, dt) {
+                            let image = egui::Image::new(egui::load::SizedTexture::new(id, shown(size)));
+                            let response = ui.add(image.sense(sense));
+                            view.handle_pointer(&response, ui);
+                        }
+                        view.handle_keys(ui, dt);
+                    }
+                    None => {
+                        if let Some(id) = displace.draw(gpu, egui_renderer, pixels, dt) {
+                            let image = egui::Image::new(egui::load::SizedTexture::new(id, shown(pixels)));
+                            let response = ui.add(image.sense(sense));
+                            displace.handle_pointer(&response, ui);
+                        }
+                        displace.handle_keys(ui, dt);
+                    }
                 }
-                displace.handle_keys(ui, dt);
                 save |= ui.input(|i| i.key_pressed(egui::Key::P));
             });
         });
@@ -172,7 +248,10 @@ impl State {
         self.frames_drawn += 1;
         let done = args.frames.is_some_and(|n| self.frames_drawn >= n);
         if save || done {
-            let cmd = self.displace.screenshot(&self.gpu, &args.screenshot)?;
+            let cmd = match (&self.indirect, self.technique) {
+                (Some(view), Technique::Indirect) => view.screenshot(&args.screenshot)?,
+                _ => self.displace.screenshot(self.gpu, &args.screenshot)?,
+            };
             self.status = format!("saved {}", args.screenshot.display());
             println!("{cmd}");
         }

@@ -2,6 +2,7 @@
 //! moving light; the frame is drawn by `quadray_displace::Renderer::draw` into an offscreen
 //! texture that egui shows, so what a person sees is exactly what `quadray displace` renders.
 
+use crate::{absolute, shell_word};
 use anyhow::Result;
 use quadray_core::image_out::Rgba8Image;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
@@ -27,9 +28,9 @@ impl MapChoice {
             .iter()
             .map(|b| MapChoice {
                 name: b.name.to_string(),
-                path: assets_dir().join(b.file),
+                path: absolute(assets_dir().join(b.file)),
                 convention: b.convention,
-                color: b.color.map(|c| assets_dir().join(c)),
+                color: b.color.map(|c| absolute(assets_dir().join(c))),
                 surface: b.surface,
             })
             .collect()
@@ -215,9 +216,9 @@ impl DisplaceView {
         let choice = &self.maps[self.map];
         let mut cmd = format!(
             "quadray displace --map {} --convention {} --resample --surface {} --method {} \
-             --view-angle {:.2} --azimuth {:.2} --zoom {:.3} --light-azimuth {:.2} --size {}x{} \
+             --view-angle {} --azimuth {} --zoom {} --light-azimuth {} --size {}x{} \
              --depth-scale {} --layers {},{} --binary-steps {} --lod {}",
-            choice.path.display(),
+            shell_word(&choice.path),
             choice.convention_flag(),
             surface_flag(self.surface),
             s.method,
@@ -237,7 +238,7 @@ impl DisplaceView {
             },
         );
         if let Some(c) = &choice.color {
-            cmd += &format!(" --color {}", c.display());
+            cmd += &format!(" --color {}", shell_word(c));
         }
         if s.shadows {
             cmd += " --shadows";
@@ -245,7 +246,7 @@ impl DisplaceView {
         if s.show_iterations {
             cmd += " --show-iterations";
         }
-        cmd + &format!(" --out {}", out.display())
+        cmd + &format!(" --out {}", shell_word(out))
     }
 
     /// Saves the frame as a PNG and the command line that reproduces it beside it (`.txt`).

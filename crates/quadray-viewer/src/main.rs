@@ -4,6 +4,7 @@
 
 mod app;
 mod displace_view;
+mod indirect_view;
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -11,7 +12,23 @@ use displace_view::MapChoice;
 use quadray_displace::heightmap::Convention;
 use quadray_displace::scene::SurfaceKind;
 use quadray_displace::{Method, Settings};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// The path without `..`, so the screenshot's command line works from any directory.
+pub fn absolute(path: PathBuf) -> PathBuf {
+    std::fs::canonicalize(&path).unwrap_or(path)
+}
+
+/// A path as one POSIX shell word (single-quoted when it holds anything but plain characters).
+pub fn shell_word(path: &Path) -> String {
+    let text = path.display().to_string();
+    let plain = |c: char| c.is_ascii_alphanumeric() || "/._-+,:=@%".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text
+    } else {
+        format!("'{}'", text.replace('\'', r"'\''"))
+    }
+}
 
 #[derive(Parser)]
 #[command(
@@ -20,6 +37,9 @@ use std::path::PathBuf;
     about = "Interactive viewer for quadray's real-time techniques"
 )]
 pub struct Args {
+    /// The technique shown first (both are a click apart in the panel).
+    #[arg(long, value_enum, default_value = "displace")]
+    technique: app::Technique,
     /// A height map of your own (shown beside the bundled ones).
     #[arg(long)]
     map: Option<PathBuf>,
@@ -42,6 +62,21 @@ pub struct Args {
     zoom: f32,
     #[arg(long)]
     shadows: bool,
+    /// An indirect-light scene file of your own (shown beside the bundled ones).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Indirect light: quadtree, quadtree-passes, rsm or reference.
+    #[arg(long, default_value = "quadtree")]
+    indirect_method: quadray_indirect::Method,
+    /// Indirect light: what the view shows.
+    #[arg(long, value_enum, default_value = "combined")]
+    show: indirect_view::Show,
+    /// Indirect light: side of the RSM (default 512, 128 on a software rasterizer).
+    #[arg(long)]
+    rsm_size: Option<u32>,
+    /// Scripted run: turn the camera by this many degrees each frame.
+    #[arg(long, default_value_t = 0.0)]
+    spin: f32,
     /// Scripted run: draw this many frames, save --screenshot, and exit.
     #[arg(long)]
     frames: Option<u32>,
@@ -77,7 +112,7 @@ fn main() -> Result<()> {
             name: path
                 .file_name()
                 .map_or("map".into(), |n| n.to_string_lossy().into_owned()),
-            path: path.clone(),
+            path: absolute(path.clone()),
             convention,
             color: None,
             surface: SurfaceKind::Wall,

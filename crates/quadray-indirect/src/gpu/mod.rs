@@ -272,6 +272,31 @@ impl Frame {
     }
 }
 
+/// A cluster of the cut: its level (0 = one RSM texel) and its node's column and row there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CutNode {
+    pub level: u32,
+    pub x: u32,
+    pub y: u32,
+}
+
+impl CutNode {
+    /// The node at `index` of the pyramid of an RSM of side `rsm_size` (finest level first).
+    pub fn at(rsm_size: u32, mut index: u32) -> Self {
+        let mut level = 0;
+        while level < rsm_size.ilog2() && index >= (rsm_size >> level).pow(2) {
+            index -= (rsm_size >> level).pow(2);
+            level += 1;
+        }
+        let side = rsm_size >> level;
+        Self {
+            level,
+            x: index % side,
+            y: index / side,
+        }
+    }
+}
+
 /// A VPL as the RSM stores it (the CPU reference's input).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vpl {
@@ -325,6 +350,12 @@ impl<'g> Renderer<'g> {
 
     pub fn settings(&self) -> &Settings {
         &self.settings
+    }
+
+    /// Moves the camera and the light to the scene's (its geometry must be the one the renderer
+    /// was made with); the next frame must `rebuild` if the light moved.
+    pub fn set_view(&mut self, scene: &Scene) {
+        self.buffers.write_scene(self.gpu, scene, &self.settings);
     }
 
     /// Changes the quadtree's parameters; the next frame with `rebuild` uses them.
@@ -451,6 +482,22 @@ impl<'g> Renderer<'g> {
         Ok(count[0])
     }
 
+    /// The clusters of the compacted cut (after a `Quadtree` frame with rebuild), in no order.
+    pub fn read_cut(&self) -> Result<Vec<CutNode>, IndirectError> {
+        let count = self.clusters_in_cut()? as usize;
+        let indices = self.buffers.read_u32(self.gpu, &self.buffers.cut)?;
+        Ok(indices[..count.min(indices.len())]
+            .iter()
+            .map(|&i| CutNode::at(self.settings.rsm_size, i))
+            .collect())
+    }
+
+    /// The RSM's flux per texel, row-major (what the cut clusters).
+    pub fn read_rsm_flux(&self) -> Result<Vec<[f32; 3]>, IndirectError> {
+        let flux = read_texture_f32(self.gpu, &self.targets.rsm[0], 0, 4)?;
+        Ok(flux.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect())
+    }
+
     /// The quadtree as built: per node (flux rgb + texel count, position + depth, normal +
     /// validity), finest level first.
     pub fn read_nodes(&self) -> Result<Vec<[[f32; 4]; 3]>, IndirectError> {
@@ -490,5 +537,25 @@ impl<'g> Renderer<'g> {
                 })
             })
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CutNode;
+
+    #[test]
+    fn cut_nodes_are_found_from_their_pyramid_index() {
+        let size = 16u32;
+        let mut index = 0;
+        for level in 0..=size.ilog2() {
+            let side = size >> level;
+            for y in 0..side {
+                for x in 0..side {
+                    assert_eq!(CutNode::at(size, index), CutNode { level, x, y });
+                    index += 1;
+                }
+            }
+        }
     }
 }

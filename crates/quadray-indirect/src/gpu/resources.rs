@@ -168,6 +168,7 @@ pub(super) struct Buffers {
     /// One `level` per uniform slot, bound with a dynamic offset.
     level_stride: u32,
     pub nodes: wgpu::Buffer,
+    pub cut: wgpu::Buffer,
     pub cut_count: wgpu::Buffer,
     pub indirect: wgpu::Buffer,
     pub direct: wgpu::Buffer,
@@ -309,6 +310,7 @@ impl Buffers {
             shade,
             level_stride,
             nodes,
+            cut,
             cut_count,
             indirect,
             direct,

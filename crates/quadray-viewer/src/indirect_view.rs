@@ -1,0 +1,491 @@
+//! The indirect-light panel: scene, method and every parameter of the light quadtree, a fly camera
+//! and a spot light that can be dragged or animated. Frames come from `quadray_indirect::Renderer`
+//! and are tone-mapped by the same code as `quadray indirect`, so the screenshot's command line
+//! renders the same picture headless. A frame is rendered only when something changed.
+
+use crate::{absolute, shell_word};
+use anyhow::{Context, Result};
+use glam::{Quat, Vec3};
+use quadray_core::image_out::Rgba8Image;
+use quadray_gpu::Gpu;
+use quadray_indirect::report::{cut_view, tone_map};
+use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
+use quadray_indirect::{ClusterSettings, FrameTiming, Method, Renderer, Scene, Settings, Validity};
+use std::path::{Path, PathBuf};
+
+/// What the view shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Show {
+    Combined,
+    Direct,
+    Indirect,
+    /// The selected clusters over the RSM.
+    Cut,
+}
+
+impl Show {
+    const ALL: [Show; 4] = [Show::Combined, Show::Direct, Show::Indirect, Show::Cut];
+
+    fn name(self) -> &'static str {
+        match self {
+            Show::Combined => "direct + indirect",
+            Show::Direct => "direct",
+            Show::Indirect => "indirect",
+            Show::Cut => "cut over the RSM",
+        }
+    }
+
+    /// The file `quadray indirect --out F.png` writes this picture to.
+    fn headless_file(self, out: &Path) -> PathBuf {
+        let stem = out.file_stem().unwrap_or_default().to_string_lossy();
+        match self {
+            Show::Combined => out.to_path_buf(),
+            Show::Direct => out.with_file_name(format!("{stem}.direct.png")),
+            Show::Indirect => out.with_file_name(format!("{stem}.indirect.png")),
+            Show::Cut => out.with_file_name(format!("{stem}.cut.png")),
+        }
+    }
+}
+
+/// Unit vector of a heading (yaw about +Y, 0 = -Z) and an elevation.
+fn direction(yaw_deg: f32, pitch_deg: f32) -> Vec3 {
+    let (yaw, pitch) = (yaw_deg.to_radians(), pitch_deg.to_radians());
+    Vec3::new(
+        pitch.cos() * yaw.sin(),
+        pitch.sin(),
+        -pitch.cos() * yaw.cos(),
+    )
+}
+
+fn yaw_pitch(d: Vec3) -> (f32, f32) {
+    let d = d.normalize();
+    (
+        d.x.atan2(-d.z).to_degrees(),
+        d.y.clamp(-1.0, 1.0).asin().to_degrees(),
+    )
+}
+
+/// The camera and light as the viewer moves them; the loaded scene keeps the originals.
+struct Pose {
+    eye: Vec3,
+    yaw: f32,
+    pitch: f32,
+    light_yaw: f32,
+    light_pitch: f32,
+    /// Angle of the animated light around its dragged direction.
+    light_phase: f32,
+}
+
+impl Pose {
+    fn of(scene: &Scene) -> Self {
+        let eye = Vec3::from(scene.camera.position);
+        let (yaw, pitch) = yaw_pitch(Vec3::from(scene.camera.target) - eye);
+        let (light_yaw, light_pitch) = yaw_pitch(scene.light.direction.into());
+        Self {
+            eye,
+            yaw,
+            pitch,
+            light_yaw,
+            light_pitch,
+            light_phase: 0.0,
+        }
+    }
+
+    /// The scene with this pose's camera and light.
+    fn apply(&self, base: &Scene, animated: bool) -> Scene {
+        let mut scene = base.clone();
+        scene.camera.position = self.eye.into();
+        scene.camera.target = (self.eye + direction(self.yaw, self.pitch)).into();
+        let mut light = direction(self.light_yaw, self.light_pitch);
+        if animated {
+            // circle 15 degrees around the dragged direction
+            let axis =
+                Quat::from_axis_angle(light, self.light_phase) * light.any_orthonormal_vector();
+            light = Quat::from_axis_angle(axis, 15f32.to_radians()) * light;
+        }
+        scene.light.direction = light.into();
+        scene
+    }
+}
+
+pub struct IndirectView {
+    gpu: &'static Gpu,
+    scenes: Vec<PathBuf>,
+    pub scene: usize,
+    /// The scene as loaded (index into `scenes`) and the pose moved from it.
+    loaded: Option<(usize, Scene, Pose)>,
+    renderer: Option<Renderer<'static>>,
+    pub settings: Settings,
+    pub method: Method,
+    pub show: Show,
+    pub exposure: f32,
+    pub animate_light: bool,
+    /// The camera moved: shade again with the light's buffers reused.
+    redraw: bool,
+    /// The light or the quadtree changed: rebuild RSM, pyramid and cut too.
+    rebuild: bool,
+    picture: Option<Rgba8Image>,
+    texture: Option<egui::TextureHandle>,
+    pub timing: Option<FrameTiming>,
+    pub clusters: Option<u32>,
+    pub error: Option<String>,
+}
+
+impl IndirectView {
+    /// The view of the bundled scenes plus `extra`, starting at `start` (a scene file's path).
+    pub fn new(
+        gpu: &'static Gpu,
+        extra: Option<PathBuf>,
+        method: Method,
+        show: Show,
+        rsm_size: Option<u32>,
+    ) -> Self {
+        let mut scenes: Vec<PathBuf> = BUNDLED_SCENES
+            .iter()
+            .map(|s| absolute(scenes_dir().join(s)))
+            .collect();
+        let scene = match extra {
+            Some(path) => {
+                scenes.push(absolute(path));
+                scenes.len() - 1
+            }
+            None => 0,
+        };
+        // a CPU rasterizer shades a 512^2 RSM's cut at a few frames per second at best
+        let rsm_size = rsm_size.unwrap_or(if gpu.is_software() { 128 } else { 512 });
+        Self {
+            gpu,
+            scenes,
+            scene,
+            loaded: None,
+            renderer: None,
+            settings: Settings {
+                rsm_size,
+                cluster: ClusterSettings::defaults(rsm_size),
+                ..Settings::default()
+            },
+            method,
+            show,
+            exposure: 1.0,
+            animate_light: false,
+            redraw: true,
+            rebuild: true,
+            picture: None,
+            texture: None,
+            timing: None,
+            clusters: None,
+            error: None,
+        }
+    }
+
+    fn scene_name(&self, i: usize) -> String {
+        self.scenes[i]
+            .file_stem()
+            .map_or("scene".into(), |s| s.to_string_lossy().into_owned())
+    }
+
+    /// Renders when something changed and returns the picture's texture and size in pixels.
+    pub fn draw(
+        &mut self,
+        ctx: &egui::Context,
+        size: [u32; 2],
+        dt: f32,
+    ) -> Option<(egui::TextureId, [u32; 2])> {
+        self.settings.width = size[0].clamp(16, 4096);
+        self.settings.height = size[1].clamp(16, 4096);
+        if self.animate_light
+            && let Some((_, _, pose)) = &mut self.loaded
+        {
+            pose.light_phase += dt * std::f32::consts::TAU / 4.0;
+            self.rebuild = true;
+        }
+        match self.render() {
+            Ok(Some(picture)) => {
+                let image = egui::ColorImage::from_rgba_unmultiplied(
+                    [picture.width as usize, picture.height as usize],
+                    bytemuck::cast_slice(&picture.pixels),
+                );
+                match &mut self.texture {
+                    Some(t) => t.set(image, egui::TextureOptions::NEAREST),
+                    None => {
+                        self.texture =
+                            Some(ctx.load_texture("indirect", image, egui::TextureOptions::NEAREST))
+                    }
+                }
+                self.picture = Some(picture);
+                self.error = None;
+            }
+            Ok(None) => {}
+            Err(e) => self.error = Some(format!("{e:#}")),
+        }
+        let picture = self.picture.as_ref()?;
+        Some((self.texture.as_ref()?.id(), [picture.width, picture.height]))
+    }
+
+    /// Loads the scene and (re)makes the renderer as the choices require, then renders a new
+    /// picture if anything changed since the last one.
+    fn render(&mut self) -> Result<Option<Rgba8Image>> {
+        let gpu = self.gpu;
+        if !matches!(&self.loaded, Some((i, ..)) if *i == self.scene) {
+            self.renderer = None;
+            self.loaded = None;
+            let path = &self.scenes[self.scene];
+            let scene = Scene::load(path)?;
+            let pose = Pose::of(&scene);
+            self.loaded = Some((self.scene, scene, pose));
+        }
+        let (_, base, pose) = self.loaded.as_ref().expect("loaded above");
+        let scene = pose.apply(base, self.animate_light);
+        self.settings.validate().map_err(anyhow::Error::msg)?;
+        let same_sizes = |r: &Renderer| {
+            let s = r.settings();
+            Settings {
+                cluster: s.cluster,
+                ..self.settings.clone()
+            } == *s
+        };
+        if !self.renderer.as_ref().is_some_and(same_sizes) {
+            self.renderer = None;
+            self.renderer = Some(Renderer::new(gpu, &scene, self.settings.clone())?);
+            self.rebuild = true;
+        }
+        let renderer = self.renderer.as_mut().expect("made above");
+        if renderer.settings().cluster != self.settings.cluster {
+            renderer.set_cluster(self.settings.cluster)?;
+            self.rebuild = true;
+        }
+        if !(self.redraw || self.rebuild) {
+            return Ok(None);
+        }
+        renderer.set_view(&scene);
+        self.timing = renderer.time(self.method, self.rebuild, 1)?;
+        self.redraw = false;
+        self.rebuild = false;
+        let (w, h, rsm_size) = (
+            self.settings.width,
+            self.settings.height,
+            self.settings.rsm_size,
+        );
+        let frame = renderer.read_frame()?;
+        self.clusters = None;
+        let cut = if self.method == Method::Quadtree || self.show == Show::Cut {
+            // the other methods do not store the cut (the per-level passes select the same set)
+            if self.method != Method::Quadtree {
+                renderer.render(Method::Quadtree, true, false)?;
+            }
+            let cut = renderer.read_cut()?;
+            self.clusters = Some(cut.len() as u32);
+            Some(cut)
+        } else {
+            None
+        };
+        Ok(Some(match self.show {
+            Show::Combined => tone_map(w, h, &frame.combined(), self.exposure),
+            Show::Direct => tone_map(w, h, &frame.direct, self.exposure),
+            Show::Indirect => tone_map(w, h, &frame.indirect, self.exposure),
+            Show::Cut => cut_view(
+                rsm_size,
+                &renderer.read_rsm_flux()?,
+                cut.as_deref().unwrap_or_default(),
+            ),
+        }))
+    }
+
+    /// The `quadray indirect` command that renders this view headless.
+    pub fn command_line(&self, out: &Path) -> Option<String> {
+        let (index, base, pose) = self.loaded.as_ref()?;
+        let scene = pose.apply(base, self.animate_light);
+        let s = &self.settings;
+        let c = &s.cluster;
+        let v = |p: [f32; 3]| format!("{},{},{}", p[0], p[1], p[2]);
+        let mut cmd = format!(
+            "quadray indirect --scene {} --method {} --rsm-size {} --limit-level {} \
+             --start-level {} --depth-threshold {} --normal-threshold {} --validity {} \
+             --samples {} --subsample {} --size {}x{} --exposure {} --camera-position {} \
+             --camera-target {} --light-position {} --light-direction {} --frames 1",
+            shell_word(&self.scenes[*index]),
+            self.method.name(),
+            s.rsm_size,
+            c.limit_level,
+            c.start_level,
+            c.depth_threshold,
+            c.normal_threshold,
+            match c.validity {
+                Validity::Local => "local",
+                Validity::Recursive => "recursive",
+            },
+            s.samples,
+            s.subsample,
+            s.width,
+            s.height,
+            self.exposure,
+            v(scene.camera.position),
+            v(scene.camera.target),
+            v(scene.light.position),
+            v(scene.light.direction),
+        );
+        if !c.flux_weighted {
+            cmd += " --unweighted-means";
+        }
+        Some(cmd + &format!(" --out {}", shell_word(out)))
+    }
+
+    /// Saves the picture shown as a PNG and the command line that reproduces it beside it
+    /// (`.txt`; the picture is the one the command writes to the file named in its comment).
+    pub fn screenshot(&self, path: &Path) -> Result<String> {
+        let picture = self.picture.as_ref().context("nothing drawn yet")?;
+        picture.save_png(path)?;
+        let out = path.with_extension("headless.png");
+        let cmd = self.command_line(&out).context("no scene loaded")?;
+        let shown = self.show.headless_file(&out);
+        std::fs::write(
+            path.with_extension("txt"),
+            format!(
+                "{cmd}\n# the picture shown is the command's {}\n",
+                shown.display()
+            ),
+        )?;
+        Ok(cmd)
+    }
+
+    /// Turns the camera by `degrees` (scripted runs).
+    pub fn spin(&mut self, degrees: f32) {
+        if let Some((_, _, pose)) = &mut self.loaded {
+            pose.yaw += degrees;
+            self.redraw = true;
+        }
+    }
+
+    /// The control panel; marks what a change invalidates.
+    pub fn controls(&mut self, ui: &mut egui::Ui) {
+        let before = (self.scene, self.method, self.show, self.exposure);
+        egui::ComboBox::from_label("scene")
+            .selected_text(self.scene_name(self.scene))
+            .show_ui(ui, |ui| {
+                for i in 0..self.scenes.len() {
+                    let name = self.scene_name(i);
+                    ui.selectable_value(&mut self.scene, i, name);
+                }
+            });
+        egui::ComboBox::from_label("method")
+            .selected_text(self.method.name())
+            .show_ui(ui, |ui| {
+                for m in Method::ALL {
+                    ui.selectable_value(&mut self.method, m, m.name());
+                }
+            });
+        egui::ComboBox::from_label("show")
+            .selected_text(self.show.name())
+            .show_ui(ui, |ui| {
+                for v in Show::ALL {
+                    ui.selectable_value(&mut self.show, v, v.name());
+                }
+            });
+        ui.add(
+            egui::Slider::new(&mut self.exposure, 0.05..=20.0)
+                .logarithmic(true)
+                .text("exposure"),
+        );
+        let s = &mut self.settings;
+        let mut rsm_log = s.rsm_size.ilog2();
+        ui.add(
+            egui::Slider::new(&mut rsm_log, 3..=10)
+                .custom_formatter(|v, _| format!("{}", 1u32 << v as u32))
+                .text("RSM size"),
+        );
+        if 1 << rsm_log != s.rsm_size {
+            s.rsm_size = 1 << rsm_log;
+            s.cluster = ClusterSettings {
+                depth_threshold: s.cluster.depth_threshold,
+                normal_threshold: s.cluster.normal_threshold,
+                validity: s.cluster.validity,
+                ..ClusterSettings::defaults(s.rsm_size)
+            };
+        }
+        let c = &mut s.cluster;
+        let top = rsm_log;
+        ui.add(egui::Slider::new(&mut c.start_level, 0..=top).text("start level"));
+        ui.add(egui::Slider::new(&mut c.limit_level, 0..=c.start_level).text("limit level"));
+        ui.add(
+            egui::Slider::new(&mut c.depth_threshold, 0.0..=0.5)
+                .logarithmic(true)
+                .text("depth threshold"),
+        );
+        ui.add(egui::Slider::new(&mut c.normal_threshold, -1.0..=1.0).text("normal threshold"));
+        let mut recursive = c.validity == Validity::Recursive;
+        ui.checkbox(&mut recursive, "recursive validity");
+        c.validity = if recursive {
+            Validity::Recursive
+        } else {
+            Validity::Local
+        };
+        ui.checkbox(&mut c.flux_weighted, "flux-weighted means");
+        ui.add(
+            egui::Slider::new(&mut s.samples, 1..=2048)
+                .logarithmic(true)
+                .text("RSM samples"),
+        );
+        ui.add(egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling"));
+        ui.checkbox(&mut self.animate_light, "animate light (L)");
+        if before != (self.scene, self.method, self.show, self.exposure) {
+            // a method's first frame builds the buffers it needs
+            self.rebuild |= before.1 != self.method;
+            self.redraw = true;
+        }
+    }
+
+    /// Look with the left button, aim the light with the right, move with the wheel.
+    pub fn handle_pointer(&mut self, response: &egui::Response, ui: &egui::Ui) {
+        let Some((_, base, pose)) = &mut self.loaded else {
+            return;
+        };
+        if response.dragged_by(egui::PointerButton::Primary) {
+            let d = response.drag_delta();
+            pose.yaw += d.x * 0.3;
+            pose.pitch = (pose.pitch - d.y * 0.3).clamp(-89.0, 89.0);
+            self.redraw = true;
+        }
+        if response.dragged_by(egui::PointerButton::Secondary) {
+            let d = response.drag_delta();
+            pose.light_yaw += d.x * 0.3;
+            pose.light_pitch = (pose.light_pitch - d.y * 0.3).clamp(-89.9, 89.9);
+            self.rebuild = true;
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                pose.eye += direction(pose.yaw, pose.pitch) * scroll * 0.001 * base.extent();
+                self.redraw = true;
+            }
+        }
+    }
+
+    /// Keyboard: W/S forward and back, A/D sideways, Q/E down and up, L animates the light.
+    pub fn handle_keys(&mut self, ui: &egui::Ui, dt: f32) {
+        let Some((_, base, pose)) = &mut self.loaded else {
+            return;
+        };
+        let forward = direction(pose.yaw, pose.pitch);
+        let right = forward.cross(Vec3::Y).normalize_or_zero();
+        let step = 0.25 * base.extent() * dt;
+        ui.input(|i| {
+            for (key, dir) in [
+                (egui::Key::W, forward),
+                (egui::Key::S, -forward),
+                (egui::Key::D, right),
+                (egui::Key::A, -right),
+                (egui::Key::E, Vec3::Y),
+                (egui::Key::Q, -Vec3::Y),
+            ] {
+                if i.key_down(key) {
+                    pose.eye += dir * step;
+                    self.redraw = true;
+                }
+            }
+            if i.key_pressed(egui::Key::L) {
+                self.animate_light = !self.animate_light;
+                self.rebuild = true;
+            }
+        });
+    }
+}

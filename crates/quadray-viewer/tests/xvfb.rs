@@ -1,0 +1,243 @@
+//! The viewer in a real window: under Xvfb with the software Vulkan driver it draws a few frames
+//! with a scripted camera, saves a screenshot and the command line that reproduces it, and that
+//! command, run headless by `quadray`, renders the same picture.
+//!
+//! Needs Xvfb (`scripts/setup.sh` installs it) and the `quadray` program built beside the viewer,
+//! as `cargo test --workspace` does.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// An Xvfb server on a free display, stopped when dropped.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Xvfb {
+        let found = std::env::var_os("PATH")
+            .is_some_and(|paths| std::env::split_paths(&paths).any(|d| d.join("Xvfb").is_file()));
+        assert!(
+            found,
+            "Xvfb is not installed: run scripts/setup.sh (it installs xvfb and the X11 libraries)"
+        );
+        let number = (90..190)
+            .find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists())
+            .expect("a free X display number");
+        let child = Command::new("Xvfb")
+            .args([
+                format!(":{number}").as_str(),
+                "-screen",
+                "0",
+                "1024x768x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("start Xvfb");
+        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{number}"));
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while !socket.exists() {
+            assert!(Instant::now() < deadline, "Xvfb :{number} did not start");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        Xvfb {
+            child,
+            display: format!(":{number}"),
+        }
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Runs `program args` on the display and waits (at most `limit`) for it to succeed.
+fn run_on(display: &str, program: &Path, args: &[&str], limit: Duration) {
+    let mut child = Command::new(program)
+        .args(args)
+        .env("DISPLAY", display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("RUST_LOG", "error")
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap_or_else(|e| panic!("start {}: {e}", program.display()));
+    let deadline = Instant::now() + limit;
+    loop {
+        if let Some(status) = child.try_wait().expect("wait for the viewer") {
+            assert!(
+                status.success(),
+                "{} {args:?} failed: {status}",
+                program.display()
+            );
+            return;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("{} {args:?} ran past {limit:?}", program.display());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+fn rgb(path: &Path) -> image::RgbImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("read {}: {e}", path.display()))
+        .to_rgb8()
+}
+
+/// Not one flat colour: the luminance's standard deviation over the picture.
+fn contrast(img: &image::RgbImage) -> f64 {
+    let lum: Vec<f64> = img
+        .pixels()
+        .map(|p| 0.299 * p[0] as f64 + 0.587 * p[1] as f64 + 0.114 * p[2] as f64)
+        .collect();
+    let mean = lum.iter().sum::<f64>() / lum.len() as f64;
+    (lum.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lum.len() as f64).sqrt()
+}
+
+/// The `quadray` program built beside the viewer.
+fn quadray() -> PathBuf {
+    let path = Path::new(env!("CARGO_BIN_EXE_quadray-view")).with_file_name("quadray");
+    assert!(
+        path.is_file(),
+        "build `quadray` first (cargo build --release -p quadray-cli; `cargo test --workspace` does)"
+    );
+    path
+}
+
+/// Runs the first line of the screenshot's `.txt` (a `quadray ...` command) with `quadray()`,
+/// and returns that line.
+fn replay(txt: &Path) -> String {
+    let text = std::fs::read_to_string(txt).expect("the screenshot's command line");
+    let command = text.lines().next().expect("a command line").to_string();
+    let bin = quadray();
+    let path = format!(
+        "{}:{}",
+        bin.parent().expect("target folder").display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let out = Command::new("sh")
+        .args(["-c", &command])
+        .env("PATH", path)
+        .output()
+        .expect("run sh");
+    assert!(
+        out.status.success(),
+        "`{command}` failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    command
+}
+
+/// Same size and, pixel by pixel, within 2/255 on average with at most 1% of the pixels off by
+/// more than 16 (the windowed and headless frames are made by the same code on the same GPU).
+fn assert_matches(shot: &Path, headless: &Path) {
+    let (a, b) = (rgb(shot), rgb(headless));
+    assert_eq!(a.dimensions(), b.dimensions(), "{}", shot.display());
+    let diffs: Vec<u8> = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| x.abs_diff(*y))
+        .collect();
+    let mean = diffs.iter().map(|&d| d as f64).sum::<f64>() / diffs.len() as f64;
+    let far = diffs.iter().filter(|&&d| d > 16).count() as f64 / diffs.len() as f64;
+    assert!(
+        mean <= 2.0 && far <= 0.01,
+        "{} vs {}: mean difference {mean:.2}, {:.2}% far off",
+        shot.display(),
+        headless.display(),
+        far * 100.0
+    );
+}
+
+#[test]
+fn viewer_screenshots_match_their_headless_command_lines() {
+    let x = Xvfb::start();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("xvfb");
+    std::fs::create_dir_all(&dir).unwrap();
+    let viewer = Path::new(env!("CARGO_BIN_EXE_quadray-view"));
+    let limit = Duration::from_secs(300);
+
+    // displacement: 3 frames turning 10 degrees each from azimuth 20
+    let shot = dir.join("displace.png");
+    let _ = std::fs::remove_file(&shot);
+    run_on(
+        &x.display,
+        viewer,
+        &[
+            "--technique",
+            "displace",
+            "--bundled",
+            "tiles",
+            "--method",
+            "pyramid",
+            "--view-angle",
+            "55",
+            "--azimuth",
+            "20",
+            "--spin",
+            "10",
+            "--shadows",
+            "--frames",
+            "3",
+            "--view-size",
+            "160x120",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+        limit,
+    );
+    let picture = rgb(&shot);
+    assert_eq!(picture.dimensions(), (160, 120));
+    assert!(
+        contrast(&picture) > 10.0,
+        "the displacement screenshot is blank"
+    );
+    let command = replay(&shot.with_extension("txt"));
+    assert!(
+        command.contains("--azimuth 40 "),
+        "scripted camera not applied: {command}"
+    );
+    assert_matches(&shot, &shot.with_extension("headless.png"));
+
+    // indirect light through `quadray view`: the camera turns 5 degrees a frame
+    let shot = dir.join("indirect.png");
+    let _ = std::fs::remove_file(&shot);
+    run_on(
+        &x.display,
+        &quadray(),
+        &[
+            "view",
+            "--technique",
+            "indirect",
+            "--rsm-size",
+            "32",
+            "--spin",
+            "5",
+            "--frames",
+            "3",
+            "--view-size",
+            "96x72",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+        limit,
+    );
+    let picture = rgb(&shot);
+    assert_eq!(picture.dimensions(), (96, 72));
+    assert!(
+        contrast(&picture) > 10.0,
+        "the indirect screenshot is blank"
+    );
+    replay(&shot.with_extension("txt"));
+    assert_matches(&shot, &shot.with_extension("headless.png"));
+}
