@@ -152,15 +152,12 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
 }
 
 /// `quadray bench indirect`.
-pub fn bench(quick: bool, out: &Path) -> Result<()> {
+pub fn bench(options: quadray_indirect::bench::BenchOptions, out: &Path) -> Result<()> {
     let gpu = Gpu::new()?;
     let bar = crate::spinner("bench indirect");
-    let results = quadray_indirect::bench::run(
-        &gpu,
-        out,
-        quadray_indirect::bench::BenchOptions { quick },
-        |m| bar.set_message(format!("bench indirect: {m}")),
-    )?;
+    let results = quadray_indirect::bench::run(&gpu, out, options, |m| {
+        bar.set_message(format!("bench indirect: {m}"))
+    })?;
     bar.finish_and_clear();
     println!("{}", std::fs::read_to_string(out.join("results.md"))?);
     println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);

@@ -75,6 +75,12 @@ enum Bench {
         /// 64x64 image and RSM, 3 frames per median: seconds on a software rasterizer.
         #[arg(long)]
         quick: bool,
+        /// Image side (default 512, quick 64).
+        #[arg(long)]
+        size: Option<u32>,
+        /// RSM side (default 512, quick 64).
+        #[arg(long)]
+        rsm_size: Option<u32>,
         #[arg(long, default_value = "out/bench/indirect")]
         out: PathBuf,
     },
@@ -149,8 +155,21 @@ fn main() -> Result<()> {
             println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);
         }
         Command::Bench {
-            what: Bench::Indirect { quick, out },
-        } => indirect::bench(quick, &out)?,
+            what:
+                Bench::Indirect {
+                    quick,
+                    size,
+                    rsm_size,
+                    out,
+                },
+        } => indirect::bench(
+            quadray_indirect::bench::BenchOptions {
+                quick,
+                size,
+                rsm_size,
+            },
+            &out,
+        )?,
     }
     Ok(())
 }

@@ -14,6 +14,10 @@ use std::path::Path;
 pub struct BenchOptions {
     /// 64x64 image and RSM, few frames: seconds on a software rasterizer.
     pub quick: bool,
+    /// Image side instead of the default (512, quick 64).
+    pub size: Option<u32>,
+    /// RSM side instead of the default (512, quick 64).
+    pub rsm_size: Option<u32>,
 }
 
 /// One measured configuration.
@@ -39,12 +43,24 @@ pub struct Ratios {
     pub passes_over_cut_indirect: Vec<(u32, Option<f64>)>,
     /// Per limit side: the same for the whole frame with a moving light.
     pub passes_over_cut_moving_frame: Vec<(u32, Option<f64>)>,
-    /// Per quadtree row of table 3: quadtree time / time of the cheapest RSM row with no more
-    /// error (static light); `None` where no RSM row reaches the quadtree's error.
-    pub quadtree_over_rsm_at_equal_error: Vec<(String, Option<f64>)>,
+    /// Per quadtree row of table 3: quadtree time / RSM-sampling time at the quadtree's error
+    /// (static light), the RSM time interpolated log-log between the two sample counts whose
+    /// errors bracket it; `None` where no RSM row reaches the quadtree's error.
+    pub quadtree_over_rsm_at_equal_error: Vec<EqualError>,
     /// Per quadtree row of table 3: quadtree time / RSM time at 2040 samples (the paper's "same
     /// quality" point), static light; with both errors.
     pub quadtree_over_rsm_2040: Vec<(String, Option<f64>, f64, f64)>,
+}
+
+/// A quadtree setting against RSM sampling at the same error.
+#[derive(Clone, Debug, Serialize)]
+pub struct EqualError {
+    pub quadtree: String,
+    pub rel_l1: f64,
+    /// RSM samples per pixel that give this error (interpolated).
+    pub rsm_samples: Option<f64>,
+    pub rsm_ms: Option<f64>,
+    pub ratio: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -59,7 +75,8 @@ pub struct BenchResults {
     pub ratios: Ratios,
 }
 
-const RSM_SAMPLES: [u32; 6] = [16, 64, 216, 256, 1024, 2040];
+/// The paper's 216, 256 and 2040, and beyond until RSM sampling reaches the quadtree's error.
+const RSM_SAMPLES: [u32; 9] = [16, 64, 216, 256, 1024, 2040, 4096, 8192, 16384];
 const LIMIT_SIDES: [u32; 3] = [16, 32, 64];
 const THRESHOLDS: [(f32, f32); 3] = [(0.45, 0.3), (0.25, 0.6), (0.05, 0.9)];
 
@@ -120,11 +137,9 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<BenchResults, IndirectError> {
     let scene = Scene::cornell();
-    let (size, rsm_size, frames) = if options.quick {
-        (64, 64, 3)
-    } else {
-        (512, 512, 30)
-    };
+    let (default_size, frames) = if options.quick { (64, 3) } else { (512, 30) };
+    let size = options.size.unwrap_or(default_size);
+    let rsm_size = options.rsm_size.unwrap_or(default_size);
     let base = Settings {
         width: size,
         height: size,
@@ -240,12 +255,14 @@ fn ratios(rows: &[Row]) -> Ratios {
         .iter()
         .filter(|r| r.table == "3" && r.method == Method::Quadtree)
         .map(|q| {
-            let cheapest = rsm
-                .iter()
-                .filter(|r| r.rel_l1 <= q.rel_l1)
-                .filter_map(|r| r.static_ms)
-                .min_by(f64::total_cmp);
-            (q.label.clone(), ratio(q.static_ms, cheapest))
+            let at = rsm_at_error(&rsm, q.rel_l1);
+            EqualError {
+                quadtree: q.label.clone(),
+                rel_l1: q.rel_l1,
+                rsm_samples: at.map(|(samples, _)| samples),
+                rsm_ms: at.map(|(_, ms)| ms),
+                ratio: ratio(q.static_ms, at.map(|(_, ms)| ms)),
+            }
         })
         .collect();
     let rsm_2040 = rsm.iter().find(|r| r.label == "2040 samples");
@@ -269,6 +286,24 @@ fn ratios(rows: &[Row]) -> Ratios {
         passes_over_cut_moving_frame,
         quadtree_over_rsm_at_equal_error,
     }
+}
+
+/// Samples and static-light time at which RSM sampling's error falls to `error`: log-log
+/// interpolation between the consecutive sample counts (rows in increasing order) that bracket it.
+fn rsm_at_error(rsm: &[&Row], error: f64) -> Option<(f64, f64)> {
+    let samples = |r: &Row| r.label.trim_end_matches(" samples").parse::<f64>().ok();
+    rsm.windows(2).find_map(|pair| {
+        let (a, b) = (pair[0], pair[1]);
+        if !(a.rel_l1 > error && b.rel_l1 <= error) {
+            return None;
+        }
+        let f = (error.ln() - a.rel_l1.ln()) / (b.rel_l1.ln() - a.rel_l1.ln());
+        let lerp = |x: f64, y: f64| (x.ln() + f * (y.ln() - x.ln())).exp();
+        Some((
+            lerp(samples(a)?, samples(b)?),
+            lerp(a.static_ms?, b.static_ms?),
+        ))
+    })
 }
 
 fn write_outputs(out: &Path, results: &BenchResults) -> Result<(), IndirectError> {
@@ -356,4 +391,43 @@ fn write_outputs(out: &Path, results: &BenchResults) -> Result<(), IndirectError
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rsm_row(samples: u32, rel_l1: f64, ms: f64) -> Row {
+        Row {
+            table: "3",
+            method: Method::Rsm,
+            label: format!("{samples} samples"),
+            clusters: None,
+            static_ms: Some(ms),
+            moving_ms: None,
+            static_timing: None,
+            moving_timing: None,
+            rel_l1,
+            rmse: 0.0,
+        }
+    }
+
+    #[test]
+    fn rsm_time_at_an_error_is_interpolated_log_log_between_the_bracketing_rows() {
+        // error halves and time quadruples with every 4x the samples
+        let rows = [
+            rsm_row(100, 0.2, 1.0),
+            rsm_row(400, 0.1, 4.0),
+            rsm_row(1600, 0.05, 16.0),
+        ];
+        let rsm: Vec<&Row> = rows.iter().collect();
+        let (samples, ms) = rsm_at_error(&rsm, 0.1).unwrap();
+        assert!((samples - 400.0).abs() < 1e-9 && (ms - 4.0).abs() < 1e-9);
+        // half way in log error between 0.1 and 0.05: half way in log time
+        let (samples, ms) = rsm_at_error(&rsm, (0.1f64 * 0.05).sqrt()).unwrap();
+        assert!((samples - 800.0).abs() < 1e-6, "{samples}");
+        assert!((ms - 8.0).abs() < 1e-9, "{ms}");
+        assert!(rsm_at_error(&rsm, 0.01).is_none());
+        assert!(rsm_at_error(&rsm, 0.5).is_none());
+    }
 }

@@ -32,18 +32,29 @@ fn rsm_sampling(@builtin(global_invocation_id) id: vec3<u32>) {
     var e = vec3<f32>(0.0);
     if (r.covered) {
         let clip = light.view_proj * vec4<f32>(r.x, 1.0);
-        let ndc = clip.xy / clip.w;
-        let centre = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * f32(params.rsm_size);
+        let side = f32(params.rsm_size);
+        // Receivers outside the spot's frustum (the walls beside and above it) project outside
+        // the RSM or, behind the light, nowhere: centre their disk on the nearest RSM point, or
+        // the middle, so that the disk still reaches the VPLs that light them.
+        let ndc = clip.xy / max(clip.w, 1e-6);
+        let projected = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * side;
+        // (a blend, not `select`: Mesa 22.3's lavapipe crashes compiling a branch here)
+        let behind = step(clip.w, 0.0);
+        let centre = mix(clamp(projected, vec2<f32>(0.0), vec2<f32>(side)), vec2<f32>(0.5 * side), behind);
+        // The pattern reaches sample.w texels; beyond the farthest corner there is nothing to
+        // sample, so shrink it to that corner (weights scale with the disk's area).
+        let corner = max(centre, vec2<f32>(side) - centre);
         let size = i32(params.rsm_size);
         for (var s = 0u; s < min(shade.sample_count, arrayLength(&samples)); s++) {
             let sample = samples[s];
-            let t = vec2<i32>(floor(centre + sample.xy));
+            let scale = min(1.0, length(corner) / sample.w);
+            let t = vec2<i32>(floor(centre + sample.xy * scale));
             if (all(t >= vec2<i32>(0)) && all(t < vec2<i32>(size))) {
                 let n = textureLoad(rsm_normal, t, 0);
                 if (n.w > 0.5) {
                     let p = textureLoad(rsm_pos, t, 0);
                     let flux = textureLoad(rsm_flux, t, 0).rgb;
-                    e += sample.z * vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, shade.r_min);
+                    e += sample.z * scale * scale * vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, shade.r_min);
                 }
             }
         }

@@ -48,7 +48,8 @@ pub fn poisson_disk(n: u32, seed: u64) -> Vec<[f32; 2]> {
 /// RSM sampling pattern: sample i at offset xi1 * R * (sin 2 pi xi2, cos 2 pi xi2) texels from the
 /// pixel's projection (dense near it, sparse far away, as in the RSM paper) with weight
 /// 2 pi xi1 R^2 / n, the inverse of that density, so the sum estimates the sum over every texel
-/// within R. Returns (dx, dy, weight, 0).
+/// within R. Returns (dx, dy, weight, R); the shader shrinks the disk (and the weights with its
+/// area) where the RSM's farthest corner is nearer than R.
 pub fn rsm_samples(n: u32, radius_texels: f32, seed: u64) -> Vec<[f32; 4]> {
     poisson_disk(n, seed)
         .into_iter()
@@ -56,7 +57,7 @@ pub fn rsm_samples(n: u32, radius_texels: f32, seed: u64) -> Vec<[f32; 4]> {
             let angle = std::f32::consts::TAU * xi2;
             let r = xi1 * radius_texels;
             let weight = std::f32::consts::TAU * xi1 * radius_texels * radius_texels / n as f32;
-            [r * angle.sin(), r * angle.cos(), weight, 0.0]
+            [r * angle.sin(), r * angle.cos(), weight, radius_texels]
         })
         .collect()
 }
