@@ -10,7 +10,7 @@ use std::sync::Arc;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
-use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
 const PANEL_WIDTH: f32 = 300.0;
@@ -59,6 +59,8 @@ struct State {
     frame_ms: f32,
     frames_drawn: u32,
     status: String,
+    /// When egui wants the next frame; `None`: only on input (nothing moves).
+    repaint_at: Option<Instant>,
 }
 
 impl State {
@@ -117,6 +119,7 @@ impl State {
             frame_ms: 0.0,
             frames_drawn: 0,
             status: String::new(),
+            repaint_at: Some(Instant::now()),
         })
     }
 
@@ -150,6 +153,9 @@ impl State {
             }
         }
         let raw = self.egui_state.take_egui_input(&self.window);
+        if scripted {
+            self.egui_ctx.request_repaint();
+        }
         let Self {
             egui_ctx,
             technique,
@@ -241,10 +247,23 @@ impl State {
                     }
                 }
                 save |= ui.input(|i| i.key_pressed(egui::Key::P));
+                // held keys move the camera and an animated light moves by itself
+                let animating = match indirect.as_ref().filter(|_| *technique == Technique::Indirect) {
+                    Some(view) => view.animate_light,
+                    None => displace.animate_light,
+                };
+                if animating || ui.input(|i| !i.keys_down.is_empty()) {
+                    ui.ctx().request_repaint();
+                }
             });
         });
         self.egui_state
             .handle_platform_output(&self.window, full.platform_output);
+        // a frame only when something moves: a CPU rasterizer idles instead of redrawing
+        self.repaint_at = full
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .and_then(|v| Instant::now().checked_add(v.repaint_delay));
         self.frames_drawn += 1;
         let done = args.frames.is_some_and(|n| self.frames_drawn >= n);
         if save || done {
@@ -341,7 +360,11 @@ impl ApplicationHandler for App {
         let Some(state) = self.state.as_mut() else {
             return;
         };
-        let _ = state.egui_state.on_window_event(&state.window, &event);
+        let response = state.egui_state.on_window_event(&state.window, &event);
+        // egui asks to repaint after every event, the redraw itself included: not after that one
+        if response.repaint && event != WindowEvent::RedrawRequested {
+            state.window.request_redraw();
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::KeyboardInput { event: key, .. }
@@ -363,10 +386,14 @@ impl ApplicationHandler for App {
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
-        // Continuous rendering: the light may be animated and timings are live.
-        if let Some(state) = &self.state {
-            state.window.request_redraw();
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(state) = &self.state else {
+            return;
+        };
+        match state.repaint_at {
+            Some(at) if at <= Instant::now() => state.window.request_redraw(),
+            Some(at) => event_loop.set_control_flow(ControlFlow::WaitUntil(at)),
+            None => event_loop.set_control_flow(ControlFlow::Wait),
         }
     }
 }
