@@ -53,6 +53,35 @@ fn gpu_brute_force_matches_the_cpu_reference() {
 }
 
 #[test]
+fn gpu_brute_force_sums_every_vpl_of_the_largest_rsm() {
+    // 1024^2 VPLs per pixel: lavapipe ends any single loop after 65,535 iterations, so this
+    // catches a brute force (or cut, or level pass) that is not split into nested loops
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let s = Settings {
+        width: 8,
+        height: 8,
+        ..settings(1024)
+    };
+    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    let gpu_image = render(&mut r, Method::Reference);
+    let vpls = r.read_vpls().unwrap();
+    assert!(vpls.len() > 500_000, "{} VPLs", vpls.len());
+    let cpu_image = reference::brute_force(&vpls, &r.read_receivers().unwrap(), scene.r_min);
+    let e = compare(&gpu_image, &cpu_image);
+    println!("GPU vs CPU brute force, 1024^2 RSM: {e:?}");
+    assert!(e.rel_l1 < 1e-4, "{e:?}");
+    // every cluster a single VPL: a cut of a million clusters, and the per-level passes
+    r.set_cluster(ClusterSettings::every_vpl(1024)).unwrap();
+    for method in [Method::Quadtree, Method::QuadtreePasses] {
+        let image = render(&mut r, method);
+        let e = compare(&image, &gpu_image);
+        println!("{method:?} with every VPL a cluster vs brute force: {e:?}");
+        assert!(e.rel_l1 < 1e-4, "{method:?}: {e:?}");
+    }
+}
+
+#[test]
 fn quadtree_with_every_cluster_one_vpl_equals_the_brute_force() {
     let gpu = gpu();
     let scene = Scene::cornell();

@@ -10,7 +10,8 @@ fn brute_force(@builtin(global_invocation_id) id: vec3<u32>) {
     var e = vec3<f32>(0.0);
     if (r.covered) {
         let size = params.rsm_size;
-        for (var i = 0u; i < min(size * size, LOOP_CAP); i++) {
+        let range = slice_range(size * size, SLICE);
+        for (var i = range.x; i < range.y; i++) {
             let t = vec2<i32>(i32(i % size), i32(i / size));
             let n = textureLoad(rsm_normal, t, 0);
             if (n.w > 0.5) {
@@ -20,7 +21,7 @@ fn brute_force(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
-    indirect[pixel_index(id.xy)] = vec4<f32>(r.albedo / PI * e, 0.0);
+    add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
 }
 
 @compute @workgroup_size(8, 8)
@@ -45,7 +46,8 @@ fn rsm_sampling(@builtin(global_invocation_id) id: vec3<u32>) {
         // sample, so shrink it to that corner (weights scale with the disk's area).
         let corner = max(centre, vec2<f32>(side) - centre);
         let size = i32(params.rsm_size);
-        for (var s = 0u; s < min(shade.sample_count, arrayLength(&samples)); s++) {
+        let range = slice_range(min(shade.sample_count, arrayLength(&samples)), SLICE);
+        for (var s = range.x; s < range.y; s++) {
             let sample = samples[s];
             let scale = min(1.0, length(corner) / sample.w);
             let t = vec2<i32>(floor(centre + sample.xy * scale));
@@ -59,5 +61,5 @@ fn rsm_sampling(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
-    indirect[pixel_index(id.xy)] = vec4<f32>(r.albedo / PI * e, 0.0);
+    add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
 }

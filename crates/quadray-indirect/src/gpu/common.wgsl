@@ -23,22 +23,24 @@ struct ClusterParams {
     normal_threshold: f32,
 }
 
-// Hard cap of every per-pixel loop (the longest legitimate one is the 512^2 brute force).
-const LOOP_CAP: u32 = 4194304u;
+// Items (VPLs, clusters, samples) one dispatch of a per-pixel sum covers: a longer sum takes
+// several dispatches that add up, each given its slice's number (see SLICE in resources.rs).
+// lavapipe ends an invocation's loops after 65,535 iterations in all.
+const SLICE: u32 = 32768u;
+// Nodes one dispatch of a per-level pass covers (each node's cut test loops over its ancestors).
+const LEVEL_SLICE: u32 = 2048u;
 const PI: f32 = 3.14159265358979;
 
 fn level_size(p: ClusterParams, level: u32) -> u32 {
     return p.rsm_size >> level;
 }
 
-// Index of the first node of `level` (levels are stored finest first).
+// Index of the first node of `level` (levels are stored finest first): the geometric series
+// S^2 (1 + 1/4 + ... ) over the finer levels, 4 (S^2 - s^2) / 3 with s the level's side. No loop:
+// it runs in every cut test, and lavapipe counts loop iterations (see SLICE).
 fn level_offset(p: ClusterParams, level: u32) -> u32 {
-    var offset = 0u;
-    for (var l = 0u; l < min(level, 16u); l++) {
-        let s = p.rsm_size >> l;
-        offset += s * s;
-    }
-    return offset;
+    let side = p.rsm_size >> min(level, 31u);
+    return 4u * (p.rsm_size * p.rsm_size - side * side) / 3u;
 }
 
 fn node_index(p: ClusterParams, level: u32, xy: vec2<u32>) -> u32 {

@@ -10,8 +10,23 @@ use wgpu::util::DeviceExt;
 
 const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Bound on the pyramid's levels (a 1024^2 RSM has 11); the per-level uniform slots.
+/// Bound on the pyramid's levels (a 1024^2 RSM has 11).
 const MAX_LEVELS: u32 = 16;
+/// Items (VPLs, clusters, samples) one dispatch of a per-pixel sum covers; longer sums take
+/// several dispatches that add up. lavapipe (llvmpipe) silently ends an invocation's loops after
+/// 65,535 iterations in all, which cut a 512^2 brute force to the RSM's top rows; on a GPU it
+/// keeps each dispatch short. Mirrors `SLICE` in common.wgsl.
+const SLICE: u64 = 32768;
+/// Nodes one dispatch of a per-level pass covers: each node's cut test climbs up to 10
+/// ancestors, so fewer nodes keep it under lavapipe's limit too. Mirrors `LEVEL_SLICE`.
+const LEVEL_SLICE: u64 = 2048;
+/// Slice uniform slots: enough for level 0 of a 1024^2 RSM in level slices, the longest sum.
+const MAX_SLICES: u32 = (1024 * 1024 / LEVEL_SLICE) as u32;
+
+/// Dispatches a sum over `items` takes, `per_slice` items each.
+fn slices(items: u64, per_slice: u64) -> u32 {
+    items.div_ceil(per_slice).clamp(1, u64::from(MAX_SLICES)) as u32
+}
 
 const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
@@ -199,17 +214,22 @@ impl Buffers {
         let cluster = uniform_buffer(gpu, "cluster", size_of::<ClusterUniform>() as u64);
         let shade = uniform_buffer(gpu, "shade", size_of::<ShadeUniform>() as u64);
         let level_stride = d.limits().min_uniform_buffer_offset_alignment.max(16);
-        let levels = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("levels"),
-            contents: &(0..MAX_LEVELS)
-                .flat_map(|l| {
-                    let mut slot = vec![0u8; level_stride as usize];
-                    slot[..4].copy_from_slice(&l.to_le_bytes());
-                    slot
-                })
-                .collect::<Vec<u8>>(),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        // uniform slots holding 0, 1, 2, ..., one bound per dispatch with a dynamic offset
+        let slots = |label, count: u32| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &(0..count)
+                    .flat_map(|i| {
+                        let mut slot = vec![0u8; level_stride as usize];
+                        slot[..4].copy_from_slice(&i.to_le_bytes());
+                        slot
+                    })
+                    .collect::<Vec<u8>>(),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        };
+        let levels = slots("levels", MAX_LEVELS);
+        let slice_slots = slots("slices", MAX_SLICES);
         let nodes = storage_buffer(gpu, "nodes", node_count(s.rsm_size) * 48);
         let cut = storage_buffer(gpu, "cut", node_count(s.rsm_size) * 4);
         let cut_count = storage_buffer(gpu, "cut count", 4);
@@ -227,11 +247,14 @@ impl Buffers {
         fn whole(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
             b.as_entire_binding()
         }
-        let level_binding = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &levels,
-            offset: 0,
-            size: wgpu::BufferSize::new(16),
-        });
+        let slot_binding = |buffer| {
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer,
+                offset: 0,
+                size: wgpu::BufferSize::new(16),
+            })
+        };
+        let level_binding = || slot_binding(&levels);
         let raster_group = |uniform: &wgpu::Buffer| {
             d.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("raster"),
@@ -267,7 +290,7 @@ impl Buffers {
             layout: &pipelines.cluster_layout,
             entries: &entries(vec![
                 whole(&cluster),
-                level_binding.clone(),
+                level_binding(),
                 tex(&rsm_views[0]),
                 tex(&rsm_views[1]),
                 tex(&rsm_views[2]),
@@ -282,7 +305,7 @@ impl Buffers {
             entries: &entries(vec![
                 whole(&cluster),
                 whole(&shade),
-                level_binding,
+                level_binding(),
                 whole(&light),
                 tex(&g_views[0]),
                 tex(&g_views[1]),
@@ -297,6 +320,7 @@ impl Buffers {
                 whole(&direct),
                 whole(&low),
                 whole(&samples_buffer),
+                slot_binding(&slice_slots),
             ]),
         });
         let buffers = Self {
@@ -426,6 +450,11 @@ impl Buffers {
     fn level_offset(&self, level: u32) -> u32 {
         level * self.level_stride
     }
+
+    /// The shading group's dynamic offsets: the level's slot, then the slice's.
+    fn shade_offsets(&self, level: u32, slice: u32) -> [u32; 2] {
+        [self.level_offset(level), slice * self.level_stride]
+    }
 }
 
 /// Every pipeline and the layouts they share.
@@ -534,6 +563,7 @@ impl Pipelines {
             storage_entry(14, false),
             storage_entry(15, false),
             storage_entry(16, true),
+            uniform_entry(17, compute, true),
         ]);
         let shade_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shade"),
@@ -784,45 +814,58 @@ impl Pipelines {
         timer: Option<&GpuTimer>,
     ) {
         let subsampled = method == Method::Quadtree && s.subsample > 1;
+        let rsm_texels = u64::from(s.rsm_size).pow(2);
+        // a cut partitions the RSM into nodes no finer than the limit level
+        let cut_slices = slices(u64::from(s.rsm_size >> s.cluster.limit_level).pow(2), SLICE);
         if method == Method::QuadtreePasses {
             encoder.clear_buffer(&b.indirect, 0, None);
         }
         {
             let mut pass = Self::compute_pass(encoder, "indirect", Pass::Indirect, timer);
-            pass.set_bind_group(0, &b.shade_group, &[b.level_offset(0)]);
+            // the sum over `items` in slices; the first slice writes, the others add
+            let sliced = |pass: &mut wgpu::ComputePass, level: u32, count: u32, w, h| {
+                for slice in 0..count {
+                    pass.set_bind_group(0, &b.shade_group, &b.shade_offsets(level, slice));
+                    dispatch_2d(pass, w, h);
+                }
+            };
+            let (w, h) = (s.width, s.height);
             match method {
                 Method::Quadtree if subsampled => {
                     pass.set_pipeline(&self.indirect_low);
                     let (lw, lh) = low_size(s);
-                    dispatch_2d(&mut pass, lw, lh);
+                    sliced(&mut pass, 0, cut_slices, lw, lh);
                 }
                 Method::Quadtree => {
                     pass.set_pipeline(&self.indirect_cut);
-                    dispatch_2d(&mut pass, s.width, s.height);
+                    sliced(&mut pass, 0, cut_slices, w, h);
                 }
                 Method::QuadtreePasses => {
                     pass.set_pipeline(&self.indirect_level);
                     let c = &s.cluster;
                     for level in (c.limit_level..=c.start_level).rev() {
-                        pass.set_bind_group(0, &b.shade_group, &[b.level_offset(level)]);
-                        dispatch_2d(&mut pass, s.width, s.height);
+                        let nodes = u64::from(s.rsm_size >> level).pow(2);
+                        sliced(&mut pass, level, slices(nodes, LEVEL_SLICE), w, h);
                     }
                 }
                 Method::Rsm => {
                     pass.set_pipeline(&self.rsm_sampling);
-                    dispatch_2d(&mut pass, s.width, s.height);
+                    sliced(&mut pass, 0, slices(u64::from(s.samples), SLICE), w, h);
                 }
                 Method::Reference => {
                     pass.set_pipeline(&self.brute_force);
-                    dispatch_2d(&mut pass, s.width, s.height);
+                    sliced(&mut pass, 0, slices(rsm_texels, SLICE), w, h);
                 }
             }
         }
         if subsampled {
+            // where the upsampler recomputes a pixel it sums the cut, in the same slices
             let mut pass = Self::compute_pass(encoder, "upsample", Pass::Upsample, timer);
-            pass.set_bind_group(0, &b.shade_group, &[b.level_offset(0)]);
             pass.set_pipeline(&self.upsample);
-            dispatch_2d(&mut pass, s.width, s.height);
+            for slice in 0..cut_slices {
+                pass.set_bind_group(0, &b.shade_group, &b.shade_offsets(0, slice));
+                dispatch_2d(&mut pass, s.width, s.height);
+            }
         }
     }
 
@@ -834,7 +877,7 @@ impl Pipelines {
         timer: Option<&GpuTimer>,
     ) {
         let mut pass = Self::compute_pass(encoder, "direct", Pass::Direct, timer);
-        pass.set_bind_group(0, &b.shade_group, &[b.level_offset(0)]);
+        pass.set_bind_group(0, &b.shade_group, &b.shade_offsets(0, 0));
         pass.set_pipeline(&self.direct_light);
         dispatch_2d(&mut pass, s.width, s.height);
     }

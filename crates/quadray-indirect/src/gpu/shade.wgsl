@@ -2,10 +2,11 @@
 // pass per level; optionally at low resolution with geometry-aware upsampling. Direct light from
 // the spot with the RSM depth as shadow map.
 
+// This dispatch's slice of the cut.
 fn cut_irradiance(r: Receiver) -> vec3<f32> {
     var e = vec3<f32>(0.0);
-    let count = min(min(cut_count, arrayLength(&cut)), LOOP_CAP);
-    for (var i = 0u; i < count; i++) {
+    let range = slice_range(min(cut_count, arrayLength(&cut)), SLICE);
+    for (var i = range.x; i < range.y; i++) {
         e += node_irradiance(nodes[cut[i]], r);
     }
     return e;
@@ -21,7 +22,7 @@ fn indirect_cut(@builtin(global_invocation_id) id: vec3<u32>) {
     if (r.covered) {
         e = cut_irradiance(r);
     }
-    indirect[pixel_index(id.xy)] = vec4<f32>(r.albedo / PI * e, 0.0);
+    add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
 }
 
 // One level of the paper's traversal: every node of the level, used when the top-down rule says
@@ -38,7 +39,8 @@ fn indirect_level(@builtin(global_invocation_id) id: vec3<u32>) {
     let level = current.level;
     let size = level_size(params, level);
     var e = vec3<f32>(0.0);
-    for (var i = 0u; i < min(size * size, LOOP_CAP); i++) {
+    let range = slice_range(size * size, LEVEL_SLICE);
+    for (var i = range.x; i < range.y; i++) {
         let xy = vec2<u32>(i % size, i / size);
         if (in_cut(params, level, xy)) {
             e += node_irradiance(nodes[level_offset(params, level) + i], r);
@@ -64,11 +66,17 @@ fn indirect_low(@builtin(global_invocation_id) id: vec3<u32>) {
     if (r.covered) {
         e = cut_irradiance(r);
     }
-    low[id.y * shade.low_width + id.x] = vec4<f32>(e, select(0.0, 1.0, r.covered));
+    let index = id.y * shade.low_width + id.x;
+    if (slice.level == 0u) {
+        low[index] = vec4<f32>(e, select(0.0, 1.0, r.covered));
+    } else {
+        low[index] += vec4<f32>(e, 0.0);
+    }
 }
 
 // Bilinear over the four nearest low-resolution samples that lie on the same surface (normals
-// and planes agree); where none does, the pixel is recomputed from the cut.
+// and planes agree); where none does, the pixel is recomputed from the cut, one slice per
+// dispatch like the cut pass.
 @compute @workgroup_size(8, 8)
 fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= shade.width || id.y >= shade.height) {
@@ -77,7 +85,7 @@ fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
     let r = receiver(id.xy);
     let index = pixel_index(id.xy);
     if (!r.covered) {
-        indirect[index] = vec4<f32>(0.0);
+        add_indirect(index, vec4<f32>(0.0));
         return;
     }
     let k = f32(shade.subsample);
@@ -99,9 +107,11 @@ fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     if (weight > 1e-3) {
-        indirect[index] = vec4<f32>(r.albedo / PI * e / weight, 0.0);
+        if (slice.level == 0u) {
+            indirect[index] = vec4<f32>(r.albedo / PI * e / weight, 0.0);
+        }
     } else {
-        indirect[index] = vec4<f32>(r.albedo / PI * cut_irradiance(r), 1.0);
+        add_indirect(index, vec4<f32>(r.albedo / PI * cut_irradiance(r), 1.0));
     }
 }
 

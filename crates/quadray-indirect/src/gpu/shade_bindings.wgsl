@@ -39,8 +39,10 @@ struct Level {
 @group(0) @binding(13) var<storage, read_write> indirect: array<vec4<f32>>;
 @group(0) @binding(14) var<storage, read_write> direct: array<vec4<f32>>;
 @group(0) @binding(15) var<storage, read_write> low: array<vec4<f32>>;
-// xy: offset in RSM texels, z: weight
+// xy: offset in RSM texels, z: weight, w: the pattern's radius
 @group(0) @binding(16) var<storage, read> samples: array<vec4<f32>>;
+// which slice of a long per-pixel sum this dispatch adds (see SLICE)
+@group(0) @binding(17) var<uniform> slice: Level;
 
 struct Receiver {
     x: vec3<f32>,
@@ -66,4 +68,19 @@ fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
 
 fn pixel_index(pixel: vec2<u32>) -> u32 {
     return pixel.y * shade.width + pixel.x;
+}
+
+// This dispatch's items of a sum over `count` items, `per_slice` at a time: [x, y).
+fn slice_range(count: u32, per_slice: u32) -> vec2<u32> {
+    let first = slice.level * per_slice;
+    return vec2<u32>(first, min(first + per_slice, count));
+}
+
+// Stores one slice's share of a pixel's indirect light: the first slice writes, the others add.
+fn add_indirect(index: u32, value: vec4<f32>) {
+    if (slice.level == 0u) {
+        indirect[index] = value;
+    } else {
+        indirect[index] += value;
+    }
 }
