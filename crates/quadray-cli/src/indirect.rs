@@ -34,8 +34,8 @@ pub struct IndirectArgs {
     /// Min dot(child normal, mean normal) of a valid cluster.
     #[arg(long, default_value_t = 0.9)]
     normal_threshold: f32,
-    /// local (the paper's) or recursive (every child valid too).
-    #[arg(long, default_value = "local")]
+    /// recursive (every child valid too) or local (the paper's).
+    #[arg(long, default_value = "recursive")]
     validity: Validity,
     /// Cluster means weighted by texel count instead of flux.
     #[arg(long)]

@@ -96,14 +96,20 @@ pub struct ClusterSettings {
 }
 
 impl ClusterSettings {
-    /// Defaults for a given RSM: the paper's thresholds (depth 0.05, normal 0.9) and local rule,
-    /// start at 8x8 as in the paper, limit at 64x64 (the paper's level 4; its 32x32 limit leaves
-    /// about 7% rel. L1 error on the Cornell box, most of it at the limit level).
+    /// Defaults for a given RSM: the paper's thresholds (depth 0.05, normal 0.9), start at 8x8 as
+    /// in the paper, limit at 64x64 (the paper's level 4; its 32x32 limit leaves about 7% rel. L1
+    /// error on the Cornell box, most of it at the limit level), and the recursive rule: on a
+    /// 512^2 RSM the local rule leaves 5.1% with 360 clusters, the recursive 3.8% with 633, less
+    /// than the local rule reaches with the same time at a finer limit (4.4% with 589).
     pub fn defaults(rsm_size: u32) -> Self {
-        Self::with_limit_side(rsm_size, 64)
+        Self {
+            validity: Validity::Recursive,
+            ..Self::with_limit_side(rsm_size, 64)
+        }
     }
 
-    /// The defaults with the limit level where nodes are `side` x `side` (16, 32, 64 in table 1).
+    /// The paper's settings (local rule) with the limit level where nodes are `side` x `side`
+    /// (16, 32, 64 in table 1).
     pub fn with_limit_side(rsm_size: u32, side: u32) -> Self {
         let top = rsm_size.ilog2();
         Self {
