@@ -56,6 +56,8 @@ struct State {
     /// Made when first shown.
     indirect: Option<IndirectView>,
     last_frame: Instant,
+    /// Wall time of the last frame's work (render, read back, panel, present), smoothed; the
+    /// time between frames says nothing when frames come only on input.
     frame_ms: f32,
     frames_drawn: u32,
     status: String,
@@ -134,7 +136,6 @@ impl State {
         let now = Instant::now();
         let dt = (now - self.last_frame).as_secs_f32().min(0.1);
         self.last_frame = now;
-        self.frame_ms = self.frame_ms * 0.9 + dt * 1e3 * 0.1;
         let scripted = args.frames.is_some();
         let mut save = false;
         if self.technique == Technique::Indirect && self.indirect.is_none() {
@@ -275,6 +276,12 @@ impl State {
             println!("{cmd}");
         }
         self.paint(full.shapes, full.textures_delta, full.pixels_per_point)?;
+        let work_ms = now.elapsed().as_secs_f32() * 1e3;
+        self.frame_ms = if self.frame_ms == 0.0 {
+            work_ms
+        } else {
+            self.frame_ms * 0.8 + work_ms * 0.2
+        };
         Ok(done)
     }
 
