@@ -427,6 +427,16 @@ impl IndirectView {
         );
         ui.add(egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling"));
         ui.checkbox(&mut self.animate_light, "animate light (L)");
+        if self.method == Method::Reference {
+            let work = f64::from(s.width) * f64::from(s.height) * f64::from(s.rsm_size).powi(2);
+            ui.colored_label(
+                egui::Color32::YELLOW,
+                format!(
+                    "brute force: {:.2} G kernel evaluations a frame",
+                    work / 1e9
+                ),
+            );
+        }
         if before != (self.scene, self.method, self.show, self.exposure) {
             // a method's first frame builds the buffers it needs
             self.rebuild |= before.1 != self.method;

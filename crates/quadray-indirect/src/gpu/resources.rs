@@ -882,3 +882,25 @@ impl Pipelines {
         dispatch_2d(&mut pass, s.width, s.height);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slices_cover_the_longest_sums_that_settings_allow() {
+        // the largest RSM's VPLs (brute force, a cut of single VPLs), its finest level in level
+        // slices (per-level passes), the most RSM samples: never clamped by the slot count
+        let vpls = 1024u64 * 1024;
+        for (items, per_slice) in [(vpls, SLICE), (vpls, LEVEL_SLICE), (65536, SLICE)] {
+            let n = slices(items, per_slice);
+            assert!(
+                u64::from(n) * per_slice >= items,
+                "{items} in {n} x {per_slice}"
+            );
+            assert!(n <= MAX_SLICES);
+        }
+        assert_eq!(slices(0, SLICE), 1, "an empty sum still writes its zeros");
+        assert_eq!(slices(SLICE + 1, SLICE), 2);
+    }
+}
