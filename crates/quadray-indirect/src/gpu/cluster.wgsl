@@ -11,7 +11,9 @@ struct Level {
 @group(0) @binding(3) var rsm_pos: texture_2d<f32>;
 @group(0) @binding(4) var rsm_normal: texture_2d<f32>;
 @group(0) @binding(5) var<storage, read_write> nodes: array<Node>;
-@group(0) @binding(6) var<storage, read_write> cut: array<u32>;
+// the cut's clusters, copied out of the pyramid so that shading reads them in a row; normal.w
+// holds the node's index (bit pattern) instead of its validity
+@group(0) @binding(6) var<storage, read_write> cut: array<Node>;
 @group(0) @binding(7) var<storage, read_write> cut_count: atomic<u32>;
 
 @compute @workgroup_size(8, 8)
@@ -111,6 +113,8 @@ fn select_cut(@builtin(global_invocation_id) id: vec3<u32>) {
     let local = index - level_offset(params, level);
     let size = level_size(params, level);
     if (in_cut(params, level, vec2<u32>(local % size, local / size))) {
-        cut[atomicAdd(&cut_count, 1u)] = index;
+        var node = nodes[index];
+        node.normal.w = bitcast<f32>(index);
+        cut[atomicAdd(&cut_count, 1u)] = node;
     }
 }

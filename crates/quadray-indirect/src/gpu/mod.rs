@@ -491,10 +491,12 @@ impl<'g> Renderer<'g> {
     /// The clusters of the compacted cut (after a `Quadtree` frame with rebuild), in no order.
     pub fn read_cut(&self) -> Result<Vec<CutNode>, IndirectError> {
         let count = self.clusters_in_cut()? as usize;
-        let indices = self.buffers.read_u32(self.gpu, &self.buffers.cut)?;
-        Ok(indices[..count.min(indices.len())]
-            .iter()
-            .map(|&i| CutNode::at(self.settings.rsm_size, i))
+        let clusters = self.buffers.read_vec4(self.gpu, &self.buffers.cut)?;
+        // three vec4 a cluster; the normal's w holds the node's index
+        Ok(clusters
+            .chunks_exact(3)
+            .take(count)
+            .map(|c| CutNode::at(self.settings.rsm_size, c[2][3].to_bits()))
             .collect())
     }
 

@@ -231,7 +231,8 @@ impl Buffers {
         let levels = slots("levels", MAX_LEVELS);
         let slice_slots = slots("slices", MAX_SLICES);
         let nodes = storage_buffer(gpu, "nodes", node_count(s.rsm_size) * 48);
-        let cut = storage_buffer(gpu, "cut", node_count(s.rsm_size) * 4);
+        // a cut partitions the RSM: at most one cluster per texel
+        let cut = storage_buffer(gpu, "cut", u64::from(s.rsm_size).pow(2) * 48);
         let cut_count = storage_buffer(gpu, "cut count", 4);
         let pixels = u64::from(s.width) * u64::from(s.height);
         let indirect = storage_buffer(gpu, "indirect", pixels * 16);

@@ -7,7 +7,7 @@ fn cut_irradiance(r: Receiver) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     let range = slice_range(min(cut_count, arrayLength(&cut)), SLICE);
     for (var i = range.x; i < range.y; i++) {
-        e += node_irradiance(nodes[cut[i]], r);
+        e += node_irradiance(cut[i], r);
     }
     return e;
 }

@@ -33,7 +33,7 @@ struct Level {
 @group(0) @binding(8) var rsm_pos: texture_2d<f32>;
 @group(0) @binding(9) var rsm_normal: texture_2d<f32>;
 @group(0) @binding(10) var<storage, read> nodes: array<Node>;
-@group(0) @binding(11) var<storage, read> cut: array<u32>;
+@group(0) @binding(11) var<storage, read> cut: array<Node>;
 @group(0) @binding(12) var<storage, read> cut_count: u32;
 // rgb: indirect radiance (or irradiance for the low-resolution pass), w: 1 when recomputed
 @group(0) @binding(13) var<storage, read_write> indirect: array<vec4<f32>>;
