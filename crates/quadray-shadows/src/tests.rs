@@ -340,7 +340,7 @@ fn transmission_updates_the_carried_state() {
     u.transmit(false);
     assert_eq!(u.sc, None);
     // An unknown condition is never sustained: the next point takes a shadow ray.
-    let (shadowed, sub) = u.hst_step(0, 10.0, false, || unreachable!(), || false);
+    let (shadowed, sub) = u.hst_step(0, 10.0, false, true, || unreachable!(), || false);
     assert_eq!(
         (shadowed, sub),
         (false, crate::shadow::Subscheme::Conventional)
@@ -409,7 +409,7 @@ fn shadow_polygons_are_silhouettes_only() {
     let v: &ShadowVolumes = prep.volumes.as_ref().unwrap();
     // Light 0 is above the boxes: each box shows 1 or 2 side faces plus its top: 4-6 silhouette
     // edges each, weight 2; the floor and wall quads add their open boundary edges, weight 1.
-    let w = &v.lights[0].weights;
+    let w: Vec<i32> = v.lights[0].polygons.iter().map(|p| p.weight).collect();
     let doubles = w.iter().filter(|&&x| x.abs() == 2).count();
     assert!(
         (8..=12).contains(&doubles),

@@ -136,9 +136,9 @@ pub struct RenderStats {
     pub conventional: u64,
     pub shadow_polygon_tests: u64,
     pub shadow_rays: u64,
-    /// Clock time the tiles' threads spent deciding shadows, and in the tiles.
-    pub shadow_thread_s: f64,
-    pub tile_thread_s: f64,
+    /// Ticks ([`crate::ticks`]) the tiles' threads spent deciding shadows, and in the tiles.
+    pub shadow_ticks: u64,
+    pub tile_ticks: u64,
     pub render_wall_s: f64,
     /// CPU time of the render, all threads (what the paper's CPU minutes measure; unlike clock
     /// time it is not inflated by other processes on a shared machine).
@@ -157,14 +157,14 @@ impl RenderStats {
         self.conventional += o.conventional;
         self.shadow_polygon_tests += o.shadow_polygon_tests;
         self.shadow_rays += o.shadow_rays;
-        self.shadow_thread_s += o.shadow_thread_s;
-        self.tile_thread_s += o.tile_thread_s;
+        self.shadow_ticks += o.shadow_ticks;
+        self.tile_ticks += o.tile_ticks;
     }
 
     /// CPU time of shadow testing: the render's CPU time split in the threads' proportion.
     pub fn shadow_cpu_s(&self) -> f64 {
-        if self.tile_thread_s > 0.0 {
-            self.render_cpu_s * self.shadow_thread_s / self.tile_thread_s
+        if self.tile_ticks > 0 {
+            self.render_cpu_s * self.shadow_ticks as f64 / self.tile_ticks as f64
         } else {
             0.0
         }
@@ -182,6 +182,18 @@ struct Scratch {
 }
 
 type States = [LightState; MAX_LIGHTS];
+
+/// A shading point and how the ray segment reached it: `p = o + t d` on `polygon`, `n` the normal
+/// on the side it arrived from.
+#[derive(Clone, Copy)]
+struct Arrival {
+    o: Vec3,
+    d: Vec3,
+    t: f32,
+    p: Vec3,
+    n: Vec3,
+    polygon: u32,
+}
 
 struct Tracer<'a> {
     prep: &'a Prepared,
@@ -232,7 +244,7 @@ pub fn render(
 
 impl Tracer<'_> {
     fn tile(&self, tx: u32, ty: u32) -> (Vec<[u8; 4]>, RenderStats) {
-        let start = Instant::now();
+        let start = crate::ticks();
         let prep = self.prep;
         let (w, h) = (self.settings.width, self.settings.height);
         let mut scratch = Scratch {
@@ -289,7 +301,7 @@ impl Tracer<'_> {
                 pixels.push([c.x as u8, c.y as u8, c.z as u8, 255]);
             }
         }
-        scratch.stats.tile_thread_s = start.elapsed().as_secs_f64();
+        scratch.stats.tile_ticks = crate::ticks().wrapping_sub(start);
         (pixels, scratch.stats)
     }
 
@@ -329,30 +341,16 @@ impl Tracer<'_> {
         sc.stats.shading_points += 1;
 
         let lights = &prep.scene.lights;
-        let mut shadowed = [true; MAX_LIGHTS];
-        let shadow_start = Instant::now();
-        let ns = match (&prep.volumes, self.settings.scheme) {
-            (Some(v), Scheme::Hst { .. }) => v.registered(&sc.walked),
-            _ => [0; MAX_LIGHTS],
-        };
-        for (l, light) in lights.iter().enumerate() {
-            let to_light = light.position - p;
-            let self_shadow = to_light.dot(n) <= 0.0;
-            shadowed[l] = self.shadowed(
-                sc,
-                l,
-                ns[l],
-                &mut states[l],
-                o,
-                d,
-                hit.t,
-                p,
-                to_light,
-                self_shadow,
-                hit.polygon,
-            );
-        }
-        sc.stats.shadow_thread_s += shadow_start.elapsed().as_secs_f64();
+        let shadow_start = crate::ticks();
+        // Whether a reflected or refracted ray leaves this point and carries the shadow state on.
+        let continues = depth > 0 && (mat.reflect > 0.0 || mat.transmit > 0.0);
+        let shadowed = self.shadow_conditions(
+            sc,
+            &mut states,
+            Arrival { o, d, t: hit.t, p, n, polygon: hit.polygon },
+            continues,
+        );
+        sc.stats.shadow_ticks += crate::ticks().wrapping_sub(shadow_start);
         sc.stats.shadow_decisions += lights.len() as u64;
         if self.settings.check {
             let mut differs = 0;
@@ -407,24 +405,63 @@ impl Tracer<'_> {
         colour
     }
 
-    /// The scheme's shadow condition for light `l` at `p` (reached along `o + t d`, `t = t_hit`,
-    /// through cells where `ns` shadow polygons of the light are registered).
+    /// Every light's shadow condition at a shading point. Kept out of line so that profilers
+    /// (callgrind's inclusive counts) see the whole of shadow testing as one function.
+    #[inline(never)]
+    fn shadow_conditions(
+        &self,
+        sc: &mut Scratch,
+        states: &mut States,
+        at: Arrival,
+        continues: bool,
+    ) -> [bool; MAX_LIGHTS] {
+        let prep = self.prep;
+        let mut shadowed = [true; MAX_LIGHTS];
+        let ns = match (&prep.volumes, self.settings.scheme) {
+            (Some(v), Scheme::Hst { .. }) => v.registered(&sc.walked),
+            _ => [0; MAX_LIGHTS],
+        };
+        for (l, light) in prep.scene.lights.iter().enumerate() {
+            let to_light = light.position - at.p;
+            let self_shadow = to_light.dot(at.n) <= 0.0;
+            shadowed[l] = self.shadowed(
+                sc,
+                l,
+                ns[l],
+                &mut states[l],
+                &at,
+                to_light,
+                self_shadow,
+                continues,
+            );
+        }
+        shadowed
+    }
+
+    /// The scheme's shadow condition for light `l` at the shading point, reached through cells
+    /// where `ns` shadow polygons of the light are registered.
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     fn shadowed(
         &self,
         sc: &mut Scratch,
         l: usize,
         ns: u32,
         state: &mut LightState,
-        o: Vec3,
-        d: Vec3,
-        t_hit: f32,
-        p: Vec3,
+        at: &Arrival,
         to_light: Vec3,
         self_shadow: bool,
-        polygon: u32,
+        continues: bool,
     ) -> bool {
         let prep = self.prep;
+        let Arrival {
+            o,
+            d,
+            t: t_hit,
+            p,
+            polygon,
+            ..
+        } = *at;
         match self.settings.scheme {
             Scheme::Conventional | Scheme::Bvh | Scheme::Embree => {
                 sc.stats.conventional += 1;
@@ -463,6 +500,7 @@ impl Tracer<'_> {
                     ns,
                     nth,
                     self_shadow,
+                    continues,
                     || {
                         v.crossings(
                             l,
