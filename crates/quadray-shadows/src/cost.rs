@@ -175,11 +175,12 @@ fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64
             (ab[0], to / dist, dist, walked)
         })
         .collect();
+    let mut occupied = Vec::new();
     let entries: u64 = segments
         .iter()
         .map(|s| {
             volumes
-                .registered(&s.3)
+                .gather(&s.3, &mut occupied)
                 .iter()
                 .map(|&n| n as u64)
                 .sum::<u64>()
@@ -193,8 +194,10 @@ fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64
     Some(median_ns(entries as usize, || {
         let mut change = 0;
         for (o, d, t, walked) in &segments {
+            volumes.gather(walked, &mut occupied);
             for l in 0..volumes.lights.len() {
-                change += volumes.crossings(l, walked, *o, *d, 0.0, *t, &mut mailbox, &mut tests);
+                change +=
+                    volumes.crossings(l, &occupied, *o, *d, 0.0, *t, &mut mailbox, &mut tests);
             }
         }
         black_box(change);

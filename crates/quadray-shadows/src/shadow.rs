@@ -61,20 +61,23 @@ impl ShadowPolygon {
     }
 }
 
-/// The shadow polygons of one light, registered in the grid.
+/// The shadow polygons of one light.
 pub struct LightVolumes {
     pub polygons: Vec<ShadowPolygon>,
-    pub cells: CellLists,
     /// D at the eye.
     pub eye_depth: i32,
 }
 
-/// Shadow polygons for every light.
+/// Shadow polygons for every light, registered in the grid.
 pub struct ShadowVolumes {
     pub lights: Vec<LightVolumes>,
-    /// Shadow polygons registered per cell and light, cell-major (saturating), so N_s of every
-    /// light is one pass over a segment's cells.
-    counts: Vec<u16>,
+    /// Row `cell * lights + light`: that light's shadow polygons registered in the cell. The
+    /// lights of one cell are neighbours in memory, so N_s of every light and the polygons of
+    /// each come from the same cache lines.
+    cells: CellLists,
+    /// One bit per cell: does it hold any light's shadow polygons (most cells a ray crosses hold
+    /// none)? Small enough to stay in cache.
+    occupied: Vec<u64>,
 }
 
 impl ShadowVolumes {
@@ -83,7 +86,7 @@ impl ShadowVolumes {
     pub fn build(scene: &Scene, polygons: &[ConvexPolygon], grid: &Grid) -> Self {
         let (vertices, eye) = (&scene.vertices, scene.camera.eye);
         let edges = edge_map(polygons, &scene.faces);
-        let lights = scene
+        let (lights, per_light): (Vec<LightVolumes>, Vec<CellLists>) = scene
             .lights
             .iter()
             .map(|l| {
@@ -91,20 +94,24 @@ impl ShadowVolumes {
                 let (outlines, polys) =
                     silhouette_polygons(polygons, vertices, &edges, light, &grid.bounds);
                 let cells = grid.register(outlines.par_iter().map(|p| p.as_slice()));
-                LightVolumes {
+                let volumes = LightVolumes {
                     eye_depth: depth_at(polygons, light, eye),
                     polygons: polys,
-                    cells,
-                }
+                };
+                (volumes, cells)
             })
-            .collect::<Vec<LightVolumes>>();
-        let mut counts = vec![0u16; grid.cell_count() * lights.len()];
-        for (l, lv) in lights.iter().enumerate() {
-            for c in 0..grid.cell_count() {
-                counts[c * lights.len() + l] = lv.cells.count(c as u32).min(u16::MAX as u32) as u16;
+            .unzip();
+        let mut occupied = vec![0u64; grid.cell_count().div_ceil(64)];
+        for c in 0..grid.cell_count() {
+            if per_light.iter().any(|cells| cells.count(c as u32) > 0) {
+                occupied[c / 64] |= 1 << (c % 64);
             }
         }
-        Self { lights, counts }
+        Self {
+            lights,
+            cells: CellLists::interleave(&per_light, grid.cell_count()),
+            occupied,
+        }
     }
 
     pub fn polygon_count(&self) -> usize {
@@ -119,29 +126,33 @@ impl ShadowVolumes {
             .unwrap_or(0)
     }
 
-    /// N_s of every light: shadow polygons registered in the cells a segment crossed (with
-    /// repeats).
+    /// Keeps in `occupied` the cells of `walked` (a segment's cells) that hold shadow polygons,
+    /// and returns N_s of every light: the shadow polygons registered in them (with repeats).
     #[inline]
-    pub fn registered(&self, walked: &[u32]) -> [u32; MAX_LIGHTS] {
-        let n = self.lights.len();
+    pub fn gather(&self, walked: &[u32], occupied: &mut Vec<u32>) -> [u32; MAX_LIGHTS] {
+        occupied.clear();
+        let n = self.lights.len() as u32;
         let mut ns = [0u32; MAX_LIGHTS];
         for &c in walked {
-            let row = &self.counts[c as usize * n..c as usize * n + n];
-            for (acc, &k) in ns.iter_mut().zip(row) {
-                *acc += k as u32;
+            if self.occupied[c as usize / 64] & (1 << (c % 64)) != 0 {
+                occupied.push(c);
+                let bounds = self.cells.row_bounds(c * n, n);
+                for (acc, w) in ns.iter_mut().zip(bounds.windows(2)) {
+                    *acc += w[1] - w[0];
+                }
             }
         }
         ns
     }
 
-    /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells are
-    /// `walked`; `tests` counts the ray/shadow-polygon tests.
+    /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells holding
+    /// shadow polygons are `cells` ([`Self::gather`]); `tests` counts the ray/shadow-polygon tests.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn crossings(
         &self,
         light: usize,
-        walked: &[u32],
+        cells: &[u32],
         o: Vec3,
         d: Vec3,
         t0: f32,
@@ -149,11 +160,11 @@ impl ShadowVolumes {
         mailbox: &mut Mailbox,
         tests: &mut u64,
     ) -> i32 {
-        let lv = &self.lights[light];
+        let (lv, n) = (&self.lights[light], self.lights.len() as u32);
         mailbox.next_ray();
         let (mut change, mut tested) = (0, 0);
-        for &c in walked {
-            for &id in lv.cells.cell(c) {
+        for &c in cells {
+            for &id in self.cells.cell(c * n + light as u32) {
                 if mailbox.first_visit(id) {
                     tested += 1;
                     change += lv.polygons[id as usize].crossing(o, d, t0, t1);

@@ -188,7 +188,7 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
         let volumes = prep.volumes.as_ref().unwrap();
         let mut objects = Mailbox::new(prep.polygons.len());
         let mut shadows = Mailbox::new(volumes.max_per_light());
-        let (mut walked, mut tests, mut checked) = (Vec::new(), 0, 0);
+        let (mut walked, mut occupied, mut tests, mut checked) = (Vec::new(), Vec::new(), 0, 0);
         for (o, d) in test_rays(&prep, 1500) {
             walked.clear();
             let t1 = prep
@@ -217,7 +217,9 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
                 ) else {
                     continue;
                 };
-                let change = volumes.crossings(l, &walked, o, d, 0.0, t1, &mut shadows, &mut tests);
+                volumes.gather(&walked, &mut occupied);
+                let change =
+                    volumes.crossings(l, &occupied, o, d, 0.0, t1, &mut shadows, &mut tests);
                 assert_eq!(
                     d0 + change,
                     d1,

@@ -178,6 +178,8 @@ struct Scratch {
     /// The ground-truth shadow rays of --check, kept apart so they do not disturb the scheme.
     check: Mailbox,
     walked: Vec<u32>,
+    /// Those of `walked` that hold shadow polygons.
+    occupied: Vec<u32>,
     stats: RenderStats,
 }
 
@@ -252,6 +254,7 @@ impl Tracer<'_> {
             shadows: Mailbox::new(prep.volumes.as_ref().map_or(0, |v| v.max_per_light())),
             check: Mailbox::new(prep.polygons.len()),
             walked: Vec::new(),
+            occupied: Vec::new(),
             stats: RenderStats::default(),
         };
         let cam = &prep.scene.camera;
@@ -347,7 +350,14 @@ impl Tracer<'_> {
         let shadowed = self.shadow_conditions(
             sc,
             &mut states,
-            Arrival { o, d, t: hit.t, p, n, polygon: hit.polygon },
+            Arrival {
+                o,
+                d,
+                t: hit.t,
+                p,
+                n,
+                polygon: hit.polygon,
+            },
             continues,
         );
         sc.stats.shadow_ticks += crate::ticks().wrapping_sub(shadow_start);
@@ -417,9 +427,9 @@ impl Tracer<'_> {
     ) -> [bool; MAX_LIGHTS] {
         let prep = self.prep;
         let mut shadowed = [true; MAX_LIGHTS];
-        let ns = match (&prep.volumes, self.settings.scheme) {
-            (Some(v), Scheme::Hst { .. }) => v.registered(&sc.walked),
-            _ => [0; MAX_LIGHTS],
+        let ns = match &prep.volumes {
+            Some(v) => v.gather(&sc.walked, &mut sc.occupied),
+            None => [0; MAX_LIGHTS],
         };
         for (l, light) in prep.scene.lights.iter().enumerate() {
             let to_light = light.position - at.p;
@@ -476,7 +486,7 @@ impl Tracer<'_> {
                 sc.stats.shadow_volume += 1;
                 let change = v.crossings(
                     l,
-                    &sc.walked,
+                    &sc.occupied,
                     o,
                     d,
                     0.0,
@@ -491,7 +501,7 @@ impl Tracer<'_> {
                 let Scratch {
                     objects,
                     shadows,
-                    walked,
+                    occupied,
                     stats,
                     ..
                 } = sc;
@@ -504,7 +514,7 @@ impl Tracer<'_> {
                     || {
                         v.crossings(
                             l,
-                            walked,
+                            occupied,
                             o,
                             d,
                             0.0,
