@@ -5,7 +5,7 @@
 use crate::SplitMix;
 use crate::geom::{Aabb, ConvexPolygon};
 use crate::grid::{Grid, Mailbox};
-use crate::trace::Prepared;
+use crate::trace::{Pinhole, Prepared};
 use glam::Vec3;
 use serde::Serialize;
 use std::hint::black_box;
@@ -81,7 +81,7 @@ pub fn scene_stats(prep: &Prepared) -> SceneStats {
     let (a, l, h) = (mean_area, mean_perimeter, cell_edge);
     let p =
         (2.0 * a / (2.0 * a + 6.0 * h * h + 0.75 * std::f64::consts::PI * l * h)).clamp(1e-6, 1.0);
-    let c_s_per_entry = shadow_entry_cost(prep, &live);
+    let c_s_per_entry = shadow_entry_cost(prep);
     let n_c = mean_shadow_ray_cells(
         &live,
         g,
@@ -157,30 +157,42 @@ fn mean_shadow_ray_cells(polygons: &[&ConvexPolygon], grid: &Grid, lights: &[Vec
 /// C_s as equation 1 uses it, measured on the scene's own shadow polygons: CPU time per shadow
 /// polygon registered in a crossed cell. N_s counts a polygon once per cell it is registered in,
 /// and the bucket (mailbox) tests it only once per segment, so most entries cost a mailbox check
-/// rather than a ray test. Timed on segments between random points on the polygons (None without
-/// shadow polygons).
-fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64> {
+/// rather than a ray test. Timed on the segments the tracer meets most, eye rays to their first
+/// hit (a 64 x 48 grid of them): how many cells a segment crosses and how long it runs through
+/// shadow volumes decide the mix of checks and tests. None without shadow polygons.
+fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
     let volumes = prep.volumes.as_ref()?;
-    let points = surface_points(polygons, 2000, &mut SplitMix(9));
-    let segments: Vec<(Vec3, Vec3, f32, Vec<u32>)> = points
-        .chunks_exact(2)
-        .map(|ab| {
-            let to = ab[1] - ab[0];
-            let dist = to.length().max(1e-6);
+    let eye = prep.scene.camera.eye;
+    let pinhole = Pinhole::new(&prep.scene.camera, 64, 48);
+    let mut objects = Mailbox::new(prep.polygons.len());
+    let mut segments: Vec<(Vec3, f32, Vec<u32>)> = Vec::new();
+    for y in 0..48 {
+        for x in 0..64 {
+            let d = pinhole.dir(x as f32 + 0.5, y as f32 + 0.5);
             let mut walked = Vec::new();
-            prep.grid.walk(ab[0], to / dist, 0.0, dist, |c, _, _| {
-                walked.push(c);
-                false
-            });
-            (ab[0], to / dist, dist, walked)
-        })
-        .collect();
-    let mut occupied = Vec::new();
+            let hit = prep.grid.closest_hit(
+                &prep.cells,
+                &prep.polygons,
+                eye,
+                d,
+                prep.eps,
+                f32::INFINITY,
+                None,
+                &mut objects,
+                &mut walked,
+            );
+            if let Some(h) = hit {
+                let mut occupied = Vec::new();
+                volumes.gather(&walked, &mut occupied);
+                segments.push((d, h.t, occupied));
+            }
+        }
+    }
     let entries: u64 = segments
         .iter()
         .map(|s| {
             volumes
-                .gather(&s.3, &mut occupied)
+                .gather(&s.2, &mut Vec::new())
                 .iter()
                 .map(|&n| n as u64)
                 .sum::<u64>()
@@ -193,11 +205,10 @@ fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64
     let mut tests = 0;
     Some(median_ns(entries as usize, || {
         let mut change = 0;
-        for (o, d, t, walked) in &segments {
-            volumes.gather(walked, &mut occupied);
+        for (d, t, occupied) in &segments {
             for l in 0..volumes.lights.len() {
                 change +=
-                    volumes.crossings(l, &occupied, *o, *d, 0.0, *t, &mut mailbox, &mut tests);
+                    volumes.crossings(l, occupied, eye, *d, 0.0, *t, &mut mailbox, &mut tests);
             }
         }
         black_box(change);

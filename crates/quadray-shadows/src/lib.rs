@@ -149,6 +149,9 @@ pub struct RunReport {
     pub disagreeing_decisions: Option<u64>,
     pub shadow_rays: u64,
     pub shadow_polygon_tests: u64,
+    /// Sum of N_s over the decisions that counted crossings (shadow polygons met in cells,
+    /// with repeats; the `tests` are those the mailbox let through).
+    pub shadow_polygon_entries: u64,
 }
 
 /// Builds what the scheme needs, predicts N_th and renders.
@@ -256,6 +259,7 @@ fn report(
         disagreeing_decisions: settings.check.then_some(r.disagreeing_decisions),
         shadow_rays: r.shadow_rays,
         shadow_polygon_tests: r.shadow_polygon_tests,
+        shadow_polygon_entries: r.shadow_polygon_entries,
     }
 }
 

@@ -135,6 +135,7 @@ pub struct RenderStats {
     pub shadow_volume: u64,
     pub conventional: u64,
     pub shadow_polygon_tests: u64,
+    pub shadow_polygon_entries: u64,
     pub shadow_rays: u64,
     /// Ticks ([`crate::ticks`]) the tiles' threads spent deciding shadows, and in the tiles.
     pub shadow_ticks: u64,
@@ -156,6 +157,7 @@ impl RenderStats {
         self.shadow_volume += o.shadow_volume;
         self.conventional += o.conventional;
         self.shadow_polygon_tests += o.shadow_polygon_tests;
+        self.shadow_polygon_entries += o.shadow_polygon_entries;
         self.shadow_rays += o.shadow_rays;
         self.shadow_ticks += o.shadow_ticks;
         self.tile_ticks += o.tile_ticks;
@@ -168,6 +170,38 @@ impl RenderStats {
         } else {
             0.0
         }
+    }
+}
+
+/// Eye rays of a pinhole camera for an image of `w` x `h` pixels.
+pub struct Pinhole {
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    /// Half the image plane's size at distance 1.
+    half: glam::Vec2,
+    size: glam::Vec2,
+}
+
+impl Pinhole {
+    pub fn new(cam: &crate::scene::Camera, w: u32, h: u32) -> Self {
+        let forward = (cam.look_at - cam.eye).normalize();
+        let right = forward.cross(cam.up).normalize();
+        let half = (cam.fov_y_deg.to_radians() * 0.5).tan();
+        Self {
+            forward,
+            right,
+            up: right.cross(forward),
+            half: glam::Vec2::new(half * w as f32 / h as f32, half),
+            size: glam::Vec2::new(w as f32, h as f32),
+        }
+    }
+
+    /// Unit direction through the image point `(x, y)` in pixels from the top-left corner.
+    pub fn dir(&self, x: f32, y: f32) -> Vec3 {
+        let px = (2.0 * x / self.size.x - 1.0) * self.half.x;
+        let py = (1.0 - 2.0 * y / self.size.y) * self.half.y;
+        (self.forward + self.right * px + self.up * py).normalize()
     }
 }
 
@@ -258,11 +292,7 @@ impl Tracer<'_> {
             stats: RenderStats::default(),
         };
         let cam = &prep.scene.camera;
-        let forward = (cam.look_at - cam.eye).normalize();
-        let right = forward.cross(cam.up).normalize();
-        let up = right.cross(forward);
-        let half = (cam.fov_y_deg.to_radians() * 0.5).tan();
-        let aspect = w as f32 / h as f32;
+        let pinhole = Pinhole::new(cam, w, h);
         let mut eye_states = [LightState::default(); MAX_LIGHTS];
         if let Some(v) = &prep.volumes {
             for (s, lv) in eye_states.iter_mut().zip(&v.lights) {
@@ -284,9 +314,7 @@ impl Tracer<'_> {
                             ((s as f32 + 0.5) * 0.618_034).fract(),
                         )
                     };
-                    let px = (2.0 * (x as f32 + u) / w as f32 - 1.0) * half * aspect;
-                    let py = (1.0 - 2.0 * (y as f32 + v) / h as f32) * half;
-                    let d = (forward + right * px + up * py).normalize();
+                    let d = pinhole.dir(x as f32 + u, y as f32 + v);
                     sum += self.trace(
                         &mut scratch,
                         cam.eye,
@@ -484,6 +512,7 @@ impl Tracer<'_> {
             Scheme::Volume => {
                 let v = prep.volumes.as_ref().expect("volumes built");
                 sc.stats.shadow_volume += 1;
+                sc.stats.shadow_polygon_entries += ns as u64;
                 let change = v.crossings(
                     l,
                     &sc.occupied,
@@ -512,6 +541,7 @@ impl Tracer<'_> {
                     self_shadow,
                     continues,
                     || {
+                        stats.shadow_polygon_entries += ns as u64;
                         v.crossings(
                             l,
                             occupied,
