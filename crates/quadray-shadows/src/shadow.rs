@@ -28,16 +28,26 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::HashMap;
 
-/// A shadow polygon (a silhouette edge extruded away from the light) prepared for crossing
-/// tests: its plane and the inward planes of the edge itself and of the two sides running away from
-/// the light. Its far side lies beyond the grid's box, where no ray segment goes, so these three
-/// decide; 64 bytes and a weight, in one array per light, against a general polygon's five edge
-/// planes behind a pointer.
+/// A shadow polygon (a silhouette edge `a b` extruded away from the light) prepared for crossing
+/// tests: its plane, the inward plane of the edge itself, and its two sides, the lines from the
+/// light through `a` and through `b`. Its far side lies beyond the grid's box, where no ray segment
+/// goes, so these three decide.
+///
+/// The sides are tested watertight: neighbouring shadow polygons share the line from the light
+/// through their common vertex, and which side of that line a ray passes is one triple product of
+/// the ray and the line (Pluecker's side relation), computed from the same numbers for both, so
+/// exactly one of them counts a ray crossing next to it. Testing each polygon's own crossing
+/// point against its own edge planes instead let rounding count such rays twice or not at all on
+/// finely meshed models (the bunny's thousands of silhouette edges).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowPolygon {
     /// Unit normal and `-normal.p` for points `p` of the plane.
     pub plane: Vec4,
-    edges: [Vec4; 3],
+    /// Inward plane of the silhouette edge.
+    edge: Vec4,
+    /// `a - light` and `b - light`, each negated or not so that a ray crossing inside has a
+    /// side relation of the sign of its direction along the normal.
+    sides: [Vec3; 2],
     /// Signed change of depth count crossing the polygon along its normal.
     pub weight: i32,
 }
@@ -45,7 +55,7 @@ pub struct ShadowPolygon {
 impl ShadowPolygon {
     /// Change of D along `o + t d`, `t` in `(t0, t1)`: 0 unless the segment crosses the polygon.
     #[inline]
-    pub fn crossing(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> i32 {
+    pub fn crossing(&self, o: Vec3, d: Vec3, t0: f32, t1: f32, light: Vec3) -> i32 {
         let n = self.plane.truncate();
         let (s_o, s_d) = (n.dot(o) + self.plane.w, n.dot(d));
         // Both ends on one side of the plane, the common case, costs no division.
@@ -53,7 +63,15 @@ impl ShadowPolygon {
             return 0;
         }
         let p = o + d * (-s_o / s_d);
-        if self.edges.iter().all(|e| e.truncate().dot(p) + e.w >= 0.0) {
+        if self.edge.truncate().dot(p) + self.edge.w < 0.0 {
+            return 0;
+        }
+        let from_light = o - light;
+        let inside = |u: Vec3| {
+            let side = u.cross(from_light).dot(d);
+            if s_d > 0.0 { side >= 0.0 } else { side <= 0.0 }
+        };
+        if inside(self.sides[0]) && inside(self.sides[1]) {
             if s_d > 0.0 { self.weight } else { -self.weight }
         } else {
             0
@@ -63,6 +81,7 @@ impl ShadowPolygon {
 
 /// The shadow polygons of one light.
 pub struct LightVolumes {
+    pub light: Vec3,
     pub polygons: Vec<ShadowPolygon>,
     /// D at the eye.
     pub eye_depth: i32,
@@ -84,7 +103,7 @@ impl ShadowVolumes {
     /// Finds the silhouette edges of every light, extrudes them to beyond the grid's box,
     /// registers them in the grid and counts the eye's depth.
     pub fn build(scene: &Scene, polygons: &[ConvexPolygon], grid: &Grid) -> Self {
-        let (vertices, eye) = (&scene.vertices, scene.camera.eye);
+        let eye = scene.camera.eye;
         let edges = edge_map(polygons, &scene.faces);
         let (lights, per_light): (Vec<LightVolumes>, Vec<CellLists>) = scene
             .lights
@@ -92,9 +111,10 @@ impl ShadowVolumes {
             .map(|l| {
                 let light = l.position;
                 let (outlines, polys) =
-                    silhouette_polygons(polygons, vertices, &edges, light, &grid.bounds);
+                    silhouette_polygons(polygons, scene, &edges, light, &grid.bounds);
                 let cells = grid.register(outlines.par_iter().map(|p| p.as_slice()));
                 let volumes = LightVolumes {
+                    light,
                     eye_depth: depth_at(polygons, light, eye),
                     polygons: polys,
                 };
@@ -167,7 +187,7 @@ impl ShadowVolumes {
             for &id in self.cells.cell(c * n + light as u32) {
                 if mailbox.first_visit(id) {
                     tested += 1;
-                    change += lv.polygons[id as usize].crossing(o, d, t0, t1);
+                    change += lv.polygons[id as usize].crossing(o, d, t0, t1, lv.light);
                 }
             }
         }
@@ -201,7 +221,7 @@ fn edge_map(polygons: &[ConvexPolygon], faces: &[Face]) -> EdgeMap {
 /// `bounds`, as outlines (for registration in the cells) and prepared for crossing tests.
 fn silhouette_polygons(
     polygons: &[ConvexPolygon],
-    vertices: &[Vec3],
+    scene: &Scene,
     edges: &EdgeMap,
     light: Vec3,
     bounds: &Aabb,
@@ -229,6 +249,23 @@ fn silhouette_polygons(
     // outside the box.
     let reach = 4.0 * corners.map(|c| (c - light).length()).fold(0.0, f32::max);
     let far = |v: Vec3| light + (v - light) * (reach / (v - light).length());
+    let vertices = &scene.vertices;
+    // How each polygon faces the light: +1 towards, -1 away, 0 edge-on (an empty shadow volume;
+    // rounding must not give it a side).
+    let facing: Vec<i8> = polygons
+        .iter()
+        .map(|poly| {
+            let to_light = light - poly.centroid();
+            let f = poly.normal.dot(to_light);
+            if poly.is_degenerate() || f.abs() <= 1e-5 * to_light.length() {
+                0
+            } else if f > 0.0 {
+                1
+            } else {
+                -1
+            }
+        })
+        .collect();
     let mut keys: Vec<&(u32, u32)> = edges.keys().collect();
     keys.sort_unstable();
     let mut out = (Vec::new(), Vec::new());
@@ -240,43 +277,50 @@ fn silhouette_polygons(
         }
         let (fa, fb) = (far(a), far(b));
         let fm = far((a + b) * 0.5);
-        let quad = ConvexPolygon::new(vec![a, b, fb, fm, fa]);
-        if quad.is_degenerate() {
+        // The plane through the light and the edge, from them alone: the far points, thousands
+        // of edge lengths away on a fine mesh, would tilt it by their rounding, and an edge
+        // pointing nearly at the light (a sliver of a shadow polygon, but one rays do cross)
+        // would read as degenerate and leave a hole in the volume's boundary.
+        let Some(n) = (b - light).cross(a - light).try_normalize() else {
             continue;
-        }
+        };
+        // Each polygon on the edge adds +1 when it lies on the positive side of the extruded plane,
+        // -1 on the negative side. Which side is decided by how the polygon faces the light and
+        // which way it runs along the edge, not by where its centroid falls: for a polygon seen
+        // nearly edge-on the two tests round differently, and the bunny's millions of such
+        // near-misses left holes in its volumes.
         let weight: i32 = faces
             .iter()
             .map(|&f| {
-                let poly = &polygons[f as usize];
-                // A polygon seen edge-on from the light has an empty shadow volume; rounding must
-                // not give it a side.
-                let to_light = light - poly.vertices[0];
-                if poly.normal.dot(to_light).abs() <= 1e-5 * to_light.length() {
-                    return 0;
-                }
-                let side = quad.normal.dot(poly.centroid() - a);
-                if side > 0.0 {
-                    1
-                } else if side < 0.0 {
-                    -1
-                } else {
-                    0
-                }
+                let v = &scene.faces[f as usize].vertices;
+                let at = v
+                    .iter()
+                    .position(|&i| i == key.0)
+                    .expect("edge of the face");
+                let forward = v[(at + 1) % v.len()] == key.1;
+                let facing = facing[f as usize] as i32;
+                if forward { facing } else { -facing }
             })
             .sum();
-        let n = quad.normal;
-        let sides = [
+        // The side lines oriented so that a point inside is on the positive side.
+        let inside = (a + b + fa + fb) * 0.25 - light;
+        let oriented = |u: Vec3| {
+            let c = u.cross(inside).dot(n);
+            (c != 0.0).then_some(if c > 0.0 { u } else { -u })
+        };
+        let parts = (
             edge_plane(n, a, b),
-            edge_plane(n, b, fb),
-            edge_plane(n, fa, a),
-        ];
-        if let (true, [Some(e0), Some(e1), Some(e2)]) = (weight != 0, sides) {
+            oriented(a - light),
+            oriented(b - light),
+        );
+        if let (true, (Some(edge), Some(side_a), Some(side_b))) = (weight != 0, parts) {
             out.1.push(ShadowPolygon {
-                plane: n.extend(-quad.offset),
-                edges: [e0, e1, e2],
+                plane: n.extend(-n.dot(a)),
+                edge,
+                sides: [side_a, side_b],
                 weight,
             });
-            out.0.push(quad.vertices);
+            out.0.push(vec![a, b, fb, fm, fa]);
         }
     }
     out
