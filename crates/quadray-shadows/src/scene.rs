@@ -123,6 +123,11 @@ pub struct Scene {
     pub background: Vec3,
 }
 
+/// The repository's `assets/` folder (scene files and meshes).
+pub fn assets_dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
+}
+
 /// The builtin look-alikes of the paper's scenes, with their polygon and light counts.
 pub const BUILTINS: [(&str, usize, usize); 4] = [
     ("glasses", 3781, 3),
