@@ -37,7 +37,11 @@ pub struct SweepPoint {
 pub struct SceneResult {
     pub scene: String,
     pub stats: SceneStats,
+    /// N_th of `--nth auto`: equation 12 with the follow-up cost.
     pub predicted_nth: f64,
+    /// Equation 12 as written.
+    pub equation_12_nth: f64,
+    pub follow_up: cost::FollowUp,
     pub schemes: Vec<SchemeRow>,
     pub sweep: Vec<SweepPoint>,
     pub best_nth: f64,
@@ -192,7 +196,8 @@ pub fn bench_shadows(
         let rows: Vec<SchemeRow> = contenders.iter().map(Contender::row).collect();
         let prep = &contenders[2].prep;
         let stats = *prep.stats();
-        let predicted = cost::predicted_nth(&costs, &stats);
+        let equation_12 = cost::predicted_nth(&costs, &stats);
+        let (predicted, follow_up) = prep.predicted_nth(&costs, depth);
         // Figure 6: the sweep and the predicted N_th, timed in the same interleaved rounds.
         let mut values = sweep_values.clone();
         values.push(predicted);
@@ -231,6 +236,8 @@ pub fn bench_shadows(
             scene: name,
             stats,
             predicted_nth: predicted,
+            equation_12_nth: equation_12,
+            follow_up,
             best_nth: best.nth,
             predicted_over_best: at_predicted.shadow / best.shadow,
             shadow_at_predicted: at_predicted.shadow,
@@ -336,6 +343,8 @@ fn markdown(r: &BenchResults) -> String {
             "alpha",
             "p",
             "N_c",
+            "N_th eq. 12",
+            "forced / free shadow rays",
             "N_th predicted",
             "N_th best (sweep)",
         ],
@@ -352,6 +361,8 @@ fn markdown(r: &BenchResults) -> String {
             format!("{:.3}", st.alpha),
             format!("{:.3}", st.p),
             format!("{:.1}", st.n_c),
+            format!("{:.2}", s.equation_12_nth),
+            format!("{:.2}", s.follow_up.ratio),
             format!("{:.2}", s.predicted_nth),
             format!("{}", s.best_nth),
         ]);

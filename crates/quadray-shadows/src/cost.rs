@@ -59,6 +59,47 @@ pub fn predicted_nth(c: &MachineCosts, s: &SceneStats) -> f64 {
     conventional_cost(c, s) / s.c_s_per_entry.unwrap_or(c.c_s)
 }
 
+/// What equation 12 leaves out. It equates the costs of one decision, but in HST's state machine
+/// a conventional test that finds shadow also leaves the depth count invalid (SDF = 0), and every
+/// later point of that ray tree (not sustained, not self-shadowed) then takes a shadow ray too,
+/// until one is lit, even where its N_s is small. Measured on a pilot render (64 x 48, HST at
+/// equation 12's N_th): `ratio` such forced decisions per free one (N_s above N_th), `forced_ns`
+/// their mean N_s.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct FollowUp {
+    pub ratio: f64,
+    pub forced_ns: f64,
+}
+
+/// The pilot render of [`FollowUp`]; zero without shadow polygons.
+pub fn follow_up(prep: &Prepared, nth: f64, depth: u32) -> FollowUp {
+    if prep.volumes.is_none() {
+        return FollowUp::default();
+    }
+    let settings = crate::trace::Settings {
+        width: 64,
+        height: 48,
+        spp: 1,
+        depth,
+        scheme: crate::trace::Scheme::Hst { nth: nth as f32 },
+        check: false,
+    };
+    let (_, r) = crate::trace::render(prep, settings, &|| {});
+    let free = r.conventional.saturating_sub(r.forced_conventional);
+    FollowUp {
+        ratio: r.forced_conventional as f64 / free.max(1) as f64,
+        forced_ns: r.forced_ns as f64 / r.forced_conventional.max(1) as f64,
+    }
+}
+
+/// N_th with the follow-up cost: choosing a shadow ray at a point costs C_cv, and with the
+/// measured `ratio` that many forced shadow rays more, each in place of a shadow-volume test of
+/// about `forced_ns` polygons: C_s N_th = C_cv (1 + ratio) - ratio C_s forced_ns.
+pub fn extended_nth(c: &MachineCosts, s: &SceneStats, f: &FollowUp) -> f64 {
+    let c_s = s.c_s_per_entry.unwrap_or(c.c_s);
+    (conventional_cost(c, s) * (1.0 + f.ratio) / c_s - f.ratio * f.forced_ns).max(0.0)
+}
+
 /// Scene statistics from the polygons and the grid.
 ///
 /// p comes from integral geometry: among random lines that meet a polygon's neighbourhood of
@@ -202,7 +243,8 @@ fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
         let mut change = 0;
         for (d, t, occupied, lights) in &segments {
             for &l in lights {
-                change += volumes.crossings(l, occupied, eye, *d, 0.0, *t, &mut mailbox, &mut tests);
+                change +=
+                    volumes.crossings(l, occupied, eye, *d, 0.0, *t, &mut mailbox, &mut tests);
             }
         }
         black_box(change);

@@ -115,7 +115,11 @@ pub struct Subschemes {
 
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct NthReport {
+    /// What `--nth auto` uses: equation 12 with the follow-up cost ([`cost::FollowUp`]).
     pub predicted: f64,
+    /// Equation 12 as the paper writes it.
+    pub equation_12: f64,
+    pub follow_up: cost::FollowUp,
     /// None when the scheme has no threshold.
     pub used: Option<f64>,
 }
@@ -152,6 +156,8 @@ pub struct RunReport {
     /// Sum of N_s over the decisions that counted crossings (shadow polygons met in cells,
     /// with repeats; the `tests` are those the mailbox let through).
     pub shadow_polygon_entries: u64,
+    /// HST's shadow rays taken because of the carried state where N_s was within N_th.
+    pub forced_conventional: u64,
 }
 
 /// Builds what the scheme needs, predicts N_th and renders.
@@ -185,7 +191,8 @@ pub fn render_prepared(
     on_tile: &(dyn Fn() + Sync),
 ) -> (Rgba8Image, RunReport) {
     let stats = *prep.stats();
-    let predicted = cost::predicted_nth(costs, &stats);
+    let equation_12 = cost::predicted_nth(costs, &stats);
+    let (predicted, follow_up) = prep.predicted_nth(costs, opts.depth);
     let used = match opts.nth {
         Nth::Auto => predicted,
         Nth::Fixed(n) => n as f64,
@@ -206,7 +213,16 @@ pub fn render_prepared(
         check: opts.check,
     };
     let (image, r) = trace::render(prep, settings, on_tile);
-    (image, report(prep, &settings, &r, &stats, costs, predicted))
+    let nth = NthReport {
+        predicted,
+        equation_12,
+        follow_up,
+        used: match scheme {
+            Scheme::Hst { nth } => Some(nth as f64),
+            _ => None,
+        },
+    };
+    (image, report(prep, &settings, &r, &stats, costs, nth))
 }
 
 fn report(
@@ -215,7 +231,7 @@ fn report(
     r: &RenderStats,
     stats: &SceneStats,
     costs: &MachineCosts,
-    predicted: f64,
+    nth: NthReport,
 ) -> RunReport {
     let shadow = r.shadow_cpu_s();
     RunReport {
@@ -242,13 +258,7 @@ fn report(
             shadow_volume: r.shadow_volume,
             conventional: r.conventional,
         },
-        nth: NthReport {
-            predicted,
-            used: match settings.scheme {
-                Scheme::Hst { nth } => Some(nth as f64),
-                _ => None,
-            },
-        },
+        nth,
         p: stats.p,
         alpha: stats.alpha,
         scene_stats: *stats,
@@ -260,6 +270,7 @@ fn report(
         shadow_rays: r.shadow_rays,
         shadow_polygon_tests: r.shadow_polygon_tests,
         shadow_polygon_entries: r.shadow_polygon_entries,
+        forced_conventional: r.forced_conventional,
     }
 }
 

@@ -72,6 +72,8 @@ pub struct Prepared {
     pub eps: f32,
     /// Scene statistics of the cost model, computed once on first use.
     stats: std::sync::OnceLock<crate::cost::SceneStats>,
+    /// The follow-up statistics of the extended N_th, measured once on first use.
+    follow_up: std::sync::OnceLock<crate::cost::FollowUp>,
     /// The same for shadow rays: much smaller, so a polygon that a shadow ray crosses right next to
     /// its start (a concave corner) counts, as it does for the depth count. Depth counts take
     /// every crossing after the segment's start.
@@ -108,6 +110,7 @@ impl Prepared {
             embree,
             preprocess_s: crate::process_cpu_s() - start,
             stats: std::sync::OnceLock::new(),
+            follow_up: std::sync::OnceLock::new(),
         }
     }
 }
@@ -117,6 +120,25 @@ impl Prepared {
     /// predicts the same N_th).
     pub fn stats(&self) -> &crate::cost::SceneStats {
         self.stats.get_or_init(|| crate::cost::scene_stats(self))
+    }
+
+    /// The N_th HST uses with `--nth auto`: equation 12 with the follow-up cost of a conventional
+    /// decision ([`crate::cost::FollowUp`]), measured once on a pilot render of recursion `depth`
+    /// (without shadow polygons: equation 12 as written).
+    pub fn predicted_nth(
+        &self,
+        costs: &crate::cost::MachineCosts,
+        depth: u32,
+    ) -> (f64, crate::cost::FollowUp) {
+        let stats = self.stats();
+        let equation_12 = crate::cost::predicted_nth(costs, stats);
+        let follow_up = *self
+            .follow_up
+            .get_or_init(|| crate::cost::follow_up(self, equation_12, depth));
+        (
+            crate::cost::extended_nth(costs, stats, &follow_up),
+            follow_up,
+        )
     }
 }
 
@@ -136,6 +158,11 @@ pub struct RenderStats {
     pub conventional: u64,
     pub shadow_polygon_tests: u64,
     pub shadow_polygon_entries: u64,
+    /// HST's conventional decisions made because of the carried state (the count invalid and the
+    /// condition shadowed or unknown) where N_s alone would have chosen the shadow volume, and
+    /// their N_s summed.
+    pub forced_conventional: u64,
+    pub forced_ns: u64,
     pub shadow_rays: u64,
     /// Ticks ([`crate::ticks`]) the tiles' threads spent deciding shadows, and in the tiles.
     pub shadow_ticks: u64,
@@ -158,6 +185,8 @@ impl RenderStats {
         self.conventional += o.conventional;
         self.shadow_polygon_tests += o.shadow_polygon_tests;
         self.shadow_polygon_entries += o.shadow_polygon_entries;
+        self.forced_conventional += o.forced_conventional;
+        self.forced_ns += o.forced_ns;
         self.shadow_rays += o.shadow_rays;
         self.shadow_ticks += o.shadow_ticks;
         self.tile_ticks += o.tile_ticks;
@@ -563,7 +592,13 @@ impl Tracer<'_> {
                     Subscheme::Sustain => stats.sustain += 1,
                     Subscheme::SelfShadow => stats.self_shadow += 1,
                     Subscheme::ShadowVolume => stats.shadow_volume += 1,
-                    Subscheme::Conventional => stats.conventional += 1,
+                    Subscheme::Conventional => {
+                        stats.conventional += 1;
+                        if ns > 0 && (ns as f32) <= nth {
+                            stats.forced_conventional += 1;
+                            stats.forced_ns += ns as u64;
+                        }
+                    }
                 }
                 shadowed
             }
