@@ -11,16 +11,27 @@
 //! - The depth count counts every polygon between a point and the light, both faces, so it is
 //!   exactly the conventional test's answer: silhouette edges (Bergeron's rule) carry weight 1 on
 //!   open boundaries and 2 between faces that face the light differently, and a ray refracted
-//!   through a polygon adds or removes that polygon ([`shadow`]).
-//! - The paper's switch is kept as written; what a refraction does to the carried state is ours
-//!   (the paper leaves it open): through a surface whose far side faces the light, the condition
+//!   through a polygon adds or removes that polygon ([`shadow`]). Which side of an extruded edge a
+//!   polygon lies on comes from how it faces the light and which way it runs along the edge, and
+//!   the sides of shadow polygons are tested watertight (the side relation of the ray and the
+//!   line from the light through the shared vertex): on a finely meshed model (the bunny) the
+//!   plain geometric tests left holes in the volumes.
+//! - The paper's switch is kept as written, with one addition: at a self-shadowed point a valid
+//!   depth count is carried through (when a ray continues from the point and N_s <= N_th), where
+//!   the paper drops it and forces shadow rays on the rest of the ray tree
+//!   ([`shadow::LightState::hst_step`]). What a refraction does to the carried state is ours (the
+//!   paper leaves it open): through a surface whose far side faces the light, the condition
 //!   becomes unknown and the next reflection point takes a shadow ray.
 //! - Shadow polygons are extruded to beyond the grid's box (as pentagons, so the far side never cuts
 //!   the box) and the grid holds the eye, whose depth count starts every eye ray.
 //! - p comes from integral geometry and alpha = n_or / 2 (the relation every row of table 2 obeys);
 //!   N_c is sampled from points on the polygons to the lights; C_s is measured per registered
-//!   shadow polygon on the scene itself ([`cost`]).
-//! - Times are CPU seconds of all threads, as the paper's CPU minutes.
+//!   shadow polygon on the scene's own eye-ray segments ([`cost`]).
+//! - `--nth auto` adds to equation 12 the follow-up cost of a conventional decision that finds
+//!   shadow (SDF = 0 forces shadow rays at the later points of the ray tree), measured on a pilot
+//!   render ([`cost::FollowUp`]); equation 12 as written is reported beside it.
+//! - Times are CPU seconds of all threads, as the paper's CPU minutes; the shadow part is split
+//!   off with the time-stamp counter around each shading point's shadow decisions.
 //! - Transparent objects must not touch other surfaces (the builtin glasses and vase float a hair
 //!   above): a refracted ray passing through two coplanar faces at once would skip one.
 
