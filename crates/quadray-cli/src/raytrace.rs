@@ -149,9 +149,14 @@ pub fn bench(quick: bool, out: &Path) -> anyhow::Result<()> {
     let results = quadray_shadows::bench::bench_shadows(quick, out, &|msg| eprintln!("{msg}"))?;
     for s in &results.scenes {
         let (conv, hst, bvh) = (&s.schemes[0], &s.schemes[2], &s.schemes[3]);
+        let embree = s
+            .schemes
+            .get(4)
+            .map(|e| format!(", hst/embree {:.2}", hst.shadow / e.shadow))
+            .unwrap_or_default();
         println!(
-            "{}: shadow hst/conventional {:.2}, total {:.2}, hst/bvh {:.2}; N_th predicted {:.1}, \
-             best {} (shadow at predicted / best {:.2})",
+            "{}: shadow hst/conventional {:.2}, total {:.2}, hst/bvh {:.2}{embree}; N_th predicted \
+             {:.1}, best {:.1} (shadow at predicted / best {:.2})",
             s.scene,
             hst.shadow / conv.shadow,
             hst.total / conv.total,

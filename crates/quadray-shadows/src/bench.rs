@@ -37,12 +37,18 @@ pub struct SweepPoint {
 pub struct SceneResult {
     pub scene: String,
     pub stats: SceneStats,
+    /// N_th of `--nth auto`: equation 12 with the follow-up cost.
     pub predicted_nth: f64,
+    /// Equation 12 as written.
+    pub equation_12_nth: f64,
+    pub follow_up: cost::FollowUp,
     pub schemes: Vec<SchemeRow>,
     pub sweep: Vec<SweepPoint>,
     pub best_nth: f64,
-    /// Shadow time at the predicted N_th over the best shadow time of the sweep.
+    /// Shadow time at the predicted N_th over the best shadow time of the sweep (both timed in
+    /// the sweep's interleaved rounds).
     pub predicted_over_best: f64,
+    pub shadow_at_predicted: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -62,47 +68,78 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Renders `runs` times (after one checked render that counts disagreements) and keeps the medians.
-fn time_scheme(
-    scene: &Scene,
+/// One scheme prepared for timing: preprocessing times of `runs` preparations, the checked
+/// render (disagreements) and the timed renders so far.
+struct Contender {
     opts: RunOptions,
-    costs: &MachineCosts,
-    runs: usize,
-    progress: &dyn Fn(&str),
-) -> (SchemeRow, Prepared) {
-    let mut preprocess = Vec::new();
-    let mut prep = None;
-    for _ in 0..runs {
-        let p = prepare(scene.clone(), opts.scheme);
-        preprocess.push(p.preprocess_s);
-        prep = Some(p);
-    }
-    let prep = prep.expect("at least one run");
-    let checked = RunOptions {
-        check: true,
-        ..opts
-    };
-    let (_, check) = render_prepared(&prep, &checked, costs, &|| {});
-    let reports: Vec<RunReport> = (0..runs)
-        .map(|_| render_prepared(&prep, &opts, costs, &|| {}).1)
-        .collect();
-    progress(&format!("{} {}", scene.name, check.scheme));
-    let pre = median(preprocess);
-    let shadow = median(reports.iter().map(|r| r.times_s.shadow).collect());
-    let other = median(reports.iter().map(|r| r.times_s.other).collect());
-    let row = SchemeRow {
-        scheme: check.scheme.clone(),
-        nth: check.nth.used,
-        preprocess: pre,
-        shadow,
-        other,
-        total: pre + shadow + other,
-        disagreements: check.disagreements.unwrap_or(0),
-        shading_points: check.shading_points,
-        report: reports[0].clone(),
-    };
-    (row, prep)
+    prep: Prepared,
+    preprocess: Vec<f64>,
+    check: RunReport,
+    reports: Vec<RunReport>,
 }
+
+impl Contender {
+    fn new(scene: &Scene, opts: RunOptions, costs: &MachineCosts, runs: usize) -> Self {
+        let mut preprocess = Vec::new();
+        let mut prep = None;
+        for _ in 0..runs {
+            let p = prepare(scene.clone(), opts.scheme);
+            preprocess.push(p.preprocess_s);
+            prep = Some(p);
+        }
+        let prep = prep.expect("at least one run");
+        let checked = RunOptions {
+            check: true,
+            ..opts
+        };
+        let (_, check) = render_prepared(&prep, &checked, costs, &|| {});
+        Self {
+            opts,
+            prep,
+            preprocess,
+            check,
+            reports: Vec::new(),
+        }
+    }
+
+    fn render(&mut self, costs: &MachineCosts) {
+        let report = render_prepared(&self.prep, &self.opts, costs, &|| {}).1;
+        self.reports.push(report);
+    }
+
+    fn row(&self) -> SchemeRow {
+        let pre = median(self.preprocess.clone());
+        let shadow = median(self.reports.iter().map(|r| r.times_s.shadow).collect());
+        let other = median(self.reports.iter().map(|r| r.times_s.other).collect());
+        SchemeRow {
+            scheme: self.check.scheme.clone(),
+            nth: self.check.nth.used,
+            preprocess: pre,
+            shadow,
+            other,
+            total: pre + shadow + other,
+            disagreements: self.check.disagreements.unwrap_or(0),
+            shading_points: self.check.shading_points,
+            report: self.reports[0].clone(),
+        }
+    }
+}
+
+/// The scenes of the benchmark: the four look-alikes, then the Cornell box and the bunny from
+/// the repository's assets.
+pub fn bench_scenes() -> Result<Vec<Scene>, crate::scene::SceneError> {
+    let mut scenes: Vec<Scene> = BUILTINS
+        .iter()
+        .map(|(name, ..)| Scene::builtin(name).expect("builtin"))
+        .collect();
+    for file in ASSET_SCENES {
+        scenes.push(Scene::load(&crate::scene::assets_dir().join(file))?);
+    }
+    Ok(scenes)
+}
+
+/// Scene files of the benchmark under `assets/`.
+pub const ASSET_SCENES: [&str; 2] = ["scenes/shadows-cornell.toml", "scenes/shadows-bunny.toml"];
 
 /// Runs the whole benchmark and writes `results.json`, `shadows.md` and one figure-6 SVG per scene
 /// into `out`.
@@ -111,13 +148,14 @@ pub fn bench_shadows(
     out: &Path,
     progress: &dyn Fn(&str),
 ) -> Result<BenchResults, FileError> {
-    let (width, height, runs) = if quick { (128, 120, 1) } else { (512, 480, 3) };
+    let (width, height, runs) = if quick { (128, 120, 1) } else { (512, 480, 5) };
     let depth = 5;
     let sweep_values: Vec<f64> = if quick {
         vec![0.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0]
     } else {
         vec![
             0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0, 32.0, 48.0, 64.0, 96.0, 128.0,
+            192.0, 256.0,
         ]
     };
     let costs = cost::calibrate();
@@ -133,10 +171,9 @@ pub fn bench_shadows(
         costs: Some(costs),
     };
     let mut scenes = Vec::new();
-    for (name, ..) in BUILTINS {
-        let scene = Scene::builtin(name).expect("builtin");
-        let mut rows = Vec::new();
-        let mut hst_prep = None;
+    let all = bench_scenes().map_err(|e| FileError::new(&e.path, &e.reason))?;
+    for scene in all {
+        let name = scene.name.clone();
         let mut schemes = vec![
             SchemeChoice::Conventional,
             SchemeChoice::Volume,
@@ -146,33 +183,40 @@ pub fn bench_shadows(
         if cfg!(feature = "embree") {
             schemes.push(SchemeChoice::Embree);
         }
-        for scheme in schemes {
-            let (row, prep) = time_scheme(
-                &scene,
-                RunOptions { scheme, ..base },
-                &costs,
-                runs,
-                progress,
-            );
-            rows.push(row);
-            if scheme == SchemeChoice::Hst {
-                hst_prep = Some(prep);
+        let mut contenders: Vec<Contender> = schemes
+            .iter()
+            .map(|&scheme| Contender::new(&scene, RunOptions { scheme, ..base }, &costs, runs))
+            .collect();
+        // Interleaved rounds, so that a busy spell of the machine weighs on every scheme alike.
+        for _ in 0..runs {
+            for c in &mut contenders {
+                c.render(&costs);
             }
         }
-        let prep = hst_prep.expect("hst prepared");
+        progress(&format!("{name}: schemes"));
+        let rows: Vec<SchemeRow> = contenders.iter().map(Contender::row).collect();
+        let prep = &contenders[2].prep;
         let stats = *prep.stats();
-        let predicted = cost::predicted_nth(&costs, &stats);
-        let sweep: Vec<SweepPoint> = sweep_values
-            .iter()
-            .map(|&nth| {
+        let equation_12 = cost::predicted_nth(&costs, &stats);
+        let (predicted, follow_up) = prep.predicted_nth(&costs, depth);
+        // Figure 6: the sweep and the predicted N_th, timed in the same interleaved rounds.
+        let mut values = sweep_values.clone();
+        values.push(predicted);
+        let mut times: Vec<Vec<RunReport>> = vec![Vec::new(); values.len()];
+        for _ in 0..runs {
+            for (&nth, t) in values.iter().zip(&mut times) {
                 let opts = RunOptions {
                     scheme: SchemeChoice::Hst,
                     nth: Nth::Fixed(nth as f32),
                     ..base
                 };
-                let reports: Vec<RunReport> = (0..runs)
-                    .map(|_| render_prepared(&prep, &opts, &costs, &|| {}).1)
-                    .collect();
+                t.push(render_prepared(prep, &opts, &costs, &|| {}).1);
+            }
+        }
+        let mut sweep: Vec<SweepPoint> = values
+            .iter()
+            .zip(&times)
+            .map(|(&nth, reports)| {
                 let r = &reports[0];
                 SweepPoint {
                     nth,
@@ -182,18 +226,22 @@ pub fn bench_shadows(
                 }
             })
             .collect();
-        progress(&format!("{name} sweep"));
+        let at_predicted = sweep.pop().expect("predicted point");
+        progress(&format!("{name}: sweep"));
         let best = sweep
             .iter()
+            .chain(std::iter::once(&at_predicted))
             .min_by(|a, b| a.shadow.total_cmp(&b.shadow))
             .expect("sweep");
-        let hst = &rows[2];
         scenes.push(SceneResult {
-            scene: name.into(),
+            scene: name,
             stats,
             predicted_nth: predicted,
+            equation_12_nth: equation_12,
+            follow_up,
             best_nth: best.nth,
-            predicted_over_best: hst.shadow / best.shadow,
+            predicted_over_best: at_predicted.shadow / best.shadow,
+            shadow_at_predicted: at_predicted.shadow,
             schemes: rows,
             sweep,
         });
@@ -296,6 +344,8 @@ fn markdown(r: &BenchResults) -> String {
             "alpha",
             "p",
             "N_c",
+            "N_th eq. 12",
+            "forced / free shadow rays",
             "N_th predicted",
             "N_th best (sweep)",
         ],
@@ -312,6 +362,8 @@ fn markdown(r: &BenchResults) -> String {
             format!("{:.3}", st.alpha),
             format!("{:.3}", st.p),
             format!("{:.1}", st.n_c),
+            format!("{:.2}", s.equation_12_nth),
+            format!("{:.2}", s.follow_up.ratio),
             format!("{:.2}", s.predicted_nth),
             format!("{}", s.best_nth),
         ]);
@@ -396,11 +448,14 @@ fn markdown(r: &BenchResults) -> String {
             "shading points",
         ],
     );
-    let (mut shadow_sum, mut total_sum) = (0.0, 0.0);
+    let (mut shadow_sum, mut total_sum, mut n) = (0.0, 0.0, 0.0);
     for s in &r.scenes {
         let (conv, vol, hst, bvh) = (&s.schemes[0], &s.schemes[1], &s.schemes[2], &s.schemes[3]);
-        shadow_sum += hst.shadow / conv.shadow;
-        total_sum += hst.total / conv.total;
+        if BUILTINS.iter().any(|b| b.0 == s.scene) {
+            shadow_sum += hst.shadow / conv.shadow;
+            total_sum += hst.total / conv.total;
+            n += 1.0;
+        }
         summary.row(vec![
             s.scene.clone(),
             format!("{:.2}", hst.shadow / conv.shadow),
@@ -423,9 +478,8 @@ fn markdown(r: &BenchResults) -> String {
             hst.shading_points.to_string(),
         ]);
     }
-    let n = r.scenes.len() as f64;
     summary.row(vec![
-        "mean".into(),
+        "mean of the four look-alikes".into(),
         format!("{:.2}", shadow_sum / n),
         format!("{:.2}", total_sum / n),
         String::new(),

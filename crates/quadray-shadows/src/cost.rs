@@ -5,7 +5,7 @@
 use crate::SplitMix;
 use crate::geom::{Aabb, ConvexPolygon};
 use crate::grid::{Grid, Mailbox};
-use crate::trace::Prepared;
+use crate::trace::{Pinhole, Prepared};
 use glam::Vec3;
 use serde::Serialize;
 use std::hint::black_box;
@@ -59,6 +59,47 @@ pub fn predicted_nth(c: &MachineCosts, s: &SceneStats) -> f64 {
     conventional_cost(c, s) / s.c_s_per_entry.unwrap_or(c.c_s)
 }
 
+/// What equation 12 leaves out. It equates the costs of one decision, but in HST's state machine
+/// a conventional test that finds shadow also leaves the depth count invalid (SDF = 0), and every
+/// later point of that ray tree (not sustained, not self-shadowed) then takes a shadow ray too,
+/// until one is lit, even where its N_s is small. Measured on a pilot render (64 x 48, HST at
+/// equation 12's N_th): `ratio` such forced decisions per free one (N_s above N_th), `forced_ns`
+/// their mean N_s.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct FollowUp {
+    pub ratio: f64,
+    pub forced_ns: f64,
+}
+
+/// The pilot render of [`FollowUp`]; zero without shadow polygons.
+pub fn follow_up(prep: &Prepared, nth: f64, depth: u32) -> FollowUp {
+    if prep.volumes.is_none() {
+        return FollowUp::default();
+    }
+    let settings = crate::trace::Settings {
+        width: 64,
+        height: 48,
+        spp: 1,
+        depth,
+        scheme: crate::trace::Scheme::Hst { nth: nth as f32 },
+        check: false,
+    };
+    let (_, r) = crate::trace::render(prep, settings, &|| {});
+    let free = r.conventional.saturating_sub(r.forced_conventional);
+    FollowUp {
+        ratio: r.forced_conventional as f64 / free.max(1) as f64,
+        forced_ns: r.forced_ns as f64 / r.forced_conventional.max(1) as f64,
+    }
+}
+
+/// N_th with the follow-up cost: choosing a shadow ray at a point costs C_cv, and with the
+/// measured `ratio` that many forced shadow rays more, each in place of a shadow-volume test of
+/// about `forced_ns` polygons: C_s N_th = C_cv (1 + ratio) - ratio C_s forced_ns.
+pub fn extended_nth(c: &MachineCosts, s: &SceneStats, f: &FollowUp) -> f64 {
+    let c_s = s.c_s_per_entry.unwrap_or(c.c_s);
+    (conventional_cost(c, s) * (1.0 + f.ratio) / c_s - f.ratio * f.forced_ns).max(0.0)
+}
+
 /// Scene statistics from the polygons and the grid.
 ///
 /// p comes from integral geometry: among random lines that meet a polygon's neighbourhood of
@@ -81,7 +122,7 @@ pub fn scene_stats(prep: &Prepared) -> SceneStats {
     let (a, l, h) = (mean_area, mean_perimeter, cell_edge);
     let p =
         (2.0 * a / (2.0 * a + 6.0 * h * h + 0.75 * std::f64::consts::PI * l * h)).clamp(1e-6, 1.0);
-    let c_s_per_entry = shadow_entry_cost(prep, &live);
+    let c_s_per_entry = shadow_entry_cost(prep);
     let n_c = mean_shadow_ray_cells(
         &live,
         g,
@@ -157,34 +198,42 @@ fn mean_shadow_ray_cells(polygons: &[&ConvexPolygon], grid: &Grid, lights: &[Vec
 /// C_s as equation 1 uses it, measured on the scene's own shadow polygons: CPU time per shadow
 /// polygon registered in a crossed cell. N_s counts a polygon once per cell it is registered in,
 /// and the bucket (mailbox) tests it only once per segment, so most entries cost a mailbox check
-/// rather than a ray test. Timed on segments between random points on the polygons (None without
-/// shadow polygons).
-fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64> {
+/// rather than a ray test. Timed on the segments the tracer meets most, eye rays to their first
+/// hit (a 64 x 48 grid of them): how many cells a segment crosses and how long it runs through
+/// shadow volumes decide the mix of checks and tests. None without shadow polygons.
+fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
     let volumes = prep.volumes.as_ref()?;
-    let points = surface_points(polygons, 2000, &mut SplitMix(9));
-    let segments: Vec<(Vec3, Vec3, f32, Vec<u32>)> = points
-        .chunks_exact(2)
-        .map(|ab| {
-            let to = ab[1] - ab[0];
-            let dist = to.length().max(1e-6);
+    let eye = prep.scene.camera.eye;
+    let pinhole = Pinhole::new(&prep.scene.camera, 64, 48);
+    let mut objects = Mailbox::new(prep.polygons.len());
+    // (direction, length, occupied cells, lights with shadow polygons in them): HST counts
+    // crossings only for a light whose N_s is not 0 (else it sustains), so only those are timed.
+    let mut segments: Vec<(Vec3, f32, Vec<u32>, Vec<usize>)> = Vec::new();
+    let mut entries = 0u64;
+    for y in 0..48 {
+        for x in 0..64 {
+            let d = pinhole.dir(x as f32 + 0.5, y as f32 + 0.5);
             let mut walked = Vec::new();
-            prep.grid.walk(ab[0], to / dist, 0.0, dist, |c, _, _| {
-                walked.push(c);
-                false
-            });
-            (ab[0], to / dist, dist, walked)
-        })
-        .collect();
-    let entries: u64 = segments
-        .iter()
-        .map(|s| {
-            volumes
-                .registered(&s.3)
-                .iter()
-                .map(|&n| n as u64)
-                .sum::<u64>()
-        })
-        .sum();
+            let hit = prep.grid.closest_hit(
+                &prep.cells,
+                &prep.polygons,
+                eye,
+                d,
+                prep.eps,
+                f32::INFINITY,
+                None,
+                &mut objects,
+                &mut walked,
+            );
+            if let Some(h) = hit {
+                let mut occupied = Vec::new();
+                let ns = volumes.gather(&walked, &mut occupied);
+                let lights: Vec<usize> = (0..volumes.lights.len()).filter(|&l| ns[l] > 0).collect();
+                entries += lights.iter().map(|&l| ns[l] as u64).sum::<u64>();
+                segments.push((d, h.t, occupied, lights));
+            }
+        }
+    }
     if entries == 0 {
         return None;
     }
@@ -192,9 +241,10 @@ fn shadow_entry_cost(prep: &Prepared, polygons: &[&ConvexPolygon]) -> Option<f64
     let mut tests = 0;
     Some(median_ns(entries as usize, || {
         let mut change = 0;
-        for (o, d, t, walked) in &segments {
-            for l in 0..volumes.lights.len() {
-                change += volumes.crossings(l, walked, *o, *d, 0.0, *t, &mut mailbox, &mut tests);
+        for (d, t, occupied, lights) in &segments {
+            for &l in lights {
+                change +=
+                    volumes.crossings(l, occupied, eye, *d, 0.0, *t, &mut mailbox, &mut tests);
             }
         }
         black_box(change);

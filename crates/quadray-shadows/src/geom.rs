@@ -109,11 +109,7 @@ impl ConvexPolygon {
         }
         let normal = newell.normalize();
         let edge_planes = (0..n)
-            .filter_map(|i| {
-                let (a, b) = (vertices[i], vertices[(i + 1) % n]);
-                let m = normal.cross(b - a).try_normalize()?;
-                Some(m.extend(-m.dot(a)))
-            })
+            .filter_map(|i| edge_plane(normal, vertices[i], vertices[(i + 1) % n]))
             .collect();
         Self {
             offset: normal.dot(vertices[0]),
@@ -171,6 +167,15 @@ impl ConvexPolygon {
             .all(|e| e.truncate().dot(p) + e.w >= 0.0)
             .then_some(t)
     }
+}
+
+/// The plane through the edge `a -> b` of a polygon with unit normal `normal`, perpendicular to
+/// the polygon, as `(m, -m.a)` with `m` pointing into a counter-clockwise polygon; None for a
+/// zero-length edge.
+#[inline]
+pub fn edge_plane(normal: Vec3, a: Vec3, b: Vec3) -> Option<Vec4> {
+    let m = normal.cross(b - a).try_normalize()?;
+    Some(m.extend(-m.dot(a)))
 }
 
 /// Keeps the part of a convex polygon with `p[axis] >= lo` (`keep_above`) or `p[axis] <= lo`.

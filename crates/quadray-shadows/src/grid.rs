@@ -29,9 +29,32 @@ impl CellLists {
         self.offsets[c as usize + 1] - self.offsets[c as usize]
     }
 
+    /// The offsets of rows `first..first + k` and the end of the last: row `first + i` holds
+    /// `r[i + 1] - r[i]` ids.
+    #[inline]
+    pub fn row_bounds(&self, first: u32, k: u32) -> &[u32] {
+        &self.offsets[first as usize..(first + k) as usize + 1]
+    }
+
     /// Total number of (cell, id) registrations.
     pub fn registrations(&self) -> usize {
         self.items.len()
+    }
+
+    /// Several lists over the same cells merged cell-major: row `c * k + i` is list `i`'s cell
+    /// `c` (`k` lists), so the rows of one cell share cache lines.
+    pub fn interleave(lists: &[CellLists], cells: usize) -> CellLists {
+        let k = lists.len();
+        let mut offsets = Vec::with_capacity(cells * k + 1);
+        let mut items = Vec::with_capacity(lists.iter().map(|l| l.items.len()).sum());
+        offsets.push(0);
+        for c in 0..cells as u32 {
+            for list in lists {
+                items.extend_from_slice(list.cell(c));
+                offsets.push(items.len() as u32);
+            }
+        }
+        CellLists { offsets, items }
     }
 }
 

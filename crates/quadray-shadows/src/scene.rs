@@ -123,6 +123,11 @@ pub struct Scene {
     pub background: Vec3,
 }
 
+/// The repository's `assets/` folder (scene files and meshes).
+pub fn assets_dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
+}
+
 /// The builtin look-alikes of the paper's scenes, with their polygon and light counts.
 pub const BUILTINS: [(&str, usize, usize); 4] = [
     ("glasses", 3781, 3),
@@ -633,6 +638,7 @@ struct SceneFile {
     background: Option<Vec3>,
     camera: Camera,
     lights: Vec<Light>,
+    #[serde(default)]
     materials: HashMap<String, Material>,
     objects: Vec<ObjectFile>,
 }
@@ -640,11 +646,17 @@ struct SceneFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ObjectFile {
-    material: String,
+    /// One of `materials`; a mesh without it takes its file's materials (diffuse colours).
+    material: Option<String>,
     #[serde(default)]
     polygons: Vec<Vec<Vec3>>,
     #[serde(rename = "box")]
     cuboid: Option<BoxFile>,
+    /// A mesh file (OBJ, PLY, glTF) relative to the scene file, placed by `scale` then
+    /// `translate`.
+    mesh: Option<String>,
+    scale: Option<f32>,
+    translate: Option<Vec3>,
 }
 
 #[derive(Deserialize)]
@@ -704,33 +716,61 @@ impl Scene {
             }
             s.material(m);
         }
+        // Vertices at the same position are one vertex, so faces find their neighbours.
         let mut welded: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut weld = |s: &mut Scene, v: Vec3| {
+            let key = v.to_array().map(f32::to_bits);
+            *welded.entry(key).or_insert_with(|| s.vertex(v))
+        };
         for (o, obj) in file.objects.iter().enumerate() {
-            let Some(material) = names.iter().position(|n| **n == obj.material) else {
-                return bad(format!("object {o}: unknown material {:?}", obj.material));
+            let material = match &obj.material {
+                Some(name) => match names.iter().position(|n| *n == name) {
+                    Some(m) => Some(m as u32),
+                    None => return bad(format!("object {o}: unknown material {name:?}")),
+                },
+                None if obj.mesh.is_some() => None,
+                None => return bad(format!("object {o}: no material")),
             };
             if let Some(b) = &obj.cuboid {
                 if !(finite(b.min) && finite(b.max)) || b.min.cmpge(b.max).any() {
                     return bad(format!("object {o}: box min must be below max"));
                 }
-                s.cuboid(b.min, b.max, material as u32);
+                s.cuboid(b.min, b.max, material.expect("checked above"));
             }
             for (p, poly) in obj.polygons.iter().enumerate() {
                 if let Err(why) = check_polygon(poly) {
                     return bad(format!("object {o}, polygon {p}: {why}"));
                 }
-                // Vertices at the same position are one vertex, so faces find their neighbours.
-                let ids = poly
-                    .iter()
-                    .map(|&v| {
-                        let key = v.to_array().map(f32::to_bits);
-                        *welded.entry(key).or_insert_with(|| {
-                            s.vertices.push(v);
-                            s.vertices.len() as u32 - 1
-                        })
-                    })
-                    .collect();
-                s.face(ids, material as u32);
+                let ids = poly.iter().map(|&v| weld(&mut s, v)).collect();
+                s.face(ids, material.expect("checked above"));
+            }
+            if let Some(mesh) = &obj.mesh {
+                let scale = obj.scale.unwrap_or(1.0);
+                let translate = obj.translate.unwrap_or(Vec3::ZERO);
+                if !(scale.is_finite() && scale > 0.0 && finite(translate)) {
+                    return bad(format!(
+                        "object {o}: scale must be finite and > 0, translate finite"
+                    ));
+                }
+                let file_path = path.parent().unwrap_or(Path::new("")).join(mesh);
+                let model = quadray_core::mesh::load_model(&file_path)
+                    .map_err(|e| scene_error(path, format!("object {o}: {e}")))?;
+                let first_material = s.materials.len() as u32;
+                if material.is_none() {
+                    for m in &model.materials {
+                        s.material(Material::matte(m.base_color));
+                    }
+                }
+                for m in &model.meshes {
+                    let mat = material.unwrap_or(first_material + m.material as u32);
+                    for tri in &m.indices {
+                        let ids = tri
+                            .iter()
+                            .map(|&i| weld(&mut s, m.positions[i as usize] * scale + translate))
+                            .collect();
+                        s.face(ids, mat);
+                    }
+                }
             }
         }
         if s.faces.is_empty() {

@@ -19,62 +19,119 @@
 //! light starts with an unknown condition (it may have left the shadow), which the next reflection
 //! point resolves with a conventional test instead of sustaining it.
 
-use crate::geom::{Aabb, ConvexPolygon};
+use crate::geom::{Aabb, ConvexPolygon, edge_plane};
 use crate::grid::{CellLists, Grid, Mailbox};
 use crate::scene::{Face, Scene};
 use crate::trace::MAX_LIGHTS;
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::HashMap;
 
-/// The shadow polygons of one light, registered in the grid.
+/// A shadow polygon (a silhouette edge `a b` extruded away from the light) prepared for crossing
+/// tests: its plane, the inward plane of the edge itself, and its two sides, the lines from the
+/// light through `a` and through `b`. Its far side lies beyond the grid's box, where no ray segment
+/// goes, so these three decide.
+///
+/// The sides are tested watertight: neighbouring shadow polygons share the line from the light
+/// through their common vertex, and which side of that line a ray passes is one triple product of
+/// the ray and the line (Pluecker's side relation), computed from the same numbers for both, so
+/// exactly one of them counts a ray crossing next to it. Testing each polygon's own crossing
+/// point against its own edge planes instead let rounding count such rays twice or not at all on
+/// finely meshed models (the bunny's thousands of silhouette edges).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowPolygon {
+    /// Unit normal and `-normal.p` for points `p` of the plane.
+    pub plane: Vec4,
+    /// Inward plane of the silhouette edge.
+    edge: Vec4,
+    /// `a - light` and `b - light`, each negated or not so that a ray crossing inside has a
+    /// side relation of the sign of its direction along the normal.
+    sides: [Vec3; 2],
+    /// Signed change of depth count crossing the polygon along its normal.
+    pub weight: i32,
+}
+
+impl ShadowPolygon {
+    /// Change of D along `o + t d`, `t` in `(t0, t1)`: 0 unless the segment crosses the polygon.
+    #[inline]
+    pub fn crossing(&self, o: Vec3, d: Vec3, t0: f32, t1: f32, light: Vec3) -> i32 {
+        let n = self.plane.truncate();
+        let (s_o, s_d) = (n.dot(o) + self.plane.w, n.dot(d));
+        // Both ends on one side of the plane, the common case, costs no division.
+        if (s_o + s_d * t0) * (s_o + s_d * t1) >= 0.0 {
+            return 0;
+        }
+        let p = o + d * (-s_o / s_d);
+        if self.edge.truncate().dot(p) + self.edge.w < 0.0 {
+            return 0;
+        }
+        let from_light = o - light;
+        let inside = |u: Vec3| {
+            let side = u.cross(from_light).dot(d);
+            if s_d > 0.0 { side >= 0.0 } else { side <= 0.0 }
+        };
+        if inside(self.sides[0]) && inside(self.sides[1]) {
+            if s_d > 0.0 { self.weight } else { -self.weight }
+        } else {
+            0
+        }
+    }
+}
+
+/// The shadow polygons of one light.
 pub struct LightVolumes {
-    pub polygons: Vec<ConvexPolygon>,
-    /// Signed weight of each shadow polygon (its change of depth count along its normal).
-    pub weights: Vec<i8>,
-    pub cells: CellLists,
+    pub light: Vec3,
+    pub polygons: Vec<ShadowPolygon>,
     /// D at the eye.
     pub eye_depth: i32,
 }
 
-/// Shadow polygons for every light.
+/// Shadow polygons for every light, registered in the grid.
 pub struct ShadowVolumes {
     pub lights: Vec<LightVolumes>,
-    /// Shadow polygons registered per cell and light, cell-major (saturating), so N_s of every
-    /// light is one pass over a segment's cells.
-    counts: Vec<u16>,
+    /// Row `cell * lights + light`: that light's shadow polygons registered in the cell. The
+    /// lights of one cell are neighbours in memory, so N_s of every light and the polygons of
+    /// each come from the same cache lines.
+    cells: CellLists,
+    /// One bit per cell: does it hold any light's shadow polygons (most cells a ray crosses hold
+    /// none)? Small enough to stay in cache.
+    occupied: Vec<u64>,
 }
 
 impl ShadowVolumes {
     /// Finds the silhouette edges of every light, extrudes them to beyond the grid's box,
     /// registers them in the grid and counts the eye's depth.
     pub fn build(scene: &Scene, polygons: &[ConvexPolygon], grid: &Grid) -> Self {
-        let (vertices, eye) = (&scene.vertices, scene.camera.eye);
+        let eye = scene.camera.eye;
         let edges = edge_map(polygons, &scene.faces);
-        let lights = scene
+        let (lights, per_light): (Vec<LightVolumes>, Vec<CellLists>) = scene
             .lights
             .iter()
             .map(|l| {
                 let light = l.position;
-                let (polys, weights) =
-                    silhouette_polygons(polygons, vertices, &edges, light, &grid.bounds);
-                let cells = grid.register(polys.par_iter().map(|p| p.vertices.as_slice()));
-                LightVolumes {
+                let (outlines, polys) =
+                    silhouette_polygons(polygons, scene, &edges, light, &grid.bounds);
+                let cells = grid.register(outlines.par_iter().map(|p| p.as_slice()));
+                let volumes = LightVolumes {
+                    light,
                     eye_depth: depth_at(polygons, light, eye),
                     polygons: polys,
-                    weights,
-                    cells,
-                }
+                };
+                (volumes, cells)
             })
-            .collect::<Vec<LightVolumes>>();
-        let mut counts = vec![0u16; grid.cell_count() * lights.len()];
-        for (l, lv) in lights.iter().enumerate() {
-            for c in 0..grid.cell_count() {
-                counts[c * lights.len() + l] = lv.cells.count(c as u32).min(u16::MAX as u32) as u16;
+            .unzip();
+        let mut occupied = vec![0u64; grid.cell_count().div_ceil(64)];
+        for c in 0..grid.cell_count() {
+            if per_light.iter().any(|cells| cells.count(c as u32) > 0) {
+                occupied[c / 64] |= 1 << (c % 64);
             }
         }
-        Self { lights, counts }
+        Self {
+            lights,
+            cells: CellLists::interleave(&per_light, grid.cell_count()),
+            occupied,
+        }
     }
 
     pub fn polygon_count(&self) -> usize {
@@ -89,29 +146,33 @@ impl ShadowVolumes {
             .unwrap_or(0)
     }
 
-    /// N_s of every light: shadow polygons registered in the cells a segment crossed (with
-    /// repeats).
+    /// Keeps in `occupied` the cells of `walked` (a segment's cells) that hold shadow polygons,
+    /// and returns N_s of every light: the shadow polygons registered in them (with repeats).
     #[inline]
-    pub fn registered(&self, walked: &[u32]) -> [u32; MAX_LIGHTS] {
-        let n = self.lights.len();
+    pub fn gather(&self, walked: &[u32], occupied: &mut Vec<u32>) -> [u32; MAX_LIGHTS] {
+        occupied.clear();
+        let n = self.lights.len() as u32;
         let mut ns = [0u32; MAX_LIGHTS];
         for &c in walked {
-            let row = &self.counts[c as usize * n..c as usize * n + n];
-            for (acc, &k) in ns.iter_mut().zip(row) {
-                *acc += k as u32;
+            if self.occupied[c as usize / 64] & (1 << (c % 64)) != 0 {
+                occupied.push(c);
+                let bounds = self.cells.row_bounds(c * n, n);
+                for (acc, w) in ns.iter_mut().zip(bounds.windows(2)) {
+                    *acc += w[1] - w[0];
+                }
             }
         }
         ns
     }
 
-    /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells are
-    /// `walked`; `tests` counts the ray/shadow-polygon tests.
+    /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells holding
+    /// shadow polygons are `cells` ([`Self::gather`]); `tests` counts the ray/shadow-polygon tests.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn crossings(
         &self,
         light: usize,
-        walked: &[u32],
+        cells: &[u32],
         o: Vec3,
         d: Vec3,
         t0: f32,
@@ -119,21 +180,18 @@ impl ShadowVolumes {
         mailbox: &mut Mailbox,
         tests: &mut u64,
     ) -> i32 {
-        let lv = &self.lights[light];
+        let (lv, n) = (&self.lights[light], self.lights.len() as u32);
         mailbox.next_ray();
-        let mut change = 0;
-        for &c in walked {
-            for &id in lv.cells.cell(c) {
+        let (mut change, mut tested) = (0, 0);
+        for &c in cells {
+            for &id in self.cells.cell(c * n + light as u32) {
                 if mailbox.first_visit(id) {
-                    *tests += 1;
-                    let p = &lv.polygons[id as usize];
-                    if p.intersect(o, d, t0, t1).is_some() {
-                        let w = lv.weights[id as usize] as i32;
-                        change += if p.normal.dot(d) > 0.0 { w } else { -w };
-                    }
+                    tested += 1;
+                    change += lv.polygons[id as usize].crossing(o, d, t0, t1, lv.light);
                 }
             }
         }
+        *tests += tested;
         change
     }
 }
@@ -159,14 +217,15 @@ fn edge_map(polygons: &[ConvexPolygon], faces: &[Face]) -> EdgeMap {
     edges
 }
 
-/// Shadow polygons of one light: each silhouette edge extruded away from the light to beyond `bounds`.
+/// Shadow polygons of one light: each silhouette edge extruded away from the light to beyond
+/// `bounds`, as outlines (for registration in the cells) and prepared for crossing tests.
 fn silhouette_polygons(
     polygons: &[ConvexPolygon],
-    vertices: &[Vec3],
+    scene: &Scene,
     edges: &EdgeMap,
     light: Vec3,
     bounds: &Aabb,
-) -> (Vec<ConvexPolygon>, Vec<i8>) {
+) -> (Vec<Vec<Vec3>>, Vec<ShadowPolygon>) {
     let corners = (0..8).map(|i| {
         Vec3::new(
             if i & 1 == 0 {
@@ -190,6 +249,23 @@ fn silhouette_polygons(
     // outside the box.
     let reach = 4.0 * corners.map(|c| (c - light).length()).fold(0.0, f32::max);
     let far = |v: Vec3| light + (v - light) * (reach / (v - light).length());
+    let vertices = &scene.vertices;
+    // How each polygon faces the light: +1 towards, -1 away, 0 edge-on (an empty shadow volume;
+    // rounding must not give it a side).
+    let facing: Vec<i8> = polygons
+        .iter()
+        .map(|poly| {
+            let to_light = light - poly.centroid();
+            let f = poly.normal.dot(to_light);
+            if poly.is_degenerate() || f.abs() <= 1e-5 * to_light.length() {
+                0
+            } else if f > 0.0 {
+                1
+            } else {
+                -1
+            }
+        })
+        .collect();
     let mut keys: Vec<&(u32, u32)> = edges.keys().collect();
     keys.sort_unstable();
     let mut out = (Vec::new(), Vec::new());
@@ -201,33 +277,50 @@ fn silhouette_polygons(
         }
         let (fa, fb) = (far(a), far(b));
         let fm = far((a + b) * 0.5);
-        let quad = ConvexPolygon::new(vec![a, b, fb, fm, fa]);
-        if quad.is_degenerate() {
+        // The plane through the light and the edge, from them alone: the far points, thousands
+        // of edge lengths away on a fine mesh, would tilt it by their rounding, and an edge
+        // pointing nearly at the light (a sliver of a shadow polygon, but one rays do cross)
+        // would read as degenerate and leave a hole in the volume's boundary.
+        let Some(n) = (b - light).cross(a - light).try_normalize() else {
             continue;
-        }
+        };
+        // Each polygon on the edge adds +1 when it lies on the positive side of the extruded plane,
+        // -1 on the negative side. Which side is decided by how the polygon faces the light and
+        // which way it runs along the edge, not by where its centroid falls: for a polygon seen
+        // nearly edge-on the two tests round differently, and the bunny's millions of such
+        // near-misses left holes in its volumes.
         let weight: i32 = faces
             .iter()
             .map(|&f| {
-                let poly = &polygons[f as usize];
-                // A polygon seen edge-on from the light has an empty shadow volume; rounding must
-                // not give it a side.
-                let to_light = light - poly.vertices[0];
-                if poly.normal.dot(to_light).abs() <= 1e-5 * to_light.length() {
-                    return 0;
-                }
-                let side = quad.normal.dot(poly.centroid() - a);
-                if side > 0.0 {
-                    1
-                } else if side < 0.0 {
-                    -1
-                } else {
-                    0
-                }
+                let v = &scene.faces[f as usize].vertices;
+                let at = v
+                    .iter()
+                    .position(|&i| i == key.0)
+                    .expect("edge of the face");
+                let forward = v[(at + 1) % v.len()] == key.1;
+                let facing = facing[f as usize] as i32;
+                if forward { facing } else { -facing }
             })
             .sum();
-        if weight != 0 {
-            out.0.push(quad);
-            out.1.push(weight.clamp(-127, 127) as i8);
+        // The side lines oriented so that a point inside is on the positive side.
+        let inside = (a + b + fa + fb) * 0.25 - light;
+        let oriented = |u: Vec3| {
+            let c = u.cross(inside).dot(n);
+            (c != 0.0).then_some(if c > 0.0 { u } else { -u })
+        };
+        let parts = (
+            edge_plane(n, a, b),
+            oriented(a - light),
+            oriented(b - light),
+        );
+        if let (true, (Some(edge), Some(side_a), Some(side_b))) = (weight != 0, parts) {
+            out.1.push(ShadowPolygon {
+                plane: n.extend(-n.dot(a)),
+                edge,
+                sides: [side_a, side_b],
+                weight,
+            });
+            out.0.push(vec![a, b, fb, fm, fa]);
         }
     }
     out
@@ -279,26 +372,41 @@ impl LightState {
 
     /// One step of the paper's pseudo code at a reflection point. `ns` is N_s of the incoming
     /// segment, `crossings` its change of D (only evaluated in the shadow-volume mode), and
-    /// `conventional` a shadow ray. Returns the shadow condition and the sub-scheme used.
+    /// `conventional` a shadow ray. `continues` says whether a reflected or refracted ray leaves
+    /// the point (so the state carried on is used again). Returns the shadow condition and the
+    /// sub-scheme used.
+    ///
+    /// One departure from the pseudo code: at a self-shadowed point whose depth count is valid, the
+    /// count is carried through the point when that is cheap (`ns <= nth`) and a ray continues
+    /// from it. The paper drops it there (SDF = 0), and as a self-shadowed point is shadowed
+    /// (SC = 1) every later point of the ray then needs a shadow ray until one is lit; on closed
+    /// objects half the points face away from each light, so that loss dominated the conventional
+    /// share. The count stays exact: a self-shadowed point is reached like any other.
     pub fn hst_step(
         &mut self,
         ns: u32,
         nth: f32,
         self_shadow: bool,
+        continues: bool,
         crossings: impl FnOnce() -> i32,
         conventional: impl FnOnce() -> bool,
     ) -> (bool, Subscheme) {
+        // Lit means D = 0, so a lit start is a valid count too.
+        let count_known = self.sdf || self.sc == Some(false);
         match self.sc {
             Some(sc) if ns == 0 => (sc, Subscheme::Sustain),
             _ if self_shadow => {
+                if continues && count_known && (ns as f32) <= nth {
+                    self.dc = if self.sdf { self.dc } else { 0 } + crossings();
+                    self.sdf = true;
+                } else {
+                    self.sdf = false;
+                }
                 self.sc = Some(true);
-                self.sdf = false;
                 (true, Subscheme::SelfShadow)
             }
-            Some(sc) if (ns as f32) <= nth && (!sc || self.sdf) => {
-                // Lit means D = 0, so a lit start is a valid count too.
-                let start = if self.sdf { self.dc } else { 0 };
-                self.dc = start + crossings();
+            Some(_) if (ns as f32) <= nth && count_known => {
+                self.dc = if self.sdf { self.dc } else { 0 } + crossings();
                 self.sc = Some(self.dc > 0);
                 self.sdf = true;
                 (self.dc > 0, Subscheme::ShadowVolume)

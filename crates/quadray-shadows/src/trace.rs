@@ -72,6 +72,8 @@ pub struct Prepared {
     pub eps: f32,
     /// Scene statistics of the cost model, computed once on first use.
     stats: std::sync::OnceLock<crate::cost::SceneStats>,
+    /// The follow-up statistics of the extended N_th, measured once on first use.
+    follow_up: std::sync::OnceLock<crate::cost::FollowUp>,
     /// The same for shadow rays: much smaller, so a polygon that a shadow ray crosses right next to
     /// its start (a concave corner) counts, as it does for the depth count. Depth counts take
     /// every crossing after the segment's start.
@@ -108,6 +110,7 @@ impl Prepared {
             embree,
             preprocess_s: crate::process_cpu_s() - start,
             stats: std::sync::OnceLock::new(),
+            follow_up: std::sync::OnceLock::new(),
         }
     }
 }
@@ -117,6 +120,25 @@ impl Prepared {
     /// predicts the same N_th).
     pub fn stats(&self) -> &crate::cost::SceneStats {
         self.stats.get_or_init(|| crate::cost::scene_stats(self))
+    }
+
+    /// The N_th HST uses with `--nth auto`: equation 12 with the follow-up cost of a conventional
+    /// decision ([`crate::cost::FollowUp`]), measured once on a pilot render of recursion `depth`
+    /// (without shadow polygons: equation 12 as written).
+    pub fn predicted_nth(
+        &self,
+        costs: &crate::cost::MachineCosts,
+        depth: u32,
+    ) -> (f64, crate::cost::FollowUp) {
+        let stats = self.stats();
+        let equation_12 = crate::cost::predicted_nth(costs, stats);
+        let follow_up = *self
+            .follow_up
+            .get_or_init(|| crate::cost::follow_up(self, equation_12, depth));
+        (
+            crate::cost::extended_nth(costs, stats, &follow_up),
+            follow_up,
+        )
     }
 }
 
@@ -135,10 +157,16 @@ pub struct RenderStats {
     pub shadow_volume: u64,
     pub conventional: u64,
     pub shadow_polygon_tests: u64,
+    pub shadow_polygon_entries: u64,
+    /// HST's conventional decisions made because of the carried state (the count invalid and the
+    /// condition shadowed or unknown) where N_s alone would have chosen the shadow volume, and
+    /// their N_s summed.
+    pub forced_conventional: u64,
+    pub forced_ns: u64,
     pub shadow_rays: u64,
-    /// Clock time the tiles' threads spent deciding shadows, and in the tiles.
-    pub shadow_thread_s: f64,
-    pub tile_thread_s: f64,
+    /// Ticks ([`crate::ticks`]) the tiles' threads spent deciding shadows, and in the tiles.
+    pub shadow_ticks: u64,
+    pub tile_ticks: u64,
     pub render_wall_s: f64,
     /// CPU time of the render, all threads (what the paper's CPU minutes measure; unlike clock
     /// time it is not inflated by other processes on a shared machine).
@@ -156,18 +184,53 @@ impl RenderStats {
         self.shadow_volume += o.shadow_volume;
         self.conventional += o.conventional;
         self.shadow_polygon_tests += o.shadow_polygon_tests;
+        self.shadow_polygon_entries += o.shadow_polygon_entries;
+        self.forced_conventional += o.forced_conventional;
+        self.forced_ns += o.forced_ns;
         self.shadow_rays += o.shadow_rays;
-        self.shadow_thread_s += o.shadow_thread_s;
-        self.tile_thread_s += o.tile_thread_s;
+        self.shadow_ticks += o.shadow_ticks;
+        self.tile_ticks += o.tile_ticks;
     }
 
     /// CPU time of shadow testing: the render's CPU time split in the threads' proportion.
     pub fn shadow_cpu_s(&self) -> f64 {
-        if self.tile_thread_s > 0.0 {
-            self.render_cpu_s * self.shadow_thread_s / self.tile_thread_s
+        if self.tile_ticks > 0 {
+            self.render_cpu_s * self.shadow_ticks as f64 / self.tile_ticks as f64
         } else {
             0.0
         }
+    }
+}
+
+/// Eye rays of a pinhole camera for an image of `w` x `h` pixels.
+pub struct Pinhole {
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    /// Half the image plane's size at distance 1.
+    half: glam::Vec2,
+    size: glam::Vec2,
+}
+
+impl Pinhole {
+    pub fn new(cam: &crate::scene::Camera, w: u32, h: u32) -> Self {
+        let forward = (cam.look_at - cam.eye).normalize();
+        let right = forward.cross(cam.up).normalize();
+        let half = (cam.fov_y_deg.to_radians() * 0.5).tan();
+        Self {
+            forward,
+            right,
+            up: right.cross(forward),
+            half: glam::Vec2::new(half * w as f32 / h as f32, half),
+            size: glam::Vec2::new(w as f32, h as f32),
+        }
+    }
+
+    /// Unit direction through the image point `(x, y)` in pixels from the top-left corner.
+    pub fn dir(&self, x: f32, y: f32) -> Vec3 {
+        let px = (2.0 * x / self.size.x - 1.0) * self.half.x;
+        let py = (1.0 - 2.0 * y / self.size.y) * self.half.y;
+        (self.forward + self.right * px + self.up * py).normalize()
     }
 }
 
@@ -178,10 +241,24 @@ struct Scratch {
     /// The ground-truth shadow rays of --check, kept apart so they do not disturb the scheme.
     check: Mailbox,
     walked: Vec<u32>,
+    /// Those of `walked` that hold shadow polygons.
+    occupied: Vec<u32>,
     stats: RenderStats,
 }
 
 type States = [LightState; MAX_LIGHTS];
+
+/// A shading point and how the ray segment reached it: `p = o + t d` on `polygon`, `n` the normal
+/// on the side it arrived from.
+#[derive(Clone, Copy)]
+struct Arrival {
+    o: Vec3,
+    d: Vec3,
+    t: f32,
+    p: Vec3,
+    n: Vec3,
+    polygon: u32,
+}
 
 struct Tracer<'a> {
     prep: &'a Prepared,
@@ -232,7 +309,7 @@ pub fn render(
 
 impl Tracer<'_> {
     fn tile(&self, tx: u32, ty: u32) -> (Vec<[u8; 4]>, RenderStats) {
-        let start = Instant::now();
+        let start = crate::ticks();
         let prep = self.prep;
         let (w, h) = (self.settings.width, self.settings.height);
         let mut scratch = Scratch {
@@ -240,14 +317,11 @@ impl Tracer<'_> {
             shadows: Mailbox::new(prep.volumes.as_ref().map_or(0, |v| v.max_per_light())),
             check: Mailbox::new(prep.polygons.len()),
             walked: Vec::new(),
+            occupied: Vec::new(),
             stats: RenderStats::default(),
         };
         let cam = &prep.scene.camera;
-        let forward = (cam.look_at - cam.eye).normalize();
-        let right = forward.cross(cam.up).normalize();
-        let up = right.cross(forward);
-        let half = (cam.fov_y_deg.to_radians() * 0.5).tan();
-        let aspect = w as f32 / h as f32;
+        let pinhole = Pinhole::new(cam, w, h);
         let mut eye_states = [LightState::default(); MAX_LIGHTS];
         if let Some(v) = &prep.volumes {
             for (s, lv) in eye_states.iter_mut().zip(&v.lights) {
@@ -269,9 +343,7 @@ impl Tracer<'_> {
                             ((s as f32 + 0.5) * 0.618_034).fract(),
                         )
                     };
-                    let px = (2.0 * (x as f32 + u) / w as f32 - 1.0) * half * aspect;
-                    let py = (1.0 - 2.0 * (y as f32 + v) / h as f32) * half;
-                    let d = (forward + right * px + up * py).normalize();
+                    let d = pinhole.dir(x as f32 + u, y as f32 + v);
                     sum += self.trace(
                         &mut scratch,
                         cam.eye,
@@ -289,7 +361,7 @@ impl Tracer<'_> {
                 pixels.push([c.x as u8, c.y as u8, c.z as u8, 255]);
             }
         }
-        scratch.stats.tile_thread_s = start.elapsed().as_secs_f64();
+        scratch.stats.tile_ticks = crate::ticks().wrapping_sub(start);
         (pixels, scratch.stats)
     }
 
@@ -329,30 +401,23 @@ impl Tracer<'_> {
         sc.stats.shading_points += 1;
 
         let lights = &prep.scene.lights;
-        let mut shadowed = [true; MAX_LIGHTS];
-        let shadow_start = Instant::now();
-        let ns = match (&prep.volumes, self.settings.scheme) {
-            (Some(v), Scheme::Hst { .. }) => v.registered(&sc.walked),
-            _ => [0; MAX_LIGHTS],
-        };
-        for (l, light) in lights.iter().enumerate() {
-            let to_light = light.position - p;
-            let self_shadow = to_light.dot(n) <= 0.0;
-            shadowed[l] = self.shadowed(
-                sc,
-                l,
-                ns[l],
-                &mut states[l],
+        let shadow_start = crate::ticks();
+        // Whether a reflected or refracted ray leaves this point and carries the shadow state on.
+        let continues = depth > 0 && (mat.reflect > 0.0 || mat.transmit > 0.0);
+        let shadowed = self.shadow_conditions(
+            sc,
+            &mut states,
+            Arrival {
                 o,
                 d,
-                hit.t,
+                t: hit.t,
                 p,
-                to_light,
-                self_shadow,
-                hit.polygon,
-            );
-        }
-        sc.stats.shadow_thread_s += shadow_start.elapsed().as_secs_f64();
+                n,
+                polygon: hit.polygon,
+            },
+            continues,
+        );
+        sc.stats.shadow_ticks += crate::ticks().wrapping_sub(shadow_start);
         sc.stats.shadow_decisions += lights.len() as u64;
         if self.settings.check {
             let mut differs = 0;
@@ -407,24 +472,63 @@ impl Tracer<'_> {
         colour
     }
 
-    /// The scheme's shadow condition for light `l` at `p` (reached along `o + t d`, `t = t_hit`,
-    /// through cells where `ns` shadow polygons of the light are registered).
+    /// Every light's shadow condition at a shading point. Kept out of line so that profilers
+    /// (callgrind's inclusive counts) see the whole of shadow testing as one function.
+    #[inline(never)]
+    fn shadow_conditions(
+        &self,
+        sc: &mut Scratch,
+        states: &mut States,
+        at: Arrival,
+        continues: bool,
+    ) -> [bool; MAX_LIGHTS] {
+        let prep = self.prep;
+        let mut shadowed = [true; MAX_LIGHTS];
+        let ns = match &prep.volumes {
+            Some(v) => v.gather(&sc.walked, &mut sc.occupied),
+            None => [0; MAX_LIGHTS],
+        };
+        for (l, light) in prep.scene.lights.iter().enumerate() {
+            let to_light = light.position - at.p;
+            let self_shadow = to_light.dot(at.n) <= 0.0;
+            shadowed[l] = self.shadowed(
+                sc,
+                l,
+                ns[l],
+                &mut states[l],
+                &at,
+                to_light,
+                self_shadow,
+                continues,
+            );
+        }
+        shadowed
+    }
+
+    /// The scheme's shadow condition for light `l` at the shading point, reached through cells
+    /// where `ns` shadow polygons of the light are registered.
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     fn shadowed(
         &self,
         sc: &mut Scratch,
         l: usize,
         ns: u32,
         state: &mut LightState,
-        o: Vec3,
-        d: Vec3,
-        t_hit: f32,
-        p: Vec3,
+        at: &Arrival,
         to_light: Vec3,
         self_shadow: bool,
-        polygon: u32,
+        continues: bool,
     ) -> bool {
         let prep = self.prep;
+        let Arrival {
+            o,
+            d,
+            t: t_hit,
+            p,
+            polygon,
+            ..
+        } = *at;
         match self.settings.scheme {
             Scheme::Conventional | Scheme::Bvh | Scheme::Embree => {
                 sc.stats.conventional += 1;
@@ -437,9 +541,10 @@ impl Tracer<'_> {
             Scheme::Volume => {
                 let v = prep.volumes.as_ref().expect("volumes built");
                 sc.stats.shadow_volume += 1;
+                sc.stats.shadow_polygon_entries += ns as u64;
                 let change = v.crossings(
                     l,
-                    &sc.walked,
+                    &sc.occupied,
                     o,
                     d,
                     0.0,
@@ -454,7 +559,7 @@ impl Tracer<'_> {
                 let Scratch {
                     objects,
                     shadows,
-                    walked,
+                    occupied,
                     stats,
                     ..
                 } = sc;
@@ -463,10 +568,12 @@ impl Tracer<'_> {
                     ns,
                     nth,
                     self_shadow,
+                    continues,
                     || {
+                        stats.shadow_polygon_entries += ns as u64;
                         v.crossings(
                             l,
-                            walked,
+                            occupied,
                             o,
                             d,
                             0.0,
@@ -485,7 +592,13 @@ impl Tracer<'_> {
                     Subscheme::Sustain => stats.sustain += 1,
                     Subscheme::SelfShadow => stats.self_shadow += 1,
                     Subscheme::ShadowVolume => stats.shadow_volume += 1,
-                    Subscheme::Conventional => stats.conventional += 1,
+                    Subscheme::Conventional => {
+                        stats.conventional += 1;
+                        if ns > 0 && (ns as f32) <= nth {
+                            stats.forced_conventional += 1;
+                            stats.forced_ns += ns as u64;
+                        }
+                    }
                 }
                 shadowed
             }
