@@ -213,7 +213,7 @@ fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
     for y in 0..48 {
         for x in 0..64 {
             let d = pinhole.dir(x as f32 + 0.5, y as f32 + 0.5);
-            let mut walked = Vec::new();
+            let mut occupied = Vec::new();
             let hit = prep.grid.closest_hit(
                 &prep.cells,
                 &prep.polygons,
@@ -223,11 +223,10 @@ fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
                 f32::INFINITY,
                 None,
                 &mut objects,
-                &mut walked,
+                Some((volumes.occupied_cells(), &mut occupied)),
             );
             if let Some(h) = hit {
-                let mut occupied = Vec::new();
-                let ns = volumes.gather(&walked, &mut occupied);
+                let ns = volumes.counts(&occupied);
                 let lights: Vec<usize> = (0..volumes.lights.len()).filter(|&l| ns[l] > 0).collect();
                 entries += lights.iter().map(|&l| ns[l] as u64).sum::<u64>();
                 segments.push((d, h.t, occupied, lights));

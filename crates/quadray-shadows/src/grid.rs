@@ -58,6 +58,29 @@ impl CellLists {
     }
 }
 
+/// A set of cells, one bit each: small enough to stay in cache while a ray walks.
+#[derive(Clone, Debug)]
+pub struct CellSet {
+    bits: Vec<u64>,
+}
+
+impl CellSet {
+    pub fn new(cells: usize) -> Self {
+        Self {
+            bits: vec![0; cells.div_ceil(64)],
+        }
+    }
+
+    pub fn insert(&mut self, c: u32) {
+        self.bits[c as usize / 64] |= 1 << (c % 64);
+    }
+
+    #[inline]
+    pub fn contains(&self, c: u32) -> bool {
+        self.bits[c as usize / 64] & (1 << (c % 64)) != 0
+    }
+}
+
 /// A per-ray "bucket": an id already tested on this ray is not tested again.
 #[derive(Clone, Debug)]
 pub struct Mailbox {
@@ -295,7 +318,9 @@ impl Grid {
     }
 
     /// Closest polygon hit in `(t_min, t_max)`, never `skip` (the polygon the ray starts on).
-    /// Every cell walked is appended to `walked` (the ray segment's cells, for N_s).
+    /// With `record`, the walked cells that are in its set are appended to its list (the cells of
+    /// the ray segment that hold shadow polygons, for N_s: a bit test per cell, in the walk that
+    /// visits them anyway).
     #[allow(clippy::too_many_arguments)]
     pub fn closest_hit(
         &self,
@@ -307,7 +332,7 @@ impl Grid {
         t_max: f32,
         skip: Option<u32>,
         mailbox: &mut Mailbox,
-        walked: &mut Vec<u32>,
+        mut record: Option<(&CellSet, &mut Vec<u32>)>,
     ) -> Option<Hit> {
         mailbox.next_ray();
         if let Some(s) = skip {
@@ -315,7 +340,11 @@ impl Grid {
         }
         let mut best: Option<Hit> = None;
         self.walk(o, d, t_min, t_max, |c, _, t_exit| {
-            walked.push(c);
+            if let Some((set, cells)) = &mut record
+                && set.contains(c)
+            {
+                cells.push(c);
+            }
             for &id in lists.cell(c) {
                 if mailbox.first_visit(id) {
                     let limit = best.map_or(t_max, |h| h.t);

@@ -20,7 +20,7 @@
 //! point resolves with a conventional test instead of sustaining it.
 
 use crate::geom::{Aabb, ConvexPolygon, edge_plane};
-use crate::grid::{CellLists, Grid, Mailbox};
+use crate::grid::{CellLists, CellSet, Grid, Mailbox};
 use crate::scene::{Face, Scene};
 use crate::trace::MAX_LIGHTS;
 use glam::{Vec3, Vec4};
@@ -94,9 +94,8 @@ pub struct ShadowVolumes {
     /// lights of one cell are neighbours in memory, so N_s of every light and the polygons of
     /// each come from the same cache lines.
     cells: CellLists,
-    /// One bit per cell: does it hold any light's shadow polygons (most cells a ray crosses hold
-    /// none)? Small enough to stay in cache.
-    occupied: Vec<u64>,
+    /// The cells that hold any light's shadow polygons (most cells a ray crosses hold none).
+    occupied: CellSet,
 }
 
 impl ShadowVolumes {
@@ -121,10 +120,10 @@ impl ShadowVolumes {
                 (volumes, cells)
             })
             .unzip();
-        let mut occupied = vec![0u64; grid.cell_count().div_ceil(64)];
-        for c in 0..grid.cell_count() {
-            if per_light.iter().any(|cells| cells.count(c as u32) > 0) {
-                occupied[c / 64] |= 1 << (c % 64);
+        let mut occupied = CellSet::new(grid.cell_count());
+        for c in 0..grid.cell_count() as u32 {
+            if per_light.iter().any(|cells| cells.count(c) > 0) {
+                occupied.insert(c);
             }
         }
         Self {
@@ -146,27 +145,29 @@ impl ShadowVolumes {
             .unwrap_or(0)
     }
 
-    /// Keeps in `occupied` the cells of `walked` (a segment's cells) that hold shadow polygons,
-    /// and returns N_s of every light: the shadow polygons registered in them (with repeats).
+    /// The cells holding shadow polygons of any light: what a ray walk records
+    /// ([`Grid::closest_hit`]) for [`Self::counts`] and [`Self::crossings`].
+    pub fn occupied_cells(&self) -> &CellSet {
+        &self.occupied
+    }
+
+    /// N_s of every light for a segment whose cells holding shadow polygons are `cells`: the
+    /// shadow polygons registered in them (with repeats).
     #[inline]
-    pub fn gather(&self, walked: &[u32], occupied: &mut Vec<u32>) -> [u32; MAX_LIGHTS] {
-        occupied.clear();
+    pub fn counts(&self, cells: &[u32]) -> [u32; MAX_LIGHTS] {
         let n = self.lights.len() as u32;
         let mut ns = [0u32; MAX_LIGHTS];
-        for &c in walked {
-            if self.occupied[c as usize / 64] & (1 << (c % 64)) != 0 {
-                occupied.push(c);
-                let bounds = self.cells.row_bounds(c * n, n);
-                for (acc, w) in ns.iter_mut().zip(bounds.windows(2)) {
-                    *acc += w[1] - w[0];
-                }
+        for &c in cells {
+            let bounds = self.cells.row_bounds(c * n, n);
+            for (acc, w) in ns.iter_mut().zip(bounds.windows(2)) {
+                *acc += w[1] - w[0];
             }
         }
         ns
     }
 
     /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells holding
-    /// shadow polygons are `cells` ([`Self::gather`]); `tests` counts the ray/shadow-polygon tests.
+    /// shadow polygons are `cells`; `tests` counts the ray/shadow-polygon tests.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn crossings(

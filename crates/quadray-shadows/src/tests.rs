@@ -95,7 +95,6 @@ fn grid_closest_hit_equals_brute_force() {
     for name in ["stars", "desk", "kaist"] {
         let prep = Prepared::new(scene_with_degenerates(name), Scheme::Conventional);
         let mut mailbox = Mailbox::new(prep.polygons.len());
-        let mut walked = Vec::new();
         for (o, d) in test_rays(&prep, 4000) {
             let grid = prep.grid.closest_hit(
                 &prep.cells,
@@ -106,7 +105,7 @@ fn grid_closest_hit_equals_brute_force() {
                 f32::INFINITY,
                 None,
                 &mut mailbox,
-                &mut walked,
+                None,
             );
             let brute = brute_closest(&prep.polygons, o, d, 0.0);
             match (grid, brute) {
@@ -188,9 +187,9 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
         let volumes = prep.volumes.as_ref().unwrap();
         let mut objects = Mailbox::new(prep.polygons.len());
         let mut shadows = Mailbox::new(volumes.max_per_light());
-        let (mut walked, mut occupied, mut tests, mut checked) = (Vec::new(), Vec::new(), 0, 0);
+        let (mut occupied, mut tests, mut checked) = (Vec::new(), 0, 0);
         for (o, d) in test_rays(&prep, 1500) {
-            walked.clear();
+            occupied.clear();
             let t1 = prep
                 .grid
                 .closest_hit(
@@ -202,7 +201,7 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
                     2.0,
                     None,
                     &mut objects,
-                    &mut walked,
+                    Some((volumes.occupied_cells(), &mut occupied)),
                 )
                 .map_or(2.0, |h| h.t * 0.5);
             let end = o + d * t1;
@@ -217,7 +216,6 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
                 ) else {
                     continue;
                 };
-                volumes.gather(&walked, &mut occupied);
                 let change =
                     volumes.crossings(l, &occupied, o, d, 0.0, t1, &mut shadows, &mut tests);
                 assert_eq!(

@@ -240,8 +240,7 @@ struct Scratch {
     shadows: Mailbox,
     /// The ground-truth shadow rays of --check, kept apart so they do not disturb the scheme.
     check: Mailbox,
-    walked: Vec<u32>,
-    /// Those of `walked` that hold shadow polygons.
+    /// The cells of the current ray segment that hold shadow polygons.
     occupied: Vec<u32>,
     stats: RenderStats,
 }
@@ -316,7 +315,6 @@ impl Tracer<'_> {
             objects: Mailbox::new(prep.polygons.len()),
             shadows: Mailbox::new(prep.volumes.as_ref().map_or(0, |v| v.max_per_light())),
             check: Mailbox::new(prep.polygons.len()),
-            walked: Vec::new(),
             occupied: Vec::new(),
             stats: RenderStats::default(),
         };
@@ -375,7 +373,7 @@ impl Tracer<'_> {
         mut states: States,
     ) -> Vec3 {
         let prep = self.prep;
-        sc.walked.clear();
+        sc.occupied.clear();
         let Some(hit) = prep.grid.closest_hit(
             &prep.cells,
             &prep.polygons,
@@ -385,7 +383,9 @@ impl Tracer<'_> {
             f32::INFINITY,
             skip,
             &mut sc.objects,
-            &mut sc.walked,
+            prep.volumes
+                .as_ref()
+                .map(|v| (v.occupied_cells(), &mut sc.occupied)),
         ) else {
             return prep.scene.background;
         };
@@ -485,7 +485,7 @@ impl Tracer<'_> {
         let prep = self.prep;
         let mut shadowed = [true; MAX_LIGHTS];
         let ns = match &prep.volumes {
-            Some(v) => v.gather(&sc.walked, &mut sc.occupied),
+            Some(v) => v.counts(&sc.occupied),
             None => [0; MAX_LIGHTS],
         };
         for (l, light) in prep.scene.lights.iter().enumerate() {
