@@ -52,3 +52,14 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     };
     Ok((n(w)?, n(h)?))
 }
+
+/// Logging for quadray's programs: `RUST_LOG` when set, else warnings, to stderr.
+#[cfg(feature = "logging")]
+pub fn init_logging() {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+}
