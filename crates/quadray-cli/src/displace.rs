@@ -79,15 +79,7 @@ pub struct DisplaceArgs {
 }
 
 fn parse_layers(s: &str) -> Result<(u32, u32), String> {
-    let (a, b) = s
-        .split_once(',')
-        .ok_or_else(|| format!("`{s}` is not MIN,MAX"))?;
-    let n = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("`{s}` is not MIN,MAX"))
-    };
-    Ok((n(a)?, n(b)?))
+    quadray_core::parse_pair(s, ',', "MIN,MAX")
 }
 
 fn parse_lod(s: &str) -> Result<Lod, String> {

@@ -93,12 +93,7 @@ fn spinner(what: &str) -> ProgressBar {
 }
 
 fn main() -> Result<()> {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
-        )
-        .with_writer(std::io::stderr)
-        .init();
+    quadray_core::init_logging();
     match Cli::parse().command {
         Command::View { args } => {
             let viewer = std::env::current_exe()?

@@ -3,14 +3,14 @@
 
 mod common;
 
-use common::{quadray, scratch};
+use common::{quadray_ok, quadray_refuses, read_json, scratch};
 
 #[test]
 fn indirect_writes_pictures_stats_and_the_error_map() {
     let dir = scratch("indirect-ok");
     let out = dir.join("cornell.png");
     let stats = dir.join("cornell.json");
-    let run = quadray(&[
+    quadray_ok(&[
         "indirect",
         "--method",
         "quadtree-passes",
@@ -28,11 +28,6 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
         "--stats",
         stats.to_str().unwrap(),
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     for name in [
         "cornell.png",
         "cornell.direct.png",
@@ -41,8 +36,7 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
     ] {
         assert!(dir.join(name).exists(), "{name}");
     }
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let json = read_json(&stats);
     assert_eq!(json["method"], "quadtree-passes");
     assert_eq!(json["width"], 48);
     assert_eq!(json["height"], 32);
@@ -86,11 +80,7 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
             "16x16",
         ];
         args.extend(extra);
-        let run = quadray(&args);
-        let err = String::from_utf8_lossy(&run.stderr);
-        assert!(!run.status.success());
-        assert!(err.contains(needle), "{err} should mention {needle}");
-        assert!(!err.contains("panicked"), "{err}");
+        quadray_refuses(&args, needle);
     }
 }
 
@@ -111,12 +101,7 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
             out.to_str().unwrap(),
         ];
         args.extend(extra);
-        let run = quadray(&args);
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        quadray_ok(&args);
         image::open(&out).unwrap().to_rgb8().into_raw()
     };
     let base = render("base.png", &[]);

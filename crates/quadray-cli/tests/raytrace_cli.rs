@@ -3,14 +3,14 @@
 
 mod common;
 
-use common::{assets, quadray, scratch};
+use common::{assets, quadray_ok, quadray_refuses, read_json, scratch};
 
 #[test]
 fn raytrace_writes_the_picture_and_the_stats() {
     let dir = scratch("raytrace-ok");
     let (out, stats) = (dir.join("demo.png"), dir.join("demo.json"));
     let scene = assets().join("scenes/shadows-demo.toml");
-    let run = quadray(&[
+    quadray_ok(&[
         "raytrace",
         "--scene",
         scene.to_str().unwrap(),
@@ -28,15 +28,9 @@ fn raytrace_writes_the_picture_and_the_stats() {
         stats.to_str().unwrap(),
         "--check",
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let img = image::open(&out).unwrap();
     assert_eq!((img.width(), img.height()), (64, 48));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let json = read_json(&stats);
     for key in [
         "scheme",
         "width",
@@ -118,11 +112,6 @@ fn raytrace_bad_input_is_a_clear_error() {
         ),
     ];
     for (args, why) in cases {
-        let run = quadray(args);
-        let err = String::from_utf8_lossy(&run.stderr);
-        assert!(
-            !run.status.success() && err.contains(why) && !err.contains("panicked"),
-            "{args:?}: {err}"
-        );
+        quadray_refuses(args, why);
     }
 }

@@ -27,7 +27,6 @@ impl FileError {
     }
 }
 
-/// Parses an image size written `WxH` (command lines).
 /// Parses `X,Y,Z` (a point or direction on a command line); every coordinate must be finite.
 pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
     let parts: Vec<f32> = s
@@ -41,14 +40,26 @@ pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
     }
 }
 
+/// Parses an image size written `WxH` (command lines).
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once('x')
-        .ok_or_else(|| format!("`{s}` is not WxH"))?;
-    let n = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("`{s}` is not WxH"))
-    };
-    Ok((n(w)?, n(h)?))
+    parse_pair(s, 'x', "WxH")
+}
+
+/// Parses two whole numbers split by `separator`; `form` names them in the error (`MIN,MAX`).
+pub fn parse_pair(s: &str, separator: char, form: &str) -> Result<(u32, u32), String> {
+    let wrong = || format!("`{s}` is not {form}");
+    let (a, b) = s.split_once(separator).ok_or_else(wrong)?;
+    let n = |v: &str| v.trim().parse::<u32>().map_err(|_| wrong());
+    Ok((n(a)?, n(b)?))
+}
+
+/// Logging for quadray's programs: `RUST_LOG` when set, else warnings, to stderr.
+#[cfg(feature = "logging")]
+pub fn init_logging() {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
 }

@@ -142,6 +142,10 @@ fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
     Some(a? / b?)
 }
 
+fn ratio_text(v: Option<f64>) -> String {
+    v.map_or("n/a".into(), |v| format!("{v:.2}"))
+}
+
 fn addressing(b: &BundledMap) -> Addressing {
     if b.surface.wraps() {
         Addressing::Wrap
@@ -206,47 +210,21 @@ pub fn run(
     for b in BUNDLED.iter().filter(|b| b.paper_row != "-") {
         let map = resized(&b.load()?, 256);
         let mut r = Renderer::new(gpu, &map, None, b.surface);
-        let point = bench.time(
-            "table1",
-            b.name,
-            &map,
-            &mut r,
-            &paper_view(fixed_layers(Method::Pyramid, 16)),
-        )?;
-        let bilinear = bench.time(
-            "table1",
-            b.name,
-            &map,
-            &mut r,
-            &paper_view(fixed_layers(Method::PyramidBilinear, 16)),
-        )?;
-        let pom = bench.time(
-            "table2",
-            b.name,
-            &map,
-            &mut r,
-            &paper_view(fixed_layers(Method::Pom, 16)),
-        )?;
-        let relief = bench.time(
-            "table2",
-            b.name,
-            &map,
-            &mut r,
-            &paper_view(fixed_layers(Method::Relief, 16)),
-        )?;
-        let ascend = bench.time(
-            "table2",
-            b.name,
-            &map,
-            &mut r,
-            &paper_view(fixed_layers(Method::PyramidAscend, 16)),
-        )?;
+        let mut time = |experiment, method| {
+            let s = paper_view(fixed_layers(method, 16));
+            bench.time(experiment, b.name, &map, &mut r, &s)
+        };
+        let point = time("table1", Method::Pyramid)?;
+        let bilinear = time("table1", Method::PyramidBilinear)?;
+        let pom = time("table2", Method::Pom)?;
+        let relief = time("table2", Method::Relief)?;
+        let ascend = time("table2", Method::PyramidAscend)?;
         let row = format!("{} ({})", b.name, b.paper_row);
         t1.row(vec![
             row.clone(),
             ms(point),
             ms(bilinear),
-            ratio(bilinear, point).map_or("n/a".into(), |r| format!("{r:.2}")),
+            ratio_text(ratio(bilinear, point)),
         ]);
         t2.row(vec![
             row,
@@ -254,7 +232,7 @@ pub fn run(
             ms(relief),
             ms(point),
             ms(ascend),
-            ratio(point, pom).map_or("n/a".into(), |r| format!("{r:.2}")),
+            ratio_text(ratio(point, pom)),
         ]);
         if b.name == "tiles" {
             ratios.pyramid_over_pom16_paper_size = ratio(point, pom);
@@ -330,7 +308,7 @@ pub fn run(
             ratios.pyramid_4096_over_256 = ratio(times[0], at_256[0]);
             ratios.pyramid_lod_auto_4096_over_256 = ratio(times[2], at_256[2]);
         }
-        let r = |k: usize| ratio(times[k], at_256[k]).map_or("n/a".into(), |r| format!("{r:.2}"));
+        let r = |k: usize| ratio_text(ratio(times[k], at_256[k]));
         f21.row(vec![
             format!("{size}^2"),
             ms(times[0]),
@@ -417,7 +395,7 @@ pub fn run(
         );
         let mut row: Vec<String> = times.iter().map(|&t| ms(t)).collect();
         for k in [1, 4] {
-            row.push(ratio(times[k], times[0]).map_or("n/a".into(), |r| format!("{r:.2}")));
+            row.push(ratio_text(ratio(times[k], times[0])));
         }
         t.row(row);
         tables.push(t);
@@ -565,7 +543,7 @@ pub fn run(
                 layers.to_string(),
                 format!("{wrong:.4}"),
                 ms(time),
-                ratio(time, pyramid_time).map_or("n/a".into(), |r| format!("{r:.2}")),
+                ratio_text(ratio(time, pyramid_time)),
             ]);
             ratios.pom_most_layers = Some((layers, wrong, ratio(time, pyramid_time)));
             if wrong <= target {

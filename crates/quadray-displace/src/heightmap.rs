@@ -63,6 +63,19 @@ pub struct HeightMap {
     pub depth: Vec<f32>,
 }
 
+/// Fails on the first texel of a `width`-wide grid that is NaN or infinite.
+fn all_finite(path: &Path, values: &[f32], width: u32) -> Result<(), HeightMapError> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(HeightMapError::NotFinite {
+            path: path.into(),
+            x: i as u32 % width,
+            y: i as u32 / width,
+            value: values[i],
+        }),
+        None => Ok(()),
+    }
+}
+
 impl HeightMap {
     pub fn size(&self) -> u32 {
         1 << self.levels
@@ -93,14 +106,7 @@ impl HeightMap {
             });
         }
         assert_eq!(depth.len(), (size * size) as usize, "depth buffer size");
-        if let Some(i) = depth.iter().position(|d| !d.is_finite()) {
-            return Err(HeightMapError::NotFinite {
-                path: name.into(),
-                x: i as u32 % size,
-                y: i as u32 / size,
-                value: depth[i],
-            });
-        }
+        all_finite(name, &depth, size)?;
         Ok(Self {
             levels: size.trailing_zeros(),
             depth: depth.into_iter().map(|d| d.clamp(0.0, 1.0)).collect(),
@@ -135,14 +141,7 @@ impl HeightMap {
                 .collect(),
             _ => raw,
         };
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(HeightMapError::NotFinite {
-                path: path.into(),
-                x: i as u32 % w,
-                y: i as u32 / w,
-                value: values[i],
-            });
-        }
+        all_finite(path, &values, w)?;
         let depth = to_depth(path, &values, convention)?;
         let (size, depth) = if w == h && w.is_power_of_two() {
             (w, depth)

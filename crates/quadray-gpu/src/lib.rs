@@ -1,13 +1,16 @@
 //! Headless wgpu for quadray: one place that finds an adapter, opens a device with the features
-//! the techniques need, reads textures back, and times passes with timestamp queries.
+//! the techniques need, makes render targets, reads textures back, and times passes with
+//! timestamp queries.
 //!
 //! Every technique takes a [`Gpu`] and never creates its own instance, so the same code runs on
 //! Mesa's lavapipe in CI and on a real GPU.
 
 mod readback;
+mod target;
 mod timer;
 
 pub use readback::{read_buffer, read_texture_f32, read_texture_rgba8};
+pub use target::{cleared_attachment, nearest_depth, texture_2d};
 pub use timer::{GpuTimer, TimingSummary};
 
 use thiserror::Error;

@@ -93,8 +93,7 @@ impl Measure<'_> {
         method: Method,
         label: String,
     ) -> Result<Row, IndirectError> {
-        r.render(method, true, false)?;
-        let frame = r.read_frame()?;
+        let frame = r.render_frame(method)?;
         let clusters = if method.uses_quadtree() {
             r.render(Method::Quadtree, true, false)?;
             Some(r.clusters_in_cut()?)
@@ -149,8 +148,7 @@ pub fn run(
     };
     let mut r = Renderer::new(gpu, &scene, base.clone())?;
     progress("brute force");
-    r.render(Method::Reference, true, false)?;
-    let brute = r.read_frame()?.indirect;
+    let brute = r.render_frame(Method::Reference)?.indirect;
     let m = Measure {
         brute: &brute,
         frames,
@@ -180,8 +178,7 @@ pub fn run(
     let buddha = Scene::load(&crate::scene::scenes_dir().join("cornell_buddha.toml"))?;
     let mut rb = Renderer::new(gpu, &buddha, base.clone())?;
     progress("table 2: Buddha brute force");
-    rb.render(Method::Reference, true, false)?;
-    let buddha_brute = rb.read_frame()?.indirect;
+    let buddha_brute = rb.render_frame(Method::Reference)?.indirect;
     let mb = Measure {
         brute: &buddha_brute,
         frames,

@@ -41,12 +41,10 @@ pub fn render_demo(
     let scene = Scene::cornell();
     progress("cornell: quadtree and brute force");
     let mut r = Renderer::new(gpu, &scene, settings(gpu, size, size, 256))?;
-    r.render(Method::Reference, true, false)?;
-    let brute = r.read_frame()?.indirect;
+    let brute = r.render_frame(Method::Reference)?.indirect;
     r.render(Method::Quadtree, true, false)?;
     let quadtree_ms = r.time(Method::Quadtree, false, FRAMES)?.map(|t| t.total_ms);
-    r.render(Method::Quadtree, true, false)?;
-    let frame = r.read_frame()?;
+    let frame = r.render_frame(Method::Quadtree)?;
     let clusters = r.clusters_in_cut()?;
     let combined = frame.combined();
     let e = compare(&frame.indirect, &brute);
@@ -120,8 +118,7 @@ pub fn render_demo(
     let atrium = Scene::load(&crate::scene::scenes_dir().join("atrium.toml"))?;
     let (w, h) = (size * 16 / 9, size);
     let mut r = Renderer::new(gpu, &atrium, settings(gpu, w, h, 256))?;
-    r.render(Method::Quadtree, true, false)?;
-    let frame = r.read_frame()?;
+    let frame = r.render_frame(Method::Quadtree)?;
     let combined = frame.combined();
     let pictures = montage(
         &[

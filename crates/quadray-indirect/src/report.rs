@@ -147,8 +147,7 @@ pub fn run(
     let mut renderer = Renderer::new(gpu, scene, settings)?;
     let method = options.method;
     let reference = if options.reference {
-        renderer.render(Method::Reference, true, false)?;
-        Some(renderer.read_frame()?.indirect)
+        Some(renderer.render_frame(Method::Reference)?.indirect)
     } else {
         None
     };
@@ -164,8 +163,7 @@ pub fn run(
     };
     let moving = renderer.time(method, true, options.frames)?;
     let still = renderer.time(method, false, options.frames)?;
-    renderer.render(method, true, false)?;
-    let frame = renderer.read_frame()?;
+    let frame = renderer.render_frame(method)?;
     let s = renderer.settings().clone();
     let (w, h) = (s.width, s.height);
     let combined = frame.combined();

@@ -362,49 +362,53 @@ fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2
     [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
 }
 
+/// Corner `i` of the box spanned by `lo` and `hi`: bits 0, 1, 2 of `i` pick `hi` in x, y, z.
+fn box_corner(lo: Vec3, hi: Vec3, i: usize) -> Vec3 {
+    let pick = |bit: usize, lo: f32, hi: f32| if i & bit == 0 { lo } else { hi };
+    Vec3::new(
+        pick(1, lo.x, hi.x),
+        pick(2, lo.y, hi.y),
+        pick(4, lo.z, hi.z),
+    )
+}
+
+// The faces of a box seen from outside, as corners of `box_corner` in quad order.
+const TOP: [usize; 4] = [6, 7, 3, 2];
+const BOTTOM: [usize; 4] = [0, 1, 5, 4];
+const FRONT: [usize; 4] = [4, 5, 7, 6]; // +z
+const BACK: [usize; 4] = [1, 0, 2, 3]; // -z
+const LEFT: [usize; 4] = [0, 4, 6, 2]; // -x
+const RIGHT: [usize; 4] = [5, 1, 3, 7]; // +x
+
+/// The two triangles of each face, the face's corners numbered as in [`box_corner`].
+fn box_faces(corners: [Vec3; 8], faces: &[([usize; 4], [f32; 3])]) -> Vec<[Vertex; 3]> {
+    faces
+        .iter()
+        .flat_map(|&([a, b, c, d], albedo)| {
+            quad(corners[a], corners[b], corners[c], corners[d], albedo)
+        })
+        .collect()
+}
+
 /// The unit room [0,1]^3 open towards +z: red wall at x = 0, green at x = 1.
 fn cornell_room() -> Vec<[Vertex; 3]> {
-    let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
-    [
-        quad(
-            p(0., 0., 1.),
-            p(1., 0., 1.),
-            p(1., 0., 0.),
-            p(0., 0., 0.),
-            WHITE,
-        ), // floor
-        quad(
-            p(0., 1., 0.),
-            p(1., 1., 0.),
-            p(1., 1., 1.),
-            p(0., 1., 1.),
-            WHITE,
-        ), // ceiling
-        quad(
-            p(0., 0., 0.),
-            p(1., 0., 0.),
-            p(1., 1., 0.),
-            p(0., 1., 0.),
-            WHITE,
-        ), // back
-        quad(
-            p(0., 0., 1.),
-            p(0., 0., 0.),
-            p(0., 1., 0.),
-            p(0., 1., 1.),
-            RED,
-        ), // left
-        quad(
-            p(1., 0., 0.),
-            p(1., 0., 1.),
-            p(1., 1., 1.),
-            p(1., 1., 0.),
-            GREEN,
-        ), // right
-    ]
-    .into_iter()
-    .flatten()
-    .collect()
+    let corners = std::array::from_fn(|i| box_corner(Vec3::ZERO, Vec3::ONE, i));
+    // seen from inside
+    let floor = [4, 5, 1, 0];
+    let ceiling = [2, 3, 7, 6];
+    let back = [0, 1, 3, 2];
+    let left = [4, 0, 2, 6];
+    let right = [1, 5, 7, 3];
+    box_faces(
+        corners,
+        &[
+            (floor, WHITE),
+            (ceiling, WHITE),
+            (back, WHITE),
+            (left, RED),
+            (right, GREEN),
+        ],
+    )
 }
 
 /// The short and the tall block of the Cornell box, turned as in the original.
@@ -414,81 +418,25 @@ fn cornell_blocks() -> Vec<[Vertex; 3]> {
     out
 }
 
-/// An upright box of footprint `side` and `height` standing on y = 0 at `centre`.
+/// An upright box of footprint `side` and `height` standing on y = 0 at `centre` (no bottom).
 fn block(centre: Vec3, side: f32, height: f32, turn_deg: f32) -> Vec<[Vertex; 3]> {
     let r = Mat4::from_translation(centre) * Mat4::from_rotation_y(turn_deg.to_radians());
     let h = side * 0.5;
-    let p = |x: f32, y: f32, z: f32| r.transform_point3(Vec3::new(x, y, z));
-    let (b0, b1, b2, b3) = (p(-h, 0., h), p(h, 0., h), p(h, 0., -h), p(-h, 0., -h));
-    let (t0, t1, t2, t3) = (
-        p(-h, height, h),
-        p(h, height, h),
-        p(h, height, -h),
-        p(-h, height, -h),
-    );
-    [
-        quad(t0, t1, t2, t3, WHITE),
-        quad(b0, b1, t1, t0, WHITE),
-        quad(b1, b2, t2, t1, WHITE),
-        quad(b2, b3, t3, t2, WHITE),
-        quad(b3, b0, t0, t3, WHITE),
-    ]
-    .into_iter()
-    .flatten()
-    .collect()
+    let (lo, hi) = (Vec3::new(-h, 0.0, -h), Vec3::new(h, height, h));
+    let corners = std::array::from_fn(|i| r.transform_point3(box_corner(lo, hi, i)));
+    box_faces(
+        corners,
+        &[TOP, FRONT, RIGHT, BACK, LEFT].map(|f| (f, WHITE)),
+    )
 }
 
 /// An axis-aligned box, faces outwards.
 fn cuboid(lo: Vec3, hi: Vec3, albedo: [f32; 3]) -> Vec<[Vertex; 3]> {
-    let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
-    let (a, b) = (lo, hi);
-    [
-        quad(
-            p(a.x, b.y, b.z),
-            p(b.x, b.y, b.z),
-            p(b.x, b.y, a.z),
-            p(a.x, b.y, a.z),
-            albedo,
-        ),
-        quad(
-            p(a.x, a.y, a.z),
-            p(b.x, a.y, a.z),
-            p(b.x, a.y, b.z),
-            p(a.x, a.y, b.z),
-            albedo,
-        ),
-        quad(
-            p(a.x, a.y, b.z),
-            p(b.x, a.y, b.z),
-            p(b.x, b.y, b.z),
-            p(a.x, b.y, b.z),
-            albedo,
-        ),
-        quad(
-            p(b.x, a.y, a.z),
-            p(a.x, a.y, a.z),
-            p(a.x, b.y, a.z),
-            p(b.x, b.y, a.z),
-            albedo,
-        ),
-        quad(
-            p(a.x, a.y, a.z),
-            p(a.x, a.y, b.z),
-            p(a.x, b.y, b.z),
-            p(a.x, b.y, a.z),
-            albedo,
-        ),
-        quad(
-            p(b.x, a.y, b.z),
-            p(b.x, a.y, a.z),
-            p(b.x, b.y, a.z),
-            p(b.x, b.y, b.z),
-            albedo,
-        ),
-    ]
-    .into_iter()
-    .flatten()
-    .collect()
+    let corners = std::array::from_fn(|i| box_corner(lo, hi, i));
+    box_faces(
+        corners,
+        &[TOP, BOTTOM, FRONT, BACK, LEFT, RIGHT].map(|f| (f, albedo)),
+    )
 }
 
 /// A vertical cylinder (no caps) with smooth normals, `segments` around and `rings` high.

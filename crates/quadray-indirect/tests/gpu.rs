@@ -23,8 +23,7 @@ fn gpu() -> Gpu {
 }
 
 fn render(r: &mut Renderer, method: Method) -> Vec<[f32; 3]> {
-    r.render(method, true, false).unwrap();
-    r.read_frame().unwrap().indirect
+    r.render_frame(method).unwrap().indirect
 }
 
 #[test]
@@ -243,8 +242,7 @@ fn subsampled_indirect_stays_close_to_full_resolution() {
         },
     )
     .unwrap();
-    r.render(Method::Quadtree, true, false).unwrap();
-    let frame = r.read_frame().unwrap();
+    let frame = r.render_frame(Method::Quadtree).unwrap();
     let e = compare(&frame.indirect, &full);
     println!(
         "subsample 4 vs full: {e:?}, {} pixels recomputed",

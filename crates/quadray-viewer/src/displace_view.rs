@@ -136,20 +136,7 @@ impl DisplaceView {
             !matches!(&self.target, Some((t, ..)) if t.width() == size[0] && t.height() == size[1]);
         if resized {
             let make = |format, usage| {
-                gpu.device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("viewer frame"),
-                    size: wgpu::Extent3d {
-                        width: size[0],
-                        height: size[1],
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
+                quadray_gpu::texture_2d(gpu, "viewer frame", (size[0], size[1]), format, usage)
             };
             let color = make(
                 wgpu::TextureFormat::Rgba8UnormSrgb,

@@ -89,12 +89,7 @@ pub struct Args {
 }
 
 fn main() -> Result<()> {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()),
-        )
-        .with_writer(std::io::stderr)
-        .init();
+    quadray_core::init_logging();
     let args = Args::parse();
     let mut maps = MapChoice::bundled();
     let mut start = maps

@@ -103,6 +103,13 @@ fn contrast(img: &image::RgbImage) -> f64 {
     (lum.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lum.len() as f64).sqrt()
 }
 
+/// The screenshot has `size` and is not blank.
+fn assert_screenshot(shot: &Path, size: (u32, u32)) {
+    let picture = rgb(shot);
+    assert_eq!(picture.dimensions(), size, "{}", shot.display());
+    assert!(contrast(&picture) > 10.0, "{} is blank", shot.display());
+}
+
 /// The `quadray` program built beside the viewer.
 fn quadray() -> PathBuf {
     let path = Path::new(env!("CARGO_BIN_EXE_quadray-view")).with_file_name("quadray");
@@ -196,12 +203,7 @@ fn viewer_screenshots_match_their_headless_command_lines() {
         ],
         limit,
     );
-    let picture = rgb(&shot);
-    assert_eq!(picture.dimensions(), (160, 120));
-    assert!(
-        contrast(&picture) > 10.0,
-        "the displacement screenshot is blank"
-    );
+    assert_screenshot(&shot, (160, 120));
     let command = replay(&shot.with_extension("txt"));
     assert!(
         command.contains("--azimuth 40 "),
@@ -232,12 +234,7 @@ fn viewer_screenshots_match_their_headless_command_lines() {
         ],
         limit,
     );
-    let picture = rgb(&shot);
-    assert_eq!(picture.dimensions(), (96, 72));
-    assert!(
-        contrast(&picture) > 10.0,
-        "the indirect screenshot is blank"
-    );
+    assert_screenshot(&shot, (96, 72));
     replay(&shot.with_extension("txt"));
     assert_matches(&shot, &shot.with_extension("headless.png"));
 }

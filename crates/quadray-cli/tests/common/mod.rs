@@ -10,12 +10,42 @@ pub fn assets() -> PathBuf {
 }
 
 /// Runs `quadray` with `args`, backtraces off so stderr holds just the error.
-pub fn quadray(args: &[&str]) -> Output {
+fn quadray(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_quadray"))
         .args(args)
         .env("RUST_BACKTRACE", "0")
         .output()
         .expect("run quadray")
+}
+
+/// Runs `quadray` with `args` and checks that it succeeded.
+pub fn quadray_ok(args: &[&str]) {
+    let run = quadray(args);
+    assert!(
+        run.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
+/// Runs `quadray` with `args` and checks that it failed with an error that mentions `needle`
+/// (and no panic); returns the exit code.
+pub fn quadray_refuses(args: &[&str], needle: &str) -> Option<i32> {
+    let run = quadray(args);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "{args:?} succeeded");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: `{needle}` not in {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    run.status.code()
+}
+
+/// The stats file a run wrote.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap();
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 /// A fresh folder for one test's outputs.

@@ -8,7 +8,10 @@ use crate::pyramid::Addressing;
 use crate::scene::{Plane, SurfaceKind, View};
 use quadray_core::image_out::Rgba8Image;
 use quadray_core::stats::Summary;
-use quadray_gpu::{Gpu, GpuError, GpuTimer, read_texture_f32, read_texture_rgba8};
+use quadray_gpu::{
+    Gpu, GpuError, GpuTimer, cleared_attachment, nearest_depth, read_texture_f32,
+    read_texture_rgba8, texture_2d,
+};
 use std::collections::HashMap;
 use wgpu::util::DeviceExt;
 
@@ -572,13 +575,7 @@ impl Renderer {
                             cull_mode: None,
                             ..Default::default()
                         },
-                        depth_stencil: Some(wgpu::DepthStencilState {
-                            format: DEPTH_FORMAT,
-                            depth_write_enabled: Some(true),
-                            depth_compare: Some(wgpu::CompareFunction::Less),
-                            stencil: Default::default(),
-                            bias: Default::default(),
-                        }),
+                        depth_stencil: Some(nearest_depth(DEPTH_FORMAT)),
                         multisample: Default::default(),
                         fragment: Some(wgpu::FragmentState {
                             module,
@@ -630,21 +627,9 @@ impl Renderer {
     }
 
     fn targets(gpu: &Gpu, s: &Settings, debug_outputs: bool) -> Vec<wgpu::Texture> {
-        let make = |format: wgpu::TextureFormat, label: &str| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: s.width,
-                    height: s.height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
+        let make = |format, label| {
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+            texture_2d(gpu, label, (s.width, s.height), format, usage)
         };
         let mut t = vec![make(COLOR_FORMAT, "color"), make(DEPTH_FORMAT, "depth")];
         if debug_outputs {
@@ -667,17 +652,6 @@ impl Renderer {
         timer: Option<&GpuTimer>,
     ) {
         let Targets { color, depth } = targets;
-        let attachment = |view, clear: wgpu::Color| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
         let sky = wgpu::Color {
             r: 0.16,
             g: 0.18,
@@ -692,11 +666,11 @@ impl Renderer {
         };
         let color_attachments = match debug {
             Some((hits, rays)) => [
-                attachment(color, sky),
-                attachment(hits, no_surface),
-                attachment(rays, no_surface),
+                cleared_attachment(color, sky),
+                cleared_attachment(hits, no_surface),
+                cleared_attachment(rays, no_surface),
             ],
-            None => [attachment(color, sky), None, None],
+            None => [cleared_attachment(color, sky), None, None],
         };
         let bind_group = if method.uses_conservative_pyramid() {
             self.bind_group_conservative.clone()

@@ -1,6 +1,18 @@
 // The reference (every VPL of the RSM, no clustering) and RSM sampling (Dachsbacher & Stamminger
 // 2005: N samples around the pixel's projection into the RSM, weights compensating the density).
 
+// Irradiance at `r` from the VPL of RSM texel `t`; an empty texel gives none.
+fn texel_irradiance(t: vec2<i32>, r: Receiver) -> vec3<f32> {
+    var e = vec3<f32>(0.0);
+    let n = textureLoad(rsm_normal, t, 0);
+    if (n.w > 0.5) {
+        let p = textureLoad(rsm_pos, t, 0);
+        let flux = textureLoad(rsm_flux, t, 0).rgb;
+        e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, shade.r_min);
+    }
+    return e;
+}
+
 @compute @workgroup_size(8, 8)
 fn brute_force(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= shade.width || id.y >= shade.height) {
@@ -13,12 +25,7 @@ fn brute_force(@builtin(global_invocation_id) id: vec3<u32>) {
         let range = slice_range(size * size, SLICE);
         for (var i = range.x; i < range.y; i++) {
             let t = vec2<i32>(i32(i % size), i32(i / size));
-            let n = textureLoad(rsm_normal, t, 0);
-            if (n.w > 0.5) {
-                let p = textureLoad(rsm_pos, t, 0);
-                let flux = textureLoad(rsm_flux, t, 0).rgb;
-                e += vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, shade.r_min);
-            }
+            e += texel_irradiance(t, r);
         }
     }
     add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
@@ -52,12 +59,7 @@ fn rsm_sampling(@builtin(global_invocation_id) id: vec3<u32>) {
             let scale = min(1.0, length(corner) / sample.w);
             let t = vec2<i32>(floor(centre + sample.xy * scale));
             if (all(t >= vec2<i32>(0)) && all(t < vec2<i32>(size))) {
-                let n = textureLoad(rsm_normal, t, 0);
-                if (n.w > 0.5) {
-                    let p = textureLoad(rsm_pos, t, 0);
-                    let flux = textureLoad(rsm_flux, t, 0).rgb;
-                    e += sample.z * scale * scale * vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, shade.r_min);
-                }
+                e += sample.z * scale * scale * texel_irradiance(t, r);
             }
         }
     }

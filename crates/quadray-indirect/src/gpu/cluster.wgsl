@@ -30,6 +30,11 @@ fn pack(@builtin(global_invocation_id) id: vec3<u32>) {
     nodes[node_index(params, 0u, id.xy)] = node;
 }
 
+// Index of child `c` (x in bit 0, y in bit 1) of node `xy` of `level`.
+fn child_index(level: u32, xy: vec2<u32>, c: u32) -> u32 {
+    return node_index(params, level - 1u, xy * 2u + vec2<u32>(c & 1u, c >> 1u));
+}
+
 fn luminance(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
@@ -50,7 +55,7 @@ fn reduce(@builtin(global_invocation_id) id: vec3<u32>) {
     var count_pos = vec4<f32>(0.0);
     var count_normal = vec3<f32>(0.0);
     for (var c = 0u; c < 4u; c++) {
-        let child = nodes[node_index(params, level - 1u, id.xy * 2u + vec2<u32>(c & 1u, c >> 1u))];
+        let child = nodes[child_index(level, id.xy, c)];
         flux += child.flux;
         let w = select(child.flux.w, luminance(child.flux.rgb), params.flux_weighted != 0u);
         pos += w * child.pos;
@@ -86,7 +91,7 @@ fn validity(@builtin(global_invocation_id) id: vec3<u32>) {
     let mean = nodes[index];
     var valid = true;
     for (var c = 0u; c < 4u; c++) {
-        let child = nodes[node_index(params, level - 1u, id.xy * 2u + vec2<u32>(c & 1u, c >> 1u))];
+        let child = nodes[child_index(level, id.xy, c)];
         if (child.flux.w > 0.5) {
             let close = abs(child.pos.w - mean.pos.w) < params.depth_threshold
                 && dot(child.normal.xyz, mean.normal.xyz) > params.normal_threshold;

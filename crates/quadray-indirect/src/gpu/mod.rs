@@ -394,7 +394,7 @@ impl<'g> Renderer<'g> {
             let t = &self.targets;
             let b = &self.buffers;
             if run.contains(&Pass::Rsm) {
-                p.raster_rsm(&mut encoder, t, b, self.vertex_count, timer);
+                p.raster(&mut encoder, Pass::Rsm, t, b, self.vertex_count, timer);
             }
             if run.contains(&Pass::Pyramid) {
                 p.build_quadtree(&mut encoder, b, &self.settings, timer);
@@ -402,7 +402,7 @@ impl<'g> Renderer<'g> {
             if run.contains(&Pass::Cut) {
                 p.select_cut(&mut encoder, b, &self.settings, timer);
             }
-            p.raster_gbuffer(&mut encoder, t, b, self.vertex_count, timer);
+            p.raster(&mut encoder, Pass::GBuffer, t, b, self.vertex_count, timer);
             p.shade_indirect(&mut encoder, b, &self.settings, method, timer);
             p.shade_direct(&mut encoder, b, &self.settings, timer);
             if let Some(timer) = timer {
@@ -466,6 +466,12 @@ impl<'g> Renderer<'g> {
 
     pub fn has_timestamps(&self) -> bool {
         self.timer.enabled()
+    }
+
+    /// Renders one frame of `method` from scratch, untimed, and reads it back.
+    pub fn render_frame(&mut self, method: Method) -> Result<Frame, IndirectError> {
+        self.render(method, true, false)?;
+        self.read_frame()
     }
 
     /// The last frame's indirect and direct light.

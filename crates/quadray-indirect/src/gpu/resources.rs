@@ -5,7 +5,7 @@ use crate::IndirectError;
 use crate::baselines;
 use crate::scene::{Scene, Vertex};
 use glam::Vec3;
-use quadray_gpu::{Gpu, GpuTimer};
+use quadray_gpu::{Gpu, GpuTimer, cleared_attachment, nearest_depth, texture_2d};
 use wgpu::util::DeviceExt;
 
 const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -94,22 +94,15 @@ fn float_target(
     size: (u32, u32),
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+    texture_2d(
+        gpu,
+        label,
+        size,
         format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+        wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+    )
 }
 
 /// The RSM (flux, position + depth, normal) and the G-buffer (position, normal, albedo).
@@ -612,13 +605,7 @@ impl Pipelines {
                     })],
                 },
                 primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
+                depth_stencil: Some(nearest_depth(DEPTH_FORMAT)),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &raster_module,
@@ -669,28 +656,26 @@ impl Pipelines {
         }
     }
 
-    fn raster(
+    /// Rasterises the scene into the RSM (`Pass::Rsm`) or the G-buffer (`Pass::GBuffer`).
+    pub fn raster(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        pipeline: &wgpu::RenderPipeline,
-        group: &wgpu::BindGroup,
-        (colors, depth): (&[wgpu::Texture; 3], &wgpu::Texture),
-        vertices: (&wgpu::Buffer, u32),
-        timestamps: Option<wgpu::RenderPassTimestampWrites>,
+        which: Pass,
+        t: &Targets,
+        b: &Buffers,
+        vertex_count: u32,
+        timer: Option<&GpuTimer>,
     ) {
+        let (pipeline, group, colors, depth) = match which {
+            Pass::Rsm => (&self.rsm, &b.rsm_group, &t.rsm, &t.rsm_depth),
+            Pass::GBuffer => (&self.gbuffer, &b.camera_group, &t.gbuffer, &t.gbuffer_depth),
+            other => unreachable!("{} is no raster pass", other.name()),
+        };
         let views = colors.each_ref().map(view);
         let depth_view = view(depth);
-        let attachments = views.each_ref().map(|v| {
-            Some(wgpu::RenderPassColorAttachment {
-                view: v,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        });
+        let attachments = views
+            .each_ref()
+            .map(|v| cleared_attachment(v, wgpu::Color::TRANSPARENT));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("raster"),
             color_attachments: &attachments,
@@ -702,49 +687,13 @@ impl Pipelines {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: timestamps,
+            timestamp_writes: timer.and_then(|t| t.render_pass(which as u32)),
             ..Default::default()
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, group, &[]);
-        pass.set_vertex_buffer(0, vertices.0.slice(..));
-        pass.draw(0..vertices.1, 0..1);
-    }
-
-    pub fn raster_rsm(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        t: &Targets,
-        b: &Buffers,
-        vertex_count: u32,
-        timer: Option<&GpuTimer>,
-    ) {
-        self.raster(
-            encoder,
-            &self.rsm,
-            &b.rsm_group,
-            (&t.rsm, &t.rsm_depth),
-            (&b.vertices, vertex_count),
-            timer.and_then(|t| t.render_pass(Pass::Rsm as u32)),
-        );
-    }
-
-    pub fn raster_gbuffer(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        t: &Targets,
-        b: &Buffers,
-        vertex_count: u32,
-        timer: Option<&GpuTimer>,
-    ) {
-        self.raster(
-            encoder,
-            &self.gbuffer,
-            &b.camera_group,
-            (&t.gbuffer, &t.gbuffer_depth),
-            (&b.vertices, vertex_count),
-            timer.and_then(|t| t.render_pass(Pass::GBuffer as u32)),
-        );
+        pass.set_vertex_buffer(0, b.vertices.slice(..));
+        pass.draw(0..vertex_count, 0..1);
     }
 
     fn compute_pass<'e>(
