@@ -21,8 +21,8 @@ pub struct RaytraceArgs {
     #[arg(long, default_value = "auto")]
     nth: String,
     /// Image size WxH.
-    #[arg(long, default_value = "512x480")]
-    size: String,
+    #[arg(long, default_value = "512x480", value_parser = quadray_core::parse_size)]
+    size: (u32, u32),
     /// Samples per pixel.
     #[arg(long, default_value_t = 1)]
     spp: u32,
@@ -41,20 +41,6 @@ pub struct RaytraceArgs {
     /// Only measure the machine constants C_s, C_i, C_c, C_o (nanoseconds) and print them.
     #[arg(long)]
     calibrate: bool,
-}
-
-fn parse_size(s: &str) -> anyhow::Result<(u32, u32)> {
-    let (w, h) = s
-        .split_once('x')
-        .with_context(|| format!("--size {s:?}: expected WxH"))?;
-    let (w, h): (u32, u32) = (
-        w.parse().context("--size width")?,
-        h.parse().context("--size height")?,
-    );
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        bail!("--size {s}: each side must be 1..=16384");
-    }
-    Ok((w, h))
 }
 
 pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
@@ -93,7 +79,10 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
             _ => bail!("--nth {n:?}: expected auto or a number >= 0"),
         },
     };
-    let (width, height) = parse_size(&args.size)?;
+    let (width, height) = args.size;
+    if width == 0 || height == 0 || width > 16384 || height > 16384 {
+        bail!("--size {width}x{height}: each side must be 1..=16384");
+    }
     if args.spp == 0 || args.spp > 1024 || args.depth > 64 {
         bail!("--spp must be 1..=1024 and --depth at most 64");
     }
