@@ -180,12 +180,14 @@ impl Grid {
         let c_axis = b.extent().min_position();
         let (a_axis, b_axis) = ((c_axis + 1) % 3, (c_axis + 2) % 3);
         let pad = self.cell_size * 1e-4;
-        let lo = |axis: usize, i: u32| {
-            self.bounds.min[axis] + i as f32 * self.cell_size[axis] - pad[axis]
-        };
-        let hi = |axis: usize, i: u32| {
-            self.bounds.min[axis] + (i + 1) as f32 * self.cell_size[axis] + pad[axis]
-        };
+        // Keeps the part of `src` in the slab of cells `i` along `axis`; false when none is left.
+        let clip_to_cells =
+            |src: &[Vec3], axis: usize, i: u32, tmp: &mut _, out: &mut Vec<Vec3>| {
+                let lo = self.bounds.min[axis] + i as f32 * self.cell_size[axis] - pad[axis];
+                let hi = self.bounds.min[axis] + (i + 1) as f32 * self.cell_size[axis] + pad[axis];
+                clip_slab(src, axis, lo, hi, tmp, out);
+                !out.is_empty()
+            };
         let (mut tmp, mut strip, mut piece) = (Vec::new(), Vec::new(), Vec::new());
         let range = |axis: usize, bx: &Aabb| {
             (
@@ -195,28 +197,12 @@ impl Grid {
         };
         let (i0, i1) = range(a_axis, &b);
         for i in i0..=i1 {
-            clip_slab(
-                poly,
-                a_axis,
-                lo(a_axis, i),
-                hi(a_axis, i),
-                &mut tmp,
-                &mut strip,
-            );
-            if strip.is_empty() {
+            if !clip_to_cells(poly, a_axis, i, &mut tmp, &mut strip) {
                 continue;
             }
             let (j0, j1) = range(b_axis, &Aabb::of_points(strip.iter().copied()));
             for j in j0..=j1 {
-                clip_slab(
-                    &strip,
-                    b_axis,
-                    lo(b_axis, j),
-                    hi(b_axis, j),
-                    &mut tmp,
-                    &mut piece,
-                );
-                if piece.is_empty() {
+                if !clip_to_cells(&strip, b_axis, j, &mut tmp, &mut piece) {
                     continue;
                 }
                 let (k0, k1) = range(c_axis, &Aabb::of_points(piece.iter().copied()));

@@ -258,19 +258,23 @@ fn assert_same_as_conventional(scene: &Scene, what: &str) {
         (SchemeChoice::Hst, Nth::Fixed(1e9)),
         (SchemeChoice::Bvh, Nth::Auto),
     ] {
-        let (_, r) = run(scene.clone(), &options(scheme, nth), &|| {});
-        let bad = r.disagreements.unwrap();
-        assert!(
-            r.shading_points > 1000,
-            "{what}: {} shading points",
-            r.shading_points
-        );
-        assert!(
-            bad as f64 <= (1e-4 * r.shading_points as f64).ceil(),
-            "{what} {scheme:?} {nth:?}: {bad} of {} shading points disagree",
-            r.shading_points
-        );
+        assert_agrees(scene, &options(scheme, nth), 1000, what);
     }
+}
+
+/// Renders with `--check` and asserts on more than `min_points` shading points that at most the
+/// bar's share disagrees with the conventional test.
+fn assert_agrees(scene: &Scene, opts: &RunOptions, min_points: u64, what: &str) {
+    let (_, r) = run(scene.clone(), opts, &|| {});
+    let bad = r.disagreements.unwrap();
+    let points = r.shading_points;
+    assert!(points > min_points, "{what}: {points} shading points");
+    assert!(
+        bad as f64 <= (1e-4 * points as f64).ceil(),
+        "{what} {:?} {:?}: {bad} of {points} shading points disagree",
+        opts.scheme,
+        opts.nth
+    );
 }
 
 #[test]
@@ -491,18 +495,7 @@ fn the_bunny_in_the_cornell_box_decides_like_the_conventional_test() {
             height: 120,
             ..options(scheme, nth)
         };
-        let (_, r) = run(scene.clone(), &opts, &|| {});
-        let bad = r.disagreements.unwrap();
-        assert!(
-            r.shading_points > 10_000,
-            "{} shading points",
-            r.shading_points
-        );
-        assert!(
-            bad as f64 <= (1e-4 * r.shading_points as f64).ceil(),
-            "{scheme:?}: {bad} of {} shading points disagree",
-            r.shading_points
-        );
+        assert_agrees(&scene, &opts, 10_000, "bunny");
     }
 }
 
