@@ -105,6 +105,14 @@ impl Mailbox {
         }
     }
 
+    /// Starts a new ray that never tests `skip` (the polygon it leaves).
+    pub fn start_ray(&mut self, skip: Option<u32>) {
+        self.next_ray();
+        if let Some(s) = skip {
+            self.first_visit(s);
+        }
+    }
+
     /// Marks `id` as tested on this ray; true the first time.
     #[inline]
     pub fn first_visit(&mut self, id: u32) -> bool {
@@ -320,10 +328,7 @@ impl Grid {
         mailbox: &mut Mailbox,
         mut record: Option<(&CellSet, &mut Vec<u32>)>,
     ) -> Option<Hit> {
-        mailbox.next_ray();
-        if let Some(s) = skip {
-            mailbox.first_visit(s);
-        }
+        mailbox.start_ray(skip);
         let mut best: Option<Hit> = None;
         self.walk(o, d, t_min, t_max, |c, _, t_exit| {
             if let Some((set, cells)) = &mut record
@@ -357,10 +362,7 @@ impl Grid {
         skip: Option<u32>,
         mailbox: &mut Mailbox,
     ) -> bool {
-        mailbox.next_ray();
-        if let Some(s) = skip {
-            mailbox.first_visit(s);
-        }
+        mailbox.start_ray(skip);
         let mut blocked = false;
         self.walk(o, d, t_min, t_max, |c, _, _| {
             blocked = lists.cell(c).iter().any(|&id| {
