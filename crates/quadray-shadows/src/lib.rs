@@ -31,7 +31,10 @@
 //!   shadow (SDF = 0 forces shadow rays at the later points of the ray tree), measured on a pilot
 //!   render ([`cost::FollowUp`]); equation 12 as written is reported beside it.
 //! - Times are CPU seconds of all threads, as the paper's CPU minutes; the shadow part is split
-//!   off with the time-stamp counter around each shading point's shadow decisions.
+//!   off with the time-stamp counter around each shading point's shadow decisions. Finding the
+//!   cells of a segment that hold shadow polygons is a bit test per cell inside the walk that
+//!   finds the hit, so it counts as "other" (the total shows it); summing their N_s and
+//!   everything after counts as shadow testing.
 //! - Transparent objects must not touch other surfaces (the builtin glasses and vase float a hair
 //!   above): a refracted ray passing through two coplanar faces at once would skip one.
 
