@@ -130,7 +130,13 @@ fn main() -> Result<()> {
                     bar.set_message(format!("displacement: {m}"))
                 })?;
             bar.finish_and_clear();
-            for f in files.into_iter().chain(indirect::demo(&gpu, &out, size)?) {
+            let files = files.into_iter().chain(indirect::demo(&gpu, &out, size)?);
+            let bar = spinner("ray tracing");
+            let traced = quadray_shadows::demo::render_demo(&out.join("raytrace"), size, |m| {
+                bar.set_message(format!("ray tracing: {m}"))
+            })?;
+            bar.finish_and_clear();
+            for f in files.chain(traced) {
                 println!("{}", f.display());
             }
         }

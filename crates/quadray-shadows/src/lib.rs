@@ -41,6 +41,7 @@
 pub mod bench;
 pub mod bvh;
 pub mod cost;
+pub mod demo;
 #[cfg(feature = "embree")]
 pub mod embree;
 pub mod geom;

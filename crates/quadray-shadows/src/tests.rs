@@ -579,3 +579,23 @@ fn self_shadowed_points_carry_a_valid_count_on() {
         (false, crate::shadow::Subscheme::Conventional)
     );
 }
+
+/// The demo writes one montage per benchmark scene: three captioned tiles side by side.
+#[test]
+fn the_demo_writes_a_montage_per_scene() {
+    let out = std::env::temp_dir().join(format!("quadray-shadows-demo-{}", std::process::id()));
+    let files = crate::demo::render_demo(&out, 48, |_| {}).unwrap();
+    assert_eq!(
+        files.len(),
+        BUILTINS.len() + crate::bench::ASSET_SCENES.len()
+    );
+    for f in &files {
+        let picture = image::open(f).unwrap();
+        assert!(
+            picture.width() > 3 * 48 && picture.height() > 45,
+            "{}",
+            f.display()
+        );
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
