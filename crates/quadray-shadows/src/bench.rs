@@ -37,7 +37,7 @@ pub struct SweepPoint {
 pub struct SceneResult {
     pub scene: String,
     pub stats: SceneStats,
-    /// N_th of `--nth auto`: equation 12 with the follow-up cost.
+    /// N_th of `--nth auto`: equation 12 with the pilot's corrections ([`cost::FollowUp`]).
     pub predicted_nth: f64,
     /// Equation 12 as written.
     pub equation_12_nth: f64,
@@ -345,6 +345,7 @@ fn markdown(r: &BenchResults) -> String {
             "p",
             "N_c",
             "N_th eq. 12",
+            "break-even N_s (pilot)",
             "forced / free shadow rays",
             "N_th predicted",
             "N_th best (sweep)",
@@ -363,6 +364,9 @@ fn markdown(r: &BenchResults) -> String {
             format!("{:.3}", st.p),
             format!("{:.1}", st.n_c),
             format!("{:.2}", s.equation_12_nth),
+            s.follow_up
+                .break_even
+                .map_or("-".into(), |n| format!("{n:.1}")),
             format!("{:.2}", s.follow_up.ratio),
             format!("{:.2}", s.predicted_nth),
             format!("{}", s.best_nth),

@@ -5,7 +5,7 @@
 use crate::SplitMix;
 use crate::geom::{Aabb, ConvexPolygon};
 use crate::grid::{Grid, Mailbox};
-use crate::trace::{Pinhole, Prepared};
+use crate::trace::{COST_BINS, CostBins, Pinhole, Prepared};
 use glam::Vec3;
 use serde::Serialize;
 use std::hint::black_box;
@@ -59,45 +59,91 @@ pub fn predicted_nth(c: &MachineCosts, s: &SceneStats) -> f64 {
     conventional_cost(c, s) / s.c_s_per_entry.unwrap_or(c.c_s)
 }
 
-/// What equation 12 leaves out. It equates the costs of one decision, but in HST's state machine
-/// a conventional test that finds shadow also leaves the depth count invalid (SDF = 0), and every
-/// later point of that ray tree (not sustained, not self-shadowed) then takes a shadow ray too,
-/// until one is lit, even where its N_s is small. Measured on a pilot render (64 x 48, HST at
-/// equation 12's N_th): `ratio` such forced decisions per free one (N_s above N_th), `forced_ns`
-/// their mean N_s.
+/// What equation 12 leaves out, measured on pilot renders (96 x 72).
+///
+/// First, in HST's state machine a conventional test that finds shadow also leaves the depth
+/// count invalid (SDF = 0), and every later point of that ray tree (not sustained, not
+/// self-shadowed) then takes a shadow ray too, until one is lit, even where its N_s is small:
+/// `ratio` such forced decisions per free one (N_s above N_th), `forced_ns` their mean N_s (HST
+/// at equation 12's N_th).
+///
+/// Second, equation 12 equates a mean shadow ray with N_s times a mean shadow-polygon test, but
+/// neither cost is the mean one where the choice is made. Points reached through many shadow
+/// polygons lie far along long segments, deep in the scene, and their shadow rays cross more cells
+/// than the mean one; and a long segment meets the same large shadow polygons in cell after cell,
+/// which the bucket tests once, so a shadow-volume decision's cost grows slower than N_s. On the
+/// look-alikes both push the break-even N_s well above equation 12's. `break_even` is where the
+/// two costs meet, measured: HST timed decision by decision with N_th infinite (every decision
+/// it can make by shadow volume) and with N_th 0 (every one by shadow ray), both binned by N_s.
+/// None when too few decisions were timed.
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
 pub struct FollowUp {
     pub ratio: f64,
     pub forced_ns: f64,
+    pub break_even: Option<f64>,
 }
 
-/// The pilot render of [`FollowUp`]; zero without shadow polygons.
+/// Fewest timed decisions of a bin the break-even reads.
+const PILOT_MIN_DECISIONS: u64 = 30;
+
+/// The pilot renders of [`FollowUp`]; zero without shadow polygons.
 pub fn follow_up(prep: &Prepared, nth: f64, depth: u32) -> FollowUp {
     if prep.volumes.is_none() {
         return FollowUp::default();
     }
-    let settings = crate::trace::Settings {
-        width: 64,
-        height: 48,
-        spp: 1,
-        depth,
-        scheme: crate::trace::Scheme::Hst { nth: nth as f32 },
-        check: false,
+    let pilot = |nth: f32, time_decisions| {
+        let settings = crate::trace::Settings {
+            width: 96,
+            height: 72,
+            spp: 1,
+            depth,
+            scheme: crate::trace::Scheme::Hst { nth },
+            check: false,
+            time_decisions,
+        };
+        crate::trace::render(prep, settings, &|| {}).1
     };
-    let (_, r) = crate::trace::render(prep, settings, &|| {});
+    // This one also warms the caches for the timed ones.
+    let r = pilot(nth as f32, false);
     let free = r.conventional.saturating_sub(r.forced_conventional);
+    let (volume, rays) = (pilot(f32::INFINITY, true), pilot(0.0, true));
     FollowUp {
         ratio: r.forced_conventional as f64 / free.max(1) as f64,
         forced_ns: r.forced_ns as f64 / r.forced_conventional.max(1) as f64,
+        break_even: break_even(&volume.shadow_volume_costs, &rays.shadow_ray_costs),
     }
 }
 
-/// N_th with the follow-up cost: choosing a shadow ray at a point costs C_cv, and with the
+/// The N_s where shadow-volume decisions start to cost more than shadow rays: interpolated
+/// between the mean N_s of the last bin where they cost less and the first where they cost more;
+/// the top of the last bin timed when they cost less everywhere.
+pub(crate) fn break_even(volume: &CostBins, rays: &CostBins) -> Option<f64> {
+    let mut below: Option<(f64, f64)> = None;
+    for b in 1..COST_BINS {
+        let (Some((ns, v)), Some((_, r))) = (
+            volume.mean(b, PILOT_MIN_DECISIONS),
+            rays.mean(b, PILOT_MIN_DECISIONS),
+        ) else {
+            continue;
+        };
+        let excess = v - r;
+        if excess > 0.0 {
+            // From the origin (no polygons cost nothing) when the first bin already costs more.
+            let (ns0, e0) = below.unwrap_or((0.0, -r));
+            return Some(ns0 + (ns - ns0) * -e0 / (excess - e0));
+        }
+        below = Some((ns, excess));
+    }
+    below.map(|(ns, _)| ns.max(1.0).log2().ceil().exp2().max(ns))
+}
+
+/// N_th with the pilot's corrections: choosing a shadow ray at a point costs C_cv, and with the
 /// measured `ratio` that many forced shadow rays more, each in place of a shadow-volume test of
-/// about `forced_ns` polygons: C_s N_th = C_cv (1 + ratio) - ratio C_s forced_ns.
+/// about `forced_ns` polygons: C_s N_th = C_cv (1 + ratio) - ratio C_s forced_ns. C_cv / C_s is
+/// the pilot's measured break-even where it has one, equation 12's otherwise.
 pub fn extended_nth(c: &MachineCosts, s: &SceneStats, f: &FollowUp) -> f64 {
-    let c_s = s.c_s_per_entry.unwrap_or(c.c_s);
-    (conventional_cost(c, s) * (1.0 + f.ratio) / c_s - f.ratio * f.forced_ns).max(0.0)
+    let cv_over_s = f.break_even.unwrap_or_else(|| predicted_nth(c, s));
+    (cv_over_s * (1.0 + f.ratio) - f.ratio * f.forced_ns).max(0.0)
 }
 
 /// Scene statistics from the polygons and the grid.

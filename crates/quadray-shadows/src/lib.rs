@@ -27,9 +27,13 @@
 //! - p comes from integral geometry and alpha = n_or / 2 (the relation every row of table 2 obeys);
 //!   N_c is sampled from points on the polygons to the lights; C_s is measured per registered
 //!   shadow polygon on the scene's own eye-ray segments ([`cost`]).
-//! - `--nth auto` adds to equation 12 the follow-up cost of a conventional decision that finds
-//!   shadow (SDF = 0 forces shadow rays at the later points of the ray tree), measured on a pilot
-//!   render ([`cost::FollowUp`]); equation 12 as written is reported beside it.
+//! - `--nth auto` is equation 12 with two corrections measured on pilot renders
+//!   ([`cost::FollowUp`]); equation 12 as written is reported beside it. The break-even of a
+//!   shadow-volume decision and a shadow ray is timed where the choice is made, binned by N_s,
+//!   instead of from the mean shadow ray and C_s N_s: HST casts its rays from points deep in the
+//!   scene, whose rays cost more than the mean one, and the bucket makes a decision's cost grow
+//!   slower than N_s. And the follow-up cost of a conventional decision that finds shadow is added
+//!   (SDF = 0 forces shadow rays at the later points of the ray tree).
 //! - Times are CPU seconds of all threads, as the paper's CPU minutes; the shadow part is split
 //!   off with the time-stamp counter around each shading point's shadow decisions. Finding the
 //!   cells of a segment that hold shadow polygons is a bit test per cell inside the walk that
@@ -130,7 +134,7 @@ pub struct Subschemes {
 
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct NthReport {
-    /// What `--nth auto` uses: equation 12 with the follow-up cost ([`cost::FollowUp`]).
+    /// What `--nth auto` uses: equation 12 with the pilot's corrections ([`cost::FollowUp`]).
     pub predicted: f64,
     /// Equation 12 as the paper writes it.
     pub equation_12: f64,
@@ -226,6 +230,7 @@ pub fn render_prepared(
         depth: opts.depth,
         scheme,
         check: opts.check,
+        time_decisions: false,
     };
     let (image, r) = trace::render(prep, settings, on_tile);
     let nth = NthReport {

@@ -19,7 +19,7 @@
 //! light starts with an unknown condition (it may have left the shadow), which the next reflection
 //! point resolves with a conventional test instead of sustaining it.
 
-use crate::geom::{Aabb, ConvexPolygon, edge_plane};
+use crate::geom::{Aabb, ConvexPolygon};
 use crate::grid::{CellLists, CellSet, Grid, Mailbox};
 use crate::scene::{Face, Scene};
 use crate::trace::MAX_LIGHTS;
@@ -29,24 +29,26 @@ use serde::Serialize;
 use std::collections::HashMap;
 
 /// A shadow polygon (a silhouette edge `a b` extruded away from the light) prepared for crossing
-/// tests: its plane, the inward plane of the edge itself, and its two sides, the lines from the
-/// light through `a` and through `b`. Its far side lies beyond the grid's box, where no ray segment
-/// goes, so these three decide.
+/// tests: its plane, its edge `a b` and its two sides, the lines from the light through `a` and
+/// through `b`. Its far side lies beyond the grid's box, where no ray segment goes, so these
+/// three lines decide.
 ///
-/// The sides are tested watertight: neighbouring shadow polygons share the line from the light
-/// through their common vertex, and which side of that line a ray passes is one triple product of
-/// the ray and the line (Pluecker's side relation), computed from the same numbers for both, so
-/// exactly one of them counts a ray crossing next to it. Testing each polygon's own crossing
-/// point against its own edge planes instead let rounding count such rays twice or not at all on
-/// finely meshed models (the bunny's thousands of silhouette edges).
+/// Which side of a line a ray passes is one triple product of the ray and the line (Pluecker's
+/// side relation), so the test needs no crossing point and no division, and it is watertight:
+/// neighbouring shadow polygons share the line from the light through their common vertex, and
+/// the relation of a ray with that line is computed from the same numbers for both, so exactly
+/// one of them counts a ray crossing next to it. Testing each polygon's own crossing point
+/// against its own edge planes instead let rounding count such rays twice or not at all on finely
+/// meshed models (the bunny's thousands of silhouette edges).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowPolygon {
     /// Unit normal and `-normal.p` for points `p` of the plane.
     pub plane: Vec4,
-    /// Inward plane of the silhouette edge.
-    edge: Vec4,
-    /// `a - light` and `b - light`, each negated or not so that a ray crossing inside has a
-    /// side relation of the sign of its direction along the normal.
+    /// The edge's direction `u` and `(a - light) x u`: the ray's side relation with the edge's
+    /// line is `u . m + d . edge_moment` for the ray moment `m = (o - light) x d`.
+    edge: [Vec3; 2],
+    /// `a - light` and `b - light`: the side relation with the line from the light along `u` is
+    /// `u . m`.
     sides: [Vec3; 2],
     /// Signed change of depth count crossing the polygon along its normal.
     pub weight: i32,
@@ -54,27 +56,31 @@ pub struct ShadowPolygon {
 
 impl ShadowPolygon {
     /// Change of D along `o + t d`, `t` in `(t0, t1)`: 0 unless the segment crosses the polygon.
+    /// `moment` is `(o - light) x d`, the same for every shadow polygon of the light. The three
+    /// lines are oriented so that a ray crossing inside has side relations of the sign of its
+    /// direction along the normal.
     #[inline]
-    pub fn crossing(&self, o: Vec3, d: Vec3, t0: f32, t1: f32, light: Vec3) -> i32 {
+    pub fn crossing(&self, o: Vec3, d: Vec3, t0: f32, t1: f32, moment: Vec3) -> i32 {
         let n = self.plane.truncate();
         let (s_o, s_d) = (n.dot(o) + self.plane.w, n.dot(d));
-        // Both ends on one side of the plane, the common case, costs no division.
+        // Both ends on one side of the plane: most tests end here.
         if (s_o + s_d * t0) * (s_o + s_d * t1) >= 0.0 {
             return 0;
         }
-        let p = o + d * (-s_o / s_d);
-        if self.edge.truncate().dot(p) + self.edge.w < 0.0 {
-            return 0;
-        }
-        let from_light = o - light;
-        let inside = |u: Vec3| {
-            let side = u.cross(from_light).dot(d);
-            if s_d > 0.0 { side >= 0.0 } else { side <= 0.0 }
-        };
-        if inside(self.sides[0]) && inside(self.sides[1]) {
-            if s_d > 0.0 { self.weight } else { -self.weight }
+        let sides = [
+            self.edge[0].dot(moment) + d.dot(self.edge[1]),
+            self.sides[0].dot(moment),
+            self.sides[1].dot(moment),
+        ];
+        let inside = if s_d > 0.0 {
+            sides.iter().all(|&r| r >= 0.0)
         } else {
-            0
+            sides.iter().all(|&r| r <= 0.0)
+        };
+        match (inside, s_d > 0.0) {
+            (false, _) => 0,
+            (true, true) => self.weight,
+            (true, false) => -self.weight,
         }
     }
 }
@@ -183,12 +189,13 @@ impl ShadowVolumes {
     ) -> i32 {
         let (lv, n) = (&self.lights[light], self.lights.len() as u32);
         mailbox.next_ray();
+        let moment = (o - lv.light).cross(d);
         let (mut change, mut tested) = (0, 0);
         for &c in cells {
             for &id in self.cells.cell(c * n + light as u32) {
                 if mailbox.first_visit(id) {
                     tested += 1;
-                    change += lv.polygons[id as usize].crossing(o, d, t0, t1, lv.light);
+                    change += lv.polygons[id as usize].crossing(o, d, t0, t1, moment);
                 }
             }
         }
@@ -303,18 +310,20 @@ fn silhouette_polygons(
                 if forward { facing } else { -facing }
             })
             .sum();
-        // The side lines oriented so that a point inside is on the positive side.
+        // Each line (direction u, moment relative to the light m) oriented so that the ray
+        // through a point inside along the normal passes on its positive side.
         let inside = (a + b + fa + fb) * 0.25 - light;
-        let oriented = |u: Vec3| {
-            let c = u.cross(inside).dot(n);
-            (c != 0.0).then_some(if c > 0.0 { u } else { -u })
+        let ray_moment = inside.cross(n);
+        let oriented = |u: Vec3, m: Vec3| {
+            let c = u.dot(ray_moment) + n.dot(m);
+            (c != 0.0).then_some(if c > 0.0 { [u, m] } else { [-u, -m] })
         };
         let parts = (
-            edge_plane(n, a, b),
-            oriented(a - light),
-            oriented(b - light),
+            oriented(b - a, (a - light).cross(b - a)),
+            oriented(a - light, Vec3::ZERO),
+            oriented(b - light, Vec3::ZERO),
         );
-        if let (true, (Some(edge), Some(side_a), Some(side_b))) = (weight != 0, parts) {
+        if let (true, (Some(edge), Some([side_a, _]), Some([side_b, _]))) = (weight != 0, parts) {
             out.1.push(ShadowPolygon {
                 plane: n.extend(-n.dot(a)),
                 edge,

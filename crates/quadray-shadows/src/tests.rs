@@ -397,6 +397,38 @@ fn cost_model_limits() {
 }
 
 #[test]
+fn break_even_is_where_shadow_volumes_start_to_cost_more_than_rays() {
+    use crate::trace::CostBins;
+    // Bins of 100 decisions each: (bin, mean N_s, ticks of a shadow-volume decision, of a ray).
+    let table = [
+        (3, 5, 50, 300),
+        (4, 10, 200, 300),
+        (5, 20, 400, 300),
+        (6, 40, 900, 300),
+    ];
+    let (mut volume, mut rays) = (CostBins::default(), CostBins::default());
+    for (b, ns, v, r) in table {
+        volume.bins[b] = [100, 100 * v, 100 * ns];
+        rays.bins[b] = [100, 100 * r, 100 * ns];
+    }
+    // Excess -100 at N_s 10 and +100 at 20: they meet half way.
+    assert!((cost::break_even(&volume, &rays).unwrap() - 15.0).abs() < 1e-9);
+    // Too few decisions in the two middle bins: from 5 (excess -250) to 40 (+600).
+    volume.bins[4][0] = 10;
+    rays.bins[5][0] = 10;
+    let expected = 5.0 + 35.0 * 250.0 / 850.0;
+    assert!((cost::break_even(&volume, &rays).unwrap() - expected).abs() < 1e-9);
+    // Cheaper everywhere: the top of the last bin timed (N_s 40 lies in [32, 64)).
+    rays.bins[6][1] = 100 * 1000;
+    assert_eq!(cost::break_even(&volume, &rays), Some(64.0));
+    // Nothing timed.
+    assert_eq!(
+        cost::break_even(&CostBins::default(), &CostBins::default()),
+        None
+    );
+}
+
+#[test]
 fn calibration_measures_positive_constants() {
     let c = cost::calibrate();
     assert!(

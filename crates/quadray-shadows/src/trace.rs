@@ -53,6 +53,9 @@ pub struct Settings {
     pub scheme: Scheme,
     /// Also run the conventional test at every shading point and count disagreements.
     pub check: bool,
+    /// Also time HST's shadow-volume decisions and shadow rays one by one (the pilot render of
+    /// the N_th prediction does; two clock reads per decision are not free).
+    pub time_decisions: bool,
 }
 
 /// Everything built before rendering: polygons, grid, shadow polygons, BVH.
@@ -122,9 +125,9 @@ impl Prepared {
         self.stats.get_or_init(|| crate::cost::scene_stats(self))
     }
 
-    /// The N_th HST uses with `--nth auto`: equation 12 with the follow-up cost of a conventional
-    /// decision ([`crate::cost::FollowUp`]), measured once on a pilot render of recursion `depth`
-    /// (without shadow polygons: equation 12 as written).
+    /// The N_th HST uses with `--nth auto`: equation 12 with the measured break-even and the
+    /// follow-up cost of a conventional decision ([`crate::cost::FollowUp`]), measured once on
+    /// pilot renders of recursion `depth` (without shadow polygons: equation 12 as written).
     pub fn predicted_nth(
         &self,
         costs: &crate::cost::MachineCosts,
@@ -167,6 +170,10 @@ pub struct RenderStats {
     /// Ticks ([`crate::ticks`]) the tiles' threads spent deciding shadows, and in the tiles.
     pub shadow_ticks: u64,
     pub tile_ticks: u64,
+    /// With [`Settings::time_decisions`]: HST's shadow-volume decisions (the crossing tests) and
+    /// its shadow rays, timed and binned by N_s.
+    pub shadow_volume_costs: CostBins,
+    pub shadow_ray_costs: CostBins,
     pub render_wall_s: f64,
     /// CPU time of the render, all threads (what the paper's CPU minutes measure; unlike clock
     /// time it is not inflated by other processes on a shared machine).
@@ -190,6 +197,8 @@ impl RenderStats {
         self.shadow_rays += o.shadow_rays;
         self.shadow_ticks += o.shadow_ticks;
         self.tile_ticks += o.tile_ticks;
+        self.shadow_volume_costs.merge(&o.shadow_volume_costs);
+        self.shadow_ray_costs.merge(&o.shadow_ray_costs);
     }
 
     /// CPU time of shadow testing: the render's CPU time split in the threads' proportion.
@@ -564,6 +573,7 @@ impl Tracer<'_> {
                     ..
                 } = sc;
                 let mut rays = 0;
+                let time = self.settings.time_decisions;
                 let (shadowed, sub) = state.hst_step(
                     ns,
                     nth,
@@ -571,35 +581,36 @@ impl Tracer<'_> {
                     continues,
                     || {
                         stats.shadow_polygon_entries += ns as u64;
-                        v.crossings(
-                            l,
-                            occupied,
-                            o,
-                            d,
-                            0.0,
-                            t_hit,
-                            shadows,
-                            &mut stats.shadow_polygon_tests,
-                        )
+                        timed(time, ns, &mut stats.shadow_volume_costs, || {
+                            v.crossings(
+                                l,
+                                occupied,
+                                o,
+                                d,
+                                0.0,
+                                t_hit,
+                                shadows,
+                                &mut stats.shadow_polygon_tests,
+                            )
+                        })
                     },
                     || {
                         rays += 1;
-                        occluded_grid(prep, objects, p, to_light, polygon)
+                        timed(time, ns, &mut stats.shadow_ray_costs, || {
+                            occluded_grid(prep, objects, p, to_light, polygon)
+                        })
                     },
                 );
                 stats.shadow_rays += rays;
-                match sub {
-                    Subscheme::Sustain => stats.sustain += 1,
-                    Subscheme::SelfShadow => stats.self_shadow += 1,
-                    Subscheme::ShadowVolume => stats.shadow_volume += 1,
-                    Subscheme::Conventional => {
-                        stats.conventional += 1;
-                        if ns > 0 && (ns as f32) <= nth {
-                            stats.forced_conventional += 1;
-                            stats.forced_ns += ns as u64;
-                        }
-                    }
-                }
+                // Tallied without branching on the sub-scheme: it changes from one decision to the
+                // next, and a jump on it was mispredicted more often than not.
+                stats.sustain += (sub == Subscheme::Sustain) as u64;
+                stats.self_shadow += (sub == Subscheme::SelfShadow) as u64;
+                stats.shadow_volume += (sub == Subscheme::ShadowVolume) as u64;
+                stats.conventional += rays;
+                let forced = rays * (ns > 0 && (ns as f32) <= nth) as u64;
+                stats.forced_conventional += forced;
+                stats.forced_ns += forced * ns as u64;
                 shadowed
             }
         }
@@ -623,6 +634,52 @@ impl Tracer<'_> {
             ),
             None => occluded_grid(prep, &mut sc.objects, p, to_light, polygon),
         }
+    }
+}
+
+/// `f()`, timed into `bins` as a decision of N_s `ns` when `on`.
+#[inline]
+fn timed<R>(on: bool, ns: u32, bins: &mut CostBins, f: impl FnOnce() -> R) -> R {
+    if !on {
+        return f();
+    }
+    let start = crate::ticks();
+    let r = f();
+    bins.add(ns, crate::ticks().wrapping_sub(start));
+    r
+}
+
+/// Number of [`CostBins`].
+pub const COST_BINS: usize = 12;
+
+/// Timed decisions by N_s: bin 0 holds N_s = 0, bin b N_s in `[2^(b-1), 2^b)`, the last all
+/// above. Each bin: decisions, their ticks and their N_s, summed.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct CostBins {
+    pub bins: [[u64; 3]; COST_BINS],
+}
+
+impl CostBins {
+    fn add(&mut self, ns: u32, ticks: u64) {
+        let b = ((u32::BITS - ns.leading_zeros()) as usize).min(COST_BINS - 1);
+        let bin = &mut self.bins[b];
+        bin[0] += 1;
+        bin[1] += ticks;
+        bin[2] += ns as u64;
+    }
+
+    fn merge(&mut self, o: &CostBins) {
+        for (a, b) in self.bins.iter_mut().zip(&o.bins) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
+            }
+        }
+    }
+
+    /// Mean N_s and mean ticks of bin `b`'s decisions, if it has at least `min` of them.
+    pub fn mean(&self, b: usize, min: u64) -> Option<(f64, f64)> {
+        let [n, ticks, ns] = self.bins[b];
+        (n >= min.max(1)).then(|| (ns as f64 / n as f64, ticks as f64 / n as f64))
     }
 }
 
