@@ -607,8 +607,9 @@ impl Tracer<'_> {
                 stats.sustain += (sub == Subscheme::Sustain) as u64;
                 stats.self_shadow += (sub == Subscheme::SelfShadow) as u64;
                 stats.shadow_volume += (sub == Subscheme::ShadowVolume) as u64;
-                stats.conventional += rays;
-                let forced = rays * (ns > 0 && (ns as f32) <= nth) as u64;
+                let conventional = (sub == Subscheme::Conventional) as u64;
+                stats.conventional += conventional;
+                let forced = conventional * (ns > 0 && (ns as f32) <= nth) as u64;
                 stats.forced_conventional += forced;
                 stats.forced_ns += forced * ns as u64;
                 shadowed
