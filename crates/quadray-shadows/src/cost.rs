@@ -84,7 +84,7 @@ pub struct FollowUp {
 }
 
 /// Fewest timed decisions of a bin the break-even reads.
-const PILOT_MIN_DECISIONS: u64 = 30;
+const PILOT_MIN_DECISIONS: usize = 30;
 
 /// The pilot renders of [`FollowUp`]; zero without shadow polygons.
 pub fn follow_up(prep: &Prepared, nth: f64, depth: u32) -> FollowUp {

@@ -399,28 +399,36 @@ fn cost_model_limits() {
 #[test]
 fn break_even_is_where_shadow_volumes_start_to_cost_more_than_rays() {
     use crate::trace::CostBins;
-    // Bins of 100 decisions each: (bin, mean N_s, ticks of a shadow-volume decision, of a ray).
-    let table = [
-        (3, 5, 50, 300),
-        (4, 10, 200, 300),
-        (5, 20, 400, 300),
-        (6, 40, 900, 300),
-    ];
-    let (mut volume, mut rays) = (CostBins::default(), CostBins::default());
-    for (b, ns, v, r) in table {
-        volume.bins[b] = [100, 100 * v, 100 * ns];
-        rays.bins[b] = [100, 100 * r, 100 * ns];
-    }
+    // 100 decisions each: (N_s, ticks of a shadow-volume decision, of a ray); bins 3 to 6.
+    let table = [(5, 50, 300), (10, 200, 300), (20, 400, 300), (40, 900, 300)];
+    let bins = |table: &[(u32, u64, usize)]| {
+        let mut bins = CostBins::default();
+        for &(ns, ticks, n) in table {
+            (0..n).for_each(|_| bins.add(ns, ticks));
+        }
+        bins
+    };
+    let volume: Vec<_> = table.iter().map(|&(ns, v, _)| (ns, v, 100)).collect();
+    let rays: Vec<_> = table.iter().map(|&(ns, _, r)| (ns, r, 100)).collect();
     // Excess -100 at N_s 10 and +100 at 20: they meet half way.
-    assert!((cost::break_even(&volume, &rays).unwrap() - 15.0).abs() < 1e-9);
+    let even = |v: &[(u32, u64, usize)], r: &[(u32, u64, usize)]| {
+        cost::break_even(&bins(v), &bins(r)).unwrap()
+    };
+    assert!((even(&volume, &rays) - 15.0).abs() < 1e-9);
+    // A few interrupted decisions, a thousand times slower, do not move it.
+    let mut interrupted = volume.clone();
+    interrupted.extend([(5, 50_000, 2), (10, 200_000, 1)]);
+    assert!((even(&interrupted, &rays) - 15.0).abs() < 1e-9);
     // Too few decisions in the two middle bins: from 5 (excess -250) to 40 (+600).
-    volume.bins[4][0] = 10;
-    rays.bins[5][0] = 10;
+    let (mut sparse_volume, mut sparse_rays) = (volume.clone(), rays.clone());
+    sparse_volume[1].2 = 10;
+    sparse_rays[2].2 = 10;
     let expected = 5.0 + 35.0 * 250.0 / 850.0;
-    assert!((cost::break_even(&volume, &rays).unwrap() - expected).abs() < 1e-9);
-    // Cheaper everywhere: the top of the last bin timed (N_s 40 lies in [32, 64)).
-    rays.bins[6][1] = 100 * 1000;
-    assert_eq!(cost::break_even(&volume, &rays), Some(64.0));
+    assert!((even(&sparse_volume, &sparse_rays) - expected).abs() < 1e-9);
+    // Cheaper everywhere (of the bins with enough decisions): the top of the last bin timed
+    // (N_s 40 lies in [32, 64)).
+    sparse_rays[3].1 = 1000;
+    assert_eq!(even(&sparse_volume, &sparse_rays), 64.0);
     // Nothing timed.
     assert_eq!(
         cost::break_even(&CostBins::default(), &CostBins::default()),

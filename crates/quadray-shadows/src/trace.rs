@@ -653,34 +653,57 @@ fn timed<R>(on: bool, ns: u32, bins: &mut CostBins, f: impl FnOnce() -> R) -> R 
 /// Number of [`CostBins`].
 pub const COST_BINS: usize = 12;
 
-/// Timed decisions by N_s: bin 0 holds N_s = 0, bin b N_s in `[2^(b-1), 2^b)`, the last all
-/// above. Each bin: decisions, their ticks and their N_s, summed.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+/// A timed decision that took this many times its bin's median was interrupted (the thread was
+/// descheduled or served an interrupt): one such decision of a millisecond would outweigh a
+/// thousand real ones in the bin's mean.
+const INTERRUPTED: u64 = 16;
+
+/// Timed decisions, read by N_s in bins: bin 0 holds N_s = 0, bin b N_s in `[2^(b-1), 2^b)`,
+/// the last all above.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
 pub struct CostBins {
-    pub bins: [[u64; 3]; COST_BINS],
+    /// (N_s, ticks) of each decision.
+    samples: Vec<(u32, u64)>,
 }
 
 impl CostBins {
-    fn add(&mut self, ns: u32, ticks: u64) {
-        let b = ((u32::BITS - ns.leading_zeros()) as usize).min(COST_BINS - 1);
-        let bin = &mut self.bins[b];
-        bin[0] += 1;
-        bin[1] += ticks;
-        bin[2] += ns as u64;
+    pub fn add(&mut self, ns: u32, ticks: u64) {
+        self.samples.push((ns, ticks));
     }
 
     fn merge(&mut self, o: &CostBins) {
-        for (a, b) in self.bins.iter_mut().zip(&o.bins) {
-            for (x, y) in a.iter_mut().zip(b) {
-                *x += y;
-            }
-        }
+        self.samples.extend_from_slice(&o.samples);
     }
 
-    /// Mean N_s and mean ticks of bin `b`'s decisions, if it has at least `min` of them.
-    pub fn mean(&self, b: usize, min: u64) -> Option<(f64, f64)> {
-        let [n, ticks, ns] = self.bins[b];
-        (n >= min.max(1)).then(|| (ns as f64 / n as f64, ticks as f64 / n as f64))
+    fn bin(ns: u32) -> usize {
+        ((u32::BITS - ns.leading_zeros()) as usize).min(COST_BINS - 1)
+    }
+
+    /// Mean N_s and mean ticks of bin `b`'s decisions, if it has at least `min` of them, the
+    /// interrupted ones left out.
+    pub fn mean(&self, b: usize, min: usize) -> Option<(f64, f64)> {
+        let mut ticks: Vec<u64> = Vec::new();
+        let mut ns = Vec::new();
+        for &(n, t) in self.samples.iter().filter(|(n, _)| Self::bin(*n) == b) {
+            ns.push(n);
+            ticks.push(t);
+        }
+        if ticks.len() < min.max(1) {
+            return None;
+        }
+        let mut sorted = ticks.clone();
+        let half = sorted.len() / 2;
+        let limit = INTERRUPTED * *sorted.select_nth_unstable(half).1;
+        let kept: Vec<(u32, u64)> = ns
+            .into_iter()
+            .zip(ticks)
+            .filter(|&(_, t)| t <= limit)
+            .collect();
+        let n = kept.len() as f64;
+        Some((
+            kept.iter().map(|&(s, _)| s as f64).sum::<f64>() / n,
+            kept.iter().map(|&(_, t)| t as f64).sum::<f64>() / n,
+        ))
     }
 }
 
