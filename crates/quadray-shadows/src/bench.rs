@@ -398,7 +398,7 @@ fn markdown(r: &BenchResults) -> String {
                 .map_or("-".into(), |n| format!("{n:.1}")),
             format!("{:.2}", s.follow_up.ratio),
             format!("{:.2}", s.predicted_nth),
-            format!("{}", s.best_nth),
+            format!("{}", (s.best_nth * 10.0).round() / 10.0),
         ]);
     }
     md += "\n";
