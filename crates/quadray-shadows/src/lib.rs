@@ -32,8 +32,10 @@
 //!   shadow-volume decision and a shadow ray is timed where the choice is made, binned by N_s,
 //!   instead of from the mean shadow ray and C_s N_s: HST casts its rays from points deep in the
 //!   scene, whose rays cost more than the mean one, and the bucket makes a decision's cost grow
-//!   slower than N_s. And the follow-up cost of a conventional decision that finds shadow is added
-//!   (SDF = 0 forces shadow rays at the later points of the ray tree).
+//!   slower than N_s. A timed decision 16 times slower than its bin's median was interrupted and
+//!   is left out (one descheduled decision would outweigh a thousand real ones in the mean). And
+//!   the follow-up cost of a conventional decision that finds shadow is added (SDF = 0 forces
+//!   shadow rays at the later points of the ray tree).
 //! - Times are CPU seconds of all threads, as the paper's CPU minutes; the shadow part is split
 //!   off with the time-stamp counter around each shading point's shadow decisions. Finding the
 //!   cells of a segment that hold shadow polygons is a bit test per cell inside the walk that
