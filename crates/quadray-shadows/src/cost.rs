@@ -4,7 +4,7 @@
 
 use crate::SplitMix;
 use crate::geom::{Aabb, ConvexPolygon};
-use crate::grid::{Grid, Mailbox};
+use crate::grid::{CellRecord, Grid, Mailbox};
 use crate::trace::{COST_BINS, CostBins, Pinhole, Prepared};
 use glam::Vec3;
 use serde::Serialize;
@@ -256,10 +256,11 @@ fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
     // crossings only for a light whose N_s is not 0 (else it sustains), so only those are timed.
     let mut segments: Vec<(Vec3, f32, Vec<u32>, Vec<usize>)> = Vec::new();
     let mut entries = 0u64;
+    let mut occupied = CellRecord::new(&prep.grid);
     for y in 0..48 {
         for x in 0..64 {
             let d = pinhole.dir(x as f32 + 0.5, y as f32 + 0.5);
-            let mut occupied = Vec::new();
+            occupied.clear();
             let hit = prep.grid.closest_hit(
                 &prep.cells,
                 &prep.polygons,
@@ -272,10 +273,10 @@ fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
                 Some((volumes.occupied_cells(), &mut occupied)),
             );
             if let Some(h) = hit {
-                let ns = volumes.counts(&occupied);
+                let ns = volumes.counts(occupied.cells());
                 let lights: Vec<usize> = (0..volumes.lights.len()).filter(|&l| ns[l] > 0).collect();
                 entries += lights.iter().map(|&l| ns[l] as u64).sum::<u64>();
-                segments.push((d, h.t, occupied, lights));
+                segments.push((d, h.t, occupied.cells().to_vec(), lights));
             }
         }
     }

@@ -41,15 +41,14 @@ impl CellLists {
         self.items.len()
     }
 
-    /// Several lists over the same cells merged cell-major over the members of `set`: row
-    /// `m * k + i` is list `i`'s cell numbered `m` in the set (`k` lists), so the rows of one
-    /// cell share cache lines and cells outside the set take no room.
-    pub fn interleave(lists: &[CellLists], set: &CellSet) -> CellLists {
+    /// Several lists over the same cells merged cell-major: row `c * k + i` is list `i`'s cell
+    /// `c` (`k` lists), so the rows of one cell share cache lines.
+    pub fn interleave(lists: &[CellLists], cells: usize) -> CellLists {
         let k = lists.len();
-        let mut offsets = Vec::with_capacity(set.len() * k + 1);
+        let mut offsets = Vec::with_capacity(cells * k + 1);
         let mut items = Vec::with_capacity(lists.iter().map(|l| l.items.len()).sum());
         offsets.push(0);
-        for c in set.members() {
+        for c in 0..cells as u32 {
             for list in lists {
                 items.extend_from_slice(list.cell(c));
                 offsets.push(items.len() as u32);
@@ -59,53 +58,59 @@ impl CellLists {
     }
 }
 
-/// A set of cells, one bit each (small enough to stay in cache while a ray walks), that numbers
-/// its members in cell order, so that data kept for the members alone is indexed by number.
+/// A set of cells, one bit each: small enough to stay in cache while a ray walks.
 #[derive(Clone, Debug)]
 pub struct CellSet {
     bits: Vec<u64>,
-    /// Members in the words before each word of `bits`.
-    before: Vec<u32>,
 }
 
 impl CellSet {
-    /// The cells among `0..cells` for which `member` holds.
-    pub fn new(cells: usize, member: impl Fn(u32) -> bool) -> Self {
-        let mut bits = vec![0u64; cells.div_ceil(64)];
-        for c in (0..cells as u32).filter(|&c| member(c)) {
-            bits[c as usize / 64] |= 1 << (c % 64);
+    pub fn new(cells: usize) -> Self {
+        Self {
+            bits: vec![0; cells.div_ceil(64)],
         }
-        let before = bits
-            .iter()
-            .scan(0, |n, w| {
-                let at = *n;
-                *n += w.count_ones();
-                Some(at)
-            })
-            .collect();
-        Self { bits, before }
     }
 
-    pub fn len(&self) -> usize {
-        self.bits.iter().map(|w| w.count_ones() as usize).sum()
+    pub fn insert(&mut self, c: u32) {
+        self.bits[c as usize / 64] |= 1 << (c % 64);
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The member cells in order: the one numbered `m` comes `m`-th.
-    pub fn members(&self) -> impl Iterator<Item = u32> + '_ {
-        (0..self.bits.len() * 64)
-            .map(|c| c as u32)
-            .filter(|&c| self.number(c).is_some())
-    }
-
-    /// Cell `c`'s number in the set, if it is a member.
     #[inline]
-    pub fn number(&self, c: u32) -> Option<u32> {
-        let (word, bit) = (self.bits[c as usize / 64], 1u64 << (c % 64));
-        (word & bit != 0).then(|| self.before[c as usize / 64] + (word & (bit - 1)).count_ones())
+    pub fn contains(&self, c: u32) -> bool {
+        self.bits[c as usize / 64] & (1 << (c % 64)) != 0
+    }
+}
+
+/// The cells of a [`CellSet`] that a walk crossed, in order. The buffer is as long as the
+/// longest walk, so that noting a cell takes no jump on whether it is in the set: that changes
+/// from cell to cell as a ray walks, and every walk asks it of every cell.
+#[derive(Clone, Debug)]
+pub struct CellRecord {
+    cells: Vec<u32>,
+    len: usize,
+}
+
+impl CellRecord {
+    pub fn new(grid: &Grid) -> Self {
+        Self {
+            cells: vec![0; grid.res.iter().sum::<u32>() as usize + 1],
+            len: 0,
+        }
+    }
+
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// The cells noted since the last [`Self::clear`].
+    pub fn cells(&self) -> &[u32] {
+        &self.cells[..self.len]
+    }
+
+    #[inline]
+    fn note(&mut self, set: &CellSet, c: u32) {
+        self.cells[self.len] = c;
+        self.len += set.contains(c) as usize;
     }
 }
 
@@ -340,9 +345,9 @@ impl Grid {
     }
 
     /// Closest polygon hit in `(t_min, t_max)`, never `skip` (the polygon the ray starts on).
-    /// With `record`, the walked cells that are in its set are appended to its list by their
-    /// numbers in the set (the cells of the ray segment that hold shadow polygons, for N_s: a bit
-    /// test per cell, in the walk that visits them anyway).
+    /// With `record`, the walked cells that are in its set are noted in it (the cells of the ray
+    /// segment that hold shadow polygons, for N_s: a bit test per cell, in the walk that visits
+    /// them anyway).
     #[allow(clippy::too_many_arguments)]
     pub fn closest_hit(
         &self,
@@ -354,15 +359,13 @@ impl Grid {
         t_max: f32,
         skip: Option<u32>,
         mailbox: &mut Mailbox,
-        mut record: Option<(&CellSet, &mut Vec<u32>)>,
+        mut record: Option<(&CellSet, &mut CellRecord)>,
     ) -> Option<Hit> {
         mailbox.start_ray(skip);
         let mut best: Option<Hit> = None;
         self.walk(o, d, t_min, t_max, |c, _, t_exit| {
-            if let Some((set, cells)) = &mut record
-                && let Some(m) = set.number(c)
-            {
-                cells.push(m);
+            if let Some((set, cells)) = &mut record {
+                cells.note(set, c);
             }
             for &id in lists.cell(c) {
                 if mailbox.first_visit(id) {

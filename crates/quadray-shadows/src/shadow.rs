@@ -96,10 +96,9 @@ pub struct LightVolumes {
 /// Shadow polygons for every light, registered in the grid.
 pub struct ShadowVolumes {
     pub lights: Vec<LightVolumes>,
-    /// Row `m * lights + light`: that light's shadow polygons registered in the cell numbered `m`
-    /// in `occupied`. The lights of one cell are neighbours in memory, so N_s of every light and
-    /// the polygons of each come from the same cache lines, and rows are kept for occupied cells
-    /// only, which keeps them in a cache (glasses: 29,466 of 187,245 cells).
+    /// Row `cell * lights + light`: that light's shadow polygons registered in the cell. The
+    /// lights of one cell are neighbours in memory, so N_s of every light and the polygons of
+    /// each come from the same cache lines.
     cells: CellLists,
     /// The cells that hold any light's shadow polygons (most cells a ray crosses hold none).
     occupied: CellSet,
@@ -127,12 +126,15 @@ impl ShadowVolumes {
                 (volumes, cells)
             })
             .unzip();
-        let occupied = CellSet::new(grid.cell_count(), |c| {
-            per_light.iter().any(|cells| cells.count(c) > 0)
-        });
+        let mut occupied = CellSet::new(grid.cell_count());
+        for c in 0..grid.cell_count() as u32 {
+            if per_light.iter().any(|cells| cells.count(c) > 0) {
+                occupied.insert(c);
+            }
+        }
         Self {
             lights,
-            cells: CellLists::interleave(&per_light, &occupied),
+            cells: CellLists::interleave(&per_light, grid.cell_count()),
             occupied,
         }
     }
@@ -149,14 +151,14 @@ impl ShadowVolumes {
             .unwrap_or(0)
     }
 
-    /// The cells holding shadow polygons of any light: what a ray walk records, by their numbers
-    /// in the set ([`Grid::closest_hit`]), for [`Self::counts`] and [`Self::crossings`].
+    /// The cells holding shadow polygons of any light: what a ray walk records
+    /// ([`Grid::closest_hit`]) for [`Self::counts`] and [`Self::crossings`].
     pub fn occupied_cells(&self) -> &CellSet {
         &self.occupied
     }
 
-    /// N_s of every light for a segment whose cells holding shadow polygons are `cells` (numbered
-    /// as in [`Self::occupied_cells`]): the shadow polygons registered in them (with repeats).
+    /// N_s of every light for a segment whose cells holding shadow polygons are `cells`: the
+    /// shadow polygons registered in them (with repeats).
     #[inline]
     pub fn counts(&self, cells: &[u32]) -> [u32; MAX_LIGHTS] {
         let n = self.lights.len() as u32;
@@ -171,8 +173,7 @@ impl ShadowVolumes {
     }
 
     /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells holding
-    /// shadow polygons are `cells` (numbered as in [`Self::occupied_cells`]); `tests` counts the
-    /// ray/shadow-polygon tests.
+    /// shadow polygons are `cells`; `tests` counts the ray/shadow-polygon tests.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn crossings(

@@ -4,7 +4,7 @@
 
 use crate::cost::{self, MachineCosts};
 use crate::geom::ConvexPolygon;
-use crate::grid::Mailbox;
+use crate::grid::{CellRecord, Mailbox};
 use crate::scene::{BUILTINS, Face, Scene};
 use crate::shadow::{LightState, ShadowVolumes, depth_at};
 use crate::trace::{Prepared, Scheme};
@@ -187,7 +187,7 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
         let volumes = prep.volumes.as_ref().unwrap();
         let mut objects = Mailbox::new(prep.polygons.len());
         let mut shadows = Mailbox::new(volumes.max_per_light());
-        let (mut occupied, mut tests, mut checked) = (Vec::new(), 0, 0);
+        let (mut occupied, mut tests, mut checked) = (CellRecord::new(&prep.grid), 0, 0);
         for (o, d) in test_rays(&prep, 1500) {
             occupied.clear();
             let t1 = prep
@@ -217,7 +217,7 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
                     continue;
                 };
                 let change =
-                    volumes.crossings(l, &occupied, o, d, 0.0, t1, &mut shadows, &mut tests);
+                    volumes.crossings(l, occupied.cells(), o, d, 0.0, t1, &mut shadows, &mut tests);
                 assert_eq!(
                     d0 + change,
                     d1,

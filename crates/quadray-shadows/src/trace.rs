@@ -4,7 +4,7 @@
 
 use crate::bvh::Bvh;
 use crate::geom::{Aabb, ConvexPolygon};
-use crate::grid::{CellLists, Grid, Mailbox};
+use crate::grid::{CellLists, CellRecord, Grid, Mailbox};
 use crate::scene::Scene;
 use crate::shadow::{LightState, ShadowVolumes, Subscheme};
 use glam::Vec3;
@@ -250,7 +250,7 @@ struct Scratch {
     /// The ground-truth shadow rays of --check, kept apart so they do not disturb the scheme.
     check: Mailbox,
     /// The cells of the current ray segment that hold shadow polygons.
-    occupied: Vec<u32>,
+    occupied: CellRecord,
     stats: RenderStats,
 }
 
@@ -324,7 +324,7 @@ impl Tracer<'_> {
             objects: Mailbox::new(prep.polygons.len()),
             shadows: Mailbox::new(prep.volumes.as_ref().map_or(0, |v| v.max_per_light())),
             check: Mailbox::new(prep.polygons.len()),
-            occupied: Vec::new(),
+            occupied: CellRecord::new(&prep.grid),
             stats: RenderStats::default(),
         };
         let cam = &prep.scene.camera;
@@ -494,7 +494,7 @@ impl Tracer<'_> {
         let prep = self.prep;
         let mut shadowed = [true; MAX_LIGHTS];
         let ns = match &prep.volumes {
-            Some(v) => v.counts(&sc.occupied),
+            Some(v) => v.counts(sc.occupied.cells()),
             None => [0; MAX_LIGHTS],
         };
         for (l, light) in prep.scene.lights.iter().enumerate() {
@@ -553,7 +553,7 @@ impl Tracer<'_> {
                 sc.stats.shadow_polygon_entries += ns as u64;
                 let change = v.crossings(
                     l,
-                    &sc.occupied,
+                    sc.occupied.cells(),
                     o,
                     d,
                     0.0,
@@ -584,7 +584,7 @@ impl Tracer<'_> {
                         timed(time, ns, &mut stats.shadow_volume_costs, || {
                             v.crossings(
                                 l,
-                                occupied,
+                                occupied.cells(),
                                 o,
                                 d,
                                 0.0,
