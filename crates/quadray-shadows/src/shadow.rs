@@ -392,6 +392,10 @@ impl LightState {
     /// (SC = 1) every later point of the ray then needs a shadow ray until one is lit; on closed
     /// objects half the points face away from each light, so that loss dominated the conventional
     /// share. The count stays exact: a self-shadowed point is reached like any other.
+    ///
+    /// Always inlined, with the closures it runs: out of line, the crossing test compiled into a
+    /// closure of its own and HST's shadow time ran 3-5% above what it is inlined.
+    #[inline(always)]
     pub fn hst_step(
         &mut self,
         ns: u32,

@@ -639,7 +639,7 @@ impl Tracer<'_> {
 }
 
 /// `f()`, timed into `bins` as a decision of N_s `ns` when `on`.
-#[inline]
+#[inline(always)]
 fn timed<R>(on: bool, ns: u32, bins: &mut CostBins, f: impl FnOnce() -> R) -> R {
     if !on {
         return f();
