@@ -4,7 +4,7 @@
 
 use crate::cost::{self, MachineCosts};
 use crate::geom::ConvexPolygon;
-use crate::grid::{CellRecord, Mailbox};
+use crate::grid::{CellRecord, CellSet, Mailbox};
 use crate::scene::{BUILTINS, Face, Scene};
 use crate::shadow::{LightState, ShadowVolumes, depth_at};
 use crate::trace::{Prepared, Scheme};
@@ -116,6 +116,63 @@ fn grid_closest_hit_equals_brute_force() {
                 ),
                 _ => panic!("{name}: grid {grid:?} vs brute force {brute:?} for ray {o} {d}"),
             }
+        }
+    }
+}
+
+#[test]
+fn the_walk_notes_the_cells_of_the_set_it_crosses_even_on_the_longest_walks() {
+    // Eye rays, rays along cell boundaries, and the grid's four diagonals from corner to corner
+    // (the longest walks there are), through a set of every other cell and one of every cell
+    // (where the longest walks fill the record).
+    let prep = Prepared::new(scene_with_degenerates("kaist"), Scheme::Conventional);
+    let grid = &prep.grid;
+    let no_polygons = grid.register(rayon::iter::empty::<&[Vec3]>());
+    let (b, e) = (grid.bounds, grid.bounds.extent());
+    let mut rays = test_rays(&prep, 1000);
+    for corner in 0..4 {
+        let flip = Vec3::new((corner & 1) as f32, (corner >> 1) as f32, 0.0);
+        let from = b.min + e * flip;
+        let to = b.min + e * (Vec3::ONE - flip);
+        rays.push((from, (to - from).normalize()));
+    }
+    let (mut mailbox, mut record) = (Mailbox::new(1), CellRecord::new(grid));
+    let longest = grid.res.iter().sum::<u32>() as usize - 2;
+    for step in [2, 1] {
+        let mut set = CellSet::new(grid.cell_count());
+        (0..grid.cell_count() as u32)
+            .filter(|c| c % step == 0)
+            .for_each(|c| set.insert(c));
+        let mut longest_noted = 0;
+        for &(o, d) in &rays {
+            record.clear();
+            let hit = grid.closest_hit(
+                &no_polygons,
+                &[],
+                o,
+                d,
+                0.0,
+                f32::INFINITY,
+                None,
+                &mut mailbox,
+                Some((&set, &mut record)),
+            );
+            assert!(hit.is_none());
+            let mut members = Vec::new();
+            grid.walk(o, d, 0.0, f32::INFINITY, |c, _, _| {
+                if c % step == 0 {
+                    members.push(c);
+                }
+                false
+            });
+            assert_eq!(record.cells(), members, "ray {o} {d}");
+            longest_noted = longest_noted.max(members.len());
+        }
+        if step == 1 {
+            assert!(
+                longest_noted + 4 >= longest,
+                "the diagonals walk {longest_noted} cells of at most {longest}"
+            );
         }
     }
 }
