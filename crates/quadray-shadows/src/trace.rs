@@ -682,27 +682,23 @@ impl CostBins {
     /// Mean N_s and mean ticks of bin `b`'s decisions, if it has at least `min` of them, the
     /// interrupted ones left out.
     pub fn mean(&self, b: usize, min: usize) -> Option<(f64, f64)> {
-        let mut ticks: Vec<u64> = Vec::new();
-        let mut ns = Vec::new();
-        for &(n, t) in self.samples.iter().filter(|(n, _)| Self::bin(*n) == b) {
-            ns.push(n);
-            ticks.push(t);
-        }
-        if ticks.len() < min.max(1) {
+        let bin: Vec<(u32, u64)> = self
+            .samples
+            .iter()
+            .copied()
+            .filter(|&(ns, _)| Self::bin(ns) == b)
+            .collect();
+        if bin.len() < min.max(1) {
             return None;
         }
-        let mut sorted = ticks.clone();
-        let half = sorted.len() / 2;
-        let limit = INTERRUPTED * *sorted.select_nth_unstable(half).1;
-        let kept: Vec<(u32, u64)> = ns
-            .into_iter()
-            .zip(ticks)
-            .filter(|&(_, t)| t <= limit)
-            .collect();
+        let mut ticks: Vec<u64> = bin.iter().map(|&(_, t)| t).collect();
+        let half = ticks.len() / 2;
+        let limit = INTERRUPTED * *ticks.select_nth_unstable(half).1;
+        let kept: Vec<&(u32, u64)> = bin.iter().filter(|&&(_, t)| t <= limit).collect();
         let n = kept.len() as f64;
         Some((
-            kept.iter().map(|&(s, _)| s as f64).sum::<f64>() / n,
-            kept.iter().map(|&(_, t)| t as f64).sum::<f64>() / n,
+            kept.iter().map(|&&(ns, _)| ns as f64).sum::<f64>() / n,
+            kept.iter().map(|&&(_, t)| t as f64).sum::<f64>() / n,
         ))
     }
 }
