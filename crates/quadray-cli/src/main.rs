@@ -93,8 +93,13 @@ fn spinner(what: &str) -> ProgressBar {
 }
 
 fn main() -> Result<()> {
+    let cli = Cli::parse();
+    if !matches!(cli.command, Command::View { .. }) {
+        // SAFETY: first thing in main, before any thread starts.
+        unsafe { quadray_gpu::skip_display_probing() };
+    }
     quadray_core::init_logging();
-    match Cli::parse().command {
+    match cli.command {
         Command::View { args } => {
             let viewer = std::env::current_exe()?
                 .with_file_name(format!("quadray-view{}", std::env::consts::EXE_SUFFIX));

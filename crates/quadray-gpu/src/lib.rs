@@ -29,6 +29,23 @@ pub enum GpuError {
     Validation(String),
 }
 
+/// Keeps Mesa's Vulkan device-selection layer from probing Wayland and X11 when a program that
+/// opens no window creates its Vulkan instance. Without a display that probe prints
+/// `error: XDG_RUNTIME_DIR is invalid or not set in the environment.` twice, which reads like a
+/// failure; the layer only puts the display's GPU first, which a headless program does not need
+/// (the adapter is chosen by power preference or `WGPU_ADAPTER_NAME`). A `NODEVICE_SELECT` the
+/// user set is left as it is, and errors of the driver itself still print.
+///
+/// # Safety
+/// It sets an environment variable, so, as [`std::env::set_var`] requires, no other thread may
+/// run yet: call it first thing in `main`.
+pub unsafe fn skip_display_probing() {
+    if std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: the caller guarantees the program is still single-threaded.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
+
 /// An adapter, its device and queue, and what they can do.
 pub struct Gpu {
     pub adapter: wgpu::Adapter,
