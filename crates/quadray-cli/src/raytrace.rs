@@ -2,7 +2,7 @@
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use quadray_shadows::scene::{BUILTINS, Scene};
+use quadray_shadows::scene::{BUILTINS, MAX_LIGHTS, Scene};
 use quadray_shadows::{Nth, RunOptions, SchemeChoice, cost};
 use std::path::{Path, PathBuf};
 
@@ -64,12 +64,8 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         })?,
         _ => bail!("give --scene PATH or --builtin NAME"),
     };
-    if scene.lights.len() > quadray_shadows::trace::MAX_LIGHTS {
-        bail!(
-            "{} lights; at most {}",
-            scene.lights.len(),
-            quadray_shadows::trace::MAX_LIGHTS
-        );
+    if scene.lights.len() > MAX_LIGHTS {
+        bail!("{} lights; at most {MAX_LIGHTS}", scene.lights.len());
     }
     let out = args.out.context("--out FILE.png is required")?;
     let nth = match args.nth.as_str() {
@@ -100,7 +96,9 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     let bar = ProgressBar::new(tiles).with_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} tiles {elapsed}",
     )?);
-    let (image, report) = quadray_shadows::run(scene, &opts, &|| bar.inc(1));
+    let name = scene.name.clone();
+    let (image, report) = quadray_shadows::run(scene, &opts, &|| bar.inc(1))
+        .with_context(|| format!("scene {name:?}"))?;
     bar.finish_and_clear();
     image.save_png(&out)?;
     let t = &report.times_s;
@@ -135,7 +133,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
 
 /// `quadray bench shadows`: the paper's tables and figure 6 into `out`, the headline ratios printed.
 pub fn bench(quick: bool, out: &Path) -> anyhow::Result<()> {
-    let results = quadray_shadows::bench::bench_shadows(quick, out, &|msg| eprintln!("{msg}"))?;
+    let results = quadray_bench::shadows::bench_shadows(quick, out, &|msg| eprintln!("{msg}"))?;
     for s in &results.scenes {
         let (conv, hst, bvh) = (&s.schemes[0], &s.schemes[2], &s.schemes[3]);
         let embree = s
