@@ -2,7 +2,7 @@
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use quadray_shadows::scene::{BUILTINS, MAX_LIGHTS, Scene};
+use quadray_shadows::scene::{BUILTINS, Scene};
 use quadray_shadows::{Nth, RunOptions, SchemeChoice, cost};
 use std::path::{Path, PathBuf};
 
@@ -64,9 +64,13 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         })?,
         _ => bail!("give --scene PATH or --builtin NAME"),
     };
-    if scene.lights.len() > MAX_LIGHTS {
-        bail!("{} lights; at most {MAX_LIGHTS}", scene.lights.len());
-    }
+    let source = match &args.scene {
+        Some(path) => path.display().to_string(),
+        None => format!("builtin scene {:?}", scene.name),
+    };
+    // Named like the loader's errors: "FILE: reason".
+    let invalid = |e: quadray_shadows::BuildError| anyhow::anyhow!("{source}: {e}");
+    scene.validate().map_err(invalid)?;
     let out = args.out.context("--out FILE.png is required")?;
     let nth = match args.nth.as_str() {
         "auto" => Nth::Auto,
@@ -96,9 +100,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     let bar = ProgressBar::new(tiles).with_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} tiles {elapsed}",
     )?);
-    let name = scene.name.clone();
-    let (image, report) = quadray_shadows::run(scene, &opts, &|| bar.inc(1))
-        .with_context(|| format!("scene {name:?}"))?;
+    let (image, report) = quadray_shadows::run(scene, &opts, &|| bar.inc(1)).map_err(invalid)?;
     bar.finish_and_clear();
     image.save_png(&out)?;
     let t = &report.times_s;
