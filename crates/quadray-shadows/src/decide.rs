@@ -6,7 +6,7 @@
 use crate::cost::CostBins;
 use crate::geom::Ray;
 use crate::grid::{CellRecord, Mailbox};
-use crate::occlusion::{GridOccluder, Occluder};
+use crate::occlusion::Occluder;
 use crate::shadow::{LightState, ShadowVolumes, Subscheme};
 use crate::stats::RenderStats;
 use glam::Vec3;
@@ -137,29 +137,29 @@ impl ShadowTest for Volumes<'_> {
 }
 
 /// HST: the depth count where the segment crossed at most `nth` shadow polygons and the count is
-/// known, a shadow ray through the grid otherwise.
-pub struct Hybrid<'a> {
+/// known, a shadow ray through `O` otherwise (the paper's: the grid).
+pub struct Hybrid<'a, O> {
     /// The shadow polygons.
     pub volumes: &'a ShadowVolumes,
-    /// The grid's shadow rays.
-    pub rays: GridOccluder<'a>,
+    /// The shadow rays.
+    pub rays: O,
     /// N_th.
     pub nth: f32,
     /// Time every shadow-volume decision and shadow ray into the render's cost bins.
     pub time_decisions: bool,
 }
 
-impl ShadowTest for Hybrid<'_> {
-    type Rays = Mailbox;
+impl<O: Occluder> ShadowTest for Hybrid<'_, O> {
+    type Rays = O::Scratch;
 
-    fn rays(&self) -> Mailbox {
+    fn rays(&self) -> O::Scratch {
         self.rays.scratch()
     }
 
     #[inline]
     fn shadowed(
         &self,
-        sc: &mut Scratch<Mailbox>,
+        sc: &mut Scratch<O::Scratch>,
         decision: Decision,
         state: &mut LightState,
         at: &Arrival,
