@@ -137,7 +137,7 @@ fn main() -> Result<()> {
             bar.finish_and_clear();
             let files = files.into_iter().chain(indirect::demo(&gpu, &out, size)?);
             let bar = spinner("ray tracing");
-            let traced = quadray_shadows::demo::render_demo(&out.join("raytrace"), size, |m| {
+            let traced = quadray_bench::shadows::render_demo(&out.join("raytrace"), size, |m| {
                 bar.set_message(format!("ray tracing: {m}"))
             })?;
             bar.finish_and_clear();

@@ -64,13 +64,13 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         })?,
         _ => bail!("give --scene PATH or --builtin NAME"),
     };
-    if scene.lights.len() > quadray_shadows::trace::MAX_LIGHTS {
-        bail!(
-            "{} lights; at most {}",
-            scene.lights.len(),
-            quadray_shadows::trace::MAX_LIGHTS
-        );
-    }
+    let source = match &args.scene {
+        Some(path) => path.display().to_string(),
+        None => format!("builtin scene {:?}", scene.name),
+    };
+    // Named like the loader's errors: "FILE: reason".
+    let invalid = |e: quadray_shadows::BuildError| anyhow::anyhow!("{source}: {e}");
+    scene.validate().map_err(invalid)?;
     let out = args.out.context("--out FILE.png is required")?;
     let nth = match args.nth.as_str() {
         "auto" => Nth::Auto,
@@ -100,7 +100,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     let bar = ProgressBar::new(tiles).with_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} tiles {elapsed}",
     )?);
-    let (image, report) = quadray_shadows::run(scene, &opts, &|| bar.inc(1));
+    let (image, report) = quadray_shadows::run(scene, &opts, &|| bar.inc(1)).map_err(invalid)?;
     bar.finish_and_clear();
     image.save_png(&out)?;
     let t = &report.times_s;
@@ -135,7 +135,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
 
 /// `quadray bench shadows`: the paper's tables and figure 6 into `out`, the headline ratios printed.
 pub fn bench(quick: bool, out: &Path) -> anyhow::Result<()> {
-    let results = quadray_shadows::bench::bench_shadows(quick, out, &|msg| eprintln!("{msg}"))?;
+    let results = quadray_bench::shadows::bench_shadows(quick, out, &|msg| eprintln!("{msg}"))?;
     for s in &results.scenes {
         let (conv, hst, bvh) = (&s.schemes[0], &s.schemes[2], &s.schemes[3]);
         let embree = s

@@ -65,9 +65,22 @@ fn raytrace_bad_input_is_a_clear_error() {
     let dir = scratch("raytrace-bad");
     let bad_scene = dir.join("bad.toml");
     std::fs::write(&bad_scene, "[camera]\neye = [0, 0, 0]\n").unwrap();
+    // More lights than the tracer's per-ray state holds: refused by the scene's validation.
+    let lights = dir.join("nine-lights.toml");
+    let light = "[[lights]]\nposition = [0, 3, 3]\nintensity = [0.1, 0.1, 0.1]\n";
+    std::fs::write(
+        &lights,
+        format!(
+            "[camera]\neye = [0, 1, 5]\nlook_at = [0, 0, 0]\nfov_y_deg = 40\n{}\
+             [materials.grey]\ndiffuse = [0.5, 0.5, 0.5]\n[[objects]]\nmaterial = \"grey\"\n\
+             polygons = [[[-1, 0, -1], [-1, 0, 1], [1, 0, 1]]]\n",
+            light.repeat(9)
+        ),
+    )
+    .unwrap();
     let out = dir.join("x.png");
     let out = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         (
             &["raytrace", "--builtin", "nope", "--out", out],
             "unknown builtin",
@@ -109,6 +122,16 @@ fn raytrace_bad_input_is_a_clear_error() {
                 out,
             ],
             "bad.toml",
+        ),
+        (
+            &[
+                "raytrace",
+                "--scene",
+                lights.to_str().unwrap(),
+                "--out",
+                out,
+            ],
+            "nine-lights.toml: 9 lights; 1 to 8",
         ),
     ];
     for (args, why) in cases {

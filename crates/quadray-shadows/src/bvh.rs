@@ -1,7 +1,8 @@
 //! Today's baseline: a binned-SAH bounding volume hierarchy over the polygons, with an occlusion
 //! query that stops at the first blocking polygon.
 
-use crate::geom::{Aabb, ConvexPolygon};
+use crate::geom::{Aabb, ConvexPolygon, Ray};
+use crate::occlusion::Occluder;
 use glam::Vec3;
 
 const BINS: usize = 12;
@@ -23,6 +24,7 @@ pub struct Bvh {
 }
 
 impl Bvh {
+    /// Builds the hierarchy over `polygons` (degenerate ones left out), binned SAH splits.
     pub fn build(polygons: &[ConvexPolygon]) -> Bvh {
         let boxes: Vec<Aabb> = polygons.iter().map(|p| p.bounds()).collect();
         let centres: Vec<Vec3> = boxes.iter().map(|b| b.centre()).collect();
@@ -35,16 +37,9 @@ impl Bvh {
         Bvh { nodes, order }
     }
 
-    /// Is any polygon but `skip` hit in `(t_min, t_max)`?
-    pub fn occluded(
-        &self,
-        polygons: &[ConvexPolygon],
-        o: Vec3,
-        d: Vec3,
-        t_min: f32,
-        t_max: f32,
-        skip: Option<u32>,
-    ) -> bool {
+    /// Is any polygon of `polygons` (those the BVH was built on) but `skip` hit on the ray?
+    pub fn occluded(&self, polygons: &[ConvexPolygon], ray: &Ray, skip: Option<u32>) -> bool {
+        let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
         let inv_d = d.recip();
         let mut stack = [0u32; 64];
         let mut top = 1;
@@ -72,6 +67,26 @@ impl Bvh {
             }
         }
         false
+    }
+}
+
+/// Shadow rays through a [`Bvh`] built on `polygons`.
+#[derive(Clone, Copy)]
+pub struct BvhOccluder<'a> {
+    /// The hierarchy.
+    pub bvh: &'a Bvh,
+    /// The polygons it was built on.
+    pub polygons: &'a [ConvexPolygon],
+}
+
+impl Occluder for BvhOccluder<'_> {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    #[inline]
+    fn occluded(&self, ray: &Ray, skip: Option<u32>, _: &mut ()) -> bool {
+        self.bvh.occluded(self.polygons, ray, skip)
     }
 }
 

@@ -1,11 +1,11 @@
 //! The paper's cost model (section II, equations 1-12): the cost of a conventional shadow test
 //! against the cost of N_s shadow-polygon tests, the threshold N_th where they meet, the machine
-//! constants measured by micro-benchmarks and the scene statistics p and alpha.
+//! constants measured by micro-benchmarks, and the measured decision costs the pilot renders
+//! ([`crate::pilot`]) bin. Nothing here renders.
 
 use crate::SplitMix;
-use crate::geom::{Aabb, ConvexPolygon};
-use crate::grid::{CellRecord, Grid, Mailbox};
-use crate::trace::{COST_BINS, CostBins, Pinhole, Prepared};
+use crate::geom::{Aabb, ConvexPolygon, Ray};
+use crate::grid::{Grid, Mailbox};
 use glam::Vec3;
 use serde::Serialize;
 use std::hint::black_box;
@@ -26,9 +26,13 @@ pub struct MachineCosts {
 /// The scene statistics of the paper's table 2 and what the model derives from them.
 #[derive(Clone, Copy, Debug, Serialize, PartialEq)]
 pub struct SceneStats {
+    /// N_ot: polygons of the scene.
     pub polygons: usize,
+    /// A_avg: mean area of the (non-degenerate) polygons.
     pub mean_area: f64,
+    /// L_avg: their mean perimeter.
     pub mean_perimeter: f64,
+    /// The grid's resolution.
     pub grid: [u32; 3],
     /// Edge of a cube of the cell's volume.
     pub cell_edge: f64,
@@ -78,41 +82,16 @@ pub fn predicted_nth(c: &MachineCosts, s: &SceneStats) -> f64 {
 /// None when too few decisions were timed.
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
 pub struct FollowUp {
+    /// Forced conventional decisions per free one.
     pub ratio: f64,
+    /// Mean N_s of the forced decisions.
     pub forced_ns: f64,
+    /// The measured N_s where a shadow-volume decision costs as much as a shadow ray.
     pub break_even: Option<f64>,
 }
 
 /// Fewest timed decisions of a bin the break-even reads.
 const PILOT_MIN_DECISIONS: usize = 30;
-
-/// The pilot renders of [`FollowUp`]; zero without shadow polygons.
-pub fn follow_up(prep: &Prepared, nth: f64, depth: u32) -> FollowUp {
-    if prep.volumes.is_none() {
-        return FollowUp::default();
-    }
-    let pilot = |nth: f32, time_decisions| {
-        let settings = crate::trace::Settings {
-            width: 96,
-            height: 72,
-            spp: 1,
-            depth,
-            scheme: crate::trace::Scheme::Hst { nth },
-            check: false,
-            time_decisions,
-        };
-        crate::trace::render(prep, settings, &|| {}).1
-    };
-    // This one also warms the caches for the timed ones.
-    let r = pilot(nth as f32, false);
-    let free = r.conventional.saturating_sub(r.forced_conventional);
-    let (volume, rays) = (pilot(f32::INFINITY, true), pilot(0.0, true));
-    FollowUp {
-        ratio: r.forced_conventional as f64 / free.max(1) as f64,
-        forced_ns: r.forced_ns as f64 / r.forced_conventional.max(1) as f64,
-        break_even: break_even(&volume.shadow_volume_costs, &rays.shadow_ray_costs),
-    }
-}
 
 /// The N_s where shadow-volume decisions start to cost more than shadow rays: interpolated
 /// between the mean N_s of the last bin where they cost less and the first where they cost more;
@@ -144,157 +123,6 @@ pub(crate) fn break_even(volume: &CostBins, rays: &CostBins) -> Option<f64> {
 pub fn extended_nth(c: &MachineCosts, s: &SceneStats, f: &FollowUp) -> f64 {
     let cv_over_s = f.break_even.unwrap_or_else(|| predicted_nth(c, s));
     (cv_over_s * (1.0 + f.ratio) - f.ratio * f.forced_ns).max(0.0)
-}
-
-/// Scene statistics from the polygons and the grid.
-///
-/// p comes from integral geometry: among random lines that meet a polygon's neighbourhood of
-/// cells (the polygon swept by a cell, K + C), the share that meets the polygon is the ratio of mean
-/// projected areas, (2A/4) / (S(K+C)/4), and for a flat polygon of area A and perimeter L and a cube
-/// cell of edge h the mean surface of K + C is 2A + 6h^2 + (3 pi / 4) L h.
-pub fn scene_stats(prep: &Prepared) -> SceneStats {
-    let live: Vec<&ConvexPolygon> = prep
-        .polygons
-        .iter()
-        .filter(|p| !p.is_degenerate())
-        .collect();
-    let n = live.len().max(1) as f64;
-    let mean_area = live.iter().map(|p| p.area() as f64).sum::<f64>() / n;
-    let mean_perimeter = live.iter().map(|p| p.perimeter() as f64).sum::<f64>() / n;
-    let g = &prep.grid;
-    let cell_edge = (g.cell_size.x as f64 * g.cell_size.y as f64 * g.cell_size.z as f64).cbrt();
-    let n_or = prep.cells.registrations() as f64 / g.cell_count() as f64;
-    let alpha = n_or / 2.0;
-    let (a, l, h) = (mean_area, mean_perimeter, cell_edge);
-    let p =
-        (2.0 * a / (2.0 * a + 6.0 * h * h + 0.75 * std::f64::consts::PI * l * h)).clamp(1e-6, 1.0);
-    let c_s_per_entry = shadow_entry_cost(prep);
-    let n_c = mean_shadow_ray_cells(
-        &live,
-        g,
-        &prep
-            .scene
-            .lights
-            .iter()
-            .map(|l| l.position)
-            .collect::<Vec<_>>(),
-    );
-    SceneStats {
-        polygons: prep.polygons.len(),
-        mean_area,
-        mean_perimeter,
-        grid: g.res,
-        cell_edge,
-        n_or,
-        alpha,
-        p,
-        n_c,
-        n_o: alpha * n_c,
-        c_s_per_entry,
-    }
-}
-
-/// Mean number of cells walked from area-weighted random points on the polygons to each light.
-/// `count` area-weighted random points on the polygons.
-fn surface_points(polygons: &[&ConvexPolygon], count: usize, rng: &mut SplitMix) -> Vec<Vec3> {
-    let mut cumulative = Vec::with_capacity(polygons.len());
-    let mut total = 0.0;
-    for p in polygons {
-        total += p.area() as f64;
-        cumulative.push(total);
-    }
-    (0..count)
-        .map(|_| {
-            let pick = cumulative
-                .partition_point(|&c| c < rng.unit() as f64 * total)
-                .min(polygons.len() - 1);
-            let poly = polygons[pick];
-            // A point inside the convex polygon: random convex weights of its vertices.
-            let w: Vec<f32> = poly.vertices.iter().map(|_| rng.unit() + 1e-3).collect();
-            let ws: f32 = w.iter().sum();
-            poly.vertices
-                .iter()
-                .zip(&w)
-                .map(|(v, w)| *v * (w / ws))
-                .sum::<Vec3>()
-        })
-        .collect()
-}
-
-/// Mean number of cells walked from area-weighted random points on the polygons to each light.
-fn mean_shadow_ray_cells(polygons: &[&ConvexPolygon], grid: &Grid, lights: &[Vec3]) -> f64 {
-    if polygons.is_empty() || lights.is_empty() {
-        return 0.0;
-    }
-    let points = surface_points(polygons, 2000, &mut SplitMix(7));
-    let mut cells = 0u64;
-    for &point in &points {
-        for &light in lights {
-            let to = light - point;
-            let dist = to.length();
-            grid.walk(point, to / dist, 0.0, dist, |_, _, _| {
-                cells += 1;
-                false
-            });
-        }
-    }
-    cells as f64 / (points.len() * lights.len()) as f64
-}
-
-/// C_s as equation 1 uses it, measured on the scene's own shadow polygons: CPU time per shadow
-/// polygon registered in a crossed cell. N_s counts a polygon once per cell it is registered in,
-/// and the bucket (mailbox) tests it only once per segment, so most entries cost a mailbox check
-/// rather than a ray test. Timed on the segments the tracer meets most, eye rays to their first
-/// hit (a 64 x 48 grid of them): how many cells a segment crosses and how long it runs through
-/// shadow volumes decide the mix of checks and tests. None without shadow polygons.
-fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
-    let volumes = prep.volumes.as_ref()?;
-    let eye = prep.scene.camera.eye;
-    let pinhole = Pinhole::new(&prep.scene.camera, 64, 48);
-    let mut objects = Mailbox::new(prep.polygons.len());
-    // (direction, length, occupied cells, lights with shadow polygons in them): HST counts
-    // crossings only for a light whose N_s is not 0 (else it sustains), so only those are timed.
-    let mut segments: Vec<(Vec3, f32, Vec<u32>, Vec<usize>)> = Vec::new();
-    let mut entries = 0u64;
-    let mut occupied = CellRecord::new(&prep.grid);
-    for y in 0..48 {
-        for x in 0..64 {
-            let d = pinhole.dir(x as f32 + 0.5, y as f32 + 0.5);
-            occupied.clear();
-            let hit = prep.grid.closest_hit(
-                &prep.cells,
-                &prep.polygons,
-                eye,
-                d,
-                prep.eps,
-                f32::INFINITY,
-                None,
-                &mut objects,
-                Some((volumes.occupied_cells(), &mut occupied)),
-            );
-            if let Some(h) = hit {
-                let ns = volumes.counts(occupied.cells());
-                let lights: Vec<usize> = (0..volumes.lights.len()).filter(|&l| ns[l] > 0).collect();
-                entries += lights.iter().map(|&l| ns[l] as u64).sum::<u64>();
-                segments.push((d, h.t, occupied.cells().to_vec(), lights));
-            }
-        }
-    }
-    if entries == 0 {
-        return None;
-    }
-    let mut mailbox = Mailbox::new(volumes.max_per_light());
-    let mut tests = 0;
-    Some(median_ns(entries as usize, || {
-        let mut change = 0;
-        for (d, t, occupied, lights) in &segments {
-            for &l in lights {
-                change +=
-                    volumes.crossings(l, occupied, eye, *d, 0.0, *t, &mut mailbox, &mut tests);
-            }
-        }
-        black_box(change);
-    }))
 }
 
 /// Measures the machine constants with micro-benchmarks on synthetic polygons and grids; each is
@@ -354,29 +182,20 @@ pub fn calibrate() -> MachineCosts {
     );
     let c_i = median_ns(rays.len(), || {
         for &(o, d) in &rays {
-            grid.walk(o, d, 0.0, 100.0, |c, _, _| black_box(c) != u32::MAX);
+            grid.walk(&Ray::new(o, d, 0.0, 100.0), |c, _, _| {
+                black_box(c) != u32::MAX
+            });
         }
     });
     let mut steps = 0usize;
-    grid.walk(
-        Vec3::splat(-2.99),
-        Vec3::ONE.normalize(),
-        0.0,
-        100.0,
-        |_, _, _| {
-            steps += 1;
-            false
-        },
-    );
+    let diagonal = Ray::new(Vec3::splat(-2.99), Vec3::ONE.normalize(), 0.0, 100.0);
+    grid.walk(&diagonal, |_, _, _| {
+        steps += 1;
+        false
+    });
     let walk_all = median_ns(rays.len(), || {
         for _ in 0..rays.len() {
-            grid.walk(
-                Vec3::splat(-2.99),
-                Vec3::ONE.normalize(),
-                0.0,
-                100.0,
-                |c, _, _| black_box(c) == u32::MAX,
-            );
+            grid.walk(&diagonal, |c, _, _| black_box(c) == u32::MAX);
         }
     });
     let c_c = ((walk_all - c_i) / steps.max(1) as f64).max(0.01);
@@ -386,7 +205,7 @@ pub fn calibrate() -> MachineCosts {
 /// Median over batches of the time per operation of `f`, which performs `ops` operations.
 /// Timed in this thread's CPU time, so neither other processes nor idle-spinning worker threads
 /// sharing the cores inflate it.
-fn median_ns(ops: usize, mut f: impl FnMut()) -> f64 {
+pub(crate) fn median_ns(ops: usize, mut f: impl FnMut()) -> f64 {
     f();
     let mut samples: Vec<f64> = (0..15)
         .map(|_| {
@@ -397,4 +216,58 @@ fn median_ns(ops: usize, mut f: impl FnMut()) -> f64 {
         .collect();
     samples.sort_by(f64::total_cmp);
     samples[samples.len() / 2]
+}
+
+/// Number of [`CostBins`].
+pub const COST_BINS: usize = 12;
+
+/// A timed decision that took this many times its bin's median was interrupted (the thread was
+/// descheduled or served an interrupt): one such decision of a millisecond would outweigh a
+/// thousand real ones in the bin's mean.
+const INTERRUPTED: u64 = 16;
+
+/// Timed decisions, read by N_s in bins: bin 0 holds N_s = 0, bin b N_s in `[2^(b-1), 2^b)`,
+/// the last all above.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct CostBins {
+    /// (N_s, ticks) of each decision.
+    samples: Vec<(u32, u64)>,
+}
+
+impl CostBins {
+    /// Notes a decision of N_s `ns` that took `ticks`.
+    pub fn add(&mut self, ns: u32, ticks: u64) {
+        self.samples.push((ns, ticks));
+    }
+
+    pub(crate) fn merge(&mut self, o: &CostBins) {
+        self.samples.extend_from_slice(&o.samples);
+    }
+
+    fn bin(ns: u32) -> usize {
+        ((u32::BITS - ns.leading_zeros()) as usize).min(COST_BINS - 1)
+    }
+
+    /// Mean N_s and mean ticks of bin `b`'s decisions, if it has at least `min` of them, the
+    /// interrupted ones left out.
+    pub fn mean(&self, b: usize, min: usize) -> Option<(f64, f64)> {
+        let bin: Vec<(u32, u64)> = self
+            .samples
+            .iter()
+            .copied()
+            .filter(|&(ns, _)| Self::bin(ns) == b)
+            .collect();
+        if bin.len() < min.max(1) {
+            return None;
+        }
+        let mut ticks: Vec<u64> = bin.iter().map(|&(_, t)| t).collect();
+        let half = ticks.len() / 2;
+        let limit = INTERRUPTED * *ticks.select_nth_unstable(half).1;
+        let kept: Vec<&(u32, u64)> = bin.iter().filter(|&&(_, t)| t <= limit).collect();
+        let n = kept.len() as f64;
+        Some((
+            kept.iter().map(|&&(ns, _)| ns as f64).sum::<f64>() / n,
+            kept.iter().map(|&&(_, t)| t as f64).sum::<f64>() / n,
+        ))
+    }
 }

@@ -1,7 +1,8 @@
 //! Today's production baseline: shadow rays as Intel Embree 3 occlusion queries (Debian's
 //! libembree-dev; `scripts/setup.sh --embree` installs it). Built only with the `embree` feature.
 
-use crate::geom::ConvexPolygon;
+use crate::geom::{ConvexPolygon, Ray};
+use crate::occlusion::Occluder;
 use embree::sys;
 use glam::Vec3;
 
@@ -9,6 +10,8 @@ use glam::Vec3;
 pub struct EmbreeScene {
     device: sys::RTCDevice,
     scene: sys::RTCScene,
+    /// Where a ray leaving a polygon starts: Embree cannot skip the polygon a ray starts on.
+    leave_eps: f32,
 }
 
 // SAFETY: a committed Embree scene may be queried from any number of threads at once, and the
@@ -17,7 +20,9 @@ unsafe impl Send for EmbreeScene {}
 unsafe impl Sync for EmbreeScene {}
 
 impl EmbreeScene {
-    pub fn build(polygons: &[ConvexPolygon]) -> Self {
+    /// Commits the polygons (degenerate ones left out); rays leaving a polygon start at
+    /// `leave_eps`.
+    pub fn build(polygons: &[ConvexPolygon], leave_eps: f32) -> Self {
         let triangles: Vec<[Vec3; 3]> = polygons
             .iter()
             .filter(|p| !p.is_degenerate())
@@ -61,13 +66,17 @@ impl EmbreeScene {
             sys::rtcAttachGeometry(scene, geometry);
             sys::rtcReleaseGeometry(geometry);
             sys::rtcCommitScene(scene);
-            Self { device, scene }
+            Self {
+                device,
+                scene,
+                leave_eps,
+            }
         }
     }
 
-    /// Is anything hit in `(t_min, t_max)`? Embree cannot skip the polygon the ray starts on, so
-    /// `t_min` keeps the ray off it.
-    pub fn occluded(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
+    /// Is anything hit on the ray?
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
         let mut context = sys::RTCIntersectContext {
             flags: sys::RTCIntersectContextFlags::INCOHERENT,
             filter: None,
@@ -90,6 +99,24 @@ impl EmbreeScene {
         // SAFETY: the scene is committed; context and ray are valid for the call.
         unsafe { sys::rtcOccluded1(self.scene, &mut context, &mut ray) };
         ray.tfar == f32::NEG_INFINITY
+    }
+}
+
+impl Occluder for EmbreeScene {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    /// A ray leaving polygon `skip` starts at the scene's `leave_eps` at least.
+    #[inline]
+    fn occluded(&self, ray: &Ray, skip: Option<u32>, _: &mut ()) -> bool {
+        match skip {
+            Some(_) => self.occluded(&Ray {
+                t_min: ray.t_min.max(self.leave_eps),
+                ..*ray
+            }),
+            None => self.occluded(ray),
+        }
     }
 }
 

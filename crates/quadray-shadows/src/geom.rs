@@ -3,23 +3,66 @@
 
 use glam::{Vec3, Vec4};
 
+/// A ray segment: the points `origin + t dir` with `t` in `(t_min, t_max)`. `dir` need not be
+/// unit length; `t` is measured in multiples of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Where `t = 0` lies.
+    pub origin: Vec3,
+    /// The direction, `t`'s unit.
+    pub dir: Vec3,
+    /// The segment starts after this parameter.
+    pub t_min: f32,
+    /// The segment ends before this parameter.
+    pub t_max: f32,
+}
+
+impl Ray {
+    /// The segment of `origin + t dir` with `t` in `(t_min, t_max)`.
+    pub fn new(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
+        Self {
+            origin,
+            dir,
+            t_min,
+            t_max,
+        }
+    }
+
+    /// The segment from `origin` to `origin + offset` with a unit direction (a shadow ray to a
+    /// light), starting after `t_min`.
+    pub fn segment(origin: Vec3, offset: Vec3, t_min: f32) -> Self {
+        let dist = offset.length();
+        Self::new(origin, offset / dist, t_min, dist)
+    }
+
+    /// The point at parameter `t`.
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
 /// Axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The lowest corner.
     pub min: Vec3,
+    /// The highest corner.
     pub max: Vec3,
 }
 
 impl Aabb {
+    /// The box of nothing: growing it by a point gives that point.
     pub const EMPTY: Aabb = Aabb {
         min: Vec3::splat(f32::INFINITY),
         max: Vec3::splat(f32::NEG_INFINITY),
     };
 
+    /// The smallest box holding the points.
     pub fn of_points(points: impl IntoIterator<Item = Vec3>) -> Aabb {
         points.into_iter().fold(Aabb::EMPTY, |b, p| b.grow(p))
     }
 
+    /// The box grown to hold `p`.
     pub fn grow(self, p: Vec3) -> Aabb {
         Aabb {
             min: self.min.min(p),
@@ -27,6 +70,7 @@ impl Aabb {
         }
     }
 
+    /// The smallest box holding both.
     pub fn union(self, o: Aabb) -> Aabb {
         Aabb {
             min: self.min.min(o.min),
@@ -34,14 +78,17 @@ impl Aabb {
         }
     }
 
+    /// Size along each axis (zero for an empty box).
     pub fn extent(&self) -> Vec3 {
         (self.max - self.min).max(Vec3::ZERO)
     }
 
+    /// The centre.
     pub fn centre(&self) -> Vec3 {
         (self.min + self.max) * 0.5
     }
 
+    /// Surface area (the SAH's measure).
     pub fn surface_area(&self) -> f32 {
         let e = self.extent();
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
@@ -75,14 +122,17 @@ impl Aabb {
 /// A degenerate polygon (zero area) has a zero normal and is never hit.
 #[derive(Clone, Debug)]
 pub struct ConvexPolygon {
+    /// The corners in order.
     pub vertices: Vec<Vec3>,
     /// Unit normal following the vertex order (Newell), zero when degenerate.
     pub normal: Vec3,
+    /// `normal . p` for the points `p` of the plane.
     pub offset: f32,
     edge_planes: Vec<Vec4>,
 }
 
 impl ConvexPolygon {
+    /// Prepares the polygon through `vertices` (convex, planar, in order).
     pub fn new(vertices: Vec<Vec3>) -> Self {
         let n = vertices.len();
         let mut newell = Vec3::ZERO;
@@ -119,10 +169,12 @@ impl ConvexPolygon {
         }
     }
 
+    /// Zero area: never hit.
     pub fn is_degenerate(&self) -> bool {
         self.normal == Vec3::ZERO
     }
 
+    /// Area.
     pub fn area(&self) -> f32 {
         let n = self.vertices.len();
         (1..n.saturating_sub(1))
@@ -135,6 +187,7 @@ impl ConvexPolygon {
             .sum()
     }
 
+    /// Perimeter.
     pub fn perimeter(&self) -> f32 {
         let n = self.vertices.len();
         (0..n)
@@ -142,10 +195,12 @@ impl ConvexPolygon {
             .sum()
     }
 
+    /// Mean of the corners.
     pub fn centroid(&self) -> Vec3 {
         self.vertices.iter().copied().sum::<Vec3>() / self.vertices.len().max(1) as f32
     }
 
+    /// Bounding box.
     pub fn bounds(&self) -> Aabb {
         Aabb::of_points(self.vertices.iter().copied())
     }

@@ -1,7 +1,7 @@
 //! The uniform grid (Fujimoto's SEADS): resolution by a density rule, exact registration of convex
 //! polygons in the cells they touch, 3DDDA traversal (Amanatides & Woo) and per-ray mailboxes.
 
-use crate::geom::{Aabb, ConvexPolygon, clip_slab};
+use crate::geom::{Aabb, ConvexPolygon, Ray, clip_slab};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -20,11 +20,13 @@ pub struct CellLists {
 
 impl CellLists {
     #[inline]
+    /// The ids registered in cell `c`.
     pub fn cell(&self, c: u32) -> &[u32] {
         &self.items[self.offsets[c as usize] as usize..self.offsets[c as usize + 1] as usize]
     }
 
     #[inline]
+    /// How many ids cell `c` holds.
     pub fn count(&self, c: u32) -> u32 {
         self.offsets[c as usize + 1] - self.offsets[c as usize]
     }
@@ -65,17 +67,20 @@ pub struct CellSet {
 }
 
 impl CellSet {
+    /// An empty set of `cells` cells.
     pub fn new(cells: usize) -> Self {
         Self {
             bits: vec![0; cells.div_ceil(64)],
         }
     }
 
+    /// Adds cell `c`.
     pub fn insert(&mut self, c: u32) {
         self.bits[c as usize / 64] |= 1 << (c % 64);
     }
 
     #[inline]
+    /// Whether cell `c` is in the set.
     pub fn contains(&self, c: u32) -> bool {
         self.bits[c as usize / 64] & (1 << (c % 64)) != 0
     }
@@ -91,6 +96,7 @@ pub struct CellRecord {
 }
 
 impl CellRecord {
+    /// An empty record for walks through `grid`.
     pub fn new(grid: &Grid) -> Self {
         Self {
             cells: vec![0; grid.res.iter().sum::<u32>() as usize + 1],
@@ -98,6 +104,7 @@ impl CellRecord {
         }
     }
 
+    /// Forgets the cells noted.
     pub fn clear(&mut self) {
         self.len = 0;
     }
@@ -122,6 +129,7 @@ pub struct Mailbox {
 }
 
 impl Mailbox {
+    /// A mailbox for ids `0..ids`.
     pub fn new(ids: usize) -> Self {
         Self {
             stamps: vec![0; ids],
@@ -159,15 +167,20 @@ impl Mailbox {
 /// Closest intersection along a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// The ray parameter of the hit.
     pub t: f32,
+    /// The polygon hit.
     pub polygon: u32,
 }
 
 /// A uniform grid of cells over a box.
 #[derive(Clone, Debug)]
 pub struct Grid {
+    /// The box the cells cover.
     pub bounds: Aabb,
+    /// Cells along each axis.
     pub res: [u32; 3],
+    /// One cell's size.
     pub cell_size: Vec3,
     inv_cell: Vec3,
 }
@@ -184,6 +197,7 @@ impl Grid {
         Grid::with_resolution(bounds, [axis(e.x), axis(e.y), axis(e.z)])
     }
 
+    /// `res` cells over `bounds`.
     pub fn with_resolution(bounds: Aabb, res: [u32; 3]) -> Grid {
         let cell_size = bounds.extent() / Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
         Grid {
@@ -194,6 +208,7 @@ impl Grid {
         }
     }
 
+    /// Number of cells.
     pub fn cell_count(&self) -> usize {
         self.res.iter().map(|&r| r as usize).product()
     }
@@ -291,14 +306,8 @@ impl Grid {
     /// 3DDDA: visits the cells the ray crosses within `[t_min, t_max]`, in order, with the ray
     /// parameters where it enters and leaves each; `visit` returns true to stop.
     #[inline]
-    pub fn walk(
-        &self,
-        o: Vec3,
-        d: Vec3,
-        t_min: f32,
-        t_max: f32,
-        mut visit: impl FnMut(u32, f32, f32) -> bool,
-    ) {
+    pub fn walk(&self, ray: &Ray, mut visit: impl FnMut(u32, f32, f32) -> bool) {
+        let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
         let inv_d = d.recip();
         let Some((t0, t1)) = self.bounds.clip_ray(o, inv_d, t_min, t_max) else {
             return;
@@ -344,26 +353,23 @@ impl Grid {
         }
     }
 
-    /// Closest polygon hit in `(t_min, t_max)`, never `skip` (the polygon the ray starts on).
-    /// With `record`, the walked cells that are in its set are noted in it (the cells of the ray
+    /// Closest polygon hit on the ray, never `skip` (the polygon the ray starts on). With
+    /// `record`, the walked cells that are in its set are noted in it (the cells of the ray
     /// segment that hold shadow polygons, for N_s: a bit test per cell, in the walk that visits
     /// them anyway).
-    #[allow(clippy::too_many_arguments)]
     pub fn closest_hit(
         &self,
         lists: &CellLists,
         polygons: &[ConvexPolygon],
-        o: Vec3,
-        d: Vec3,
-        t_min: f32,
-        t_max: f32,
+        ray: &Ray,
         skip: Option<u32>,
         mailbox: &mut Mailbox,
         mut record: Option<(&CellSet, &mut CellRecord)>,
     ) -> Option<Hit> {
+        let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
         mailbox.start_ray(skip);
         let mut best: Option<Hit> = None;
-        self.walk(o, d, t_min, t_max, |c, _, t_exit| {
+        self.walk(ray, |c, _, t_exit| {
             if let Some((set, cells)) = &mut record {
                 cells.note(set, c);
             }
@@ -380,22 +386,19 @@ impl Grid {
         best
     }
 
-    /// Occlusion query: is any polygon but `skip` hit in `(t_min, t_max)`? Stops at the first.
-    #[allow(clippy::too_many_arguments)]
+    /// Occlusion query: is any polygon but `skip` hit on the ray? Stops at the first.
     pub fn occluded(
         &self,
         lists: &CellLists,
         polygons: &[ConvexPolygon],
-        o: Vec3,
-        d: Vec3,
-        t_min: f32,
-        t_max: f32,
+        ray: &Ray,
         skip: Option<u32>,
         mailbox: &mut Mailbox,
     ) -> bool {
+        let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
         mailbox.start_ray(skip);
         let mut blocked = false;
-        self.walk(o, d, t_min, t_max, |c, _, _| {
+        self.walk(ray, |c, _, _| {
             blocked = lists.cell(c).iter().any(|&id| {
                 mailbox.first_visit(id)
                     && polygons[id as usize]

@@ -3,9 +3,42 @@
 //! hybrid switch between them with its cost model, and a SAH BVH (and, with the `embree` feature,
 //! Intel Embree) as today's baselines.
 //!
-//! Rooms: [`scene`] (procedural look-alikes of the paper's scenes, TOML scene files), [`grid`]
-//! (SEADS, 3DDDA, mailboxes), [`trace`] (the renderer), [`shadow`] (shadow polygons and HST),
-//! [`cost`] (equations 1-12 and the micro-benchmarks), [`bvh`], [`bench`] (the paper's tables).
+//! Rooms, from the bottom up: [`scene`] (a scene built in code with [`Scene::new`] and its
+//! `add_` methods, procedural look-alikes of the paper's scenes, TOML scene files), [`geom`]
+//! ([`Ray`], convex polygons), [`grid`] (SEADS, 3DDDA, mailboxes), [`occlusion`] (the
+//! [`Occluder`] interface of shadow rays: the grid, [`bvh`], `embree`), [`shadow`] (shadow
+//! polygons and HST's state machine), [`mod@prepare`] (what a scheme builds before rendering),
+//! [`decide`] (the shadow tests the tracer is generic over: shadow rays through any occluder,
+//! shadow volumes, HST), [`trace`] (the renderer), [`cost`] (equations 1-12 and the
+//! micro-benchmarks; it renders nothing) and [`pilot`] (the pilot renders that calibrate it).
+//!
+//! A scene built in code and rendered with HST (the whole program is
+//! `examples/hst_scene.rs`):
+//!
+//! ```
+//! use glam::Vec3;
+//! use quadray_shadows::{Camera, Light, Material, Nth, RunOptions, Scene, SchemeChoice};
+//!
+//! let camera = Camera { eye: Vec3::new(0.0, 2.0, 4.0), look_at: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
+//! let mut scene = Scene::new("doc", camera);
+//! let grey = scene.add_material(Material::matte(Vec3::splat(0.7)));
+//! scene.add_light(Light::white(Vec3::new(1.0, 4.0, 2.0), 0.8));
+//! let floor = [[-2.0, 0.0, -2.0], [-2.0, 0.0, 2.0], [2.0, 0.0, 2.0], [2.0, 0.0, -2.0]];
+//! let corners = floor.map(|p| scene.add_vertex(Vec3::from_array(p)));
+//! scene.add_face(corners.to_vec(), grey).unwrap();
+//! let options = RunOptions {
+//!     scheme: SchemeChoice::Hst,
+//!     nth: Nth::Fixed(8.0),
+//!     width: 32,
+//!     height: 24,
+//!     spp: 1,
+//!     depth: 2,
+//!     check: false,
+//!     costs: None,
+//! };
+//! let (image, report) = quadray_shadows::run(scene, &options, &|| {}).unwrap();
+//! assert_eq!((image.width, report.polygons), (32, 1));
+//! ```
 //!
 //! Where this departs from the paper, and why:
 //! - The depth count counts every polygon between a point and the light, both faces, so it is
@@ -44,41 +77,55 @@
 //! - Transparent objects must not touch other surfaces (the builtin glasses and vase float a hair
 //!   above): a refracted ray passing through two coplanar faces at once would skip one.
 
-pub mod bench;
+#![warn(missing_docs)]
+
 pub mod bvh;
 pub mod cost;
-pub mod demo;
+pub mod decide;
 #[cfg(feature = "embree")]
 pub mod embree;
 pub mod geom;
 pub mod grid;
+pub mod occlusion;
+pub mod pilot;
+pub mod prepare;
 pub mod scene;
 pub mod shadow;
+pub mod stats;
 pub mod trace;
 
 #[cfg(test)]
 mod tests;
 
 use cost::{MachineCosts, SceneStats};
+pub use geom::Ray;
+pub use occlusion::Occluder;
+pub use prepare::{Prepared, Scheme};
 use quadray_core::image_out::Rgba8Image;
-use scene::Scene;
+pub use scene::{BuildError, Camera, Light, Material, Scene};
 use serde::Serialize;
-use trace::{Prepared, RenderStats, Scheme, Settings};
+use stats::RenderStats;
+use trace::Settings;
 
 /// How the HST threshold is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Nth {
     /// Equation 12 from measured machine constants and the scene's statistics.
     Auto,
+    /// This N_th.
     Fixed(f32),
 }
 
 /// The shadow scheme asked for on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SchemeChoice {
+    /// A shadow ray per light through the grid.
     Conventional,
+    /// Shadow volumes: depth counts carried along every ray segment.
     Volume,
+    /// The hybrid switch (HST) with threshold N_th.
     Hst,
+    /// A shadow ray per light through a SAH BVH.
     Bvh,
     /// Embree occlusion rays; needs the `embree` feature.
     Embree,
@@ -106,12 +153,19 @@ impl std::str::FromStr for SchemeChoice {
 /// One render's parameters.
 #[derive(Clone, Copy, Debug)]
 pub struct RunOptions {
+    /// How shadows are decided.
     pub scheme: SchemeChoice,
+    /// HST's threshold (ignored by the other schemes).
     pub nth: Nth,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel.
     pub spp: u32,
+    /// Recursion depth of reflection and refraction.
     pub depth: u32,
+    /// Also run the conventional test at every shading point and count disagreements.
     pub check: bool,
     /// Machine constants; measured when `nth` is `Auto` and none are given.
     pub costs: Option<MachineCosts>,
@@ -120,26 +174,37 @@ pub struct RunOptions {
 /// CPU seconds (all threads), as the paper's table 4 reports CPU minutes.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Times {
+    /// Building the grid and the shadow polygons or BVH.
     pub preprocess: f64,
+    /// Deciding shadows at the shading points.
     pub shadow: f64,
+    /// Everything else of the render (eye and secondary rays, shading).
     pub other: f64,
+    /// Preprocessing and render.
     pub total: f64,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
+/// HST's decisions by sub-scheme (the paper's table 3); the other schemes count theirs as one.
 pub struct Subschemes {
+    /// The condition carried on unchanged (no shadow polygons on the segment).
     pub sustain: u64,
+    /// The point faces away from the light.
     pub self_shadow: u64,
+    /// Decided by the depth count.
     pub shadow_volume: u64,
+    /// Decided by a shadow ray.
     pub conventional: u64,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
+/// The N_th of a render: predicted, as the paper writes it, and used.
 pub struct NthReport {
     /// What `--nth auto` uses: equation 12 with the pilot's corrections ([`cost::FollowUp`]).
     pub predicted: f64,
     /// Equation 12 as the paper writes it.
     pub equation_12: f64,
+    /// The pilot measurements behind `predicted`.
     pub follow_up: cost::FollowUp,
     /// None when the scheme has no threshold.
     pub used: Option<f64>,
@@ -148,31 +213,53 @@ pub struct NthReport {
 /// The stats JSON of `quadray raytrace --stats`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunReport {
+    /// The scene's name.
     pub scene: String,
+    /// The scheme's name.
     pub scheme: String,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel.
     pub spp: u32,
+    /// Recursion depth.
     pub depth: u32,
+    /// Polygons of the scene.
     pub polygons: usize,
+    /// Point lights.
     pub lights: usize,
+    /// Shadow polygons of all lights (volume and HST).
     pub shadow_polygons: usize,
+    /// The grid's resolution.
     pub grid: [u32; 3],
+    /// CPU seconds by part.
     pub times_s: Times,
     /// Clock time of the render alone.
     pub render_wall_s: f64,
+    /// Decisions by sub-scheme.
     pub subschemes: Subschemes,
+    /// N_th predicted and used.
     pub nth: NthReport,
+    /// The cost model's p ([`SceneStats::p`]).
     pub p: f64,
+    /// The cost model's alpha ([`SceneStats::alpha`]).
     pub alpha: f64,
+    /// All of the cost model's scene statistics.
     pub scene_stats: SceneStats,
+    /// The machine constants used.
     pub machine_costs_ns: MachineCosts,
+    /// Points where rays hit a polygon and were shaded.
     pub shading_points: u64,
+    /// Shading points times lights.
     pub shadow_decisions: u64,
     /// Present with --check.
     pub disagreements: Option<u64>,
+    /// Decisions (point, light) that differ from the conventional test; present with --check.
     pub disagreeing_decisions: Option<u64>,
+    /// Shadow rays cast.
     pub shadow_rays: u64,
+    /// Ray / shadow-polygon crossing tests.
     pub shadow_polygon_tests: u64,
     /// Sum of N_s over the decisions that counted crossings (shadow polygons met in cells,
     /// with repeats; the `tests` are those the mailbox let through).
@@ -181,19 +268,21 @@ pub struct RunReport {
     pub forced_conventional: u64,
 }
 
-/// Builds what the scheme needs, predicts N_th and renders.
+/// Checks the scene, builds what the scheme needs, predicts N_th and renders.
 pub fn run(
     scene: Scene,
     opts: &RunOptions,
     on_tile: &(dyn Fn() + Sync),
-) -> (Rgba8Image, RunReport) {
-    let prepared = prepare(scene, opts.scheme);
+) -> Result<(Rgba8Image, RunReport), BuildError> {
+    let prepared = prepare(scene, opts.scheme)?;
     let costs = opts.costs.unwrap_or_else(cost::calibrate);
-    render_prepared(&prepared, opts, &costs, on_tile)
+    Ok(render_prepared(&prepared, opts, &costs, on_tile))
 }
 
-/// The preprocessing step alone (grid, and shadow polygons or BVH when the scheme needs them).
-pub fn prepare(scene: Scene, scheme: SchemeChoice) -> Prepared {
+/// The preprocessing step alone (grid, and shadow polygons or BVH when the scheme needs them),
+/// after checking the scene ([`Scene::validate`]).
+pub fn prepare(scene: Scene, scheme: SchemeChoice) -> Result<Prepared, BuildError> {
+    scene.validate()?;
     let s = match scheme {
         SchemeChoice::Conventional => Scheme::Conventional,
         SchemeChoice::Volume => Scheme::Volume,
@@ -201,7 +290,7 @@ pub fn prepare(scene: Scene, scheme: SchemeChoice) -> Prepared {
         SchemeChoice::Bvh => Scheme::Bvh,
         SchemeChoice::Embree => Scheme::Embree,
     };
-    Prepared::new(scene, s)
+    Ok(Prepared::new(scene, s))
 }
 
 /// Renders an already prepared scene.
@@ -300,6 +389,7 @@ fn report(
 pub struct SplitMix(pub u64);
 
 impl SplitMix {
+    /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;

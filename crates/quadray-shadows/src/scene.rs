@@ -13,7 +13,9 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[error("{path}: {reason}")]
 pub struct SceneError {
+    /// The file.
     pub path: String,
+    /// What is wrong with it.
     pub reason: String,
 }
 
@@ -28,16 +30,22 @@ fn scene_error(path: &Path, reason: impl ToString) -> SceneError {
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
+    /// Diffuse colour (linear RGB).
     pub diffuse: Vec3,
     #[serde(default)]
+    /// Weight of the Blinn-Phong highlight.
     pub specular: f32,
     #[serde(default = "default_shininess")]
+    /// Blinn-Phong exponent.
     pub shininess: f32,
     #[serde(default)]
+    /// Weight of the mirror reflection.
     pub reflect: f32,
     #[serde(default)]
+    /// Weight of the refracted ray (transparent when above 0).
     pub transmit: f32,
     #[serde(default = "default_ior")]
+    /// Index of refraction.
     pub ior: f32,
 }
 
@@ -49,6 +57,7 @@ fn default_ior() -> f32 {
 }
 
 impl Material {
+    /// A dull surface of colour `diffuse`.
     pub fn matte(diffuse: Vec3) -> Self {
         Self {
             diffuse,
@@ -60,6 +69,7 @@ impl Material {
         }
     }
 
+    /// A shiny surface that mirrors `reflect` of the light.
     pub fn glossy(diffuse: Vec3, reflect: f32) -> Self {
         Self {
             specular: 0.6,
@@ -69,6 +79,7 @@ impl Material {
         }
     }
 
+    /// Clear glass (index 1.5).
     pub fn glass() -> Self {
         Self {
             diffuse: Vec3::splat(0.05),
@@ -85,18 +96,34 @@ impl Material {
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Light {
+    /// Where the light is.
     pub position: Vec3,
+    /// Its colour and strength (linear RGB).
     pub intensity: Vec3,
+}
+
+impl Light {
+    /// A white point light of the given intensity.
+    pub fn white(position: Vec3, intensity: f32) -> Self {
+        Self {
+            position,
+            intensity: Vec3::splat(intensity),
+        }
+    }
 }
 
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
+    /// Where the camera is.
     pub eye: Vec3,
+    /// The point seen in the image's centre.
     pub look_at: Vec3,
     #[serde(default = "default_up")]
+    /// Up in the image (need not be perpendicular to the view).
     pub up: Vec3,
+    /// Vertical field of view in degrees.
     pub fov_y_deg: f32,
 }
 
@@ -107,19 +134,30 @@ fn default_up() -> Vec3 {
 /// A convex planar face: indices into the scene's vertices (shared between faces of one mesh).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Face {
+    /// Indices into [`Scene::vertices`], in order around the face.
     pub vertices: Vec<u32>,
+    /// Index into [`Scene::materials`].
     pub material: u32,
 }
 
 #[derive(Clone, Debug)]
+/// Polygons with materials, point lights and a camera: build one with [`Scene::new`] and the `add_` methods, [`Scene::builtin`] or [`Scene::load`].
 pub struct Scene {
+    /// The name in reports.
     pub name: String,
+    /// Vertex positions, shared by the faces of a mesh.
     pub vertices: Vec<Vec3>,
+    /// Convex planar faces.
     pub faces: Vec<Face>,
+    /// Materials, by the faces' indices.
     pub materials: Vec<Material>,
+    /// Point lights (at most [`MAX_LIGHTS`]).
     pub lights: Vec<Light>,
+    /// The camera.
     pub camera: Camera,
+    /// Ambient light, times each surface's diffuse colour.
     pub ambient: Vec3,
+    /// The colour of rays that hit nothing.
     pub background: Vec3,
 }
 
@@ -136,8 +174,61 @@ pub const BUILTINS: [(&str, usize, usize); 4] = [
     ("kaist", 981, 4),
 ];
 
+/// Most lights a scene may have (the tracer's per-ray shadow state is a fixed array).
+pub const MAX_LIGHTS: usize = 8;
+
+/// What is wrong with a scene built in code ([`Scene::add_face`], [`Scene::add_mesh`],
+/// [`Scene::validate`]).
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum BuildError {
+    /// A face refers to a vertex the scene does not have.
+    #[error("face {face}: vertex index {index} out of range ({vertices} vertices)")]
+    VertexOutOfRange {
+        /// The face's index (the one it would have had).
+        face: usize,
+        /// The offending vertex index.
+        index: u32,
+        /// How many vertices the scene has.
+        vertices: usize,
+    },
+    /// A face refers to a material the scene does not have.
+    #[error("face {face}: material {material} out of range ({materials} materials)")]
+    MaterialOutOfRange {
+        /// The face's index.
+        face: usize,
+        /// The offending material index.
+        material: u32,
+        /// How many materials the scene has.
+        materials: usize,
+    },
+    /// A vertex with a NaN or infinite coordinate.
+    #[error("face {face}: vertex {index} is not finite ({position})")]
+    NonFiniteVertex {
+        /// The face's index.
+        face: usize,
+        /// The vertex index.
+        index: u32,
+        /// Where the vertex is.
+        position: Vec3,
+    },
+    /// Fewer than three distinct vertices, or all on one line: the face has no area.
+    #[error("face {face}: degenerate (no area: fewer than 3 distinct or collinear vertices)")]
+    DegenerateFace {
+        /// The face's index.
+        face: usize,
+    },
+    /// A triangle list whose length is not a multiple of three.
+    #[error("mesh: {0} indices is not a whole number of triangles")]
+    PartialTriangle(usize),
+    /// Something else about the scene: the camera, the lights, a material.
+    #[error("{0}")]
+    Invalid(String),
+}
+
 impl Scene {
-    fn empty(name: &str, camera: Camera) -> Self {
+    /// An empty scene seen through `camera`, with the default ambient light and background. Add
+    /// materials, lights, vertices and faces with the `add_` methods.
+    pub fn new(name: &str, camera: Camera) -> Self {
         Self {
             name: name.into(),
             vertices: Vec::new(),
@@ -165,6 +256,7 @@ impl Scene {
             .collect()
     }
 
+    /// A look-alike of one of the paper's scenes ([`BUILTINS`]), None for another name.
     pub fn builtin(name: &str) -> Option<Scene> {
         match name {
             "glasses" => Some(glasses()),
@@ -175,24 +267,167 @@ impl Scene {
         }
     }
 
-    fn material(&mut self, m: Material) -> u32 {
+    /// Adds a material; faces refer to it by the index returned.
+    pub fn add_material(&mut self, m: Material) -> u32 {
         self.materials.push(m);
         self.materials.len() as u32 - 1
     }
 
-    fn light(&mut self, position: Vec3, intensity: f32) {
-        self.lights.push(Light {
-            position,
-            intensity: Vec3::splat(intensity),
-        });
+    /// Adds a point light (at most [`MAX_LIGHTS`]; [`Self::validate`] checks).
+    pub fn add_light(&mut self, light: Light) {
+        self.lights.push(light);
     }
 
-    fn vertex(&mut self, p: Vec3) -> u32 {
+    /// Adds a vertex; faces refer to it by the index returned. Faces of one closed mesh must
+    /// share their vertices: the shadow volumes find silhouette edges through shared indices.
+    pub fn add_vertex(&mut self, p: Vec3) -> u32 {
         self.vertices.push(p);
         self.vertices.len() as u32 - 1
     }
 
-    fn face(&mut self, mut vertices: Vec<u32>, material: u32) {
+    /// Adds a convex planar face through `vertices` (indices of [`Self::add_vertex`]), counter-
+    /// clockwise seen from its front, and returns its index. An index or material out of range,
+    /// a vertex that is not finite and a face without area are errors, and nothing is added.
+    pub fn add_face(&mut self, vertices: Vec<u32>, material: u32) -> Result<u32, BuildError> {
+        let face = self.faces.len();
+        if material as usize >= self.materials.len() {
+            return Err(BuildError::MaterialOutOfRange {
+                face,
+                material,
+                materials: self.materials.len(),
+            });
+        }
+        for &index in &vertices {
+            let Some(&position) = self.vertices.get(index as usize) else {
+                return Err(BuildError::VertexOutOfRange {
+                    face,
+                    index,
+                    vertices: self.vertices.len(),
+                });
+            };
+            if !position.is_finite() {
+                return Err(BuildError::NonFiniteVertex {
+                    face,
+                    index,
+                    position,
+                });
+            }
+        }
+        let corners = vertices
+            .iter()
+            .map(|&i| self.vertices[i as usize])
+            .collect();
+        if ConvexPolygon::new(corners).is_degenerate() {
+            return Err(BuildError::DegenerateFace { face });
+        }
+        self.push_face(vertices, material);
+        Ok(face as u32)
+    }
+
+    /// Adds an indexed triangle mesh: `positions` become vertices shared by its triangles
+    /// (`indices`, three per triangle, counter-clockwise from the front, into `positions`).
+    /// Checked as [`Self::add_face`]; on an error nothing is added.
+    pub fn add_mesh(
+        &mut self,
+        positions: &[Vec3],
+        indices: &[u32],
+        material: u32,
+    ) -> Result<(), BuildError> {
+        if !indices.len().is_multiple_of(3) {
+            return Err(BuildError::PartialTriangle(indices.len()));
+        }
+        let (vertices, faces) = (self.vertices.len(), self.faces.len());
+        let base = vertices as u32;
+        self.vertices.extend_from_slice(positions);
+        let added = indices.chunks_exact(3).try_for_each(|tri| {
+            let ids = tri
+                .iter()
+                .map(|&i| {
+                    if (i as usize) < positions.len() {
+                        Ok(base + i)
+                    } else {
+                        Err(BuildError::VertexOutOfRange {
+                            face: self.faces.len(),
+                            index: i,
+                            vertices: positions.len(),
+                        })
+                    }
+                })
+                .collect::<Result<Vec<u32>, _>>()?;
+            self.add_face(ids, material).map(|_| ())
+        });
+        if added.is_err() {
+            self.vertices.truncate(vertices);
+            self.faces.truncate(faces);
+        }
+        added
+    }
+
+    /// Adds a closed axis-aligned box from `min` to `max` (8 shared vertices, 6 faces), as a
+    /// scene file's `box` object. `min` must lie below `max` on every axis.
+    pub fn add_box(&mut self, min: Vec3, max: Vec3, material: u32) -> Result<(), BuildError> {
+        if !(min.is_finite() && max.is_finite()) || min.cmpge(max).any() {
+            return Err(BuildError::Invalid(format!(
+                "box from {min} to {max}: min must be finite and below max"
+            )));
+        }
+        if material as usize >= self.materials.len() {
+            return Err(BuildError::MaterialOutOfRange {
+                face: self.faces.len(),
+                material,
+                materials: self.materials.len(),
+            });
+        }
+        self.cuboid(min, max, material);
+        Ok(())
+    }
+
+    /// Checks what the tracer relies on: a finite camera looking somewhere with a field of view
+    /// in (0, 180) degrees, 1 to [`MAX_LIGHTS`] finite lights, finite materials with an index
+    /// of refraction above 0, at least one face.
+    pub fn validate(&self) -> Result<(), BuildError> {
+        let bad = |why: String| Err(BuildError::Invalid(why));
+        let c = &self.camera;
+        if !(c.eye.is_finite() && c.look_at.is_finite() && c.up.is_finite())
+            || c.look_at == c.eye
+            || c.up.cross(c.look_at - c.eye) == Vec3::ZERO
+        {
+            return bad("camera: eye, look_at and up must be finite, eye and look_at distinct, up not along the view".into());
+        }
+        if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+            return bad(format!(
+                "camera: fov_y_deg {} is not in (0, 180)",
+                c.fov_y_deg
+            ));
+        }
+        if self.lights.is_empty() || self.lights.len() > MAX_LIGHTS {
+            return bad(format!("{} lights; 1 to {MAX_LIGHTS}", self.lights.len()));
+        }
+        if let Some(l) = self
+            .lights
+            .iter()
+            .find(|l| !(l.position.is_finite() && l.intensity.is_finite()))
+        {
+            return bad(format!("light at {} is not finite", l.position));
+        }
+        for (i, m) in self.materials.iter().enumerate() {
+            let finite = [m.specular, m.shininess, m.reflect, m.transmit, m.ior]
+                .iter()
+                .all(|x| x.is_finite());
+            if !finite || !m.diffuse.is_finite() || m.ior <= 0.0 {
+                return bad(format!("material {i}: values must be finite and ior > 0"));
+            }
+        }
+        if self.faces.is_empty() {
+            return bad("no faces".into());
+        }
+        Ok(())
+    }
+
+    /// Adds a face unchecked: the builtin scenes and mesh files may hold faces without area
+    /// (welded mesh triangles), which are never hit and cast no shadow. Repeated corners (a
+    /// lathe's apex) are dropped.
+    fn push_face(&mut self, mut vertices: Vec<u32>, material: u32) {
         vertices.dedup();
         if vertices.len() > 1 && vertices.first() == vertices.last() {
             vertices.pop();
@@ -208,14 +443,14 @@ impl Scene {
             .map(|&(r, y)| {
                 if r == 0.0 {
                     vec![
-                        self.vertex(place.transform_point3(Vec3::new(0.0, y, 0.0)));
+                        self.add_vertex(place.transform_point3(Vec3::new(0.0, y, 0.0)));
                         slices as usize
                     ]
                 } else {
                     (0..slices)
                         .map(|j| {
                             let a = j as f32 / slices as f32 * std::f32::consts::TAU;
-                            self.vertex(place.transform_point3(Vec3::new(
+                            self.add_vertex(place.transform_point3(Vec3::new(
                                 r * a.cos(),
                                 y,
                                 -r * a.sin(),
@@ -228,7 +463,7 @@ impl Scene {
         for w in rings.windows(2) {
             for j in 0..slices as usize {
                 let k = (j + 1) % slices as usize;
-                self.face(vec![w[0][j], w[0][k], w[1][k], w[1][j]], material);
+                self.push_face(vec![w[0][j], w[0][k], w[1][k], w[1][j]], material);
             }
         }
     }
@@ -247,17 +482,17 @@ impl Scene {
         let base = self.vertices.len() as u32;
         for z in [0.0, depth] {
             for p in points {
-                self.vertex(place.transform_point3(p.extend(z)));
+                self.add_vertex(place.transform_point3(p.extend(z)));
             }
         }
         let back = |i: u32| base + points.len() as u32 + i;
         for piece in pieces {
-            self.face(piece.iter().rev().map(|&i| base + i).collect(), material);
-            self.face(piece.iter().map(|&i| back(i)).collect(), material);
+            self.push_face(piece.iter().rev().map(|&i| base + i).collect(), material);
+            self.push_face(piece.iter().map(|&i| back(i)).collect(), material);
         }
         for (e, &i) in outline.iter().enumerate() {
             let j = outline[(e + 1) % outline.len()];
-            self.face(vec![base + i, base + j, back(j), back(i)], material);
+            self.push_face(vec![base + i, base + j, back(j), back(i)], material);
         }
     }
 
@@ -314,13 +549,13 @@ impl Scene {
         let base = self.vertices.len() as u32;
         for r in 0..=rows {
             for c in 0..=cols {
-                self.vertex(Vec3::new(lerp(x0, x1, c, cols), y, lerp(z0, z1, r, rows)));
+                self.add_vertex(Vec3::new(lerp(x0, x1, c, cols), y, lerp(z0, z1, r, rows)));
             }
         }
         let at = |r: usize, c: usize| base + (r * (cols + 1) + c) as u32;
         for r in 0..rows {
             for c in 0..cols {
-                self.face(
+                self.push_face(
                     vec![at(r, c), at(r + 1, c), at(r + 1, c + 1), at(r, c + 1)],
                     tiles[(r + c) % 2],
                 );
@@ -331,13 +566,13 @@ impl Scene {
                 .map(|c| {
                     let x = lerp(x0, x1, c, rest);
                     (
-                        self.vertex(Vec3::new(x, y, z0)),
-                        self.vertex(Vec3::new(x, y + wall_height, z0)),
+                        self.add_vertex(Vec3::new(x, y, z0)),
+                        self.add_vertex(Vec3::new(x, y + wall_height, z0)),
                     )
                 })
                 .collect();
             for c in 0..rest {
-                self.face(
+                self.push_face(
                     vec![wall[c].0, wall[c + 1].0, wall[c + 1].1, wall[c].1],
                     tiles[c % 2],
                 );
@@ -362,14 +597,14 @@ fn at(x: f32, y: f32, z: f32) -> Affine3A {
 /// Four lathed wine glasses (closed, thick, transparent) on a checkered floor: 3,781 polygons,
 /// 3 lights.
 fn glasses() -> Scene {
-    let mut s = Scene::empty(
+    let mut s = Scene::new(
         "glasses",
         camera(Vec3::new(0.0, 3.0, 6.5), Vec3::new(0.0, 1.0, 0.0), 45.0),
     );
-    let glass = s.material(Material::glass());
+    let glass = s.add_material(Material::glass());
     let tiles = [
-        s.material(Material::matte(Vec3::new(0.8, 0.75, 0.6))),
-        s.material(Material::glossy(Vec3::new(0.25, 0.2, 0.3), 0.2)),
+        s.add_material(Material::matte(Vec3::new(0.8, 0.75, 0.6))),
+        s.add_material(Material::glossy(Vec3::new(0.25, 0.2, 0.3), 0.2)),
     ];
     // A closed profile from the foot's centre, out and up the outside, over the rim and down the
     // inside of the bowl back to the axis: 21 points, 20 segments.
@@ -402,31 +637,31 @@ fn glasses() -> Scene {
         s.lathe(&profile, 36, at(x, 0.002, z), glass);
     }
     s.floor(901, -4.0, 4.0, -4.0, 4.0, 0.0, 2.0, tiles);
-    s.light(Vec3::new(-3.0, 6.0, 3.0), 0.6);
-    s.light(Vec3::new(4.0, 5.0, 2.0), 0.5);
-    s.light(Vec3::new(0.5, 7.0, -3.0), 0.4);
+    s.add_light(Light::white(Vec3::new(-3.0, 6.0, 3.0), 0.6));
+    s.add_light(Light::white(Vec3::new(4.0, 5.0, 2.0), 0.5));
+    s.add_light(Light::white(Vec3::new(0.5, 7.0, -3.0), 0.4));
     s
 }
 
 /// A desk with books, a lamp (with a light under its shade, inside the grid), a glass vase and a mirror
 /// ball: 523 polygons, 3 lights.
 fn desk() -> Scene {
-    let mut s = Scene::empty(
+    let mut s = Scene::new(
         "desk",
         camera(Vec3::new(0.5, 3.2, 5.0), Vec3::new(0.0, 1.4, 0.0), 45.0),
     );
-    let wood = s.material(Material::glossy(Vec3::new(0.55, 0.35, 0.2), 0.1));
+    let wood = s.add_material(Material::glossy(Vec3::new(0.55, 0.35, 0.2), 0.1));
     let books = [
-        s.material(Material::matte(Vec3::new(0.7, 0.15, 0.1))),
-        s.material(Material::matte(Vec3::new(0.1, 0.3, 0.6))),
-        s.material(Material::matte(Vec3::new(0.2, 0.5, 0.2))),
+        s.add_material(Material::matte(Vec3::new(0.7, 0.15, 0.1))),
+        s.add_material(Material::matte(Vec3::new(0.1, 0.3, 0.6))),
+        s.add_material(Material::matte(Vec3::new(0.2, 0.5, 0.2))),
     ];
-    let metal = s.material(Material::glossy(Vec3::new(0.6, 0.6, 0.55), 0.3));
-    let mirror = s.material(Material::glossy(Vec3::splat(0.2), 0.7));
-    let glass = s.material(Material::glass());
+    let metal = s.add_material(Material::glossy(Vec3::new(0.6, 0.6, 0.55), 0.3));
+    let mirror = s.add_material(Material::glossy(Vec3::splat(0.2), 0.7));
+    let glass = s.add_material(Material::glass());
     let tiles = [
-        s.material(Material::matte(Vec3::new(0.6, 0.6, 0.6))),
-        s.material(Material::matte(Vec3::new(0.35, 0.35, 0.4))),
+        s.add_material(Material::matte(Vec3::new(0.6, 0.6, 0.6))),
+        s.add_material(Material::matte(Vec3::new(0.35, 0.35, 0.4))),
     ];
     s.cuboid(Vec3::new(-2.0, 1.5, -1.0), Vec3::new(2.0, 1.6, 1.0), wood);
     for (x, z) in [(-1.9, -0.9), (1.8, -0.9), (-1.9, 0.8), (1.8, 0.8)] {
@@ -481,15 +716,15 @@ fn desk() -> Scene {
         .collect();
     s.lathe(&ball, 16, at(0.2, 1.6, 0.3), mirror);
     s.floor(523 - s.faces.len(), -4.0, 4.0, -3.0, 3.0, 0.0, 3.0, tiles);
-    s.light(Vec3::new(-1.28, 2.2, -0.3), 0.5);
-    s.light(Vec3::new(3.0, 5.0, 2.5), 0.5);
-    s.light(Vec3::new(-3.0, 4.5, 2.0), 0.4);
+    s.add_light(Light::white(Vec3::new(-1.28, 2.2, -0.3), 0.5));
+    s.add_light(Light::white(Vec3::new(3.0, 5.0, 2.5), 0.5));
+    s.add_light(Light::white(Vec3::new(-3.0, 4.5, 2.0), 0.4));
     s
 }
 
 /// Five extruded five-pointed stars, tilted and floating over a floor: 113 polygons, 5 lights.
 fn stars() -> Scene {
-    let mut s = Scene::empty(
+    let mut s = Scene::new(
         "stars",
         camera(Vec3::new(0.0, 2.5, 7.0), Vec3::new(0.0, 1.5, 0.0), 50.0),
     );
@@ -502,11 +737,11 @@ fn stars() -> Scene {
     ];
     let mats: Vec<u32> = colours
         .iter()
-        .map(|&c| s.material(Material::glossy(c, 0.3)))
+        .map(|&c| s.add_material(Material::glossy(c, 0.3)))
         .collect();
     let tiles = [
-        s.material(Material::matte(Vec3::new(0.7, 0.7, 0.7))),
-        s.material(Material::matte(Vec3::new(0.4, 0.4, 0.45))),
+        s.add_material(Material::matte(Vec3::new(0.7, 0.7, 0.7))),
+        s.add_material(Material::matte(Vec3::new(0.4, 0.4, 0.45))),
     ];
     // Outline alternates outer points and inner corners; a pentagon and five triangles cover it.
     let points: Vec<Vec2> = (0..10)
@@ -534,17 +769,17 @@ fn stars() -> Scene {
         s.extrude(&points, &pieces, &outline, 0.3, place, m);
     }
     s.floor(3, -5.0, 5.0, -4.0, 4.0, 0.0, 4.0, tiles);
-    s.light(Vec3::new(-4.0, 6.0, 4.0), 0.3);
-    s.light(Vec3::new(4.0, 6.0, 4.0), 0.3);
-    s.light(Vec3::new(0.0, 3.0, 2.0), 0.25);
-    s.light(Vec3::new(-3.0, 5.0, -3.0), 0.25);
-    s.light(Vec3::new(3.5, 2.0, -2.0), 0.25);
+    s.add_light(Light::white(Vec3::new(-4.0, 6.0, 4.0), 0.3));
+    s.add_light(Light::white(Vec3::new(4.0, 6.0, 4.0), 0.3));
+    s.add_light(Light::white(Vec3::new(0.0, 3.0, 2.0), 0.25));
+    s.add_light(Light::white(Vec3::new(-3.0, 5.0, -3.0), 0.25));
+    s.add_light(Light::white(Vec3::new(3.5, 2.0, -2.0), 0.25));
     s
 }
 
 /// The letters K, A, I, S, T extruded (the S swept along two arcs): 981 polygons, 4 lights.
 fn kaist() -> Scene {
-    let mut s = Scene::empty(
+    let mut s = Scene::new(
         "kaist",
         camera(Vec3::new(4.0, 3.0, 7.5), Vec3::new(4.0, 1.0, 0.0), 50.0),
     );
@@ -557,11 +792,11 @@ fn kaist() -> Scene {
     ];
     let m: Vec<u32> = colours
         .iter()
-        .map(|&c| s.material(Material::glossy(c, 0.25)))
+        .map(|&c| s.add_material(Material::glossy(c, 0.25)))
         .collect();
     let tiles = [
-        s.material(Material::matte(Vec3::new(0.75, 0.75, 0.7))),
-        s.material(Material::glossy(Vec3::new(0.3, 0.3, 0.35), 0.3)),
+        s.add_material(Material::matte(Vec3::new(0.75, 0.75, 0.7))),
+        s.add_material(Material::glossy(Vec3::new(0.3, 0.3, 0.35), 0.3)),
     ];
     let v = Vec2::new;
     let (w, depth) = (0.35, 0.5);
@@ -620,10 +855,10 @@ fn kaist() -> Scene {
     s.bar(v(0.7, 0.0), v(0.7, 1.85), w, depth, place(6.1), m[4]);
     s.bar(v(0.0, 1.85), v(1.4, 1.85), 0.3, depth, place(6.1), m[4]);
     s.floor(981 - s.faces.len(), -2.0, 10.0, -3.0, 4.0, 0.0, 3.0, tiles);
-    s.light(Vec3::new(-1.0, 5.0, 4.0), 0.35);
-    s.light(Vec3::new(8.0, 5.0, 4.0), 0.35);
-    s.light(Vec3::new(4.0, 2.6, 3.0), 0.3);
-    s.light(Vec3::new(4.0, 6.0, -2.5), 0.3);
+    s.add_light(Light::white(Vec3::new(-1.0, 5.0, 4.0), 0.35));
+    s.add_light(Light::white(Vec3::new(8.0, 5.0, 4.0), 0.35));
+    s.add_light(Light::white(Vec3::new(4.0, 2.6, 3.0), 0.3));
+    s.add_light(Light::white(Vec3::new(4.0, 6.0, -2.5), 0.3));
     s
 }
 
@@ -700,7 +935,7 @@ impl Scene {
         {
             return bad(format!("light at {} is not finite", l.position));
         }
-        let mut s = Scene::empty(file.name.as_deref().unwrap_or("scene"), c);
+        let mut s = Scene::new(file.name.as_deref().unwrap_or("scene"), c);
         s.lights = file.lights;
         s.ambient = file.ambient.unwrap_or(s.ambient);
         s.background = file.background.unwrap_or(s.background);
@@ -714,13 +949,13 @@ impl Scene {
             if !ok || !finite(m.diffuse) || m.ior <= 0.0 {
                 return bad(format!("material {n}: values must be finite and ior > 0"));
             }
-            s.material(m);
+            s.add_material(m);
         }
         // Vertices at the same position are one vertex, so faces find their neighbours.
         let mut welded: HashMap<[u32; 3], u32> = HashMap::new();
         let mut weld = |s: &mut Scene, v: Vec3| {
             let key = v.to_array().map(f32::to_bits);
-            *welded.entry(key).or_insert_with(|| s.vertex(v))
+            *welded.entry(key).or_insert_with(|| s.add_vertex(v))
         };
         for (o, obj) in file.objects.iter().enumerate() {
             let material = match &obj.material {
@@ -742,7 +977,7 @@ impl Scene {
                     return bad(format!("object {o}, polygon {p}: {why}"));
                 }
                 let ids = poly.iter().map(|&v| weld(&mut s, v)).collect();
-                s.face(ids, material.expect("checked above"));
+                s.push_face(ids, material.expect("checked above"));
             }
             if let Some(mesh) = &obj.mesh {
                 let scale = obj.scale.unwrap_or(1.0);
@@ -758,7 +993,7 @@ impl Scene {
                 let first_material = s.materials.len() as u32;
                 if material.is_none() {
                     for m in &model.materials {
-                        s.material(Material::matte(m.base_color));
+                        s.add_material(Material::matte(m.base_color));
                     }
                 }
                 for m in &model.meshes {
@@ -768,7 +1003,7 @@ impl Scene {
                             .iter()
                             .map(|&i| weld(&mut s, m.positions[i as usize] * scale + translate))
                             .collect();
-                        s.face(ids, mat);
+                        s.push_face(ids, mat);
                     }
                 }
             }

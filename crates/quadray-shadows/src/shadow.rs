@@ -19,10 +19,9 @@
 //! light starts with an unknown condition (it may have left the shadow), which the next reflection
 //! point resolves with a conventional test instead of sustaining it.
 
-use crate::geom::{Aabb, ConvexPolygon};
+use crate::geom::{Aabb, ConvexPolygon, Ray};
 use crate::grid::{CellLists, CellSet, Grid, Mailbox};
-use crate::scene::{Face, Scene};
-use crate::trace::MAX_LIGHTS;
+use crate::scene::{Face, MAX_LIGHTS, Scene};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -87,7 +86,9 @@ impl ShadowPolygon {
 
 /// The shadow polygons of one light.
 pub struct LightVolumes {
+    /// The light's position.
     pub light: Vec3,
+    /// Its shadow polygons, by the ids registered in the grid.
     pub polygons: Vec<ShadowPolygon>,
     /// D at the eye.
     pub eye_depth: i32,
@@ -95,6 +96,7 @@ pub struct LightVolumes {
 
 /// Shadow polygons for every light, registered in the grid.
 pub struct ShadowVolumes {
+    /// Each light's shadow polygons, in the scene's light order.
     pub lights: Vec<LightVolumes>,
     /// Row `cell * lights + light`: that light's shadow polygons registered in the cell. The
     /// lights of one cell are neighbours in memory, so N_s of every light and the polygons of
@@ -139,10 +141,12 @@ impl ShadowVolumes {
         }
     }
 
+    /// Shadow polygons of all lights.
     pub fn polygon_count(&self) -> usize {
         self.lights.iter().map(|l| l.polygons.len()).sum()
     }
 
+    /// The most shadow polygons one light has (the size of a crossing-test mailbox).
     pub fn max_per_light(&self) -> usize {
         self.lights
             .iter()
@@ -172,21 +176,18 @@ impl ShadowVolumes {
         ns
     }
 
-    /// Change of D for `light` along the segment `o + t d`, `t` in `(t0, t1)`, whose cells holding
-    /// shadow polygons are `cells`; `tests` counts the ray/shadow-polygon tests.
-    #[allow(clippy::too_many_arguments)]
+    /// Change of D for `light` along the ray segment, whose cells holding shadow polygons are
+    /// `cells`; `tests` counts the ray/shadow-polygon tests.
     #[inline]
     pub fn crossings(
         &self,
         light: usize,
         cells: &[u32],
-        o: Vec3,
-        d: Vec3,
-        t0: f32,
-        t1: f32,
+        ray: &Ray,
         mailbox: &mut Mailbox,
         tests: &mut u64,
     ) -> i32 {
+        let (o, d, t0, t1) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
         let (lv, n) = (&self.lights[light], self.lights.len() as u32);
         mailbox.next_ray();
         let moment = (o - lv.light).cross(d);
@@ -347,9 +348,13 @@ pub fn depth_at(polygons: &[ConvexPolygon], light: Vec3, p: Vec3) -> i32 {
 /// The paper's sub-schemes (table 3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Subscheme {
+    /// The condition carried on unchanged.
     Sustain,
+    /// The point faces away from the light.
     SelfShadow,
+    /// Decided by the depth count.
     ShadowVolume,
+    /// Decided by a shadow ray.
     Conventional,
 }
 
@@ -357,8 +362,11 @@ pub enum Subscheme {
 /// the shadow depth flag SDF, and the depth count DC (meaningful when SDF is set).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LightState {
+    /// SC: shadowed where the ray starts (None: unknown).
     pub sc: Option<bool>,
+    /// SDF: the depth count is valid.
     pub sdf: bool,
+    /// DC: the depth count.
     pub dc: i32,
 }
 

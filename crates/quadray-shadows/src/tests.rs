@@ -3,11 +3,11 @@
 //! shadow condition against the conventional test at every shading point.
 
 use crate::cost::{self, MachineCosts};
-use crate::geom::ConvexPolygon;
+use crate::geom::{ConvexPolygon, Ray};
 use crate::grid::{CellRecord, CellSet, Mailbox};
+use crate::prepare::{Prepared, Scheme};
 use crate::scene::{BUILTINS, Face, Scene};
 use crate::shadow::{LightState, ShadowVolumes, depth_at};
-use crate::trace::{Prepared, Scheme};
 use crate::{Nth, RunOptions, SchemeChoice, SplitMix, run};
 use glam::Vec3;
 use std::path::Path;
@@ -99,10 +99,7 @@ fn grid_closest_hit_equals_brute_force() {
             let grid = prep.grid.closest_hit(
                 &prep.cells,
                 &prep.polygons,
-                o,
-                d,
-                0.0,
-                f32::INFINITY,
+                &Ray::new(o, d, 0.0, f32::INFINITY),
                 None,
                 &mut mailbox,
                 None,
@@ -149,17 +146,14 @@ fn the_walk_notes_the_cells_of_the_set_it_crosses_even_on_the_longest_walks() {
             let hit = grid.closest_hit(
                 &no_polygons,
                 &[],
-                o,
-                d,
-                0.0,
-                f32::INFINITY,
+                &Ray::new(o, d, 0.0, f32::INFINITY),
                 None,
                 &mut mailbox,
                 Some((&set, &mut record)),
             );
             assert!(hit.is_none());
             let mut members = Vec::new();
-            grid.walk(o, d, 0.0, f32::INFINITY, |c, _, _| {
+            grid.walk(&Ray::new(o, d, 0.0, f32::INFINITY), |c, _, _| {
                 if c % step == 0 {
                     members.push(c);
                 }
@@ -189,7 +183,7 @@ fn bvh_and_grid_occlusion_equal_brute_force() {
             .iter()
             .any(|p| p.intersect(o, d, 0.0, t_max).is_some());
         assert_eq!(
-            bvh.occluded(&prep.polygons, o, d, 0.0, t_max, None),
+            bvh.occluded(&prep.polygons, &Ray::new(o, d, 0.0, t_max), None),
             brute,
             "bvh {o} {d}"
         );
@@ -197,10 +191,7 @@ fn bvh_and_grid_occlusion_equal_brute_force() {
             prep.grid.occluded(
                 &prep.cells,
                 &prep.polygons,
-                o,
-                d,
-                0.0,
-                t_max,
+                &Ray::new(o, d, 0.0, t_max),
                 None,
                 &mut mailbox
             ),
@@ -252,10 +243,7 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
                 .closest_hit(
                     &prep.cells,
                     &prep.polygons,
-                    o,
-                    d,
-                    0.0,
-                    2.0,
+                    &Ray::new(o, d, 0.0, 2.0),
                     None,
                     &mut objects,
                     Some((volumes.occupied_cells(), &mut occupied)),
@@ -273,8 +261,13 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
                 ) else {
                     continue;
                 };
-                let change =
-                    volumes.crossings(l, occupied.cells(), o, d, 0.0, t1, &mut shadows, &mut tests);
+                let change = volumes.crossings(
+                    l,
+                    occupied.cells(),
+                    &Ray::new(o, d, 0.0, t1),
+                    &mut shadows,
+                    &mut tests,
+                );
                 assert_eq!(
                     d0 + change,
                     d1,
@@ -322,7 +315,7 @@ fn assert_same_as_conventional(scene: &Scene, what: &str) {
 /// Renders with `--check` and asserts on more than `min_points` shading points that at most the
 /// bar's share disagrees with the conventional test.
 fn assert_agrees(scene: &Scene, opts: &RunOptions, min_points: u64, what: &str) {
-    let (_, r) = run(scene.clone(), opts, &|| {});
+    let (_, r) = run(scene.clone(), opts, &|| {}).unwrap();
     let bad = r.disagreements.unwrap();
     let points = r.shading_points;
     assert!(points > min_points, "{what}: {points} shading points");
@@ -414,8 +407,8 @@ fn renders_are_deterministic_and_not_empty() {
         check: false,
         ..options(SchemeChoice::Hst, Nth::Fixed(8.0))
     };
-    let (a, r) = run(Scene::builtin("stars").unwrap(), &opts, &|| {});
-    let (b, _) = run(Scene::builtin("stars").unwrap(), &opts, &|| {});
+    let (a, r) = run(Scene::builtin("stars").unwrap(), &opts, &|| {}).unwrap();
+    let (b, _) = run(Scene::builtin("stars").unwrap(), &opts, &|| {}).unwrap();
     assert_eq!(a, b);
     assert!(
         a.pixels
@@ -440,7 +433,7 @@ fn cost_model_limits() {
         c_o: 1.88,
     };
     let prep = Prepared::new(Scene::builtin("stars").unwrap(), Scheme::Conventional);
-    let mut s = cost::scene_stats(&prep);
+    let mut s = crate::pilot::scene_stats(&prep);
     assert!(s.p > 0.0 && s.p < 1.0 && s.alpha > 0.0 && s.n_c >= 1.0);
     s.n_o = 0.0;
     assert!((cost::conventional_cost(&c, &s) - c.c_i).abs() < 1e-9);
@@ -455,7 +448,7 @@ fn cost_model_limits() {
 
 #[test]
 fn break_even_is_where_shadow_volumes_start_to_cost_more_than_rays() {
-    use crate::trace::CostBins;
+    use crate::cost::CostBins;
     // 100 decisions each: (N_s, ticks of a shadow-volume decision, of a ray); bins 3 to 6.
     let table = [(5, 50, 300), (10, 200, 300), (20, 400, 300), (40, 900, 300)];
     let bins = |table: &[(u32, u64, usize)]| {
@@ -677,22 +670,62 @@ fn self_shadowed_points_carry_a_valid_count_on() {
     );
 }
 
-/// The demo writes one montage per benchmark scene: three captioned tiles side by side.
+/// The builder refuses what would break the tracer, says which face and why, and adds nothing.
 #[test]
-fn the_demo_writes_a_montage_per_scene() {
-    let out = std::env::temp_dir().join(format!("quadray-shadows-demo-{}", std::process::id()));
-    let files = crate::demo::render_demo(&out, 48, |_| {}).unwrap();
-    assert_eq!(
-        files.len(),
-        BUILTINS.len() + crate::bench::ASSET_SCENES.len()
+fn the_builder_refuses_bad_faces_and_scenes_with_clear_errors() {
+    use crate::scene::{BuildError, Camera, Light, Material};
+    let camera = Camera {
+        eye: Vec3::new(0.0, 1.0, 3.0),
+        look_at: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+    };
+    let mut s = Scene::new("built", camera);
+    assert!(
+        matches!(s.validate(), Err(BuildError::Invalid(_))),
+        "no lights"
     );
-    for f in &files {
-        let picture = image::open(f).unwrap();
-        assert!(
-            picture.width() > 3 * 48 && picture.height() > 45,
-            "{}",
-            f.display()
-        );
+    let grey = s.add_material(Material::matte(Vec3::splat(0.5)));
+    let ids: Vec<u32> = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X * 2.0, Vec3::NAN]
+        .map(|p| s.add_vertex(p))
+        .to_vec();
+    let errors = [
+        (vec![0, 1, 9], grey),
+        (vec![0, 1, 2], 7),
+        (vec![0, 1, 4], grey),
+        (vec![0, 1, 3], grey),
+        (vec![0, 1, 1], grey),
+    ]
+    .map(|(v, m)| s.add_face(v, m).unwrap_err().to_string());
+    for (e, why) in errors.iter().zip([
+        "vertex index 9 out of range (5 vertices)",
+        "material 7 out of range (1 materials)",
+        "vertex 4 is not finite",
+        "degenerate",
+        "degenerate",
+    ]) {
+        assert!(e.starts_with("face 0: ") && e.contains(why), "{e}");
     }
-    std::fs::remove_dir_all(&out).unwrap();
+    assert!(s.faces.is_empty());
+    assert_eq!(s.add_face(ids[0..3].to_vec(), grey), Ok(0));
+    // A mesh with a bad triangle is refused whole.
+    let positions = [Vec3::ZERO, Vec3::Z, Vec3::X];
+    assert_eq!(
+        s.add_mesh(&positions, &[0, 1, 2, 0, 1], grey),
+        Err(BuildError::PartialTriangle(5))
+    );
+    assert!(s.add_mesh(&positions, &[0, 1, 2, 0, 1, 3], grey).is_err());
+    assert_eq!((s.faces.len(), s.vertices.len()), (1, 5));
+    s.add_mesh(&positions, &[0, 1, 2], grey).unwrap();
+    assert_eq!((s.faces.len(), s.vertices.len()), (2, 8));
+    assert!(s.add_box(Vec3::ONE, Vec3::ZERO, grey).is_err());
+    for _ in 0..=crate::scene::MAX_LIGHTS {
+        s.add_light(Light::white(Vec3::Y * 4.0, 0.1));
+    }
+    assert!(s.validate().unwrap_err().to_string().contains("9 lights"));
+    s.lights.truncate(1);
+    s.validate().unwrap();
+    s.lights[0].position.x = f32::NAN;
+    let e = run(s, &options(SchemeChoice::Hst, Nth::Fixed(4.0)), &|| {}).unwrap_err();
+    assert!(e.to_string().contains("not finite"), "{e}");
 }

@@ -2,213 +2,39 @@
 //! point for several point lights, mirror reflection and refraction to a depth, supersampling,
 //! rayon over image tiles (deterministic: every pixel depends only on its own rays).
 
-use crate::bvh::Bvh;
-use crate::geom::{Aabb, ConvexPolygon};
-use crate::grid::{CellLists, CellRecord, Grid, Mailbox};
-use crate::scene::Scene;
-use crate::shadow::{LightState, ShadowVolumes, Subscheme};
+use crate::decide::{Arrival, Decision, Hybrid, Scratch, ShadowRays, ShadowTest, Volumes};
+use crate::geom::Ray;
+use crate::grid::{CellRecord, Mailbox};
+use crate::occlusion::Occluder;
+use crate::prepare::{Prepared, Scheme};
+use crate::scene::MAX_LIGHTS;
+use crate::shadow::LightState;
+use crate::stats::RenderStats;
 use glam::Vec3;
 use quadray_core::image_out::Rgba8Image;
 use rayon::prelude::*;
-use serde::Serialize;
 use std::time::Instant;
 
-/// Most lights a scene may have (the per-ray shadow state is a fixed array).
-pub const MAX_LIGHTS: usize = 8;
 const TILE: u32 = 16;
 
-/// How shadows are decided.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Scheme {
-    /// A shadow ray through the grid per light, stopping at the first occluder.
-    Conventional,
-    /// Depth counts carried along every ray segment.
-    Volume,
-    /// The hybrid switch with threshold N_th.
-    Hst { nth: f32 },
-    /// A shadow ray through the SAH BVH.
-    Bvh,
-    /// A shadow ray as an Embree occlusion query (`embree` feature).
-    Embree,
-}
-
-impl Scheme {
-    pub fn name(&self) -> &'static str {
-        match self {
-            Scheme::Conventional => "conventional",
-            Scheme::Volume => "volume",
-            Scheme::Hst { .. } => "hst",
-            Scheme::Bvh => "bvh",
-            Scheme::Embree => "embree",
-        }
-    }
-}
-
+/// One render's parameters.
 #[derive(Clone, Copy, Debug)]
 pub struct Settings {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel.
     pub spp: u32,
+    /// Recursion depth of reflection and refraction.
     pub depth: u32,
+    /// How shadows are decided.
     pub scheme: Scheme,
     /// Also run the conventional test at every shading point and count disagreements.
     pub check: bool,
     /// Also time HST's shadow-volume decisions and shadow rays one by one (the pilot render of
     /// the N_th prediction does; two clock reads per decision are not free).
     pub time_decisions: bool,
-}
-
-/// Everything built before rendering: polygons, grid, shadow polygons, BVH.
-pub struct Prepared {
-    pub scene: Scene,
-    pub polygons: Vec<ConvexPolygon>,
-    pub grid: Grid,
-    pub cells: CellLists,
-    pub volumes: Option<ShadowVolumes>,
-    pub bvh: Option<Bvh>,
-    #[cfg(feature = "embree")]
-    pub embree: Option<crate::embree::EmbreeScene>,
-    /// CPU seconds spent building the grid (always) and the shadow polygons or BVH the scheme
-    /// needs.
-    pub preprocess_s: f64,
-    /// Smallest ray parameter counted as a hit of a ray leaving a surface (scaled to the scene).
-    pub eps: f32,
-    /// Scene statistics of the cost model, computed once on first use.
-    stats: std::sync::OnceLock<crate::cost::SceneStats>,
-    /// The follow-up statistics of the extended N_th, measured once on first use.
-    follow_up: std::sync::OnceLock<crate::cost::FollowUp>,
-    /// The same for shadow rays: much smaller, so a polygon that a shadow ray crosses right next to
-    /// its start (a concave corner) counts, as it does for the depth count. Depth counts take
-    /// every crossing after the segment's start.
-    pub shadow_eps: f32,
-}
-
-impl Prepared {
-    pub fn new(scene: Scene, scheme: Scheme) -> Prepared {
-        let start = crate::process_cpu_s();
-        let polygons = scene.polygons();
-        // The grid holds the eye too, so the eye's depth count describes every eye ray's start.
-        let bounds = polygons
-            .iter()
-            .fold(Aabb::EMPTY, |b, p| b.union(p.bounds()))
-            .grow(scene.camera.eye);
-        let grid = Grid::for_polygons(bounds, polygons.len());
-        let cells = grid.register(polygons.par_iter().map(|p| p.vertices.as_slice()));
-        let volumes = matches!(scheme, Scheme::Volume | Scheme::Hst { .. })
-            .then(|| ShadowVolumes::build(&scene, &polygons, &grid));
-        let bvh = (scheme == Scheme::Bvh).then(|| Bvh::build(&polygons));
-        #[cfg(feature = "embree")]
-        let embree =
-            (scheme == Scheme::Embree).then(|| crate::embree::EmbreeScene::build(&polygons));
-        Prepared {
-            eps: bounds.extent().length() * 1e-5,
-            shadow_eps: bounds.extent().length() * 1e-7,
-            scene,
-            polygons,
-            grid,
-            cells,
-            volumes,
-            bvh,
-            #[cfg(feature = "embree")]
-            embree,
-            preprocess_s: crate::process_cpu_s() - start,
-            stats: std::sync::OnceLock::new(),
-            follow_up: std::sync::OnceLock::new(),
-        }
-    }
-}
-
-impl Prepared {
-    /// The cost model's scene statistics (measured once, so every render of this preparation
-    /// predicts the same N_th).
-    pub fn stats(&self) -> &crate::cost::SceneStats {
-        self.stats.get_or_init(|| crate::cost::scene_stats(self))
-    }
-
-    /// The N_th HST uses with `--nth auto`: equation 12 with the measured break-even and the
-    /// follow-up cost of a conventional decision ([`crate::cost::FollowUp`]), measured once on
-    /// pilot renders of recursion `depth` (without shadow polygons: equation 12 as written).
-    pub fn predicted_nth(
-        &self,
-        costs: &crate::cost::MachineCosts,
-        depth: u32,
-    ) -> (f64, crate::cost::FollowUp) {
-        let stats = self.stats();
-        let equation_12 = crate::cost::predicted_nth(costs, stats);
-        let follow_up = *self
-            .follow_up
-            .get_or_init(|| crate::cost::follow_up(self, equation_12, depth));
-        (
-            crate::cost::extended_nth(costs, stats, &follow_up),
-            follow_up,
-        )
-    }
-}
-
-/// Counts and times of one render.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct RenderStats {
-    pub shading_points: u64,
-    /// Shading points times lights.
-    pub shadow_decisions: u64,
-    /// Shading points where some light's condition differs from the conventional test (--check).
-    pub disagreements: u64,
-    /// Decisions (point, light) that differ from the conventional test (--check).
-    pub disagreeing_decisions: u64,
-    pub sustain: u64,
-    pub self_shadow: u64,
-    pub shadow_volume: u64,
-    pub conventional: u64,
-    pub shadow_polygon_tests: u64,
-    pub shadow_polygon_entries: u64,
-    /// HST's conventional decisions made because of the carried state (the count invalid and the
-    /// condition shadowed or unknown) where N_s alone would have chosen the shadow volume, and
-    /// their N_s summed.
-    pub forced_conventional: u64,
-    pub forced_ns: u64,
-    pub shadow_rays: u64,
-    /// Ticks ([`crate::ticks`]) the tiles' threads spent deciding shadows, and in the tiles.
-    pub shadow_ticks: u64,
-    pub tile_ticks: u64,
-    /// With [`Settings::time_decisions`]: HST's shadow-volume decisions (the crossing tests) and
-    /// its shadow rays, timed and binned by N_s.
-    pub shadow_volume_costs: CostBins,
-    pub shadow_ray_costs: CostBins,
-    pub render_wall_s: f64,
-    /// CPU time of the render, all threads (what the paper's CPU minutes measure; unlike clock
-    /// time it is not inflated by other processes on a shared machine).
-    pub render_cpu_s: f64,
-}
-
-impl RenderStats {
-    fn add(&mut self, o: &RenderStats) {
-        self.shading_points += o.shading_points;
-        self.shadow_decisions += o.shadow_decisions;
-        self.disagreements += o.disagreements;
-        self.disagreeing_decisions += o.disagreeing_decisions;
-        self.sustain += o.sustain;
-        self.self_shadow += o.self_shadow;
-        self.shadow_volume += o.shadow_volume;
-        self.conventional += o.conventional;
-        self.shadow_polygon_tests += o.shadow_polygon_tests;
-        self.shadow_polygon_entries += o.shadow_polygon_entries;
-        self.forced_conventional += o.forced_conventional;
-        self.forced_ns += o.forced_ns;
-        self.shadow_rays += o.shadow_rays;
-        self.shadow_ticks += o.shadow_ticks;
-        self.tile_ticks += o.tile_ticks;
-        self.shadow_volume_costs.merge(&o.shadow_volume_costs);
-        self.shadow_ray_costs.merge(&o.shadow_ray_costs);
-    }
-
-    /// CPU time of shadow testing: the render's CPU time split in the threads' proportion.
-    pub fn shadow_cpu_s(&self) -> f64 {
-        if self.tile_ticks > 0 {
-            self.render_cpu_s * self.shadow_ticks as f64 / self.tile_ticks as f64
-        } else {
-            0.0
-        }
-    }
 }
 
 /// Eye rays of a pinhole camera for an image of `w` x `h` pixels.
@@ -222,6 +48,7 @@ pub struct Pinhole {
 }
 
 impl Pinhole {
+    /// The eye rays of `cam` for a `w` x `h` image.
     pub fn new(cam: &crate::scene::Camera, w: u32, h: u32) -> Self {
         let forward = (cam.look_at - cam.eye).normalize();
         let right = forward.cross(cam.up).normalize();
@@ -243,37 +70,17 @@ impl Pinhole {
     }
 }
 
-/// Per-tile scratch: mailboxes and the cells of the current ray segment.
-struct Scratch {
-    objects: Mailbox,
-    shadows: Mailbox,
-    /// The ground-truth shadow rays of --check, kept apart so they do not disturb the scheme.
-    check: Mailbox,
-    /// The cells of the current ray segment that hold shadow polygons.
-    occupied: CellRecord,
-    stats: RenderStats,
-}
-
 type States = [LightState; MAX_LIGHTS];
 
-/// A shading point and how the ray segment reached it: `p = o + t d` on `polygon`, `n` the normal
-/// on the side it arrived from.
-#[derive(Clone, Copy)]
-struct Arrival {
-    o: Vec3,
-    d: Vec3,
-    t: f32,
-    p: Vec3,
-    n: Vec3,
-    polygon: u32,
-}
-
-struct Tracer<'a> {
+struct Tracer<'a, S> {
     prep: &'a Prepared,
     settings: Settings,
+    test: S,
 }
 
-/// Renders the scene; `on_tile` is called after each finished tile (for a progress bar).
+/// Renders the scene; `on_tile` is called after each finished tile (for a progress bar). The
+/// scene must have at most [`MAX_LIGHTS`] lights and the structures `settings.scheme` needs must
+/// have been prepared.
 pub fn render(
     prep: &Prepared,
     settings: Settings,
@@ -283,7 +90,47 @@ pub fn render(
         prep.scene.lights.len() <= MAX_LIGHTS,
         "at most {MAX_LIGHTS} lights"
     );
-    let tracer = Tracer { prep, settings };
+    let volumes = || prep.volumes.as_ref().expect("shadow volumes prepared");
+    match settings.scheme {
+        Scheme::Conventional => {
+            render_with(prep, settings, ShadowRays(prep.grid_occluder()), on_tile)
+        }
+        Scheme::Bvh => {
+            let bvh = prep.bvh_occluder().expect("BVH prepared");
+            render_with(prep, settings, ShadowRays(bvh), on_tile)
+        }
+        #[cfg(feature = "embree")]
+        Scheme::Embree => {
+            let embree = prep.embree.as_ref().expect("Embree scene prepared");
+            render_with(prep, settings, ShadowRays(embree), on_tile)
+        }
+        #[cfg(not(feature = "embree"))]
+        Scheme::Embree => render_with(prep, settings, ShadowRays(prep.grid_occluder()), on_tile),
+        Scheme::Volume => render_with(prep, settings, Volumes(volumes()), on_tile),
+        Scheme::Hst { nth } => {
+            let test = Hybrid {
+                volumes: volumes(),
+                rays: prep.grid_occluder(),
+                nth,
+                time_decisions: settings.time_decisions,
+            };
+            render_with(prep, settings, test, on_tile)
+        }
+    }
+}
+
+/// [`render`] with the shadow test chosen.
+fn render_with<S: ShadowTest>(
+    prep: &Prepared,
+    settings: Settings,
+    test: S,
+    on_tile: &(dyn Fn() + Sync),
+) -> (Rgba8Image, RenderStats) {
+    let tracer = Tracer {
+        prep,
+        settings,
+        test,
+    };
     let (w, h) = (settings.width, settings.height);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
@@ -315,13 +162,14 @@ pub fn render(
     (image, stats)
 }
 
-impl Tracer<'_> {
+impl<S: ShadowTest> Tracer<'_, S> {
     fn tile(&self, tx: u32, ty: u32) -> (Vec<[u8; 4]>, RenderStats) {
         let start = crate::ticks();
         let prep = self.prep;
         let (w, h) = (self.settings.width, self.settings.height);
         let mut scratch = Scratch {
             objects: Mailbox::new(prep.polygons.len()),
+            rays: self.test.rays(),
             shadows: Mailbox::new(prep.volumes.as_ref().map_or(0, |v| v.max_per_light())),
             check: Mailbox::new(prep.polygons.len()),
             occupied: CellRecord::new(&prep.grid),
@@ -374,7 +222,7 @@ impl Tracer<'_> {
 
     fn trace(
         &self,
-        sc: &mut Scratch,
+        sc: &mut Scratch<S::Rays>,
         o: Vec3,
         d: Vec3,
         skip: Option<u32>,
@@ -386,10 +234,7 @@ impl Tracer<'_> {
         let Some(hit) = prep.grid.closest_hit(
             &prep.cells,
             &prep.polygons,
-            o,
-            d,
-            prep.eps,
-            f32::INFINITY,
+            &Ray::new(o, d, prep.eps, f32::INFINITY),
             skip,
             &mut sc.objects,
             prep.volumes
@@ -417,9 +262,7 @@ impl Tracer<'_> {
             sc,
             &mut states,
             Arrival {
-                o,
-                d,
-                t: hit.t,
+                segment: Ray::new(o, d, 0.0, hit.t),
                 p,
                 n,
                 polygon: hit.polygon,
@@ -433,7 +276,11 @@ impl Tracer<'_> {
             for (l, light) in lights.iter().enumerate() {
                 let to_light = light.position - p;
                 let truth = to_light.dot(n) <= 0.0
-                    || occluded_grid(prep, &mut sc.check, p, to_light, hit.polygon);
+                    || prep.grid_occluder().occluded(
+                        &Ray::segment(p, to_light, prep.shadow_eps),
+                        Some(hit.polygon),
+                        &mut sc.check,
+                    );
                 differs += (truth != shadowed[l]) as u64;
             }
             sc.stats.disagreeing_decisions += differs;
@@ -486,7 +333,7 @@ impl Tracer<'_> {
     #[inline(never)]
     fn shadow_conditions(
         &self,
-        sc: &mut Scratch,
+        sc: &mut Scratch<S::Rays>,
         states: &mut States,
         at: Arrival,
         continues: bool,
@@ -499,227 +346,17 @@ impl Tracer<'_> {
         };
         for (l, light) in prep.scene.lights.iter().enumerate() {
             let to_light = light.position - at.p;
-            let self_shadow = to_light.dot(at.n) <= 0.0;
-            shadowed[l] = self.shadowed(
-                sc,
-                l,
-                ns[l],
-                &mut states[l],
-                &at,
+            let decision = Decision {
+                light: l,
+                ns: ns[l],
                 to_light,
-                self_shadow,
+                self_shadow: to_light.dot(at.n) <= 0.0,
                 continues,
-            );
+            };
+            shadowed[l] = self
+                .test
+                .shadowed(sc, decision, &mut states[l], &at, prep.shadow_eps);
         }
         shadowed
     }
-
-    /// The scheme's shadow condition for light `l` at the shading point, reached through cells
-    /// where `ns` shadow polygons of the light are registered.
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn shadowed(
-        &self,
-        sc: &mut Scratch,
-        l: usize,
-        ns: u32,
-        state: &mut LightState,
-        at: &Arrival,
-        to_light: Vec3,
-        self_shadow: bool,
-        continues: bool,
-    ) -> bool {
-        let prep = self.prep;
-        let Arrival {
-            o,
-            d,
-            t: t_hit,
-            p,
-            polygon,
-            ..
-        } = *at;
-        match self.settings.scheme {
-            Scheme::Conventional | Scheme::Bvh | Scheme::Embree => {
-                sc.stats.conventional += 1;
-                if self_shadow {
-                    return true;
-                }
-                sc.stats.shadow_rays += 1;
-                self.shadow_ray_with(sc, p, to_light, polygon)
-            }
-            Scheme::Volume => {
-                let v = prep.volumes.as_ref().expect("volumes built");
-                sc.stats.shadow_volume += 1;
-                sc.stats.shadow_polygon_entries += ns as u64;
-                let change = v.crossings(
-                    l,
-                    sc.occupied.cells(),
-                    o,
-                    d,
-                    0.0,
-                    t_hit,
-                    &mut sc.shadows,
-                    &mut sc.stats.shadow_polygon_tests,
-                );
-                state.volume_step(change, self_shadow)
-            }
-            Scheme::Hst { nth } => {
-                let v = prep.volumes.as_ref().expect("volumes built");
-                let Scratch {
-                    objects,
-                    shadows,
-                    occupied,
-                    stats,
-                    ..
-                } = sc;
-                let mut rays = 0;
-                let time = self.settings.time_decisions;
-                let (shadowed, sub) = state.hst_step(
-                    ns,
-                    nth,
-                    self_shadow,
-                    continues,
-                    || {
-                        stats.shadow_polygon_entries += ns as u64;
-                        timed(time, ns, &mut stats.shadow_volume_costs, || {
-                            v.crossings(
-                                l,
-                                occupied.cells(),
-                                o,
-                                d,
-                                0.0,
-                                t_hit,
-                                shadows,
-                                &mut stats.shadow_polygon_tests,
-                            )
-                        })
-                    },
-                    || {
-                        rays += 1;
-                        timed(time, ns, &mut stats.shadow_ray_costs, || {
-                            occluded_grid(prep, objects, p, to_light, polygon)
-                        })
-                    },
-                );
-                stats.shadow_rays += rays;
-                // Tallied without branching on the sub-scheme: it changes from one decision to the
-                // next, and a jump on it was mispredicted more often than not.
-                stats.sustain += (sub == Subscheme::Sustain) as u64;
-                stats.self_shadow += (sub == Subscheme::SelfShadow) as u64;
-                stats.shadow_volume += (sub == Subscheme::ShadowVolume) as u64;
-                let conventional = (sub == Subscheme::Conventional) as u64;
-                stats.conventional += conventional;
-                let forced = conventional * (ns > 0 && (ns as f32) <= nth) as u64;
-                stats.forced_conventional += forced;
-                stats.forced_ns += forced * ns as u64;
-                shadowed
-            }
-        }
-    }
-
-    fn shadow_ray_with(&self, sc: &mut Scratch, p: Vec3, to_light: Vec3, polygon: u32) -> bool {
-        let prep = self.prep;
-        let dist = to_light.length();
-        #[cfg(feature = "embree")]
-        if let Some(embree) = &prep.embree {
-            return embree.occluded(p, to_light / dist, prep.eps, dist);
-        }
-        match &prep.bvh {
-            Some(bvh) => bvh.occluded(
-                &prep.polygons,
-                p,
-                to_light / dist,
-                prep.shadow_eps,
-                dist,
-                Some(polygon),
-            ),
-            None => occluded_grid(prep, &mut sc.objects, p, to_light, polygon),
-        }
-    }
-}
-
-/// `f()`, timed into `bins` as a decision of N_s `ns` when `on`.
-#[inline(always)]
-fn timed<R>(on: bool, ns: u32, bins: &mut CostBins, f: impl FnOnce() -> R) -> R {
-    if !on {
-        return f();
-    }
-    let start = crate::ticks();
-    let r = f();
-    bins.add(ns, crate::ticks().wrapping_sub(start));
-    r
-}
-
-/// Number of [`CostBins`].
-pub const COST_BINS: usize = 12;
-
-/// A timed decision that took this many times its bin's median was interrupted (the thread was
-/// descheduled or served an interrupt): one such decision of a millisecond would outweigh a
-/// thousand real ones in the bin's mean.
-const INTERRUPTED: u64 = 16;
-
-/// Timed decisions, read by N_s in bins: bin 0 holds N_s = 0, bin b N_s in `[2^(b-1), 2^b)`,
-/// the last all above.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
-pub struct CostBins {
-    /// (N_s, ticks) of each decision.
-    samples: Vec<(u32, u64)>,
-}
-
-impl CostBins {
-    pub fn add(&mut self, ns: u32, ticks: u64) {
-        self.samples.push((ns, ticks));
-    }
-
-    fn merge(&mut self, o: &CostBins) {
-        self.samples.extend_from_slice(&o.samples);
-    }
-
-    fn bin(ns: u32) -> usize {
-        ((u32::BITS - ns.leading_zeros()) as usize).min(COST_BINS - 1)
-    }
-
-    /// Mean N_s and mean ticks of bin `b`'s decisions, if it has at least `min` of them, the
-    /// interrupted ones left out.
-    pub fn mean(&self, b: usize, min: usize) -> Option<(f64, f64)> {
-        let bin: Vec<(u32, u64)> = self
-            .samples
-            .iter()
-            .copied()
-            .filter(|&(ns, _)| Self::bin(ns) == b)
-            .collect();
-        if bin.len() < min.max(1) {
-            return None;
-        }
-        let mut ticks: Vec<u64> = bin.iter().map(|&(_, t)| t).collect();
-        let half = ticks.len() / 2;
-        let limit = INTERRUPTED * *ticks.select_nth_unstable(half).1;
-        let kept: Vec<&(u32, u64)> = bin.iter().filter(|&&(_, t)| t <= limit).collect();
-        let n = kept.len() as f64;
-        Some((
-            kept.iter().map(|&&(ns, _)| ns as f64).sum::<f64>() / n,
-            kept.iter().map(|&&(_, t)| t as f64).sum::<f64>() / n,
-        ))
-    }
-}
-
-/// A shadow ray from `p` (on `polygon`) to the light through the grid.
-fn occluded_grid(
-    prep: &Prepared,
-    mailbox: &mut Mailbox,
-    p: Vec3,
-    to_light: Vec3,
-    polygon: u32,
-) -> bool {
-    let dist = to_light.length();
-    prep.grid.occluded(
-        &prep.cells,
-        &prep.polygons,
-        p,
-        to_light / dist,
-        prep.shadow_eps,
-        dist,
-        Some(polygon),
-        mailbox,
-    )
 }

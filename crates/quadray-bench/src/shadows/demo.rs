@@ -2,10 +2,10 @@
 //! Cornell box, the bunny) with conventional shadow rays and with HST side by side, and where their
 //! pixels differ.
 
-use crate::bench::bench_scenes;
-use crate::{Nth, RunOptions, SchemeChoice, cost, run};
+use super::measure::bench_scenes;
 use quadray_core::FileError;
 use quadray_core::image_out::{heat_map, montage};
+use quadray_shadows::{Nth, RunOptions, SchemeChoice, cost, run};
 use std::path::{Path, PathBuf};
 
 /// A pixel difference this large (of 255, largest channel) is white in the heat map.
@@ -37,13 +37,15 @@ pub fn render_demo(
     for scene in scenes {
         let name = scene.name.clone();
         progress(&format!("{name}: conventional"));
+        let invalid = |e: quadray_shadows::BuildError| FileError::new(Path::new(&name), e);
         let (conventional, c) = run(
             scene.clone(),
             &options(SchemeChoice::Conventional, false),
             &|| {},
-        );
+        )
+        .map_err(invalid)?;
         progress(&format!("{name}: hst"));
-        let (hst, h) = run(scene, &options(SchemeChoice::Hst, true), &|| {});
+        let (hst, h) = run(scene, &options(SchemeChoice::Hst, true), &|| {}).map_err(invalid)?;
         let difference: Vec<f32> = conventional
             .pixels
             .iter()
@@ -81,4 +83,27 @@ pub fn render_demo(
         files.push(path);
     }
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::measure::ASSET_SCENES;
+    use quadray_shadows::scene::BUILTINS;
+
+    /// The demo writes one montage per benchmark scene: three captioned tiles side by side.
+    #[test]
+    fn the_demo_writes_a_montage_per_scene() {
+        let out = std::env::temp_dir().join(format!("quadray-shadows-demo-{}", std::process::id()));
+        let files = super::render_demo(&out, 48, |_| {}).unwrap();
+        assert_eq!(files.len(), BUILTINS.len() + ASSET_SCENES.len());
+        for f in &files {
+            let picture = image::open(f).unwrap();
+            assert!(
+                picture.width() > 3 * 48 && picture.height() > 45,
+                "{}",
+                f.display()
+            );
+        }
+        std::fs::remove_dir_all(&out).unwrap();
+    }
 }

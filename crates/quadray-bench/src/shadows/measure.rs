@@ -1,13 +1,16 @@
-//! `quadray bench shadows`: the paper's tables 1-4 and figure 6 on the four look-alike scenes,
-//! with the SAH BVH as today's baseline. Every time is the median of several renders; methods are
+//! The measurements of `quadray bench shadows`: every scheme on the four look-alike scenes and
+//! the two asset scenes, the N_th sweep of figure 6 and the paired renders that hold the
+//! predicted N_th against the best. Every time is the median of several renders; methods are
 //! compared as ratios within one run.
 
-use crate::cost::{self, MachineCosts, SceneStats};
-use crate::scene::{BUILTINS, Scene};
-use crate::trace::Prepared;
-use crate::{Nth, RunOptions, RunReport, SchemeChoice, prepare, render_prepared};
+use super::tables::{figure6, markdown};
 use quadray_core::FileError;
-use quadray_core::bench::{PlotSpec, Series, Table, line_plot, write_json, write_text};
+use quadray_core::bench::{write_json, write_text};
+use quadray_shadows::cost::{self, MachineCosts, SceneStats};
+use quadray_shadows::scene::{BUILTINS, Scene, SceneError, assets_dir};
+use quadray_shadows::{
+    Nth, Prepared, RunOptions, RunReport, SchemeChoice, prepare, render_prepared,
+};
 use serde::Serialize;
 use std::path::Path;
 
@@ -84,11 +87,17 @@ struct Contender {
 }
 
 impl Contender {
-    fn new(scene: &Scene, opts: RunOptions, costs: &MachineCosts, runs: usize) -> Self {
+    fn new(
+        scene: &Scene,
+        opts: RunOptions,
+        costs: &MachineCosts,
+        runs: usize,
+    ) -> Result<Self, FileError> {
         let mut preprocess = Vec::new();
         let mut prep = None;
         for _ in 0..runs {
-            let p = prepare(scene.clone(), opts.scheme);
+            let p = prepare(scene.clone(), opts.scheme)
+                .map_err(|e| FileError::new(Path::new(&scene.name), e))?;
             preprocess.push(p.preprocess_s);
             prep = Some(p);
         }
@@ -98,13 +107,13 @@ impl Contender {
             ..opts
         };
         let (_, check) = render_prepared(&prep, &checked, costs, &|| {});
-        Self {
+        Ok(Self {
             opts,
             prep,
             preprocess,
             check,
             reports: Vec::new(),
-        }
+        })
     }
 
     fn render(&mut self, costs: &MachineCosts) {
@@ -132,13 +141,13 @@ impl Contender {
 
 /// The scenes of the benchmark: the four look-alikes, then the Cornell box and the bunny from
 /// the repository's assets.
-pub fn bench_scenes() -> Result<Vec<Scene>, crate::scene::SceneError> {
+pub fn bench_scenes() -> Result<Vec<Scene>, SceneError> {
     let mut scenes: Vec<Scene> = BUILTINS
         .iter()
         .map(|(name, ..)| Scene::builtin(name).expect("builtin"))
         .collect();
     for file in ASSET_SCENES {
-        scenes.push(Scene::load(&crate::scene::assets_dir().join(file))?);
+        scenes.push(Scene::load(&assets_dir().join(file))?);
     }
     Ok(scenes)
 }
@@ -192,7 +201,7 @@ pub fn bench_shadows(
         let mut contenders: Vec<Contender> = schemes
             .iter()
             .map(|&scheme| Contender::new(&scene, RunOptions { scheme, ..base }, &costs, runs))
-            .collect();
+            .collect::<Result<_, _>>()?;
         // Interleaved rounds, so that a busy spell of the machine weighs on every scheme alike.
         for _ in 0..runs {
             for c in &mut contenders {
@@ -289,256 +298,4 @@ pub fn bench_shadows(
     }
     write_text(&out.join("shadows.md"), &markdown(&results))?;
     Ok(results)
-}
-
-fn figure6(path: &Path, s: &SceneResult) -> Result<(), FileError> {
-    let ms = |x: f64| x * 1e3;
-    let xmax = s.sweep.last().map_or(1.0, |p| p.nth);
-    let flat = |name: &str, y: f64| Series {
-        name: name.into(),
-        points: vec![(0.0, ms(y)), (xmax, ms(y))],
-    };
-    let top = s
-        .sweep
-        .iter()
-        .map(|p| p.shadow)
-        .chain(s.schemes.iter().map(|r| r.shadow))
-        .fold(0.0, f64::max);
-    let mut series = vec![
-        Series {
-            name: "HST".into(),
-            points: s.sweep.iter().map(|p| (p.nth, ms(p.shadow))).collect(),
-        },
-        flat("conventional", s.schemes[0].shadow),
-        flat("shadow volume", s.schemes[1].shadow),
-        flat("BVH shadow rays", s.schemes[3].shadow),
-        Series {
-            name: format!("predicted N_th = {:.1}", s.predicted_nth),
-            points: vec![
-                (s.predicted_nth.min(xmax), 0.0),
-                (s.predicted_nth.min(xmax), ms(top)),
-            ],
-        },
-    ];
-    if let Some(embree) = s.schemes.get(4) {
-        series.push(flat("Embree shadow rays", embree.shadow));
-    }
-    let title = format!("{}: shadow testing time against N_th", s.scene);
-    let spec = PlotSpec {
-        title: &title,
-        x_label: "N_th",
-        y_label: "shadow testing (ms)",
-        log_x: false,
-        log_y: false,
-    };
-    line_plot(path, &spec, &series)
-}
-
-fn markdown(r: &BenchResults) -> String {
-    let pct = |x: f64, of: f64| format!("{:.0}%", 100.0 * x / of.max(1e-12));
-    let ms = |x: f64| format!("{:.1}", x * 1e3);
-    let mut md = format!(
-        "## Hybrid shadow testing (`quadray bench shadows{}`)\n\n{}x{}, recursion depth {}, 1 sample per pixel, median of {} render(s), {} threads. \
-         Times are CPU milliseconds of all threads (the paper reports CPU minutes); ratios from one run. \
-         Shadow time at the predicted N_th over the best N_th of the sweep: median of {} paired renders.\n\n",
-        if r.quick { " --quick" } else { "" },
-        r.width,
-        r.height,
-        r.depth,
-        r.runs,
-        r.threads,
-        r.confirm_rounds
-    );
-    let c = &r.costs_ns;
-    let mut t1 = Table::new(
-        "Table 1: machine constants (ns; the paper: 2.00, 2.54, 0.23, 1.88 ms)",
-        &["C_s", "C_i", "C_c", "C_o"],
-    );
-    t1.row(vec![
-        format!("{:.1}", c.c_s),
-        format!("{:.1}", c.c_i),
-        format!("{:.1}", c.c_c),
-        format!("{:.1}", c.c_o),
-    ]);
-    md += &t1.to_markdown();
-    let mut t2 = Table::new(
-        "Table 2: scene statistics and predicted N_th",
-        &[
-            "scene",
-            "A_avg",
-            "L_avg",
-            "n_or",
-            "N_ot",
-            "grid",
-            "alpha",
-            "p",
-            "N_c",
-            "N_th eq. 12",
-            "break-even N_s (pilot)",
-            "forced / free shadow rays",
-            "N_th predicted",
-            "N_th best (sweep)",
-        ],
-    );
-    for s in &r.scenes {
-        let st = &s.stats;
-        t2.row(vec![
-            s.scene.clone(),
-            format!("{:.4}", st.mean_area),
-            format!("{:.3}", st.mean_perimeter),
-            format!("{:.3}", st.n_or),
-            st.polygons.to_string(),
-            format!("{}x{}x{}", st.grid[0], st.grid[1], st.grid[2]),
-            format!("{:.3}", st.alpha),
-            format!("{:.3}", st.p),
-            format!("{:.1}", st.n_c),
-            format!("{:.2}", s.equation_12_nth),
-            s.follow_up
-                .break_even
-                .map_or("-".into(), |n| format!("{n:.1}")),
-            format!("{:.2}", s.follow_up.ratio),
-            format!("{:.2}", s.predicted_nth),
-            format!("{}", (s.best_nth * 10.0).round() / 10.0),
-        ]);
-    }
-    md += "\n";
-    md += &t2.to_markdown();
-    let mut t3 = Table::new(
-        "Table 3: HST sub-schemes at the predicted N_th (per light and shading point)",
-        &[
-            "scene",
-            "sustain",
-            "self-shadow",
-            "shadow volume",
-            "conventional",
-            "total",
-        ],
-    );
-    for s in &r.scenes {
-        let sub = &s.schemes[2].report.subschemes;
-        let total = (sub.sustain + sub.self_shadow + sub.shadow_volume + sub.conventional) as f64;
-        let cell = |n: u64| format!("{n} ({})", pct(n as f64, total));
-        t3.row(vec![
-            s.scene.clone(),
-            cell(sub.sustain),
-            cell(sub.self_shadow),
-            cell(sub.shadow_volume),
-            cell(sub.conventional),
-            format!("{total}"),
-        ]);
-    }
-    md += "\n";
-    md += &t3.to_markdown();
-    let mut t4 = Table::new(
-        "Table 4: preprocessing / shadow testing / other / total (ms)",
-        &[
-            "scene",
-            "scheme",
-            "preprocess",
-            "shadow",
-            "other",
-            "total",
-            "shadow / conventional",
-            "total / conventional",
-        ],
-    );
-    for s in &r.scenes {
-        let conv = &s.schemes[0];
-        for row in &s.schemes {
-            let name = match row.nth {
-                Some(n) => format!("{} (N_th={:.1})", row.scheme, n),
-                None => row.scheme.clone(),
-            };
-            t4.row(vec![
-                s.scene.clone(),
-                name,
-                format!(
-                    "{} ({})",
-                    ms(row.preprocess),
-                    pct(row.preprocess, row.total)
-                ),
-                format!("{} ({})", ms(row.shadow), pct(row.shadow, row.total)),
-                format!("{} ({})", ms(row.other), pct(row.other, row.total)),
-                ms(row.total),
-                format!("{:.2}", row.shadow / conv.shadow),
-                format!("{:.2}", row.total / conv.total),
-            ]);
-        }
-    }
-    md += "\n";
-    md += &t4.to_markdown();
-    let mut summary = Table::new(
-        "Summary: HST against the conventional grid test and the SAH BVH; sameness",
-        &[
-            "scene",
-            "hst/conventional shadow",
-            "hst/conventional total",
-            "hst/bvh shadow",
-            "hst/embree shadow",
-            "shadow at predicted / best N_th (paired renders)",
-            "disagreements volume",
-            "disagreements hst",
-            "shading points",
-        ],
-    );
-    let (mut shadow_sum, mut total_sum, mut n) = (0.0, 0.0, 0.0);
-    for s in &r.scenes {
-        let (conv, vol, hst, bvh) = (&s.schemes[0], &s.schemes[1], &s.schemes[2], &s.schemes[3]);
-        if BUILTINS.iter().any(|b| b.0 == s.scene) {
-            shadow_sum += hst.shadow / conv.shadow;
-            total_sum += hst.total / conv.total;
-            n += 1.0;
-        }
-        summary.row(vec![
-            s.scene.clone(),
-            format!("{:.2}", hst.shadow / conv.shadow),
-            format!("{:.2}", hst.total / conv.total),
-            format!("{:.2}", hst.shadow / bvh.shadow),
-            s.schemes
-                .get(4)
-                .map_or("-".into(), |e| format!("{:.2}", hst.shadow / e.shadow)),
-            format!("{:.2}", s.predicted_over_best),
-            format!(
-                "{} ({:.1e})",
-                vol.disagreements,
-                vol.disagreements as f64 / vol.shading_points as f64
-            ),
-            format!(
-                "{} ({:.1e})",
-                hst.disagreements,
-                hst.disagreements as f64 / hst.shading_points as f64
-            ),
-            hst.shading_points.to_string(),
-        ]);
-    }
-    summary.row(vec![
-        "mean of the four look-alikes".into(),
-        format!("{:.2}", shadow_sum / n),
-        format!("{:.2}", total_sum / n),
-        String::new(),
-        String::new(),
-        String::new(),
-        String::new(),
-        String::new(),
-        String::new(),
-    ]);
-    md += "\n";
-    md += &summary.to_markdown();
-    let mut sweep = Table::new(
-        "Figure 6 data: HST shadow time (ms) against N_th (fig6-SCENE.svg)",
-        &["N_th"],
-    );
-    sweep
-        .columns
-        .extend(r.scenes.iter().map(|s| s.scene.clone()));
-    if let Some(first) = r.scenes.first() {
-        for (i, p) in first.sweep.iter().enumerate() {
-            let mut row = vec![format!("{}", p.nth)];
-            row.extend(r.scenes.iter().map(|s| ms(s.sweep[i].shadow)));
-            sweep.row(row);
-        }
-    }
-    md += "\n";
-    md += &sweep.to_markdown();
-    md
 }
