@@ -17,6 +17,34 @@ pub enum Convention {
     DepthPhoto,
 }
 
+impl Convention {
+    /// Every convention.
+    pub const ALL: [Convention; 3] = [
+        Convention::Height,
+        Convention::Depth,
+        Convention::DepthPhoto,
+    ];
+
+    /// The name `--convention` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Convention::Height => "height",
+            Convention::Depth => "depth",
+            Convention::DepthPhoto => "depth-photo",
+        }
+    }
+}
+
+impl std::str::FromStr for Convention {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| format!("unknown convention `{s}` (height, depth, depth-photo)"))
+    }
+}
+
 /// What to do with a map that is not 2^n x 2^n.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fit {

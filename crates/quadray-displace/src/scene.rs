@@ -17,6 +17,24 @@ pub enum SurfaceKind {
 }
 
 impl SurfaceKind {
+    /// Every surface.
+    pub const ALL: [SurfaceKind; 4] = [
+        SurfaceKind::Wall,
+        SurfaceKind::Terrain,
+        SurfaceKind::Photo,
+        SurfaceKind::Torus,
+    ];
+
+    /// The name `--surface` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            SurfaceKind::Wall => "wall",
+            SurfaceKind::Terrain => "terrain",
+            SurfaceKind::Photo => "photo",
+            SurfaceKind::Torus => "torus",
+        }
+    }
+
     pub fn tiles(self) -> u32 {
         match self {
             SurfaceKind::Wall | SurfaceKind::Torus => 8,
@@ -73,15 +91,10 @@ impl SurfaceKind {
 impl std::str::FromStr for SurfaceKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "wall" => Ok(SurfaceKind::Wall),
-            "terrain" => Ok(SurfaceKind::Terrain),
-            "photo" => Ok(SurfaceKind::Photo),
-            "torus" => Ok(SurfaceKind::Torus),
-            _ => Err(format!(
-                "unknown surface `{s}` (one of: wall, terrain, photo, torus)"
-            )),
-        }
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown surface `{s}` (one of: wall, terrain, photo, torus)"))
     }
 }
 
