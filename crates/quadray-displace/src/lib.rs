@@ -9,7 +9,9 @@
 //! same way.
 //!
 //! Data flows one way: [`heightmap`] (load) -> [`pyramid`] (build) -> [`gpu`] (trace and shade)
-//! -> [`accuracy`] (measure against [`reference`]).
+//! -> [`accuracy`] (measure against [`reference`](mod@reference)).
+
+#![warn(missing_docs)]
 
 pub mod accuracy;
 pub mod gpu;
