@@ -253,7 +253,9 @@ fn main() {
     let picture = render(&device, &queue, &tile_map());
     let out: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples");
     std::fs::create_dir_all(&out).expect("create out/examples");
-    let path = out.join("displaced_quad.png");
+    let path = std::fs::canonicalize(out)
+        .expect("out/examples")
+        .join("displaced_quad.png");
     picture.save(&path).expect("write the picture");
     println!("{}", path.display());
 }
