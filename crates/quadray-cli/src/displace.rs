@@ -36,19 +36,19 @@ pub struct DisplaceArgs {
     #[arg(long, default_value_t = 5)]
     binary_steps: u32,
     /// Finest pyramid level: `auto` (from screen-space derivatives) or a level number.
-    #[arg(long, default_value = "0", value_parser = parse_lod)]
+    #[arg(long, default_value = "0")]
     lod: Lod,
     /// Self-shadowing by tracing from the light.
     #[arg(long)]
     shadows: bool,
     /// Camera azimuth around the surface normal, degrees.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     azimuth: f32,
     /// Camera distance as a multiple of the default.
     #[arg(long, default_value_t = 1.0)]
     zoom: f32,
     /// Light azimuth around the surface normal, degrees.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     light_azimuth: f32,
     /// Colour pixels by the iterations their search took (0..64: black, red, yellow, white).
     #[arg(long)]
@@ -61,7 +61,7 @@ pub struct DisplaceArgs {
     surface: SurfaceKind,
     /// How the map stores its values: height (white = high), depth (white = deep) or depth-photo
     /// (a Kinect/TUM depth image: 0 = no measurement).
-    #[arg(long, default_value = "height", value_parser = parse_convention)]
+    #[arg(long, default_value = "height")]
     convention: Convention,
     /// Resample maps that are not 2^n x 2^n to the nearest power of two instead of refusing them.
     #[arg(long)]
@@ -80,27 +80,6 @@ pub struct DisplaceArgs {
 
 fn parse_layers(s: &str) -> Result<(u32, u32), String> {
     quadray_core::parse_pair(s, ',', "MIN,MAX")
-}
-
-fn parse_lod(s: &str) -> Result<Lod, String> {
-    match s {
-        "auto" => Ok(Lod::Auto),
-        n => n
-            .parse()
-            .map(Lod::Level)
-            .map_err(|_| format!("`{s}` is not `auto` or a level")),
-    }
-}
-
-fn parse_convention(s: &str) -> Result<Convention, String> {
-    match s {
-        "height" => Ok(Convention::Height),
-        "depth" => Ok(Convention::Depth),
-        "depth-photo" => Ok(Convention::DepthPhoto),
-        _ => Err(format!(
-            "unknown convention `{s}` (height, depth, depth-photo)"
-        )),
-    }
 }
 
 #[derive(Serialize)]
@@ -127,22 +106,29 @@ struct Stats<'a> {
     error_map: Option<PathBuf>,
 }
 
+impl DisplaceArgs {
+    /// The library's settings these flags spell (`Settings::to_args` spells them back).
+    fn settings(&self) -> Settings {
+        Settings {
+            method: self.method,
+            view_angle_deg: self.view_angle,
+            width: self.size.0,
+            height: self.size.1,
+            depth_scale: self.depth_scale,
+            layers: self.layers,
+            binary_steps: self.binary_steps,
+            lod: self.lod,
+            shadows: self.shadows,
+            azimuth_deg: self.azimuth,
+            zoom: self.zoom,
+            light_azimuth_deg: self.light_azimuth,
+            show_iterations: self.show_iterations,
+        }
+    }
+}
+
 pub fn run(args: DisplaceArgs) -> Result<()> {
-    let settings = Settings {
-        method: args.method,
-        view_angle_deg: args.view_angle,
-        width: args.size.0,
-        height: args.size.1,
-        depth_scale: args.depth_scale,
-        layers: args.layers,
-        binary_steps: args.binary_steps,
-        lod: args.lod,
-        shadows: args.shadows,
-        azimuth_deg: args.azimuth,
-        zoom: args.zoom,
-        light_azimuth_deg: args.light_azimuth,
-        show_iterations: args.show_iterations,
-    };
+    let settings = args.settings();
     if let Err(e) = settings.validate() {
         bail!("{e}");
     }
@@ -205,4 +191,47 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
         None => println!("{json}"),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: DisplaceArgs,
+    }
+
+    /// The viewer prints `Settings::to_args` beside its screenshots: every setting must come back
+    /// through these flags unchanged, defaults and otherwise.
+    #[test]
+    fn settings_round_trip_through_the_flags() {
+        let changed = Settings {
+            method: Method::Relief,
+            view_angle_deg: 71.5,
+            width: 96,
+            height: 64,
+            depth_scale: 0.25,
+            layers: (3, 40),
+            binary_steps: 7,
+            lod: Lod::Auto,
+            shadows: true,
+            azimuth_deg: -12.25,
+            zoom: 1.5,
+            light_azimuth_deg: -200.0,
+            show_iterations: true,
+        };
+        for settings in [Settings::default(), changed] {
+            let mut argv = vec![
+                "displace".to_string(),
+                "--map=m.png".into(),
+                "--out=o.png".into(),
+            ];
+            argv.extend(settings.to_args());
+            let cli = Cli::try_parse_from(&argv).unwrap();
+            assert_eq!(cli.args.settings(), settings, "{argv:?}");
+        }
+    }
 }

@@ -130,10 +130,12 @@ fn main() -> Result<()> {
             }
             let gpu = quadray_gpu::Gpu::new()?;
             let bar = spinner("displacement");
-            let files =
-                quadray_displace::demo::render_demo(&gpu, &out.join("displace"), size, |m| {
-                    bar.set_message(format!("displacement: {m}"))
-                })?;
+            let files = quadray_bench::displace::demo::render_demo(
+                &gpu,
+                &out.join("displace"),
+                size,
+                |m| bar.set_message(format!("displacement: {m}")),
+            )?;
             bar.finish_and_clear();
             let files = files.into_iter().chain(indirect::demo(&gpu, &out, size)?);
             let bar = spinner("ray tracing");
@@ -150,10 +152,10 @@ fn main() -> Result<()> {
         } => {
             let gpu = quadray_gpu::Gpu::new()?;
             let bar = spinner("bench displace");
-            let results = quadray_displace::bench::run(
+            let results = quadray_bench::displace::run(
                 &gpu,
                 &out,
-                quadray_displace::bench::BenchOptions { quick },
+                quadray_bench::displace::BenchOptions { quick },
                 |m| bar.set_message(format!("bench displace: {m}")),
             )?;
             bar.finish_and_clear();

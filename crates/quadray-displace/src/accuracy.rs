@@ -13,16 +13,23 @@ use quadray_core::image_out::{Rgba8Image, heat_map};
 pub const STATUS_MISMATCH_TEXELS: f32 = 8.0;
 
 #[derive(Clone, Debug, serde::Serialize)]
+/// A GPU frame measured against the ground truth.
 pub struct Accuracy {
     /// Pixels that show the surface.
     pub covered: usize,
+    /// Covered pixels more than a texel off (or of the wrong hit/miss status).
     pub wrong: usize,
+    /// `wrong` / `covered`.
     pub wrong_hit_fraction: f64,
+    /// Mean distance to the true hit over covered pixels, in texels.
     pub mean_error_texels: f64,
+    /// Largest distance to the true hit, in texels.
     pub max_error_texels: f64,
     #[serde(skip)]
+    /// Frame width in pixels.
     pub width: u32,
     #[serde(skip)]
+    /// Frame height in pixels.
     pub height: u32,
     /// Per pixel, the distance to the true hit in texels (NaN where there is no surface).
     #[serde(skip)]
@@ -30,6 +37,7 @@ pub struct Accuracy {
 }
 
 impl Accuracy {
+    /// Traces every pixel's ray of `frame` on the CPU against `truth` and compares the hits.
     pub fn measure(frame: &Frame, map: &HeightMap, addressing: Addressing, truth: Surface) -> Self {
         let rays: Vec<Option<Ray>> = frame
             .rays
@@ -84,12 +92,16 @@ impl Accuracy {
 /// Iterations per pixel and how many pixels the iteration cap stopped.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Cost {
+    /// Mean iterations over covered pixels.
     pub mean_iterations: f64,
+    /// Most iterations any pixel took.
     pub max_iterations: u32,
+    /// Pixels a cap stopped (must be 0).
     pub iteration_cap_hits: usize,
 }
 
 impl Cost {
+    /// The cost of `frame`'s searches.
     pub fn of(frame: &Frame) -> Self {
         let covered = frame.hits.iter().filter(|h| h[2] != -2.0);
         let (mut sum, mut max, mut caps, mut n) = (0.0, 0u32, 0, 0usize);

@@ -1,4 +1,4 @@
-//! Height maps in the spec's convention: depth in [0,1] (0 = the polygon's plane, 1 = deepest),
+//! Height maps in the spec's convention: depth in `[0, 1]` (0 = the polygon's plane, 1 = deepest),
 //! 2^n x 2^n texels, row-major with row 0 at v = 0.
 
 use std::path::{Path, PathBuf};
@@ -17,15 +17,46 @@ pub enum Convention {
     DepthPhoto,
 }
 
+impl Convention {
+    /// Every convention.
+    pub const ALL: [Convention; 3] = [
+        Convention::Height,
+        Convention::Depth,
+        Convention::DepthPhoto,
+    ];
+
+    /// The name `--convention` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Convention::Height => "height",
+            Convention::Depth => "depth",
+            Convention::DepthPhoto => "depth-photo",
+        }
+    }
+}
+
+impl std::str::FromStr for Convention {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| format!("unknown convention `{s}` (height, depth, depth-photo)"))
+    }
+}
+
 /// What to do with a map that is not 2^n x 2^n.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fit {
+    /// Refuse it with an error suggesting `--resample`.
     Refuse,
     /// Bilinear resampling to the nearest power of two (1025 -> 1024, 348 -> 256, 640x480 -> 512).
     Resample,
 }
 
+/// Why a map was refused; every message names the file.
 #[derive(Debug, Error)]
+#[allow(missing_docs)] // each variant's message says what its fields are
 pub enum HeightMapError {
     #[error("{path}: cannot read the image: {reason}")]
     Unreadable { path: PathBuf, reason: String },
@@ -57,9 +88,11 @@ pub enum HeightMapError {
 pub const MAX_SIZE: u32 = 8192;
 
 #[derive(Clone, Debug, PartialEq)]
+/// A square 2^n x 2^n height field in depth convention.
 pub struct HeightMap {
     /// log2 of the side: the pyramid has `levels + 1` levels, the root being 1x1.
     pub levels: u32,
+    /// Depths in [0, 1], row-major, row 0 at v = 0.
     pub depth: Vec<f32>,
 }
 
@@ -77,15 +110,17 @@ fn all_finite(path: &Path, values: &[f32], width: u32) -> Result<(), HeightMapEr
 }
 
 impl HeightMap {
+    /// Texels per side (2^levels).
     pub fn size(&self) -> u32 {
         1 << self.levels
     }
 
+    /// The depth of texel (x, y).
     pub fn at(&self, x: u32, y: u32) -> f32 {
         self.depth[(y * self.size() + x) as usize]
     }
 
-    /// Builds a map from depths in [0,1]; `name` is used in errors.
+    /// Builds a map from depths in `[0, 1]`; `name` is used in errors.
     pub fn from_depths(name: &Path, size: u32, depth: Vec<f32>) -> Result<Self, HeightMapError> {
         if size == 0 || depth.is_empty() {
             return Err(HeightMapError::Empty { path: name.into() });

@@ -3,12 +3,17 @@
 //! baselines it is compared against (bump, parallax, POM, relief, a real displaced mesh); and the
 //! exact CPU ground truth every GPU method is measured against.
 //!
+//! To displace surfaces in your own renderer: load a [`heightmap::HeightMap`], build a
+//! [`HeightPyramid`] on your `wgpu::Device`, and include [`TRACE_WGSL`] in your fragment shader
+//! (`examples/displaced_quad.rs` is a whole program). quadray's own [`Renderer`] is built the
+//! same way.
+//!
 //! Data flows one way: [`heightmap`] (load) -> [`pyramid`] (build) -> [`gpu`] (trace and shade)
-//! -> [`accuracy`] (measure against [`reference`]).
+//! -> [`accuracy`] (measure against [`reference`](mod@reference)).
+
+#![warn(missing_docs)]
 
 pub mod accuracy;
-pub mod bench;
-pub mod demo;
 pub mod gpu;
 pub mod heightmap;
 pub mod maps;
@@ -16,19 +21,27 @@ pub mod method;
 pub mod pyramid;
 pub mod reference;
 pub mod scene;
+pub mod settings;
 
 /// Anything that can go wrong between a map file and a measured picture.
 #[derive(Debug, thiserror::Error)]
 pub enum DisplaceError {
+    /// The map could not be loaded.
     #[error(transparent)]
     HeightMap(#[from] heightmap::HeightMapError),
+    /// The GPU refused the work.
     #[error(transparent)]
     Gpu(#[from] quadray_gpu::GpuError),
+    /// An output could not be written.
     #[error(transparent)]
     File(#[from] quadray_core::FileError),
+    /// The settings make no picture.
     #[error("invalid parameters: {0}")]
     Settings(String),
 }
 
-pub use gpu::{Frame, Lod, Renderer, Settings, Targets};
+pub use gpu::{
+    Frame, HeightPyramid, PyramidBuilder, PyramidInfo, PyramidKind, Renderer, TRACE_WGSL, Targets,
+};
 pub use method::Method;
+pub use settings::{Lod, Settings};

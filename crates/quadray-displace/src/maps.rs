@@ -5,19 +5,25 @@ use crate::scene::SurfaceKind;
 use quadray_core::image_out::Rgba8Image;
 use std::path::{Path, PathBuf};
 
+/// A height map bundled under `assets/`, and how quadray shows it.
 pub struct BundledMap {
+    /// Its short name (the viewer's and the benchmark's).
     pub name: &'static str,
     /// Relative to the assets folder.
     pub file: &'static str,
+    /// How the file stores its values.
     pub convention: Convention,
+    /// An albedo image beside it, relative to the assets folder.
     pub color: Option<&'static str>,
     /// Sharp maps (steep walls) are where searches by fixed steps fail.
     pub sharp: bool,
+    /// The surface it is shown on.
     pub surface: SurfaceKind,
     /// The paper's row this map stands in for (tables 1 and 2).
     pub paper_row: &'static str,
 }
 
+/// Every bundled map: tiles (the sharp one), bevy-cube, puget-sound, tum-photo.
 pub const BUNDLED: [BundledMap; 4] = [
     BundledMap {
         name: "tiles",
@@ -68,6 +74,7 @@ pub fn assets_dir() -> PathBuf {
 }
 
 impl BundledMap {
+    /// Loads the map (resampled to a power of two when it is not one).
     pub fn load(&self) -> Result<HeightMap, HeightMapError> {
         HeightMap::load(
             &assets_dir().join(self.file),
@@ -76,6 +83,7 @@ impl BundledMap {
         )
     }
 
+    /// Loads its albedo image, if it has one.
     pub fn load_color(&self) -> Result<Option<Rgba8Image>, HeightMapError> {
         self.color
             .map(|rel| load_color(&assets_dir().join(rel)))

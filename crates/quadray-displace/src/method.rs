@@ -4,6 +4,7 @@ use crate::reference::Surface;
 use std::fmt;
 use std::str::FromStr;
 
+/// A way to find where a view ray meets the height field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
@@ -13,6 +14,7 @@ pub enum Method {
     PyramidAscend,
     /// Section 3.3: the bilinear surface, on the conservative pyramid.
     PyramidBilinear,
+    /// Bump mapping: no search, only the shading normal changes.
     Bump,
     /// Parallax mapping with offset limiting.
     Parallax,
@@ -25,6 +27,7 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method, in shader-id order.
     pub const ALL: [Method; 8] = [
         Method::Pyramid,
         Method::PyramidAscend,
@@ -36,6 +39,7 @@ impl Method {
         Method::Mesh,
     ];
 
+    /// The name `--method` takes.
     pub fn name(self) -> &'static str {
         match self {
             Method::Pyramid => "pyramid",
@@ -49,9 +53,21 @@ impl Method {
         }
     }
 
-    /// The value of the shader's METHOD override constant.
-    pub(crate) fn shader_id(self) -> f64 {
-        Self::ALL.iter().position(|&m| m == self).expect("listed") as f64
+    /// The method's id in WGSL: the value of the surface shader's METHOD override constant.
+    pub fn shader_id(self) -> u32 {
+        Self::ALL.iter().position(|&m| m == self).expect("listed") as u32
+    }
+
+    /// WGSL constants naming every id, `const METHOD_PYRAMID_ASCEND: u32 = 1u;` and so on: the
+    /// shaders compare METHOD with these, so the ids are spelled only here.
+    pub fn wgsl_constants() -> String {
+        Self::ALL
+            .iter()
+            .map(|m| {
+                let name = m.name().to_uppercase().replace('-', "_");
+                format!("const METHOD_{name}: u32 = {}u;\n", m.shader_id())
+            })
+            .collect()
     }
 
     /// The surface whose exact intersection is this method's ground truth: the pyramid methods
@@ -69,6 +85,7 @@ impl Method {
         self != Method::Mesh
     }
 
+    /// Methods that trace the conservative pyramid (section 3.3) rather than the point one.
     pub fn uses_conservative_pyramid(self) -> bool {
         self == Method::PyramidBilinear
     }

@@ -8,11 +8,14 @@ use crate::heightmap::HeightMap;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Addressing {
+    /// Reads wrap around (a tiled surface).
     Wrap,
+    /// Reads clamp to the edge (a terrain patch).
     Clamp,
 }
 
 impl Addressing {
+    /// Texel index `i` of a `size`-texel row under this addressing.
     pub fn texel(self, i: i64, size: u32) -> u32 {
         match self {
             Addressing::Wrap => i.rem_euclid(size as i64) as u32,
@@ -24,6 +27,7 @@ impl Addressing {
 /// All levels, finest first: `levels[k]` is (2^(n-k))^2 depths.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pyramid {
+    /// `levels[k]` holds (2^(n-k))^2 depths, row-major.
     pub levels: Vec<Vec<f32>>,
 }
 

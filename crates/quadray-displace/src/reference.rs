@@ -20,12 +20,16 @@ pub enum Surface {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
+/// A tangent-space ray P(z) = p0 + e z.
 pub struct Ray {
+    /// Where the ray meets the polygon (uv).
     pub p0: DVec2,
+    /// uv change per unit of depth.
     pub e: DVec2,
 }
 
 impl Ray {
+    /// The ray's uv at depth `z`.
     pub fn at(&self, z: f64) -> DVec2 {
         self.p0 + self.e * z
     }
@@ -34,10 +38,13 @@ impl Ray {
 /// Where a ray meets the surface, or `None` when it leaves a clamped (terrain) map first.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// Hit uv.
     pub uv: DVec2,
+    /// Hit depth.
     pub z: f64,
 }
 
+/// The exact first intersection of `ray` with `surface`, or `None` when it leaves a clamped map.
 pub fn intersect(
     map: &HeightMap,
     addressing: Addressing,

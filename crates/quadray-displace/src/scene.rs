@@ -17,6 +17,25 @@ pub enum SurfaceKind {
 }
 
 impl SurfaceKind {
+    /// Every surface.
+    pub const ALL: [SurfaceKind; 4] = [
+        SurfaceKind::Wall,
+        SurfaceKind::Terrain,
+        SurfaceKind::Photo,
+        SurfaceKind::Torus,
+    ];
+
+    /// The name `--surface` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            SurfaceKind::Wall => "wall",
+            SurfaceKind::Terrain => "terrain",
+            SurfaceKind::Photo => "photo",
+            SurfaceKind::Torus => "torus",
+        }
+    }
+
+    /// Texture repeats per side of the surface.
     pub fn tiles(self) -> u32 {
         match self {
             SurfaceKind::Wall | SurfaceKind::Torus => 8,
@@ -24,6 +43,7 @@ impl SurfaceKind {
         }
     }
 
+    /// Whether rays wrap around the map (a tiled surface) rather than leave it.
     pub fn wraps(self) -> bool {
         matches!(self, SurfaceKind::Wall | SurfaceKind::Torus)
     }
@@ -73,25 +93,24 @@ impl SurfaceKind {
 impl std::str::FromStr for SurfaceKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "wall" => Ok(SurfaceKind::Wall),
-            "terrain" => Ok(SurfaceKind::Terrain),
-            "photo" => Ok(SurfaceKind::Photo),
-            "torus" => Ok(SurfaceKind::Torus),
-            _ => Err(format!(
-                "unknown surface `{s}` (one of: wall, terrain, photo, torus)"
-            )),
-        }
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown surface `{s}` (one of: wall, terrain, photo, torus)"))
     }
 }
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+/// A surface vertex as the surface pass reads it.
 pub struct Vertex {
+    /// World position.
     pub position: [f32; 3],
+    /// World normal.
     pub normal: [f32; 3],
     /// xyz: world direction of +u; w: sign such that +v = w * (N x T).
     pub tangent: [f32; 4],
+    /// Texture coordinate (one repeat per unit).
     pub uv: [f32; 2],
 }
 
@@ -165,12 +184,16 @@ impl bevy_mikktspace::Geometry for TriangleList {
 /// The plane every surface lies in: y = 0, +u along +x, +v along +z, normal +y; one tile is one
 /// world unit.
 pub struct Plane {
+    /// The corner where u = v = 0.
     pub origin: Vec3,
+    /// World vector per unit of u.
     pub u: Vec3,
+    /// World vector per unit of v.
     pub v: Vec3,
 }
 
 impl Plane {
+    /// The plane of a surface kind (its centre at the origin).
     pub fn of(kind: SurfaceKind) -> Self {
         let extent = kind.tiles() as f32;
         Self {
@@ -180,6 +203,7 @@ impl Plane {
         }
     }
 
+    /// The unit normal, v x u.
     pub fn normal(&self) -> Vec3 {
         self.v.cross(self.u).normalize()
     }
@@ -215,8 +239,11 @@ impl Plane {
 /// view direction at the surface centre and the surface normal, looking 30 degrees off the v axis
 /// so both DDA axes work; [`View::orbit`] puts the camera anywhere on its sphere.
 pub struct View {
+    /// Projection times view.
     pub view_proj: Mat4,
+    /// Camera position.
     pub eye: Vec3,
+    /// Light position.
     pub light: Vec3,
 }
 

@@ -4,11 +4,10 @@
 mod common;
 
 use quadray_displace::accuracy::{Accuracy, Cost};
-use quadray_displace::gpu::{PyramidBuilder, read_pyramid};
 use quadray_displace::pyramid::{Addressing, Pyramid};
 use quadray_displace::scene::SurfaceKind;
-use quadray_displace::{Lod, Method, Renderer, Settings};
-use quadray_gpu::Gpu;
+use quadray_displace::{HeightPyramid, Lod, Method, PyramidKind, Renderer, Settings};
+use quadray_gpu::{Gpu, read_texture_f32};
 
 const ANGLES: [f32; 6] = [0.0, 30.0, 60.0, 70.0, 80.0, 85.0];
 
@@ -30,29 +29,45 @@ fn settings(method: Method, angle: f32) -> Settings {
     }
 }
 
+/// Every level of a pyramid, read back, finest first.
+fn read_back(gpu: &Gpu, pyramid: &HeightPyramid) -> Vec<Vec<f32>> {
+    (0..=pyramid.levels())
+        .map(|level| read_texture_f32(gpu, pyramid.texture(), level, 1).unwrap())
+        .collect()
+}
+
 #[test]
-fn gpu_pyramids_are_bit_identical_to_the_cpu_ones() {
+fn gpu_and_uploaded_pyramids_are_bit_identical_to_the_cpu_ones() {
     let gpu = Gpu::new().expect("a GPU adapter");
-    let builder = PyramidBuilder::new(&gpu);
+    let (device, queue) = (&gpu.device, &gpu.queue);
     for (name, map, _) in common::bundled_maps() {
         let cases = [
-            (None, Pyramid::build(&map)),
+            (PyramidKind::Point, Pyramid::build(&map)),
             (
-                Some(Addressing::Wrap),
+                PyramidKind::Conservative(Addressing::Wrap),
                 Pyramid::build_conservative(&map, Addressing::Wrap),
             ),
             (
-                Some(Addressing::Clamp),
+                PyramidKind::Conservative(Addressing::Clamp),
                 Pyramid::build_conservative(&map, Addressing::Clamp),
             ),
         ];
-        for (conservative, cpu) in cases {
-            let (_, texture) = builder.build(&gpu, &map, conservative, None);
-            let levels = read_pyramid(&gpu, &texture).unwrap();
-            assert_eq!(levels.len(), cpu.levels.len(), "{name}");
-            for (k, (g, c)) in levels.iter().zip(&cpu.levels).enumerate() {
-                let same = g.iter().zip(c).all(|(a, b)| a.to_bits() == b.to_bits());
-                assert!(same, "{name} {conservative:?}: level {k} differs");
+        for (kind, cpu) in cases {
+            let built = [
+                ("gpu", HeightPyramid::build_gpu(device, queue, &map, kind)),
+                ("cpu", HeightPyramid::build_cpu(device, queue, &map, kind)),
+            ];
+            for (how, pyramid) in built {
+                assert_eq!(pyramid.levels(), map.levels, "{name} {how}");
+                let levels = read_back(&gpu, &pyramid);
+                assert_eq!(levels.len(), cpu.levels.len(), "{name} {how}");
+                for (k, (g, c)) in levels.iter().zip(&cpu.levels).enumerate() {
+                    let same = g.iter().zip(c).all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(
+                        same,
+                        "{name} {kind:?} built on the {how}: level {k} differs"
+                    );
+                }
             }
         }
     }

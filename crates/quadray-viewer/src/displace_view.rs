@@ -35,30 +35,6 @@ impl MapChoice {
             })
             .collect()
     }
-
-    fn convention_flag(&self) -> &'static str {
-        match self.convention {
-            Convention::Height => "height",
-            Convention::Depth => "depth",
-            Convention::DepthPhoto => "depth-photo",
-        }
-    }
-}
-
-const SURFACES: [SurfaceKind; 4] = [
-    SurfaceKind::Wall,
-    SurfaceKind::Terrain,
-    SurfaceKind::Photo,
-    SurfaceKind::Torus,
-];
-
-fn surface_flag(s: SurfaceKind) -> &'static str {
-    match s {
-        SurfaceKind::Wall => "wall",
-        SurfaceKind::Terrain => "terrain",
-        SurfaceKind::Photo => "photo",
-        SurfaceKind::Torus => "torus",
-    }
 }
 
 pub struct DisplaceView {
@@ -199,39 +175,16 @@ impl DisplaceView {
 
     /// The `quadray displace` command that renders this view headless.
     pub fn command_line(&self, out: &Path) -> String {
-        let s = &self.settings;
         let choice = &self.maps[self.map];
         let mut cmd = format!(
-            "quadray displace --map {} --convention {} --resample --surface {} --method {} \
-             --view-angle {} --azimuth {} --zoom {} --light-azimuth {} --size {}x{} \
-             --depth-scale {} --layers {},{} --binary-steps {} --lod {}",
+            "quadray displace --map {} --convention {} --resample --surface {} {}",
             shell_word(&choice.path),
-            choice.convention_flag(),
-            surface_flag(self.surface),
-            s.method,
-            s.view_angle_deg,
-            s.azimuth_deg,
-            s.zoom,
-            s.light_azimuth_deg,
-            s.width,
-            s.height,
-            s.depth_scale,
-            s.layers.0,
-            s.layers.1,
-            s.binary_steps,
-            match s.lod {
-                Lod::Auto => "auto".to_string(),
-                Lod::Level(l) => l.to_string(),
-            },
+            choice.convention.name(),
+            self.surface.name(),
+            self.settings.to_args().join(" "),
         );
         if let Some(c) = &choice.color {
             cmd += &format!(" --color {}", shell_word(c));
-        }
-        if s.shadows {
-            cmd += " --shadows";
-        }
-        if s.show_iterations {
-            cmd += " --show-iterations";
         }
         cmd + &format!(" --out {}", shell_word(out))
     }
@@ -259,10 +212,10 @@ impl DisplaceView {
                 }
             });
         egui::ComboBox::from_label("surface")
-            .selected_text(surface_flag(self.surface))
+            .selected_text(self.surface.name())
             .show_ui(ui, |ui| {
-                for k in SURFACES {
-                    ui.selectable_value(&mut self.surface, k, surface_flag(k));
+                for k in SurfaceKind::ALL {
+                    ui.selectable_value(&mut self.surface, k, k.name());
                 }
             });
         egui::ComboBox::from_label("method")

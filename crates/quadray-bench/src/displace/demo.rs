@@ -1,35 +1,14 @@
 //! The pictures a person looks at: for every bundled map and a few view angles, every method side
 //! by side with the error heat maps of the searches; self-shadowing; LOD levels (figure 18).
 
-use crate::DisplaceError;
-use crate::accuracy::{Accuracy, Cost};
-use crate::gpu::{Lod, Renderer, Settings};
-use crate::maps::BUNDLED;
-use crate::method::Method;
-use crate::pyramid::Addressing;
-use crate::scene::SurfaceKind;
 use quadray_core::image_out::{Rgba8Image, montage};
+use quadray_displace::accuracy::{Accuracy, Cost};
+use quadray_displace::maps::BUNDLED;
+use quadray_displace::pyramid::Addressing;
+use quadray_displace::scene::SurfaceKind;
+use quadray_displace::{DisplaceError, Lod, Method, Renderer, Settings};
 use quadray_gpu::Gpu;
 use std::path::{Path, PathBuf};
-
-/// POM as Bevy ships it: 16 layers at grazing angles down to 1 head-on, depth scale 0.1.
-pub fn bevy_pom() -> Settings {
-    Settings {
-        method: Method::Pom,
-        layers: (1, 16),
-        ..Default::default()
-    }
-}
-
-/// Relief mapping as three.js's example ships it: 20..25 layers and 5 binary steps.
-pub fn threejs_relief() -> Settings {
-    Settings {
-        method: Method::Relief,
-        layers: (20, 25),
-        binary_steps: 5,
-        ..Default::default()
-    }
-}
 
 fn caption(s: &Settings) -> String {
     match s.method {
@@ -84,13 +63,13 @@ pub fn render_demo(
                     view_angle_deg: angle,
                     width: size,
                     height: size,
-                    ..bevy_pom()
+                    ..Settings::bevy_pom()
                 },
                 Settings {
                     view_angle_deg: angle,
                     width: size,
                     height: size,
-                    ..threejs_relief()
+                    ..Settings::threejs_relief()
                 },
                 Settings {
                     method: Method::Parallax,
@@ -130,8 +109,8 @@ pub fn render_demo(
                 shadows: true,
                 ..Default::default()
             },
-            bevy_pom(),
-            threejs_relief(),
+            Settings::bevy_pom(),
+            Settings::threejs_relief(),
         ] {
             let s = at(s);
             let frame = torus.render(gpu, &s)?;

@@ -1,0 +1,243 @@
+//! `quadray bench displace`: the paper's tables 1 and 2 and figures 20 and 21 as GPU-time ratios
+//! measured in one run, an accuracy-vs-view-angle table for every method, and how many POM layers
+//! it takes to match the pyramid's accuracy. Writes results.json, results.md and SVG plots.
+//! Each table or figure is one function ([`timing`], [`accuracy`]); [`run`] runs them in order.
+
+pub mod accuracy;
+pub mod demo;
+pub mod timing;
+
+use quadray_core::bench::{Table, write_json, write_text};
+use quadray_displace::heightmap::HeightMap;
+use quadray_displace::maps::BundledMap;
+use quadray_displace::pyramid::Addressing;
+use quadray_displace::{DisplaceError, Lod, Method, Renderer, Settings};
+use quadray_gpu::Gpu;
+use serde::Serialize;
+use std::path::Path;
+
+/// How much to measure.
+#[derive(Clone, Copy, Debug)]
+pub struct BenchOptions {
+    /// Smaller frames, fewer angles and sizes, fewer frames: minutes on a software rasterizer.
+    pub quick: bool,
+}
+
+/// One timed configuration.
+#[derive(Serialize)]
+pub struct TimingRow {
+    pub experiment: String,
+    pub map: String,
+    pub map_size: u32,
+    pub method: String,
+    pub width: u32,
+    pub height: u32,
+    pub view_angle_deg: f32,
+    pub gpu_time_ms: Option<f64>,
+    pub p10_ms: Option<f64>,
+    pub p90_ms: Option<f64>,
+    pub frames: usize,
+    pub memory_bytes: u64,
+}
+
+/// One method's accuracy on one map at one view angle.
+#[derive(Serialize)]
+pub struct AccuracyRow {
+    pub map: String,
+    pub method: String,
+    pub view_angle_deg: f32,
+    pub wrong_hit_fraction: f64,
+    pub mean_error_texels: f64,
+    pub covered: usize,
+    pub mean_iterations: f64,
+    pub iteration_cap_hits: usize,
+}
+
+/// The paper's claims as ratios.
+#[derive(Serialize, Default)]
+pub struct Ratios {
+    /// pyramid / POM-16 GPU time at 512x512 with a 256^2 map (target <= 1.5).
+    pub pyramid_over_pom16_paper_size: Option<f64>,
+    /// The same at 1920x1080 with a 1024^2 map.
+    pub pyramid_over_pom16_today: Option<f64>,
+    /// POM layers needed to reach the pyramid's accuracy on the sharp map at 80 degrees.
+    pub pom_layers_to_match: Option<u32>,
+    /// POM time at that layer count / pyramid time (target >= 5).
+    pub pom_matched_over_pyramid: Option<f64>,
+    /// The last POM layer count tried: (layers, wrong-hit fraction, POM time / pyramid time).
+    pub pom_most_layers: Option<(u32, f64, Option<f64>)>,
+    /// Pyramid time with the 4096^2 map / with the 256^2 map (target <= 1.3).
+    pub pyramid_4096_over_256: Option<f64>,
+    /// The same with the LOD of section 3.4 chosen from screen-space derivatives.
+    pub pyramid_lod_auto_4096_over_256: Option<f64>,
+    /// Pyramid with LOD from derivatives / POM-16 at 1920x1080 (POM samples level 0 as here).
+    pub pyramid_lod_auto_over_pom16_today: Option<f64>,
+}
+
+/// Everything results.json holds.
+#[derive(Serialize)]
+pub struct Results {
+    pub adapter: String,
+    pub software_rasterizer: bool,
+    pub quick: bool,
+    pub frames: usize,
+    pub timings: Vec<TimingRow>,
+    pub accuracy: Vec<AccuracyRow>,
+    pub ratios: Ratios,
+    pub tables: Vec<Table>,
+}
+
+/// The measuring context every table shares: the GPU, how long to time, and the timings so far.
+pub struct Bench<'a> {
+    pub gpu: &'a Gpu,
+    pub quick: bool,
+    /// Frames per median.
+    pub frames: usize,
+    /// The paper's screen side (smaller when quick).
+    pub paper: u32,
+    pub timings: Vec<TimingRow>,
+}
+
+impl Bench<'_> {
+    /// Times `s` on `renderer` and keeps the row; returns the median GPU ms.
+    pub fn time(
+        &mut self,
+        experiment: &str,
+        name: &str,
+        map: &HeightMap,
+        renderer: &mut Renderer,
+        s: &Settings,
+    ) -> Result<Option<f64>, DisplaceError> {
+        let summary = renderer.time(self.gpu, s, self.frames)?;
+        let mut label = match s.method {
+            Method::Pom | Method::Relief => format!("{}-{}", s.method, s.layers.1),
+            m => m.to_string(),
+        };
+        if s.lod == Lod::Auto {
+            label += " lod-auto";
+        }
+        self.timings.push(TimingRow {
+            experiment: experiment.into(),
+            map: name.into(),
+            map_size: map.size(),
+            method: label,
+            width: s.width,
+            height: s.height,
+            view_angle_deg: s.view_angle_deg,
+            gpu_time_ms: summary.map(|t| t.median_ms),
+            p10_ms: summary.map(|t| t.p10_ms),
+            p90_ms: summary.map(|t| t.p90_ms),
+            frames: self.frames,
+            memory_bytes: renderer.memory_bytes(s.method),
+        });
+        Ok(summary.map(|t| t.median_ms))
+    }
+
+    /// `s` at the paper's screen size and its 60 degree view.
+    pub fn paper_view(&self, s: Settings) -> Settings {
+        Settings {
+            width: self.paper,
+            height: self.paper,
+            view_angle_deg: 60.0,
+            ..s
+        }
+    }
+}
+
+/// A method with a fixed POM / relief layer count.
+pub fn fixed_layers(method: Method, layers: u32) -> Settings {
+    Settings {
+        method,
+        layers: (layers, layers),
+        binary_steps: 5,
+        ..Default::default()
+    }
+}
+
+fn ms(v: Option<f64>) -> String {
+    v.map_or("n/a".into(), |v| format!("{v:.3}"))
+}
+
+fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    Some(a? / b?)
+}
+
+fn ratio_text(v: Option<f64>) -> String {
+    v.map_or("n/a".into(), |v| format!("{v:.2}"))
+}
+
+fn addressing(b: &BundledMap) -> Addressing {
+    if b.surface.wraps() {
+        Addressing::Wrap
+    } else {
+        Addressing::Clamp
+    }
+}
+
+/// Runs every table and figure, writes results.json, results.md and the plots into `out`.
+pub fn run(
+    gpu: &Gpu,
+    out: &Path,
+    opts: BenchOptions,
+    mut progress: impl FnMut(&str),
+) -> Result<Results, DisplaceError> {
+    let quick = opts.quick;
+    let mut bench = Bench {
+        gpu,
+        quick,
+        frames: if quick { 5 } else { 30 },
+        paper: if quick { 256 } else { 512 },
+        timings: Vec::new(),
+    };
+    let mut ratios = Ratios::default();
+    progress("tables 1, 2 and figure 20");
+    let mut tables = timing::tables_1_2_figure_20(&mut bench, &mut ratios)?;
+    progress("figure 21");
+    let tiles = quadray_displace::maps::BUNDLED[0].load()?;
+    tables.push(timing::figure_21(&mut bench, &tiles, out, &mut ratios)?);
+    progress("pyramid build");
+    tables.push(timing::pyramid_build(&bench, &tiles)?);
+    progress("1920x1080");
+    tables.push(timing::todays_frame(&mut bench, &tiles, &mut ratios)?);
+    progress("accuracy by view angle");
+    let (accuracy_tables, accuracy) = accuracy::by_view_angle(&bench, out)?;
+    tables.extend(accuracy_tables);
+    progress("POM layers to match the pyramid");
+    tables.push(accuracy::pom_layers_to_match(
+        &mut bench,
+        &tiles,
+        out,
+        &mut ratios,
+    )?);
+
+    let results = Results {
+        adapter: gpu.describe(),
+        software_rasterizer: gpu.is_software(),
+        quick,
+        frames: bench.frames,
+        timings: bench.timings,
+        accuracy,
+        ratios,
+        tables,
+    };
+    write_json(&out.join("results.json"), &results)?;
+    let mut md = format!(
+        "# quadray bench displace\n\nAdapter: {}{}\n\n",
+        results.adapter,
+        if results.software_rasterizer {
+            " (software rasterizer: compare ratios only)"
+        } else {
+            ""
+        }
+    );
+    md += &format!(
+        "Ratios: {}\n\n",
+        serde_json::to_string(&results.ratios).unwrap_or_default()
+    );
+    for t in &results.tables {
+        md += &t.to_markdown();
+        md.push('\n');
+    }
+    write_text(&out.join("results.md"), &md)?;
+    Ok(results)
+}

@@ -1,0 +1,276 @@
+//! The paper's timing tables and figures (tables 1 and 2, figures 20 and 21, the pyramid build)
+//! and today's frame size, each as the rows it measured.
+
+use super::{Bench, Ratios, fixed_layers, ms, ratio, ratio_text};
+use quadray_core::bench::{PlotSpec, Series, Table, line_plot};
+use quadray_core::stats::time_cpu;
+use quadray_displace::heightmap::HeightMap;
+use quadray_displace::maps::{BUNDLED, resized};
+use quadray_displace::pyramid::Pyramid;
+use quadray_displace::scene::SurfaceKind;
+use quadray_displace::{
+    DisplaceError, Lod, Method, PyramidBuilder, PyramidKind, Renderer, Settings,
+};
+use quadray_gpu::GpuTimer;
+use std::path::Path;
+
+/// The map sides of figure 21 and the pyramid build table.
+fn map_sizes(quick: bool) -> &'static [u32] {
+    if quick {
+        &[256, 512, 1024]
+    } else {
+        &[256, 512, 1024, 2048, 4096]
+    }
+}
+
+/// Tables 1 (point vs bilinear) and 2 (POM vs relief vs pyramid) and figure 20 (the displaced
+/// mesh), measured in the same renders: the paper's screen size, 256^2 maps.
+pub fn tables_1_2_figure_20(
+    bench: &mut Bench,
+    ratios: &mut Ratios,
+) -> Result<Vec<Table>, DisplaceError> {
+    let (gpu, paper) = (bench.gpu, bench.paper);
+    let mut t1 = Table::new(
+        format!("Table 1: point vs bilinear, GPU ms ({paper}x{paper}, 256^2 maps, 60 deg)"),
+        &[
+            "map (paper row)",
+            "pyramid (point)",
+            "pyramid-bilinear",
+            "bilinear / point",
+        ],
+    );
+    let mut t2 = Table::new(
+        format!(
+            "Table 2: POM vs relief vs pyramid, GPU ms ({paper}x{paper}, 256^2 maps, 16 layers)"
+        ),
+        &[
+            "map (paper row)",
+            "pom-16",
+            "relief-16+5",
+            "pyramid",
+            "pyramid-ascend",
+            "pyramid / pom-16",
+        ],
+    );
+    let mut f20 = Table::new(
+        format!(
+            "Figure 20: displaced mesh (2 x 256^2 triangles) vs pyramid ({paper}x{paper}, one 256^2 tile)"
+        ),
+        &["map", "method", "GPU ms", "memory (MB)"],
+    );
+    for b in BUNDLED.iter().filter(|b| b.paper_row != "-") {
+        let map = resized(&b.load()?, 256);
+        let mut r = Renderer::new(gpu, &map, None, b.surface);
+        let mut time = |experiment, method| {
+            let s = bench.paper_view(fixed_layers(method, 16));
+            bench.time(experiment, b.name, &map, &mut r, &s)
+        };
+        let point = time("table1", Method::Pyramid)?;
+        let bilinear = time("table1", Method::PyramidBilinear)?;
+        let pom = time("table2", Method::Pom)?;
+        let relief = time("table2", Method::Relief)?;
+        let ascend = time("table2", Method::PyramidAscend)?;
+        let row = format!("{} ({})", b.name, b.paper_row);
+        t1.row(vec![
+            row.clone(),
+            ms(point),
+            ms(bilinear),
+            ratio_text(ratio(bilinear, point)),
+        ]);
+        t2.row(vec![
+            row,
+            ms(pom),
+            ms(relief),
+            ms(point),
+            ms(ascend),
+            ratio_text(ratio(point, pom)),
+        ]);
+        if b.name == "tiles" {
+            ratios.pyramid_over_pom16_paper_size = ratio(point, pom);
+            // One copy of the map, as in the paper's figure: 2 * 256^2 triangles for the mesh.
+            let mut one = Renderer::new(gpu, &map, None, SurfaceKind::Terrain);
+            for method in [Method::Pyramid, Method::Mesh] {
+                let s = bench.paper_view(fixed_layers(method, 16));
+                let t = bench.time("figure20", b.name, &map, &mut one, &s)?;
+                let mb = one.memory_bytes(method) as f64 / 1e6;
+                f20.row(vec![
+                    b.name.into(),
+                    method.to_string(),
+                    ms(t),
+                    format!("{mb:.2}"),
+                ]);
+            }
+        }
+    }
+    Ok(vec![t1, t2, f20])
+}
+
+/// Figure 21: GPU time against map size (and its plot, figure21_map_size.svg in `out`).
+pub fn figure_21(
+    bench: &mut Bench,
+    tiles: &HeightMap,
+    out: &Path,
+    ratios: &mut Ratios,
+) -> Result<Table, DisplaceError> {
+    let (gpu, paper, sizes) = (bench.gpu, bench.paper, map_sizes(bench.quick));
+    let mut f21 = Table::new(
+        format!("Figure 21: GPU ms by map size ({paper}x{paper}, tiles, 60 deg)"),
+        &[
+            "map size",
+            "pyramid",
+            "pyramid-ascend",
+            "pyramid lod-auto",
+            "pyramid / at 256^2",
+            "lod-auto / at 256^2",
+        ],
+    );
+    let variants = [
+        ("pyramid", fixed_layers(Method::Pyramid, 16)),
+        ("pyramid-ascend", fixed_layers(Method::PyramidAscend, 16)),
+        (
+            "pyramid lod-auto",
+            Settings {
+                lod: Lod::Auto,
+                ..fixed_layers(Method::Pyramid, 16)
+            },
+        ),
+    ];
+    let mut f21_series: Vec<Series> = variants
+        .iter()
+        .map(|(name, _)| Series {
+            name: name.to_string(),
+            points: vec![],
+        })
+        .collect();
+    let mut at_256 = [None; 3];
+    for &size in sizes {
+        let map = resized(tiles, size);
+        let mut r = Renderer::new(gpu, &map, None, BUNDLED[0].surface);
+        let mut times = [None; 3];
+        for (k, (_, s)) in variants.iter().enumerate() {
+            times[k] = bench.time(
+                "figure21",
+                "tiles",
+                &map,
+                &mut r,
+                &bench.paper_view(s.clone()),
+            )?;
+            if let Some(t) = times[k] {
+                f21_series[k].points.push((f64::from(size), t));
+            }
+        }
+        if size == 256 {
+            at_256 = times;
+        }
+        if size == 4096 {
+            ratios.pyramid_4096_over_256 = ratio(times[0], at_256[0]);
+            ratios.pyramid_lod_auto_4096_over_256 = ratio(times[2], at_256[2]);
+        }
+        let r = |k: usize| ratio_text(ratio(times[k], at_256[k]));
+        f21.row(vec![
+            format!("{size}^2"),
+            ms(times[0]),
+            ms(times[1]),
+            ms(times[2]),
+            r(0),
+            r(2),
+        ]);
+    }
+    if f21_series.iter().all(|s| !s.points.is_empty()) {
+        let spec = PlotSpec {
+            title: "GPU time by map size (figure 21)",
+            x_label: "map side (texels)",
+            y_label: "GPU ms",
+            log_x: true,
+            log_y: false,
+        };
+        line_plot(&out.join("figure21_map_size.svg"), &spec, &f21_series)?;
+    }
+    Ok(f21)
+}
+
+/// Section 3.1: building the pyramid, on the CPU (the paper: 2.3 ms for 256^2) and on the GPU.
+pub fn pyramid_build(bench: &Bench, tiles: &HeightMap) -> Result<Table, DisplaceError> {
+    let (gpu, frames, sizes) = (bench.gpu, bench.frames, map_sizes(bench.quick));
+    let mut build = Table::new(
+        "Pyramid build (section 3.1): CPU ms (median, one thread) and GPU ms (compute, timestamps)",
+        &["map size", "CPU", "GPU"],
+    );
+    let builder = PyramidBuilder::new(&gpu.device);
+    for &size in sizes {
+        let map = resized(tiles, size);
+        let (_, cpu) = time_cpu(frames, || Pyramid::build(&map));
+        let mut timer = GpuTimer::new(gpu, 1);
+        for _ in 0..frames {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let kind = PyramidKind::Point;
+            let writes = timer.compute_pass(0);
+            builder.record(&gpu.device, &gpu.queue, &mut encoder, &map, kind, writes);
+            timer.resolve(&mut encoder);
+            gpu.queue.submit([encoder.finish()]);
+            timer.collect(gpu)?;
+        }
+        let gpu_ms = timer.summaries()[0].map(|t| t.median_ms);
+        build.row(vec![
+            format!("{size}^2"),
+            format!("{:.3}", cpu.median_ms),
+            ms(gpu_ms),
+        ]);
+    }
+    Ok(build)
+}
+
+/// Today's frame: 1920x1080 with a 1024^2 map (480x270 when quick).
+pub fn todays_frame(
+    bench: &mut Bench,
+    tiles: &HeightMap,
+    ratios: &mut Ratios,
+) -> Result<Table, DisplaceError> {
+    let gpu = bench.gpu;
+    let (w, h) = if bench.quick {
+        (480, 270)
+    } else {
+        (1920, 1080)
+    };
+    let mut r = Renderer::new(gpu, tiles, None, BUNDLED[0].surface);
+    let today = |s: Settings| Settings {
+        width: w,
+        height: h,
+        view_angle_deg: 60.0,
+        ..s
+    };
+    let columns = [
+        ("pom-16", fixed_layers(Method::Pom, 16)),
+        ("pyramid", fixed_layers(Method::Pyramid, 16)),
+        ("pyramid-ascend", fixed_layers(Method::PyramidAscend, 16)),
+        (
+            "pyramid-bilinear",
+            fixed_layers(Method::PyramidBilinear, 16),
+        ),
+        (
+            "pyramid lod-auto",
+            Settings {
+                lod: Lod::Auto,
+                ..fixed_layers(Method::Pyramid, 16)
+            },
+        ),
+    ];
+    let mut times = Vec::new();
+    for (_, s) in &columns {
+        times.push(bench.time("today", "tiles", tiles, &mut r, &today(s.clone()))?);
+    }
+    ratios.pyramid_over_pom16_today = ratio(times[1], times[0]);
+    ratios.pyramid_lod_auto_over_pom16_today = ratio(times[4], times[0]);
+    let mut header: Vec<&str> = columns.iter().map(|(n, _)| *n).collect();
+    header.extend(["pyramid / pom-16", "lod-auto / pom-16"]);
+    let mut t = Table::new(
+        format!("Today's frame: {w}x{h}, tiles 1024^2, 60 deg, GPU ms"),
+        &header,
+    );
+    let mut row: Vec<String> = times.iter().map(|&t| ms(t)).collect();
+    for k in [1, 4] {
+        row.push(ratio_text(ratio(times[k], times[0])));
+    }
+    t.row(row);
+    Ok(t)
+}

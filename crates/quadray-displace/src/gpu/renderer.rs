@@ -1,0 +1,375 @@
+//! quadray's own renderer: one map on one of its surfaces, drawn with any method by the surface
+//! pass, on the same [`HeightPyramid`]s a user would build.
+
+use super::height_pyramid::{HeightPyramid, PyramidKind};
+use super::pyramid_build::PyramidBuilder;
+use super::surface_pass::{
+    COLOR_FORMAT, DEPTH_FORMAT, FrameParams, Geometry, HIT_FORMAT, MapParams, MapTextures,
+    SurfacePass, Targets,
+};
+use crate::heightmap::HeightMap;
+use crate::method::Method;
+use crate::pyramid::Addressing;
+use crate::scene::{Plane, SurfaceKind, View};
+use crate::{DisplaceError, Lod, Settings};
+use quadray_core::image_out::Rgba8Image;
+use quadray_core::stats::Summary;
+use quadray_gpu::{Gpu, GpuTimer, read_texture_f32, read_texture_rgba8, texture_2d};
+use wgpu::util::DeviceExt;
+
+/// What one frame produced, read back.
+pub struct Frame {
+    /// The picture.
+    pub color: Rgba8Image,
+    /// Per pixel: hit u, hit v, hit depth (-1: left the map, -2: no surface), iterations
+    /// (negative: stopped by the cap).
+    pub hits: Vec<[f32; 4]>,
+    /// Per pixel: the ray's p0 and e.
+    pub rays: Vec<[f32; 4]>,
+}
+
+/// One map on one surface, ready to render with any method.
+pub struct Renderer {
+    pass: SurfacePass,
+    map_levels: u32,
+    map_size: u32,
+    surface: SurfaceKind,
+    point_group: wgpu::BindGroup,
+    conservative_group: wgpu::BindGroup,
+    triangles: wgpu::Buffer,
+    vertex_count: u32,
+}
+
+impl Renderer {
+    /// `color`: the albedo texture; `None` tints by depth.
+    pub fn new(
+        gpu: &Gpu,
+        map: &HeightMap,
+        color: Option<&Rgba8Image>,
+        surface: SurfaceKind,
+    ) -> Self {
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let addressing = if surface.wraps() {
+            Addressing::Wrap
+        } else {
+            Addressing::Clamp
+        };
+        let builder = PyramidBuilder::new(device);
+        let point = builder.build(device, queue, map, PyramidKind::Point);
+        let conservative = builder.build(device, queue, map, PyramidKind::Conservative(addressing));
+        let tinted;
+        let color = match color {
+            Some(c) => c,
+            None => {
+                tinted = tint_by_depth(map);
+                &tinted
+            }
+        };
+        let albedo = device.create_texture_with_data(
+            queue,
+            &wgpu::TextureDescriptor {
+                label: Some("albedo"),
+                size: wgpu::Extent3d {
+                    width: color.width,
+                    height: color.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8UnormSrgb,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            color.pixels.as_flattened(),
+        );
+        let albedo = albedo.create_view(&Default::default());
+        let gradients = upload_gradients(gpu, map).create_view(&Default::default());
+        let plane = Plane::of(surface);
+        let v4 = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
+        let params = SurfacePass::map_params(
+            device,
+            &MapParams {
+                plane_origin: v4(plane.origin),
+                plane_u: v4(plane.u),
+                plane_v: v4(plane.v),
+                pyramid: point.info(addressing),
+                tile_world: surface.tile_world(),
+                mesh_grid: map.size(),
+                tiles: surface.tiles(),
+                _pad: 0,
+            },
+        );
+        let pass = SurfacePass::new(device);
+        let group = |pyramid: &HeightPyramid| {
+            let textures = MapTextures {
+                pyramid: pyramid.view(),
+                depth_map: point.view(),
+                normal_map: &gradients,
+                color_map: &albedo,
+            };
+            pass.map_group(device, &params, textures)
+        };
+        let (point_group, conservative_group) = (group(&point), group(&conservative));
+        let vertices = surface.vertices();
+        let triangles = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("surface triangles"),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        Self {
+            pass,
+            map_levels: map.levels,
+            map_size: map.size(),
+            surface,
+            point_group,
+            conservative_group,
+            triangles,
+            vertex_count: vertices.len() as u32,
+        }
+    }
+
+    /// The surface the map is drawn on.
+    pub fn surface(&self) -> SurfaceKind {
+        self.surface
+    }
+
+    /// Memory the method needs beyond the albedo, in bytes.
+    pub fn memory_bytes(&self, method: Method) -> u64 {
+        let texels = u64::from(self.map_size).pow(2);
+        match method {
+            // Pyramid levels above 0 add a third; normal map RGBA16F.
+            Method::Pyramid | Method::PyramidAscend | Method::PyramidBilinear => {
+                texels * 4 * 4 / 3 + texels * 8
+            }
+            Method::Mesh => {
+                // The paper's figure 20 counts a vertex buffer (position + normal) per grid point.
+                let vertices = (u64::from(self.map_size) + 1).pow(2);
+                vertices * 24 + texels * 4 + texels * 8
+            }
+            _ => texels * 4 + texels * 8,
+        }
+    }
+
+    fn write_frame(&self, gpu: &Gpu, s: &Settings, view: &View) {
+        let v4 = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
+        let params = FrameParams {
+            view_proj: view.view_proj.to_cols_array_2d(),
+            eye: v4(view.eye),
+            light: v4(view.light),
+            depth_scale: s.depth_scale,
+            lod: match s.lod {
+                Lod::Auto => -1,
+                Lod::Level(l) => l.min(self.map_levels) as i32,
+            },
+            layers_min: s.layers.0 as f32,
+            layers_max: s.layers.1 as f32,
+            binary_steps: s.binary_steps,
+            shadows: u32::from(s.shadows),
+            show_iterations: u32::from(s.show_iterations),
+            _pad: 0,
+        };
+        self.pass.write_frame(&gpu.queue, &params);
+    }
+
+    fn targets(gpu: &Gpu, s: &Settings, debug_outputs: bool) -> Vec<wgpu::Texture> {
+        let make = |format, label| {
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+            texture_2d(gpu, label, (s.width, s.height), format, usage)
+        };
+        let mut t = vec![make(COLOR_FORMAT, "color"), make(DEPTH_FORMAT, "depth")];
+        if debug_outputs {
+            t.push(make(HIT_FORMAT, "hits"));
+            t.push(make(HIT_FORMAT, "rays"));
+        }
+        t
+    }
+
+    fn encode(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        method: Method,
+        targets: Targets,
+        debug: Option<(&wgpu::TextureView, &wgpu::TextureView)>,
+        timer: Option<&GpuTimer>,
+    ) {
+        let map_group = if method.uses_conservative_pyramid() {
+            &self.conservative_group
+        } else {
+            &self.point_group
+        };
+        let geometry = if method == Method::Mesh {
+            Geometry::MeshGrid {
+                grid: self.map_size,
+                tiles: self.surface.tiles(),
+            }
+        } else {
+            Geometry::Triangles(&self.triangles, self.vertex_count)
+        };
+        self.pass.record(
+            &gpu.device,
+            encoder,
+            method,
+            map_group,
+            geometry,
+            targets,
+            debug,
+            timer.and_then(|t| t.render_pass(0)),
+        );
+    }
+
+    /// Draws one frame into an application's own targets, seen from `view`. `timer`, when given,
+    /// times the pass as its query 0.
+    pub fn draw(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        s: &Settings,
+        view: &View,
+        targets: Targets,
+        timer: Option<&GpuTimer>,
+    ) -> Result<(), DisplaceError> {
+        self.check(s)?;
+        self.write_frame(gpu, s, view);
+        self.encode(gpu, encoder, s.method, targets, None, timer);
+        Ok(())
+    }
+
+    fn check(&self, s: &Settings) -> Result<(), DisplaceError> {
+        s.validate().map_err(DisplaceError::Settings)?;
+        if s.method == Method::Mesh && !self.surface.is_planar() {
+            return Err(DisplaceError::Settings(format!(
+                "the mesh baseline displaces a flat grid; the {:?} surface is curved",
+                self.surface
+            )));
+        }
+        Ok(())
+    }
+
+    /// Renders one frame with the hit and ray outputs and reads everything back.
+    pub fn render(&mut self, gpu: &Gpu, s: &Settings) -> Result<Frame, DisplaceError> {
+        self.check(s)?;
+        self.write_frame(gpu, s, &View::of(self.surface, s));
+        let targets = Self::targets(gpu, s, true);
+        let views: Vec<_> = targets
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        gpu.checked(|| {
+            self.encode(
+                gpu,
+                &mut encoder,
+                s.method,
+                Targets {
+                    color: &views[0],
+                    depth: &views[1],
+                },
+                Some((&views[2], &views[3])),
+                None,
+            )
+        })?;
+        gpu.queue.submit([encoder.finish()]);
+        let pixels = |v: Vec<f32>| -> Vec<[f32; 4]> {
+            v.chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect()
+        };
+        Ok(Frame {
+            color: Rgba8Image::from_bytes(
+                s.width,
+                s.height,
+                &read_texture_rgba8(gpu, &targets[0])?,
+            ),
+            hits: pixels(read_texture_f32(gpu, &targets[2], 0, 4)?),
+            rays: pixels(read_texture_f32(gpu, &targets[3], 0, 4)?),
+        })
+    }
+
+    /// GPU time of the shading pass alone (colour target only, as an application would draw),
+    /// median of `frames` frames after two warm-up frames. `None` without timestamp queries.
+    pub fn time(
+        &mut self,
+        gpu: &Gpu,
+        s: &Settings,
+        frames: usize,
+    ) -> Result<Option<Summary>, DisplaceError> {
+        self.check(s)?;
+        let view = View::of(self.surface, s);
+        let targets = Self::targets(gpu, s, false);
+        let views: Vec<_> = targets
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
+        let mut timer = GpuTimer::new(gpu, 1);
+        for frame in 0..frames + 2 {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            gpu.checked(|| {
+                self.draw(
+                    gpu,
+                    &mut encoder,
+                    s,
+                    &view,
+                    Targets {
+                        color: &views[0],
+                        depth: &views[1],
+                    },
+                    Some(&timer),
+                )
+            })??;
+            timer.resolve(&mut encoder);
+            gpu.queue.submit([encoder.finish()]);
+            timer.collect(gpu)?;
+            if frame == 1 {
+                timer.clear();
+            }
+        }
+        Ok(timer.summaries()[0])
+    }
+}
+
+/// Depth gradients per unit of uv at texel centres (central differences), filtered by the sampler
+/// and turned into normals in the shader with the frame's depth scale: n ~ (grad * s, 1).
+fn upload_gradients(gpu: &Gpu, map: &HeightMap) -> wgpu::Texture {
+    let n = map.size() as i64;
+    let d = |i: i64, j: i64| map.at(i.rem_euclid(n) as u32, j.rem_euclid(n) as u32);
+    let mut texels: Vec<half::f16> = Vec::with_capacity((n * n * 4) as usize);
+    for j in 0..n {
+        for i in 0..n {
+            let du = (d(i + 1, j) - d(i - 1, j)) * 0.5 * n as f32;
+            let dv = (d(i, j + 1) - d(i, j - 1)) * 0.5 * n as f32;
+            texels.extend([du, dv, 0.0, 0.0].map(half::f16::from_f32));
+        }
+    }
+    gpu.device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("depth gradients"),
+            size: wgpu::Extent3d {
+                width: n as u32,
+                height: n as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&texels),
+    )
+}
+
+/// An albedo for maps without a colour image: warm stone, darker with depth.
+fn tint_by_depth(map: &HeightMap) -> Rgba8Image {
+    let mut img = Rgba8Image::new(map.size(), map.size(), [0, 0, 0, 255]);
+    for (px, d) in img.pixels.iter_mut().zip(&map.depth) {
+        let k = 1.0 - 0.55 * d;
+        *px = [(220.0 * k) as u8, (190.0 * k) as u8, (150.0 * k) as u8, 255];
+    }
+    img
+}

@@ -1,0 +1,281 @@
+// quadray-displace's tracing module: pyramid inverse displacement mapping (Oh & Ki 2007) as plain
+// WGSL functions, for any renderer's fragment or compute shader. It declares no bindings, no
+// entry points, no overrides and uses nothing else of quadray: concatenate it ahead of your own
+// code (`quadray_displace::TRACE_WGSL` holds this text). Names it declares: PyramidInfo, TraceHit,
+// pyramid_*, depth_bilinear, bilinear_*, ray_slope, shadow_lit, outside_map.
+//
+// What a caller provides
+// - Texture space: uv in [0, 1)^2 per copy of the map; texel (i, j) of a 2^n x 2^n level covers
+//   [i, i + 1) / 2^n x [j, j + 1) / 2^n, row j = 0 at v = 0.
+// - Depth, not height: 0 is the polygon's plane, 1 the deepest point of the map.
+// - The pyramid: a texture_2d<f32> (wgpu R32Float, unfilterable) of 2^n x 2^n texels with n + 1
+//   mips; mip k holds at each texel the minimum depth of the 2^k x 2^k texels of mip 0 below it,
+//   mip n is 1x1. `quadray_displace::HeightPyramid` builds it: the point variant (mip 0 is the map
+//   itself) or the conservative one for the bilinear surface (mip 0 the minimum over each texel's
+//   3x3 neighbourhood). The bilinear functions also read the map: mip 0 of the point pyramid.
+// - The ray: P(z) = p0 + e * z, its parameter z the depth in [0, 1]. p0 is the uv where the view
+//   ray meets the polygon (wrapped into [0, 1) on a tiling map); e = ray_slope(V, depth_scale)
+//   = -V.xy / V.z * depth_scale, with V the unit tangent-space direction towards the eye (x along
+//   +u, y along +v, z along the surface normal, V.z > 0) and depth_scale the texture units per
+//   unit of depth. The hit's uv is p0 + e * z.
+// - A PyramidInfo (below), e.g. uploaded as a uniform (`quadray_displace::PyramidInfo`).
+// Every function reads mips with textureLoad only, so it works in any shader stage; only the
+// caller's derivatives for pyramid_lod need a fragment shader.
+
+struct PyramidInfo {
+    levels: i32,        // n: mip 0 is 2^n x 2^n, the root (mip n) is 1x1
+    clamp_to_map: u32,  // 1: rays that leave [0, 1)^2 miss (terrain); 0: the map tiles
+    iteration_cap: u32, // hard cap on the steps of any one trace (the per-ray bound is far lower)
+    refine_cap: u32,    // hard cap on bilinear_trace's refinement rounds
+}
+
+// What a trace found: the depth z where it stopped, the steps it took, whether the ray left a
+// clamped map (missed) and whether a cap stopped it (capped: a bound was too low).
+struct TraceHit {
+    z: f32,
+    iterations: u32,
+    missed: bool,
+    capped: bool,
+}
+
+// e of the ray towards `towards` (a unit tangent-space direction with towards.z > 0).
+fn ray_slope(towards: vec3f, depth_scale: f32) -> vec2f {
+    return -towards.xy / towards.z * depth_scale;
+}
+
+fn pyramid_address(info: PyramidInfo, t: vec2i, size: i32) -> vec2i {
+    if info.clamp_to_map == 1u {
+        return clamp(t, vec2i(0), vec2i(size - 1));
+    }
+    return ((t % size) + size) % size;
+}
+
+fn pyramid_load(pyramid: texture_2d<f32>, info: PyramidInfo, level: i32, node: vec2f) -> f32 {
+    let size = 1 << u32(info.levels - level);
+    return textureLoad(pyramid, pyramid_address(info, vec2i(node), size), level).r;
+}
+
+// True when p is off a clamped map (a ray there has missed).
+fn outside_map(info: PyramidInfo, p: vec2f) -> bool {
+    return info.clamp_to_map == 1u && (any(p < vec2f(0.0)) || any(p >= vec2f(1.0)));
+}
+
+// The bilinear surface's depth at p, between texel centres at (i + 0.5) / 2^n, by hand: hardware
+// filtering has only a few bits of sub-texel precision and differs between GPUs.
+fn depth_bilinear(depth_map: texture_2d<f32>, info: PyramidInfo, p: vec2f) -> f32 {
+    let size = i32(textureDimensions(depth_map).x);
+    let x = p * f32(size) - 0.5;
+    let i = vec2i(floor(x));
+    let f = x - floor(x);
+    let d00 = textureLoad(depth_map, pyramid_address(info, i, size), 0).r;
+    let d10 = textureLoad(depth_map, pyramid_address(info, i + vec2i(1, 0), size), 0).r;
+    let d01 = textureLoad(depth_map, pyramid_address(info, i + vec2i(0, 1), size), 0).r;
+    let d11 = textureLoad(depth_map, pyramid_address(info, i + vec2i(1, 1), size), 0).r;
+    return mix(mix(d00, d10, f.x), mix(d01, d11, f.x), f.y);
+}
+
+// Sections 3.2 and 4 (figure 13): the first intersection of the ray with the point-sampled height
+// field (flat-topped texel columns), from depth z_start on pyramid level start_level (info.levels
+// for a whole ray), reading at the ray's current point. `finest` is the level whose nodes act as
+// leaves (0, or pyramid_lod's choice). `ascend`: after a node crossing go one level up (maximum
+// mipmaps / QDM) instead of staying on the level (the paper).
+fn pyramid_trace(pyramid: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2f, z_start: f32, start_level: i32, finest: i32, ascend: bool) -> TraceHit {
+    let res0 = f32(1 << u32(info.levels));
+    // Node crossing steps 0.1% of a finest texel past the boundary. The step can clip the corner
+    // of a texel the ray only grazes (the paper's 1% missed such corners visibly on real maps);
+    // 0.1% is still above float spacing for coordinates in [0, 1) up to 4096^2 maps, and the
+    // next-float guard below keeps the ray moving where it is not.
+    let delta = 0.001 / res0;
+    var t: TraceHit;
+    t.z = z_start;
+    var level = start_level;
+    // A bound on any ray: at most two steps per node its footprint crosses on each level, plus
+    // the descents; the global cap keeps even absurd inputs finite.
+    let cap = min(info.iteration_cap, u32(8.0 * (length(e) * res0 + 2.0)) + 16u * u32(info.levels + 1));
+    loop {
+        if level < finest {
+            break;
+        }
+        if t.iterations >= cap {
+            t.capped = true;
+            break;
+        }
+        t.iterations += 1u;
+        let res = f32(1 << u32(info.levels - level));
+        let p = p0 + e * t.z;
+        if outside_map(info, p) {
+            t.missed = true;
+            break;
+        }
+        let node = floor(p * res);
+        let d = pyramid_load(pyramid, info, level, node);
+        if t.z < d {
+            let advanced = p0 + e * d;
+            if all(floor(advanced * res) == node) {
+                t.z = d;
+                level -= 1;
+            } else {
+                // Node crossing: move to the nearer boundary along the ray, just past it.
+                let boundary = (node + select(vec2f(0.0), vec2f(1.0), e > vec2f(0.0))) / res;
+                let to_boundary = select(vec2f(1.0e30), (boundary - p0) / e, e != vec2f(0.0));
+                let x_first = to_boundary.x < to_boundary.y;
+                let crossing = select(to_boundary.y, to_boundary.x, x_first);
+                // Step `delta` along the footprint, not along the crossing axis: when that axis
+                // is nearly parallel to the ray, a step of delta along it could skip texels on the
+                // other. If rounding keeps the ray in its node, the next crossing steps on again.
+                t.z = max(max(t.z, crossing) + delta / length(e), bitcast<f32>(bitcast<u32>(t.z) + 1u));
+                if ascend {
+                    level = min(level + 1, info.levels);
+                }
+            }
+        } else {
+            level -= 1;
+        }
+    }
+    return t;
+}
+
+// Exact intersection with the bilinear patches (cells between texel centres) the ray crosses
+// from depth z_start, at most `max_cells` of them. x: the hit depth, or -1 when none; y: the depth
+// where the walk stopped; z: cells visited.
+fn bilinear_cells(depth_map: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2f, z_start: f32, max_cells: u32) -> vec3f {
+    let res0 = f32(1 << u32(info.levels));
+    let size = i32(res0);
+    let q = (p0 + e * z_start) * res0 - 0.5;
+    var cell = floor(q);
+    let dir = select(vec2f(-1.0), vec2f(1.0), e >= vec2f(0.0));
+    let boundary = cell + select(vec2f(0.0), vec2f(1.0), e > vec2f(0.0));
+    // Depth at which the ray crosses the next cell boundary on each axis, and per cell after.
+    var next = select(vec2f(1.0e30), z_start + (boundary - q) / (e * res0), e != vec2f(0.0));
+    let step = select(vec2f(1.0e30), abs(1.0 / (e * res0)), e != vec2f(0.0));
+    var z_in = z_start;
+    for (var k = 0u; k < max_cells; k++) {
+        let z_out = min(min(next.x, next.y), 1.0);
+        let c = vec2i(cell);
+        let s00 = textureLoad(depth_map, pyramid_address(info, c, size), 0).r;
+        let s10 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 0), size), 0).r;
+        let s01 = textureLoad(depth_map, pyramid_address(info, c + vec2i(0, 1), size), 0).r;
+        let s11 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 1), size), 0).r;
+        // Cell coordinates f(z) = a + b z; surface s = s00 + A fx + B fy + C fx fy; the ray is
+        // above the surface while g(z) = s - z > 0, a quadratic in z.
+        let a = p0 * res0 - 0.5 - cell;
+        let b = e * res0;
+        let ca = s10 - s00;
+        let cb = s01 - s00;
+        let cc = s00 - s10 - s01 + s11;
+        let c0 = s00 + ca * a.x + cb * a.y + cc * a.x * a.y;
+        let c1 = ca * b.x + cb * b.y + cc * (a.x * b.y + a.y * b.x) - 1.0;
+        let c2 = cc * b.x * b.y;
+        let g_in = c0 + c1 * z_in + c2 * z_in * z_in;
+        if g_in <= 0.0 {
+            return vec3f(z_in, z_in, f32(k + 1u));
+        }
+        var root = 2.0;
+        if abs(c2) < 1.0e-7 * max(abs(c1), 1.0) {
+            root = -c0 / c1;
+        } else {
+            let disc = c1 * c1 - 4.0 * c2 * c0;
+            if disc >= 0.0 {
+                let h = -0.5 * (c1 + select(-1.0, 1.0, c1 >= 0.0) * sqrt(disc));
+                let r1 = h / c2;
+                let r2 = c0 / h;
+                if r1 >= z_in && r1 <= z_out { root = r1; }
+                if r2 >= z_in && r2 <= z_out { root = min(root, r2); }
+            }
+        }
+        let g_out = c0 + c1 * z_out + c2 * z_out * z_out;
+        if root >= z_in && root <= z_out {
+            return vec3f(root, root, f32(k + 1u));
+        }
+        // The sign changed but rounding put the root just outside the cell; or the ray reached
+        // depth 1, at or below every surface point (rounding can leave g a hair above 0 there).
+        if g_out <= 0.0 || z_out >= 1.0 {
+            return vec3f(z_out, z_out, f32(k + 1u));
+        }
+        if next.x < next.y {
+            cell.x += dir.x;
+            z_in = next.x;
+            next.x += step.x;
+        } else {
+            cell.y += dir.y;
+            z_in = next.y;
+            next.y += step.y;
+        }
+    }
+    return vec3f(-1.0, z_in, f32(max_cells));
+}
+
+// Section 3.3, magnification: the first intersection with the bilinear surface. `pyramid` is the
+// conservative pyramid, `depth_map` the map (mip 0 of the point pyramid). The point-sampled
+// search on the conservative pyramid brings the ray to just above the bilinear surface; there the
+// intersection is refined. The paper interpolates between half a texel back and half a texel
+// forward and, when the ray is still above the surface, jumps on to the surface depth there
+// (d_i). Both lose intersections on steep maps (the jump by up to whole features at grazing
+// angles), so the refinement here solves the ray/bilinear-patch quadratic exactly over the next
+// few cells, then resumes the conservative search (climbing from level 0, as maximum mipmaps do)
+// when the ray passed them untouched.
+fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2f, finest: i32) -> TraceHit {
+    let res0 = f32(1 << u32(info.levels));
+    var t = pyramid_trace(pyramid, info, p0, e, 0.0, info.levels, finest, false);
+    // Refinement rounds can at most walk the ray's whole footprint.
+    let round_cap = min(info.refine_cap, u32(length(e) * res0 + 4.0));
+    var round = 0u;
+    loop {
+        if t.missed || t.capped {
+            break;
+        }
+        if round >= round_cap {
+            t.capped = true;
+            break;
+        }
+        round += 1u;
+        let cells = bilinear_cells(depth_map, info, p0, e, t.z, 4u);
+        t.iterations += u32(cells.z);
+        if cells.x >= 0.0 {
+            t.z = cells.x;
+            t.missed = outside_map(info, p0 + e * t.z);
+            break;
+        }
+        let resumed = pyramid_trace(pyramid, info, p0, e, cells.y, 0, finest, true);
+        t.z = resumed.z;
+        t.missed = resumed.missed;
+        t.capped = resumed.capped;
+        t.iterations += resumed.iterations;
+    }
+    return t;
+}
+
+// Section 3.4: the finest level worth reaching for a pixel whose uv changes by uv_dx, uv_dy to
+// its neighbours (in a fragment shader: dpdx(uv), dpdy(uv), taken in uniform control flow), as
+// mip selection does.
+fn pyramid_lod(uv_dx: vec2f, uv_dy: vec2f, levels: i32) -> i32 {
+    let res0 = f32(1 << u32(levels));
+    let footprint = max(length(uv_dx), length(uv_dy)) * res0;
+    return clamp(i32(floor(log2(max(footprint, 1.0)))), 0, levels);
+}
+
+// Self-shadowing (section 4). The light's ray through a hit at uv `hit` and depth z enters the
+// height field at hit - el * z (depth 0), with el = ray_slope(L, depth_scale) and L the unit
+// tangent-space direction towards the light. Trace that ray from its entry (with the same search
+// as the view ray); the hit is lit when the trace, `from_light`, gets to it: within 1.5 texels
+// along the surface, or within a small depth when the light is nearly overhead. A light ray that
+// enters a clamped map through its side is not blocked before it.
+fn shadow_lit(info: PyramidInfo, z: f32, from_light: TraceHit, el: vec2f) -> bool {
+    if from_light.missed {
+        return true;
+    }
+    let short_by = z - from_light.z;
+    let res0 = f32(1 << u32(info.levels));
+    return short_by * length(el) <= 1.5 / res0 || short_by <= 2.0e-3;
+}
+
+// shadow_lit with the point-sampled trace: is the hit (uv, depth z) lit by a light in unit
+// tangent-space direction to_light?
+fn pyramid_lit(pyramid: texture_2d<f32>, info: PyramidInfo, hit: vec2f, z: f32, to_light: vec3f, depth_scale: f32, finest: i32) -> bool {
+    if to_light.z <= 1.0e-4 {
+        return false;
+    }
+    let el = ray_slope(to_light, depth_scale);
+    let from_light = pyramid_trace(pyramid, info, hit - el * z, el, 0.0, info.levels, finest, false);
+    return shadow_lit(info, z, from_light, el);
+}
