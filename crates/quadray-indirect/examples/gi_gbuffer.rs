@@ -354,7 +354,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let instance =
         wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
-    let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
+    // three Rgba32Float targets (48 bytes a sample) exceed the default limit of 32: ask for the
+    // adapter's own limits
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_limits: adapter.limits(),
+        ..Default::default()
+    }))?;
     let radiance = render(&device, &queue)?;
     let s = settings();
     let path =

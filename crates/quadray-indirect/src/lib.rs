@@ -3,7 +3,7 @@
 //! hundreds of thousands of VPLs, and deferred shading sums the cut per pixel.
 //!
 //! Data flows one way: [`scene`] (load) -> [`gpu`] (RSM, quadtree, cut, shading) -> measured
-//! against [`reference`] (CPU brute force) and the GPU brute force of [`baselines`].
+//! against [`reference`](mod@reference) (CPU brute force) and the GPU brute force of [`baselines`].
 //!
 //! To add the bounce to your own wgpu renderer, record the passes into your encoder:
 //! [`RsmPass`] (or your own [`RsmViews`]) -> [`LightQuadtree`] (build, cut) -> [`Gather`] into your

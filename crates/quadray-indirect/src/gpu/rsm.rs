@@ -157,7 +157,9 @@ pub(crate) fn record_raster(
     pass.draw(0..vertex_count, 0..1);
 }
 
-/// Renders the RSM of a spot light into textures it owns ([`RsmPass::views`]).
+/// Renders the RSM of a spot light into textures it owns ([`RsmPass::views`]). Its three
+/// Rgba32Float targets take 48 bytes a sample: open the device with the adapter's limits
+/// (`max_color_attachment_bytes_per_sample` is 32 by default).
 pub struct RsmPass {
     rsm_size: u32,
     pipeline: wgpu::RenderPipeline,
