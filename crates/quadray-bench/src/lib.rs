@@ -3,4 +3,5 @@
 //! technique crates only through their public APIs, as any other program would.
 
 pub mod displace;
+pub mod indirect;
 pub mod shadows;

@@ -3,9 +3,9 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
+use quadray_bench::indirect::run::{RunOptions, run};
 use quadray_core::bench::write_json;
 use quadray_gpu::Gpu;
-use quadray_indirect::report::{RunOptions, run};
 use quadray_indirect::{ClusterSettings, Method, Scene, Settings, Validity};
 use std::path::{Path, PathBuf};
 
@@ -19,7 +19,7 @@ pub struct IndirectArgs {
     #[arg(long, default_value = "quadtree")]
     method: Method,
     /// Side of the reflective shadow map (power of two).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = Settings::default().rsm_size)]
     rsm_size: u32,
     /// Level where every cluster is accepted (mip level: 0 = the RSM, each level halves the
     /// side); default: the level of 64x64 nodes.
@@ -29,10 +29,10 @@ pub struct IndirectArgs {
     #[arg(long)]
     start_level: Option<u32>,
     /// Max |child depth - mean depth| of a valid cluster (depth in units of the scene's extent).
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = Settings::default().cluster.depth_threshold)]
     depth_threshold: f32,
     /// Min dot(child normal, mean normal) of a valid cluster.
-    #[arg(long, default_value_t = 0.9)]
+    #[arg(long, default_value_t = Settings::default().cluster.normal_threshold)]
     normal_threshold: f32,
     /// recursive (every child valid too) or local (the paper's).
     #[arg(long, default_value = "recursive")]
@@ -41,10 +41,10 @@ pub struct IndirectArgs {
     #[arg(long)]
     unweighted_means: bool,
     /// RSM-sampling samples per pixel.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = Settings::default().samples)]
     samples: u32,
     /// Indirect at one sample per KxK pixels, upsampled where the geometry agrees (quadtree).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = Settings::default().subsample)]
     subsample: u32,
     /// Image size WxH.
     #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
@@ -152,10 +152,10 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
 }
 
 /// `quadray bench indirect`.
-pub fn bench(options: quadray_indirect::bench::BenchOptions, out: &Path) -> Result<()> {
+pub fn bench(options: quadray_bench::indirect::tables::BenchOptions, out: &Path) -> Result<()> {
     let gpu = Gpu::new()?;
     let bar = crate::spinner("bench indirect");
-    let results = quadray_indirect::bench::run(&gpu, out, options, |m| {
+    let results = quadray_bench::indirect::tables::run(&gpu, out, options, |m| {
         bar.set_message(format!("bench indirect: {m}"))
     })?;
     bar.finish_and_clear();
@@ -167,9 +167,10 @@ pub fn bench(options: quadray_indirect::bench::BenchOptions, out: &Path) -> Resu
 /// The indirect-light pictures of `quadray demo`.
 pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
     let bar = crate::spinner("indirect light");
-    let files = quadray_indirect::demo::render_demo(gpu, &out.join("indirect"), size, |m| {
-        bar.set_message(format!("indirect light: {m}"))
-    })?;
+    let files =
+        quadray_bench::indirect::demo::render_demo(gpu, &out.join("indirect"), size, |m| {
+            bar.set_message(format!("indirect light: {m}"))
+        })?;
     bar.finish_and_clear();
     Ok(files)
 }

@@ -171,7 +171,7 @@ fn main() -> Result<()> {
                     out,
                 },
         } => indirect::bench(
-            quadray_indirect::bench::BenchOptions {
+            quadray_bench::indirect::tables::BenchOptions {
                 quick,
                 size,
                 rsm_size,

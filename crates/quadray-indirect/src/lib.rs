@@ -3,14 +3,17 @@
 //! hundreds of thousands of VPLs, and deferred shading sums the cut per pixel.
 //!
 //! Data flows one way: [`scene`] (load) -> [`gpu`] (RSM, quadtree, cut, shading) -> measured
-//! against [`reference`] (CPU brute force) and the GPU brute force of [`baselines`].
+//! against [`reference`](mod@reference) (CPU brute force) and the GPU brute force of [`baselines`].
+//!
+//! To add the bounce to your own wgpu renderer, record the passes into your encoder:
+//! [`RsmPass`] (or your own [`RsmViews`]) -> [`LightQuadtree`] (build, cut) -> [`Gather`] into your
+//! [`GBufferViews`] -> [`OutputPass`] into your texture, all configured by one [`Settings`].
+//! `examples/gi_gbuffer.rs` is a whole program doing that.
 
 pub mod baselines;
-pub mod bench;
-pub mod demo;
 pub mod gpu;
+pub mod picture;
 pub mod reference;
-pub mod report;
 pub mod scene;
 
 /// Anything that can go wrong between a scene file and a measured picture.
@@ -25,6 +28,8 @@ pub enum IndirectError {
 }
 
 pub use gpu::{
-    ClusterSettings, CutNode, Frame, FrameTiming, Method, Pass, Renderer, Settings, Validity,
+    ClusterSettings, CutNode, FLOAT_FORMAT, Frame, FrameTiming, GBufferViews, Gather,
+    LightQuadtree, Method, OutputPass, OutputTerm, Pass, Renderer, RsmPass, RsmViews, Settings,
+    Spot, Validity,
 };
 pub use scene::Scene;

@@ -169,7 +169,7 @@ fn the_cut_covers_every_lit_rsm_texel_exactly_once() {
         assert!(n == 1 || !lit(i), "lit texel {i} is in no cluster");
     }
     // the picture of it: the RSM magnified to 512 pixels with the clusters outlined
-    let picture = quadray_indirect::report::cut_view(size, &flux, &cut);
+    let picture = quadray_indirect::picture::cut_view(size, &flux, &cut);
     assert_eq!((picture.width, picture.height), (512, 512));
 }
 

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::Gpu;
-use quadray_indirect::report::{cut_view, tone_map};
+use quadray_indirect::picture::{cut_view, tone_map};
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
 use quadray_indirect::{ClusterSettings, FrameTiming, Method, Renderer, Scene, Settings, Validity};
 use std::path::{Path, PathBuf};

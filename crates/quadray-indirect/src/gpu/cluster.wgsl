@@ -1,20 +1,18 @@
 // The light quadtree: pack the RSM into level 0, reduce level by level (summed flux, means),
 // mark valid clusters (local or recursive rule), and compact the cut into a list.
 
-struct Level {
-    level: u32,
-}
-
+// Group 0, per light update: the settings, the RSM and the quadtree.
 @group(0) @binding(0) var<uniform> params: ClusterParams;
-@group(0) @binding(1) var<uniform> current: Level;
-@group(0) @binding(2) var rsm_flux: texture_2d<f32>;
-@group(0) @binding(3) var rsm_pos: texture_2d<f32>;
-@group(0) @binding(4) var rsm_normal: texture_2d<f32>;
-@group(0) @binding(5) var<storage, read_write> nodes: array<Node>;
+@group(0) @binding(1) var rsm_flux: texture_2d<f32>;
+@group(0) @binding(2) var rsm_pos: texture_2d<f32>;
+@group(0) @binding(3) var rsm_normal: texture_2d<f32>;
+@group(0) @binding(4) var<storage, read_write> nodes: array<Node>;
 // the cut's clusters, copied out of the pyramid so that shading reads them in a row; normal.w
 // holds the node's index (bit pattern) instead of its validity
-@group(0) @binding(6) var<storage, read_write> cut: array<Node>;
-@group(0) @binding(7) var<storage, read_write> cut_count: atomic<u32>;
+@group(0) @binding(5) var<storage, read_write> cut: array<Node>;
+@group(0) @binding(6) var<storage, read_write> cut_count: atomic<u32>;
+// Group 1, per dispatch: the level (a dynamic offset into slots 0, 1, 2, ...).
+@group(1) @binding(0) var<uniform> current: Level;
 
 @compute @workgroup_size(8, 8)
 fn pack(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -23,13 +23,12 @@ struct ClusterParams {
     normal_threshold: f32,
 }
 
-// Items (VPLs, clusters, samples) one dispatch of a per-pixel sum covers: a longer sum takes
-// several dispatches that add up, each given its slice's number (see SLICE in resources.rs).
-// lavapipe ends an invocation's loops after 65,535 iterations in all.
-const SLICE: u32 = 32768u;
-// Nodes one dispatch of a per-level pass covers (each node's cut test loops over its ancestors).
-const LEVEL_SLICE: u32 = 2048u;
-const PI: f32 = 3.14159265358979;
+// SLICE, LEVEL_SLICE (items one dispatch of a long sum covers), MAX_LEVELS and PI come from the
+// prelude generated from Rust (contract.rs).
+
+struct Level {
+    level: u32,
+}
 
 fn level_size(p: ClusterParams, level: u32) -> u32 {
     return p.rsm_size >> level;

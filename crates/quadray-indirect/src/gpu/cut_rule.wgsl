@@ -12,7 +12,7 @@ fn in_cut(p: ClusterParams, level: u32, xy: vec2<u32>) -> bool {
     if (nodes[node_index(p, level, xy)].flux.w < 0.5 || !accepted(p, level, xy)) {
         return false;
     }
-    for (var a = level + 1u; a <= min(p.start_level, 16u); a++) {
+    for (var a = level + 1u; a <= min(p.start_level, MAX_LEVELS); a++) {
         if (accepted(p, a, xy >> vec2<u32>(a - level))) {
             return false;
         }

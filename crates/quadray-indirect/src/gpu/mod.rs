@@ -1,17 +1,44 @@
-//! The GPU side. Raster passes (`raster.wgsl`): the RSM from the spot and the camera's G-buffer.
-//! Compute passes (`cluster.wgsl`): pack the RSM into the quadtree, reduce it level by level, mark
-//! valid clusters, compact the cut. Shading (`shade.wgsl`, and the baselines' `baselines.wgsl`):
-//! indirect from the cut or the per-level passes, sub-sampled with upsampling, direct light.
+//! The GPU side, one file per pass, each owning its pipelines, layouts, bind groups and
+//! recording, all recording into the caller's `wgpu::CommandEncoder` on the caller's device:
+//! [`RsmPass`] (the spot's reflective shadow map; or bring your own [`RsmViews`]),
+//! [`LightQuadtree`] (pyramid, validity, compacted cut), [`Gather`] (indirect light into the
+//! caller's G-buffer from the cut or the paper's per-level passes, the baselines of the same
+//! shape, the direct light) and [`OutputPass`] (the radiance into the caller's texture). Bindings
+//! are grouped by how often they change: per light update, per frame, per dispatch.
+//! [`Renderer`] is quadray's own user of these passes. The Rust <-> WGSL contract (shared
+//! structs, the generated WGSL prelude) is in `contract.rs`.
 
-mod resources;
+mod contract;
+mod gather;
+mod gbuffer;
+mod light;
+mod output;
+mod quadtree;
+mod renderer;
+mod rsm;
 
-use crate::IndirectError;
-use crate::baselines;
-use crate::scene::Scene;
-use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
-use resources::{Buffers, Pipelines, Targets};
+pub use gather::{GBufferViews, Gather};
+pub use light::Spot;
+pub use output::{OutputPass, OutputTerm};
+pub use quadtree::LightQuadtree;
+pub use renderer::Renderer;
+pub use rsm::{FLOAT_FORMAT, RsmPass, RsmViews};
+
 use serde::Serialize;
 use std::collections::BTreeMap;
+
+/// Every shader's parts (before the prelude), by pass: what the contract test parses.
+#[cfg(test)]
+pub(crate) fn shaders() -> Vec<(&'static str, Vec<String>)> {
+    let owned = |parts: &[&str]| parts.iter().map(|p| p.to_string()).collect();
+    vec![
+        ("rsm", owned(&rsm::SOURCES)),
+        ("gbuffer", owned(&gbuffer::SOURCES)),
+        ("quadtree", owned(&quadtree::SOURCES)),
+        ("gather", owned(&gather::SOURCES)),
+        ("output", output::sources("rgba16float").to_vec()),
+    ]
+}
 
 /// How the indirect term is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -317,241 +344,6 @@ pub struct Receiver {
     pub position: [f32; 3],
     pub normal: [f32; 3],
     pub albedo: [f32; 3],
-}
-
-/// Everything one scene needs on the GPU at one set of sizes.
-pub struct Renderer<'g> {
-    gpu: &'g Gpu,
-    settings: Settings,
-    pipelines: Pipelines,
-    targets: Targets,
-    buffers: Buffers,
-    vertex_count: u32,
-    /// A timer for all passes; `None` when the adapter has no timestamp queries.
-    timer: GpuTimer,
-}
-
-impl<'g> Renderer<'g> {
-    pub fn new(gpu: &'g Gpu, scene: &Scene, settings: Settings) -> Result<Self, IndirectError> {
-        settings.validate().map_err(IndirectError::Settings)?;
-        let pipelines = gpu.checked(|| Pipelines::new(gpu))?;
-        let targets = gpu.checked(|| Targets::new(gpu, &settings))?;
-        let samples = baselines::rsm_samples(
-            settings.samples,
-            settings.rsm_radius * settings.rsm_size as f32 * std::f32::consts::SQRT_2,
-            0x5eed,
-        );
-        let buffers =
-            gpu.checked(|| Buffers::new(gpu, scene, &settings, &samples, &pipelines, &targets))?;
-        Ok(Self {
-            gpu,
-            vertex_count: (scene.triangles.len() * 3) as u32,
-            timer: GpuTimer::new(gpu, Pass::ALL.len() as u32),
-            settings,
-            pipelines,
-            targets,
-            buffers,
-        })
-    }
-
-    pub fn settings(&self) -> &Settings {
-        &self.settings
-    }
-
-    /// Moves the camera and the light to the scene's (its geometry must be the one the renderer
-    /// was made with); the next frame must `rebuild` if the light moved.
-    pub fn set_view(&mut self, scene: &Scene) {
-        self.buffers.write_scene(self.gpu, scene, &self.settings);
-    }
-
-    /// Changes the quadtree's parameters; the next frame with `rebuild` uses them.
-    pub fn set_cluster(&mut self, cluster: ClusterSettings) -> Result<(), IndirectError> {
-        let settings = Settings {
-            cluster,
-            ..self.settings.clone()
-        };
-        settings.validate().map_err(IndirectError::Settings)?;
-        self.settings = settings;
-        self.buffers.write_cluster(self.gpu, &self.settings);
-        Ok(())
-    }
-
-    /// Renders one frame of `method`. With `rebuild` the light-dependent work (RSM, pyramid,
-    /// validity, cut) is redone, as when the light moves; without it those buffers are reused.
-    /// With `timed` the passes' GPU times are recorded.
-    pub fn render(
-        &mut self,
-        method: Method,
-        rebuild: bool,
-        timed: bool,
-    ) -> Result<(), IndirectError> {
-        let gpu = self.gpu;
-        let run = self.passes_run(method, rebuild);
-        gpu.checked(|| {
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let timer = timed.then_some(&self.timer);
-            let p = &self.pipelines;
-            let t = &self.targets;
-            let b = &self.buffers;
-            if run.contains(&Pass::Rsm) {
-                p.raster(&mut encoder, Pass::Rsm, t, b, self.vertex_count, timer);
-            }
-            if run.contains(&Pass::Pyramid) {
-                p.build_quadtree(&mut encoder, b, &self.settings, timer);
-            }
-            if run.contains(&Pass::Cut) {
-                p.select_cut(&mut encoder, b, &self.settings, timer);
-            }
-            p.raster(&mut encoder, Pass::GBuffer, t, b, self.vertex_count, timer);
-            p.shade_indirect(&mut encoder, b, &self.settings, method, timer);
-            p.shade_direct(&mut encoder, b, &self.settings, timer);
-            if let Some(timer) = timer {
-                timer.resolve(&mut encoder);
-            }
-            gpu.queue.submit([encoder.finish()]);
-        })?;
-        if timed {
-            self.timer.collect(gpu)?;
-        }
-        Ok(())
-    }
-
-    /// The passes a frame of `method` records (the timer's slots of the others hold stale times).
-    pub fn passes_run(&self, method: Method, rebuild: bool) -> Vec<Pass> {
-        let mut passes = Vec::new();
-        if rebuild {
-            passes.push(Pass::Rsm);
-            if method.uses_quadtree() {
-                passes.extend([Pass::Pyramid, Pass::Validity]);
-            }
-            if method == Method::Quadtree {
-                passes.push(Pass::Cut);
-            }
-        }
-        passes.extend([Pass::GBuffer, Pass::Indirect, Pass::Direct]);
-        if method == Method::Quadtree && self.settings.subsample > 1 {
-            passes.push(Pass::Upsample);
-        }
-        passes
-    }
-
-    /// Renders `frames` timed frames of `method` (rebuilding the light's buffers each frame with
-    /// `rebuild`) and returns the median GPU time of each pass; `None` without timestamp queries.
-    pub fn time(
-        &mut self,
-        method: Method,
-        rebuild: bool,
-        frames: u32,
-    ) -> Result<Option<FrameTiming>, IndirectError> {
-        self.timer.clear();
-        for _ in 0..frames {
-            self.render(method, rebuild, true)?;
-        }
-        if !self.timer.enabled() || frames == 0 {
-            return Ok(None);
-        }
-        let run = self.passes_run(method, rebuild);
-        let passes: BTreeMap<&'static str, f64> = Pass::ALL
-            .into_iter()
-            .zip(self.timer.summaries())
-            .filter(|(p, _)| run.contains(p))
-            .filter_map(|(p, s)| s.map(|s| (p.name(), s.median_ms)))
-            .collect();
-        Ok(Some(FrameTiming {
-            total_ms: passes.values().sum(),
-            passes,
-            frames,
-        }))
-    }
-
-    pub fn has_timestamps(&self) -> bool {
-        self.timer.enabled()
-    }
-
-    /// Renders one frame of `method` from scratch, untimed, and reads it back.
-    pub fn render_frame(&mut self, method: Method) -> Result<Frame, IndirectError> {
-        self.render(method, true, false)?;
-        self.read_frame()
-    }
-
-    /// The last frame's indirect and direct light.
-    pub fn read_frame(&self) -> Result<Frame, IndirectError> {
-        let indirect = self.buffers.read_vec4(self.gpu, &self.buffers.indirect)?;
-        let direct = self.buffers.read_vec4(self.gpu, &self.buffers.direct)?;
-        let rgb = |v: &[[f32; 4]]| v.iter().map(|p| [p[0], p[1], p[2]]).collect();
-        Ok(Frame {
-            width: self.settings.width,
-            height: self.settings.height,
-            recomputed: indirect.iter().filter(|p| p[3] > 0.5).count() as u32,
-            indirect: rgb(&indirect),
-            direct: rgb(&direct),
-        })
-    }
-
-    /// Number of clusters in the compacted cut (after a `Quadtree` frame with rebuild).
-    pub fn clusters_in_cut(&self) -> Result<u32, IndirectError> {
-        let count = self.buffers.read_u32(self.gpu, &self.buffers.cut_count)?;
-        Ok(count[0])
-    }
-
-    /// The clusters of the compacted cut (after a `Quadtree` frame with rebuild), in no order.
-    pub fn read_cut(&self) -> Result<Vec<CutNode>, IndirectError> {
-        let count = self.clusters_in_cut()? as usize;
-        let clusters = self.buffers.read_vec4(self.gpu, &self.buffers.cut)?;
-        // three vec4 a cluster; the normal's w holds the node's index
-        Ok(clusters
-            .chunks_exact(3)
-            .take(count)
-            .map(|c| CutNode::at(self.settings.rsm_size, c[2][3].to_bits()))
-            .collect())
-    }
-
-    /// The RSM's flux per texel, row-major (what the cut clusters).
-    pub fn read_rsm_flux(&self) -> Result<Vec<[f32; 3]>, IndirectError> {
-        let flux = read_texture_f32(self.gpu, &self.targets.rsm[0], 0, 4)?;
-        Ok(flux.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect())
-    }
-
-    /// The quadtree as built: per node (flux rgb + texel count, position + depth, normal +
-    /// validity), finest level first.
-    pub fn read_nodes(&self) -> Result<Vec<[[f32; 4]; 3]>, IndirectError> {
-        let flat = self.buffers.read_vec4(self.gpu, &self.buffers.nodes)?;
-        Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
-    }
-
-    /// The RSM's VPLs (texels that see geometry), for the CPU reference.
-    pub fn read_vpls(&self) -> Result<Vec<Vpl>, IndirectError> {
-        let read = |tex: &wgpu::Texture| read_texture_f32(self.gpu, tex, 0, 4);
-        let flux = read(&self.targets.rsm[0])?;
-        let pos = read(&self.targets.rsm[1])?;
-        let normal = read(&self.targets.rsm[2])?;
-        Ok((0..flux.len() / 4)
-            .filter(|i| normal[i * 4 + 3] > 0.5)
-            .map(|i| Vpl {
-                flux: [flux[i * 4], flux[i * 4 + 1], flux[i * 4 + 2]],
-                position: [pos[i * 4], pos[i * 4 + 1], pos[i * 4 + 2]],
-                normal: [normal[i * 4], normal[i * 4 + 1], normal[i * 4 + 2]],
-            })
-            .collect())
-    }
-
-    /// The G-buffer, for the CPU reference.
-    pub fn read_receivers(&self) -> Result<Vec<Option<Receiver>>, IndirectError> {
-        let read = |tex: &wgpu::Texture| read_texture_f32(self.gpu, tex, 0, 4);
-        let pos = read(&self.targets.gbuffer[0])?;
-        let normal = read(&self.targets.gbuffer[1])?;
-        let albedo = read(&self.targets.gbuffer[2])?;
-        let v3 = |v: &[f32], i: usize| [v[i * 4], v[i * 4 + 1], v[i * 4 + 2]];
-        Ok((0..pos.len() / 4)
-            .map(|i| {
-                (pos[i * 4 + 3] > 0.5).then(|| Receiver {
-                    position: v3(&pos, i),
-                    normal: v3(&normal, i),
-                    albedo: v3(&albedo, i),
-                })
-            })
-            .collect())
-    }
 }
 
 #[cfg(test)]

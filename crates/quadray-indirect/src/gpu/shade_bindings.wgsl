@@ -18,31 +18,30 @@ struct Shade {
     pad1: u32,
 }
 
-struct Level {
-    level: u32,
-}
-
+// Group 0, per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
 @group(0) @binding(0) var<uniform> params: ClusterParams;
-@group(0) @binding(1) var<uniform> shade: Shade;
-@group(0) @binding(2) var<uniform> current: Level;
-@group(0) @binding(3) var<uniform> light: Light;
-@group(0) @binding(4) var g_pos: texture_2d<f32>;
-@group(0) @binding(5) var g_normal: texture_2d<f32>;
-@group(0) @binding(6) var g_albedo: texture_2d<f32>;
-@group(0) @binding(7) var rsm_flux: texture_2d<f32>;
-@group(0) @binding(8) var rsm_pos: texture_2d<f32>;
-@group(0) @binding(9) var rsm_normal: texture_2d<f32>;
-@group(0) @binding(10) var<storage, read> nodes: array<Node>;
-@group(0) @binding(11) var<storage, read> cut: array<Node>;
-@group(0) @binding(12) var<storage, read> cut_count: u32;
+@group(0) @binding(1) var<uniform> light: Light;
+@group(0) @binding(2) var rsm_flux: texture_2d<f32>;
+@group(0) @binding(3) var rsm_pos: texture_2d<f32>;
+@group(0) @binding(4) var rsm_normal: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read> nodes: array<Node>;
+@group(0) @binding(6) var<storage, read> cut: array<Node>;
+@group(0) @binding(7) var<storage, read> cut_count: u32;
+// Group 1, per frame (its targets): the sizes, the G-buffer, the outputs and the RSM samples.
+@group(1) @binding(0) var<uniform> shade: Shade;
+@group(1) @binding(1) var g_pos: texture_2d<f32>;
+@group(1) @binding(2) var g_normal: texture_2d<f32>;
+@group(1) @binding(3) var g_albedo: texture_2d<f32>;
 // rgb: indirect radiance (or irradiance for the low-resolution pass), w: 1 when recomputed
-@group(0) @binding(13) var<storage, read_write> indirect: array<vec4<f32>>;
-@group(0) @binding(14) var<storage, read_write> direct: array<vec4<f32>>;
-@group(0) @binding(15) var<storage, read_write> low: array<vec4<f32>>;
+@group(1) @binding(4) var<storage, read_write> indirect: array<vec4<f32>>;
+@group(1) @binding(5) var<storage, read_write> direct: array<vec4<f32>>;
+@group(1) @binding(6) var<storage, read_write> low: array<vec4<f32>>;
 // xy: offset in RSM texels, z: weight, w: the pattern's radius
-@group(0) @binding(16) var<storage, read> samples: array<vec4<f32>>;
-// which slice of a long per-pixel sum this dispatch adds (see SLICE)
-@group(0) @binding(17) var<uniform> slice: Level;
+@group(1) @binding(7) var<storage, read> samples: array<vec4<f32>>;
+// Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
+// this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
+@group(2) @binding(0) var<uniform> current: Level;
+@group(2) @binding(1) var<uniform> slice: Level;
 
 struct Receiver {
     x: vec3<f32>,

@@ -2,12 +2,12 @@
 //! brute force and the error heat map beside them; the paper's figure 9 (quadtree against RSM
 //! sampling at equal time and at 2040 samples); the atrium.
 
-use crate::gpu::{ClusterSettings, Method, Renderer, Settings};
-use crate::reference::{compare, error_map};
-use crate::report::{cut_view, tone_map};
-use crate::{IndirectError, Scene};
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
+use quadray_indirect::picture::{cut_view, tone_map};
+use quadray_indirect::reference::{compare, error_map};
+use quadray_indirect::scene::scenes_dir;
+use quadray_indirect::{ClusterSettings, IndirectError, Method, Renderer, Scene, Settings};
 use std::path::{Path, PathBuf};
 
 const EXPOSURE: f32 = 1.0;
@@ -115,7 +115,7 @@ pub fn render_demo(
     )?);
 
     progress("atrium");
-    let atrium = Scene::load(&crate::scene::scenes_dir().join("atrium.toml"))?;
+    let atrium = Scene::load(&scenes_dir().join("atrium.toml"))?;
     let (w, h) = (size * 16 / 9, size);
     let mut r = Renderer::new(gpu, &atrium, settings(gpu, w, h, 256))?;
     let frame = r.render_frame(Method::Quadtree)?;

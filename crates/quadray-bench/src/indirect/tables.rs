@@ -3,11 +3,13 @@
 //! error-vs-time plot, and the speed ratios (compacted cut vs per-level passes, quadtree vs RSM at
 //! equal error). GPU times are medians of timestamp queries; ratios come from one run.
 
-use crate::gpu::{ClusterSettings, FrameTiming, Method, Renderer, Settings, Validity};
-use crate::reference::compare;
-use crate::{IndirectError, Scene};
 use quadray_core::bench::{PlotSpec, Series, Table, line_plot, write_json, write_text};
 use quadray_gpu::Gpu;
+use quadray_indirect::reference::compare;
+use quadray_indirect::scene::scenes_dir;
+use quadray_indirect::{
+    ClusterSettings, FrameTiming, IndirectError, Method, Renderer, Scene, Settings, Validity,
+};
 use serde::Serialize;
 use std::path::Path;
 
@@ -129,6 +131,121 @@ fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
     }
 }
 
+/// The Cornell box's renderer at the benchmark's sizes, its brute force, and the frames per median.
+struct Bench<'g> {
+    scene: Scene,
+    base: Settings,
+    renderer: Renderer<'g>,
+    brute: Vec<[f32; 3]>,
+    frames: u32,
+}
+
+/// Table 1: the limit level (16^2, 32^2, 64^2 nodes), compacted cut and per-level passes.
+fn table1(b: &mut Bench, progress: &mut dyn FnMut(&str)) -> Result<Vec<Row>, IndirectError> {
+    let rsm_size = b.base.rsm_size;
+    let m = Measure {
+        brute: &b.brute,
+        frames: b.frames,
+    };
+    let mut rows = Vec::new();
+    for side in LIMIT_SIDES.into_iter().filter(|&s| s < rsm_size) {
+        b.renderer
+            .set_cluster(ClusterSettings::with_limit_side(rsm_size, side))?;
+        for method in [Method::Quadtree, Method::QuadtreePasses] {
+            progress(&format!("table 1: limit {side}^2, {}", method.name()));
+            rows.push(m.row(&mut b.renderer, "1", method, format!("limit {side}^2"))?);
+        }
+    }
+    Ok(rows)
+}
+
+/// Table 2: the thresholds under both validity rules on the Cornell box, then the local rule on
+/// the Buddha (100k triangles) in the Cornell room.
+fn table2(
+    gpu: &Gpu,
+    b: &mut Bench,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<Row>, IndirectError> {
+    let rsm_size = b.base.rsm_size;
+    let m = Measure {
+        brute: &b.brute,
+        frames: b.frames,
+    };
+    let mut rows = Vec::new();
+    for validity in [Validity::Local, Validity::Recursive] {
+        for (depth, normal) in THRESHOLDS {
+            progress(&format!("table 2: {depth}/{normal} {validity:?}"));
+            b.renderer.set_cluster(ClusterSettings {
+                depth_threshold: depth,
+                normal_threshold: normal,
+                validity,
+                ..ClusterSettings::with_limit_side(rsm_size, 32)
+            })?;
+            let label = format!("depth {depth} normal {normal} {validity:?}, limit 32^2");
+            rows.push(m.row(&mut b.renderer, "2", Method::Quadtree, label)?);
+        }
+    }
+    let buddha = Scene::load(&scenes_dir().join("cornell_buddha.toml"))?;
+    let mut rb = Renderer::new(gpu, &buddha, b.base.clone())?;
+    progress("table 2: Buddha brute force");
+    let buddha_brute = rb.render_frame(Method::Reference)?.indirect;
+    let mb = Measure {
+        brute: &buddha_brute,
+        frames: b.frames,
+    };
+    for (depth, normal) in THRESHOLDS {
+        progress(&format!("table 2: Buddha {depth}/{normal}"));
+        rb.set_cluster(ClusterSettings {
+            depth_threshold: depth,
+            normal_threshold: normal,
+            ..ClusterSettings::with_limit_side(rsm_size, 32)
+        })?;
+        let label = format!("Buddha: depth {depth} normal {normal} Local, limit 32^2");
+        rows.push(mb.row(&mut rb, "2", Method::Quadtree, label)?);
+    }
+    Ok(rows)
+}
+
+/// Table 3: the quadtree at limits 16^2 and 32^2 against RSM sampling at every sample count.
+fn table3(
+    gpu: &Gpu,
+    b: &mut Bench,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<Row>, IndirectError> {
+    let rsm_size = b.base.rsm_size;
+    let m = Measure {
+        brute: &b.brute,
+        frames: b.frames,
+    };
+    let mut rows = Vec::new();
+    for side in [16, 32] {
+        b.renderer
+            .set_cluster(ClusterSettings::with_limit_side(rsm_size, side))?;
+        progress(&format!("table 3: quadtree limit {side}^2"));
+        rows.push(m.row(
+            &mut b.renderer,
+            "3",
+            Method::Quadtree,
+            format!("limit {side}^2"),
+        )?);
+    }
+    for samples in RSM_SAMPLES {
+        progress(&format!("table 3: RSM {samples} samples"));
+        let mut rs = Renderer::new(
+            gpu,
+            &b.scene,
+            Settings {
+                samples,
+                ..b.base.clone()
+            },
+        )?;
+        rows.push(m.row(&mut rs, "3", Method::Rsm, format!("{samples} samples"))?);
+    }
+    Ok(rows)
+}
+
+/// Every table, the ratios between them, and `results.md`, `results.json` and the error-vs-time
+/// plot in `out`.
 pub fn run(
     gpu: &Gpu,
     out: &Path,
@@ -146,74 +263,23 @@ pub fn run(
         cluster: ClusterSettings::defaults(rsm_size),
         ..Settings::default()
     };
-    let mut r = Renderer::new(gpu, &scene, base.clone())?;
+    let mut renderer = Renderer::new(gpu, &scene, base.clone())?;
     progress("brute force");
-    let brute = r.render_frame(Method::Reference)?.indirect;
-    let m = Measure {
-        brute: &brute,
+    let brute = renderer.render_frame(Method::Reference)?.indirect;
+    let mut b = Bench {
+        scene,
+        base,
+        renderer,
+        brute,
         frames,
     };
-    let mut rows = Vec::new();
-    for side in LIMIT_SIDES.into_iter().filter(|&s| s < rsm_size) {
-        r.set_cluster(ClusterSettings::with_limit_side(rsm_size, side))?;
-        for method in [Method::Quadtree, Method::QuadtreePasses] {
-            progress(&format!("table 1: limit {side}^2, {}", method.name()));
-            rows.push(m.row(&mut r, "1", method, format!("limit {side}^2"))?);
-        }
-    }
-    for validity in [Validity::Local, Validity::Recursive] {
-        for (depth, normal) in THRESHOLDS {
-            progress(&format!("table 2: {depth}/{normal} {validity:?}"));
-            r.set_cluster(ClusterSettings {
-                depth_threshold: depth,
-                normal_threshold: normal,
-                validity,
-                ..ClusterSettings::with_limit_side(rsm_size, 32)
-            })?;
-            let label = format!("depth {depth} normal {normal} {validity:?}, limit 32^2");
-            rows.push(m.row(&mut r, "2", Method::Quadtree, label)?);
-        }
-    }
-    // Table 2's second scene: the Buddha (100k triangles) in the Cornell room.
-    let buddha = Scene::load(&crate::scene::scenes_dir().join("cornell_buddha.toml"))?;
-    let mut rb = Renderer::new(gpu, &buddha, base.clone())?;
-    progress("table 2: Buddha brute force");
-    let buddha_brute = rb.render_frame(Method::Reference)?.indirect;
-    let mb = Measure {
-        brute: &buddha_brute,
-        frames,
-    };
-    for (depth, normal) in THRESHOLDS {
-        progress(&format!("table 2: Buddha {depth}/{normal}"));
-        rb.set_cluster(ClusterSettings {
-            depth_threshold: depth,
-            normal_threshold: normal,
-            ..ClusterSettings::with_limit_side(rsm_size, 32)
-        })?;
-        let label = format!("Buddha: depth {depth} normal {normal} Local, limit 32^2");
-        rows.push(mb.row(&mut rb, "2", Method::Quadtree, label)?);
-    }
-    for side in [16, 32] {
-        r.set_cluster(ClusterSettings::with_limit_side(rsm_size, side))?;
-        progress(&format!("table 3: quadtree limit {side}^2"));
-        rows.push(m.row(&mut r, "3", Method::Quadtree, format!("limit {side}^2"))?);
-    }
-    for samples in RSM_SAMPLES {
-        progress(&format!("table 3: RSM {samples} samples"));
-        let mut rs = Renderer::new(
-            gpu,
-            &scene,
-            Settings {
-                samples,
-                ..base.clone()
-            },
-        )?;
-        rows.push(m.row(&mut rs, "3", Method::Rsm, format!("{samples} samples"))?);
-    }
+    let mut rows = table1(&mut b, &mut progress)?;
+    rows.extend(table2(gpu, &mut b, &mut progress)?);
+    rows.extend(table3(gpu, &mut b, &mut progress)?);
     let ratios = ratios(&rows);
     let results = BenchResults {
         adapter: gpu.describe(),
-        scene: scene.name.clone(),
+        scene: b.scene.name.clone(),
         width: size,
         height: size,
         rsm_size,

@@ -1,0 +1,6 @@
+//! The light-quadtree paper's harness: `quadray indirect`'s measured run, the tables of
+//! `quadray bench indirect` and the pictures of `quadray demo`.
+
+pub mod demo;
+pub mod run;
+pub mod tables;

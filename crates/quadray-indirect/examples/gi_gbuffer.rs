@@ -1,0 +1,371 @@
+//! One-bounce indirect light added to a G-buffer you render yourself. This program opens its own
+//! wgpu device, builds a Cornell-like box with a block in code, rasterises its own G-buffer with
+//! its own shader, then records quadray's passes into its encoder: the spot's RSM, the light
+//! quadtree and its cut, the gather into its G-buffer, and the radiance into its output texture.
+//! Writes `out/examples/gi_gbuffer.png`.
+//!
+//! `cargo run --release -p quadray-indirect --example gi_gbuffer`
+
+use glam::Vec3;
+use quadray_indirect::scene::{Camera, Scene, SpotLight, Vertex};
+use quadray_indirect::{
+    ClusterSettings, FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, OutputPass,
+    OutputTerm, RsmPass, Settings, Spot,
+};
+use wgpu::util::DeviceExt;
+
+/// The G-buffer the gather reads: world position (w = 1 where covered), normal towards the
+/// camera, albedo; all Rgba32Float.
+const GBUFFER_WGSL: &str = "
+struct Camera { view_proj: mat4x4<f32>, eye: vec4<f32> }
+@group(0) @binding(0) var<uniform> camera: Camera;
+struct Out { @builtin(position) clip: vec4<f32>, @location(0) world: vec3<f32>,
+             @location(1) normal: vec3<f32>, @location(2) albedo: vec3<f32> }
+@vertex fn vs(@location(0) p: vec3<f32>, @location(1) n: vec3<f32>, @location(2) a: vec3<f32>) -> Out {
+    return Out(camera.view_proj * vec4<f32>(p, 1.0), p, n, a);
+}
+struct GBuffer { @location(0) pos: vec4<f32>, @location(1) normal: vec4<f32>, @location(2) albedo: vec4<f32> }
+@fragment fn fs(v: Out) -> GBuffer {
+    var n = normalize(v.normal);
+    n = select(-n, n, dot(n, camera.eye.xyz - v.world) >= 0.0);
+    return GBuffer(vec4<f32>(v.world, 1.0), vec4<f32>(n, 1.0), vec4<f32>(v.albedo, 1.0));
+}";
+
+/// Two triangles a b c, a c d with the normal of their winding.
+fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2] {
+    let normal = (b - a).cross(d - a).normalize().into();
+    let v = |p: Vec3| Vertex {
+        position: p.into(),
+        normal,
+        albedo,
+    };
+    [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
+}
+
+/// A unit room open towards +z (red wall left, green right) with a white block, a spot light
+/// under the ceiling and the camera in front.
+pub fn scene() -> Scene {
+    let (white, red, green) = ([0.73; 3], [0.63, 0.065, 0.05], [0.14, 0.45, 0.091]);
+    let p = |x, y, z| Vec3::new(x, y, z);
+    let mut triangles = Vec::new();
+    for (a, b, c, d, albedo) in [
+        (
+            p(0., 0., 1.),
+            p(1., 0., 1.),
+            p(1., 0., 0.),
+            p(0., 0., 0.),
+            white,
+        ), // floor
+        (
+            p(0., 1., 0.),
+            p(1., 1., 0.),
+            p(1., 1., 1.),
+            p(0., 1., 1.),
+            white,
+        ), // ceiling
+        (
+            p(0., 0., 0.),
+            p(1., 0., 0.),
+            p(1., 1., 0.),
+            p(0., 1., 0.),
+            white,
+        ), // back
+        (
+            p(0., 0., 1.),
+            p(0., 0., 0.),
+            p(0., 1., 0.),
+            p(0., 1., 1.),
+            red,
+        ), // left
+        (
+            p(1., 0., 0.),
+            p(1., 0., 1.),
+            p(1., 1., 1.),
+            p(1., 1., 0.),
+            green,
+        ), // right
+        // the block: 0.3 wide, 0.5 high, its top and four sides
+        (
+            p(0.2, 0.5, 0.6),
+            p(0.5, 0.5, 0.6),
+            p(0.5, 0.5, 0.3),
+            p(0.2, 0.5, 0.3),
+            white,
+        ),
+        (
+            p(0.2, 0., 0.6),
+            p(0.5, 0., 0.6),
+            p(0.5, 0.5, 0.6),
+            p(0.2, 0.5, 0.6),
+            white,
+        ),
+        (
+            p(0.5, 0., 0.6),
+            p(0.5, 0., 0.3),
+            p(0.5, 0.5, 0.3),
+            p(0.5, 0.5, 0.6),
+            white,
+        ),
+        (
+            p(0.5, 0., 0.3),
+            p(0.2, 0., 0.3),
+            p(0.2, 0.5, 0.3),
+            p(0.5, 0.5, 0.3),
+            white,
+        ),
+        (
+            p(0.2, 0., 0.3),
+            p(0.2, 0., 0.6),
+            p(0.2, 0.5, 0.6),
+            p(0.2, 0.5, 0.3),
+            white,
+        ),
+    ] {
+        triangles.extend(quad(a, b, c, d, albedo));
+    }
+    Scene {
+        name: "gi_gbuffer".into(),
+        camera: Camera {
+            position: [0.5, 0.5, 2.4],
+            target: [0.5, 0.5, 0.0],
+            up: [0.0, 1.0, 0.0],
+            fov_deg: 39.0,
+        },
+        light: SpotLight {
+            position: [0.5, 0.97, 0.85],
+            direction: [0.25, -1.0, -0.55],
+            cone_deg: 55.0,
+            falloff_deg: 15.0,
+            intensity: [2.0; 3],
+        },
+        r_min: 0.05,
+        triangles,
+    }
+}
+
+/// The picture's size and the quadtree's defaults for a 128^2 RSM.
+pub fn settings() -> Settings {
+    Settings {
+        width: 256,
+        height: 256,
+        rsm_size: 128,
+        cluster: ClusterSettings::defaults(128),
+        ..Settings::default()
+    }
+}
+
+fn texture(
+    device: &wgpu::Device,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// Renders the scene (direct + one bounce) and returns linear radiance, rgba per pixel.
+pub fn render(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+) -> Result<Vec<[f32; 4]>, Box<dyn std::error::Error>> {
+    let (scene, s) = (scene(), settings());
+    let size = (s.width, s.height);
+    let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("vertices"),
+        contents: bytemuck::cast_slice(&scene.triangles),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let vertex_count = scene.triangles.len() as u32 * 3;
+
+    // Our own G-buffer pass.
+    let target = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+    let view = |format| texture(device, size, format, target).create_view(&Default::default());
+    let gbuffer = [(); 3].map(|_| view(FLOAT_FORMAT));
+    let depth = view(wgpu::TextureFormat::Depth32Float);
+    let camera = scene
+        .camera_view_proj(s.width as f32 / s.height as f32)
+        .to_cols_array();
+    let eye = scene.camera.position;
+    let camera = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("camera"),
+        contents: bytemuck::cast_slice(&[&camera[..], &[eye[0], eye[1], eye[2], 1.0]].concat()),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("gbuffer"),
+        source: wgpu::ShaderSource::Wgsl(GBUFFER_WGSL.into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("gbuffer"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: size_of::<Vertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3],
+            })],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[
+                Some(FLOAT_FORMAT.into()),
+                Some(FLOAT_FORMAT.into()),
+                Some(FLOAT_FORMAT.into()),
+            ],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: camera.as_entire_binding(),
+        }],
+    });
+
+    // quadray's passes on our device: the RSM, the quadtree over it, the gather into our G-buffer.
+    let spot = Spot::of_scene(&scene);
+    let rsm = RsmPass::new(device, s.rsm_size);
+    rsm.set_light(queue, &spot);
+    let quadtree = LightQuadtree::new(device, queue, s.rsm_size, s.cluster, rsm.views());
+    let views = GBufferViews {
+        position: &gbuffer[0],
+        normal: &gbuffer[1],
+        albedo: &gbuffer[2],
+    };
+    let gather = Gather::new(device, &s, &quadtree, rsm.views(), views)?;
+    gather.set_light(queue, &spot, scene.r_min);
+    let output_pass = OutputPass::new(device, FLOAT_FORMAT, OutputTerm::Combined)?;
+    let output_usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    let output = texture(device, size, FLOAT_FORMAT, output_usage);
+
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let attachment = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("gbuffer"),
+            color_attachments: &[
+                attachment(&gbuffer[0]),
+                attachment(&gbuffer[1]),
+                attachment(&gbuffer[2]),
+            ],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &camera_group, &[]);
+        pass.set_vertex_buffer(0, vertices.slice(..));
+        pass.draw(0..vertex_count, 0..1);
+    }
+    rsm.record(&mut encoder, vertices.slice(..), vertex_count, None);
+    quadtree.record_build(&mut encoder, None);
+    quadtree.record_cut(&mut encoder, None);
+    gather.record_indirect(&mut encoder, Method::Quadtree, &quadtree, None);
+    gather.record_direct(&mut encoder, None);
+    output_pass.record(
+        device,
+        &mut encoder,
+        &gather,
+        &output.create_view(&Default::default()),
+    );
+
+    // Read the output back (256 pixels of 16 bytes: rows already 256-byte aligned).
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: u64::from(s.width * s.height) * 16,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_texture_to_buffer(
+        output.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &readback,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(s.width * 16),
+                rows_per_image: None,
+            },
+        },
+        output.size(),
+    );
+    queue.submit([encoder.finish()]);
+    readback
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, |r| r.expect("map the readback"));
+    device.poll(wgpu::PollType::wait_indefinitely())?;
+    let pixels = bytemuck::pod_collect_to_vec(&readback.slice(..).get_mapped_range()?);
+    Ok(pixels)
+}
+
+/// Linear radiance to 8-bit sRGB with quadray's tone curve (1 - exp(-x)).
+pub fn to_png(width: u32, height: u32, radiance: &[[f32; 4]]) -> image::RgbaImage {
+    let rgb: Vec<[f32; 3]> = radiance.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    let picture = quadray_indirect::picture::tone_map(width, height, &rgb, 1.0);
+    image::RgbaImage::from_raw(width, height, picture.pixels.concat()).expect("sized")
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
+    // three Rgba32Float targets (48 bytes a sample) exceed the default limit of 32: ask for the
+    // adapter's own limits
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_limits: adapter.limits(),
+        ..Default::default()
+    }))?;
+    let radiance = render(&device, &queue)?;
+    let s = settings();
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples/gi_gbuffer.png");
+    std::fs::create_dir_all(path.parent().unwrap())?;
+    to_png(s.width, s.height, &radiance).save(&path)?;
+    println!("{}", path.display());
+    Ok(())
+}

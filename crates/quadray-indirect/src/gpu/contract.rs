@@ -1,0 +1,453 @@
+//! The Rust side of the Rust <-> WGSL contract: every uniform and storage struct the shaders share
+//! (`#[repr(C)]`, `Pod`; layout entries carry their `min_binding_size`), the constants of a WGSL
+//! prelude generated here and put in front of every shader, and the helpers the passes build
+//! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
+//! shared struct's size and field offsets against these.
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+/// Items (VPLs, clusters, samples) one dispatch of a per-pixel sum covers; longer sums take
+/// several dispatches that add up. lavapipe (llvmpipe) silently ends an invocation's loops after
+/// 65,535 iterations in all, which cut a 512^2 brute force to the RSM's top rows; on a GPU it
+/// keeps each dispatch short.
+pub(crate) const SLICE: u32 = 32768;
+/// Nodes one dispatch of a per-level pass covers: each node's cut test climbs up to 10
+/// ancestors, so fewer nodes keep it under lavapipe's limit too.
+pub(crate) const LEVEL_SLICE: u32 = 2048;
+/// Bound on the pyramid's levels (a 1024^2 RSM has 11).
+pub(crate) const MAX_LEVELS: u32 = 16;
+/// Slice uniform slots: enough for level 0 of a 1024^2 RSM in level slices, the longest sum.
+pub(crate) const MAX_SLICES: u32 = 1024 * 1024 / LEVEL_SLICE;
+
+/// The WGSL constants every shader starts with, generated from the Rust ones.
+pub(crate) fn prelude() -> String {
+    format!(
+        "// Generated from gpu/contract.rs: do not repeat these by hand.\n\
+         const SLICE: u32 = {SLICE}u;\n\
+         const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;\n\
+         const MAX_LEVELS: u32 = {MAX_LEVELS}u;\n\
+         const PI: f32 = {:?};\n\
+         const OUTPUT_INDIRECT: u32 = {}u;\n\
+         const OUTPUT_DIRECT: u32 = {}u;\n\
+         const OUTPUT_COMBINED: u32 = {}u;\n",
+        std::f32::consts::PI,
+        crate::gpu::output::OutputTerm::Indirect as u32,
+        crate::gpu::output::OutputTerm::Direct as u32,
+        crate::gpu::output::OutputTerm::Combined as u32,
+    )
+}
+
+/// A shader's whole source: the prelude, then `parts` in order.
+pub(crate) fn shader_source(parts: &[&str]) -> String {
+    std::iter::once(prelude().as_str())
+        .chain(parts.iter().copied())
+        .collect()
+}
+
+pub(crate) fn shader_module(
+    device: &wgpu::Device,
+    label: &str,
+    parts: &[&str],
+) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(shader_source(parts).into()),
+    })
+}
+
+/// WGSL `Light`: the spot light.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct LightUniform {
+    pub view_proj: [[f32; 4]; 4],
+    pub position: [f32; 4],
+    pub direction: [f32; 4],
+    pub intensity: [f32; 4],
+}
+
+/// WGSL `Raster`: a raster pass's projection.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct RasterUniform {
+    pub view_proj: [[f32; 4]; 4],
+    pub eye: [f32; 4],
+    pub texel: [f32; 4],
+}
+
+/// WGSL `ClusterParams`: the quadtree's settings.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct ClusterUniform {
+    pub rsm_size: u32,
+    pub levels: u32,
+    pub start_level: u32,
+    pub limit_level: u32,
+    pub recursive: u32,
+    pub flux_weighted: u32,
+    pub depth_threshold: f32,
+    pub normal_threshold: f32,
+}
+
+/// WGSL `Shade`: sizes and constants of the per-pixel passes.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct ShadeUniform {
+    pub width: u32,
+    pub height: u32,
+    pub r_min: f32,
+    pub sample_count: u32,
+    pub subsample: u32,
+    pub low_width: u32,
+    pub low_height: u32,
+    pub depth_bias: f32,
+    pub normal_agreement: f32,
+    pub plane_agreement: f32,
+    pub pad0: u32,
+    pub pad1: u32,
+}
+
+/// WGSL `Level`: one slot of the per-dispatch uniforms (a level, or a slice of a long sum).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct LevelSlot {
+    pub level: u32,
+}
+
+/// WGSL `Node`: one cluster of the quadtree (see common.wgsl for what each lane holds).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub(crate) struct GpuNode {
+    pub flux: [f32; 4],
+    pub pos: [f32; 4],
+    pub normal: [f32; 4],
+}
+
+fn min_size<T>() -> Option<wgpu::BufferSize> {
+    wgpu::BufferSize::new(size_of::<T>() as u64)
+}
+
+/// A uniform holding a `T`.
+pub(crate) fn uniform_entry<T>(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    dynamic: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: min_size::<T>(),
+        },
+        count: None,
+    }
+}
+
+/// A storage buffer of `T`s (at least one).
+pub(crate) fn storage_entry<T>(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: min_size::<T>(),
+        },
+        count: None,
+    }
+}
+
+/// A float texture read with `textureLoad` (any float format: no filtering).
+pub(crate) fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+pub(crate) fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size_of::<T>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+pub(crate) fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Uniform slots holding 0, 1, 2, ... `count - 1`, one bound per dispatch with a dynamic offset
+/// (a multiple of the returned stride).
+pub(crate) struct Slots {
+    pub buffer: wgpu::Buffer,
+    pub stride: u32,
+}
+
+impl Slots {
+    pub fn new(device: &wgpu::Device, label: &str, count: u32) -> Self {
+        let stride = device.limits().min_uniform_buffer_offset_alignment.max(16);
+        let contents: Vec<u8> = (0..count)
+            .flat_map(|i| {
+                let mut slot = vec![0u8; stride as usize];
+                slot[..4].copy_from_slice(&i.to_le_bytes());
+                slot
+            })
+            .collect();
+        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &contents,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        Self { buffer, stride }
+    }
+
+    /// The binding of one slot (the dynamic offset picks which).
+    pub fn binding(&self) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(16),
+        })
+    }
+
+    pub fn offset(&self, index: u32) -> u32 {
+        index * self.stride
+    }
+}
+
+/// Bind group entries numbered from 0 in the order given.
+pub(crate) fn entries(list: Vec<wgpu::BindingResource<'_>>) -> Vec<wgpu::BindGroupEntry<'_>> {
+    list.into_iter()
+        .enumerate()
+        .map(|(i, resource)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource,
+        })
+        .collect()
+}
+
+pub(crate) fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    list: Vec<wgpu::BindingResource<'_>>,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries(list),
+    })
+}
+
+pub(crate) fn layout(
+    device: &wgpu::Device,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries,
+    })
+}
+
+pub(crate) fn pipeline_layout(
+    device: &wgpu::Device,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().copied().map(Some).collect();
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    })
+}
+
+pub(crate) fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+pub(crate) fn whole(buffer: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+    buffer.as_entire_binding()
+}
+
+pub(crate) fn tex(view: &wgpu::TextureView) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::TextureView(view)
+}
+
+pub(crate) fn dispatch_2d(pass: &mut wgpu::ComputePass, width: u32, height: u32) {
+    pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+}
+
+/// Dispatches a sum over `items` takes, `per_slice` items each.
+pub(crate) fn slices(items: u64, per_slice: u32) -> u32 {
+    items
+        .div_ceil(u64::from(per_slice))
+        .clamp(1, u64::from(MAX_SLICES)) as u32
+}
+
+/// A compute pass, timed into `slot` of the timer when there is one.
+pub(crate) fn compute_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    timestamps: Option<wgpu::ComputePassTimestampWrites<'e>>,
+) -> wgpu::ComputePass<'e> {
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: timestamps,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::offset_of;
+
+    #[test]
+    fn slices_cover_the_longest_sums_that_settings_allow() {
+        // the largest RSM's VPLs (brute force, a cut of single VPLs), its finest level in level
+        // slices (per-level passes), the most RSM samples: never clamped by the slot count
+        let vpls = 1024u64 * 1024;
+        for (items, per_slice) in [(vpls, SLICE), (vpls, LEVEL_SLICE), (65536, SLICE)] {
+            let n = slices(items, per_slice);
+            assert!(
+                u64::from(n) * u64::from(per_slice) >= items,
+                "{items} in {n} x {per_slice}"
+            );
+            assert!(n <= MAX_SLICES);
+        }
+        assert_eq!(slices(0, SLICE), 1, "an empty sum still writes its zeros");
+        assert_eq!(slices(u64::from(SLICE) + 1, SLICE), 2);
+    }
+
+    /// A shared struct: its WGSL name, Rust size and Rust field offsets by name.
+    struct Shared {
+        wgsl: &'static str,
+        size: usize,
+        fields: Vec<(&'static str, usize)>,
+    }
+
+    macro_rules! shared {
+        ($wgsl:literal, $rust:ty, [$($field:ident),*]) => {
+            Shared {
+                wgsl: $wgsl,
+                size: size_of::<$rust>(),
+                fields: vec![$((stringify!($field), offset_of!($rust, $field))),*],
+            }
+        };
+    }
+
+    #[test]
+    fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
+        let shared = [
+            shared!(
+                "Light",
+                LightUniform,
+                [view_proj, position, direction, intensity]
+            ),
+            shared!("Raster", RasterUniform, [view_proj, eye, texel]),
+            shared!(
+                "ClusterParams",
+                ClusterUniform,
+                [
+                    rsm_size,
+                    levels,
+                    start_level,
+                    limit_level,
+                    recursive,
+                    flux_weighted,
+                    depth_threshold,
+                    normal_threshold
+                ]
+            ),
+            shared!(
+                "Shade",
+                ShadeUniform,
+                [
+                    width,
+                    height,
+                    r_min,
+                    sample_count,
+                    subsample,
+                    low_width,
+                    low_height,
+                    depth_bias,
+                    normal_agreement,
+                    plane_agreement,
+                    pad0,
+                    pad1
+                ]
+            ),
+            shared!("Level", LevelSlot, [level]),
+            shared!("Node", GpuNode, [flux, pos, normal]),
+        ];
+        let mut seen = std::collections::BTreeSet::new();
+        for (name, parts) in crate::gpu::shaders() {
+            let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
+            let source = shader_source(&parts);
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(Default::default(), naga::valid::Capabilities::all())
+                .validate(&module)
+                .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+            for (_, ty) in module.types.iter() {
+                let naga::TypeInner::Struct { members, span } = &ty.inner else {
+                    continue;
+                };
+                let Some(s) = shared.iter().find(|s| ty.name.as_deref() == Some(s.wgsl)) else {
+                    continue;
+                };
+                assert_eq!(*span as usize, s.size, "{name}: size of {}", s.wgsl);
+                let wgsl: Vec<(&str, usize)> = members
+                    .iter()
+                    .map(|m| (m.name.as_deref().unwrap_or(""), m.offset as usize))
+                    .collect();
+                assert_eq!(wgsl, s.fields, "{name}: fields of {}", s.wgsl);
+                seen.insert(s.wgsl);
+            }
+        }
+        for s in &shared {
+            assert!(seen.contains(s.wgsl), "no shader declares {}", s.wgsl);
+        }
+    }
+
+    #[test]
+    fn the_prelude_holds_the_rust_constants() {
+        let prelude = prelude();
+        for line in [
+            format!("const SLICE: u32 = {SLICE}u;"),
+            format!("const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;"),
+            format!("const MAX_LEVELS: u32 = {MAX_LEVELS}u;"),
+        ] {
+            assert!(prelude.contains(&line), "{line}");
+        }
+    }
+}

@@ -1,0 +1,378 @@
+//! The gather: deferred shading of the caller's G-buffer from the light quadtree (the compacted
+//! cut, or the paper's one pass per level; optionally at low resolution with geometry-aware
+//! upsampling), the baselines of the same shape (RSM sampling, the brute force over every VPL),
+//! and the direct light of the spot with the RSM depth as shadow map. Writes radiance buffers an
+//! [`super::OutputPass`] copies into the caller's texture.
+
+use super::contract::{
+    ClusterUniform, GpuNode, LEVEL_SLICE, LevelSlot, LightUniform, MAX_SLICES, SLICE, ShadeUniform,
+    Slots, bind_group, compute_pass, compute_pipeline, dispatch_2d, layout, pipeline_layout,
+    shader_module, slices, storage_buffer, storage_entry, tex, texture_entry, uniform_buffer,
+    uniform_entry, whole,
+};
+use super::light::Spot;
+use super::quadtree::{COMMON_WGSL, CUT_RULE_WGSL, LightQuadtree};
+use super::rsm::{LIGHT_WGSL, RsmViews};
+use super::{Method, Settings};
+use crate::{IndirectError, baselines};
+use quadray_gpu::GpuTimer;
+use wgpu::util::DeviceExt;
+
+/// The gather's shader, in order.
+pub(crate) const SOURCES: [&str; 6] = [
+    COMMON_WGSL,
+    LIGHT_WGSL,
+    include_str!("shade_bindings.wgsl"),
+    CUT_RULE_WGSL,
+    include_str!("shade.wgsl"),
+    baselines::WGSL,
+];
+
+/// The caller's G-buffer: three textures of the output's size, any float format `textureLoad`
+/// reads (quadray's are [`super::FLOAT_FORMAT`]).
+#[derive(Clone, Copy)]
+pub struct GBufferViews<'a> {
+    /// xyz: world position; w: 1 where geometry is seen, 0 elsewhere (no light there).
+    pub position: &'a wgpu::TextureView,
+    /// xyz: unit normal, turned towards the viewer.
+    pub normal: &'a wgpu::TextureView,
+    /// rgb: diffuse albedo.
+    pub albedo: &'a wgpu::TextureView,
+}
+
+/// Where a low-resolution indirect sample's pixel is (one sample per `subsample`^2 pixels).
+fn low_size(s: &Settings) -> (u32, u32) {
+    (
+        s.width.div_ceil(s.subsample),
+        s.height.div_ceil(s.subsample),
+    )
+}
+
+/// The per-frame buffers: sizes, radiance out, RSM samples.
+struct Outputs {
+    shade: wgpu::Buffer,
+    indirect: wgpu::Buffer,
+    direct: wgpu::Buffer,
+    low: wgpu::Buffer,
+    samples: wgpu::Buffer,
+}
+
+impl Outputs {
+    fn frame_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        gbuffer: GBufferViews,
+    ) -> wgpu::BindGroup {
+        bind_group(
+            device,
+            "gather frame",
+            layout,
+            vec![
+                whole(&self.shade),
+                tex(gbuffer.position),
+                tex(gbuffer.normal),
+                tex(gbuffer.albedo),
+                whole(&self.indirect),
+                whole(&self.direct),
+                whole(&self.low),
+                whole(&self.samples),
+            ],
+        )
+    }
+}
+
+/// The shading pipelines and the radiance they write, at one set of sizes.
+pub struct Gather {
+    settings: Settings,
+    indirect_cut: wgpu::ComputePipeline,
+    indirect_level: wgpu::ComputePipeline,
+    indirect_low: wgpu::ComputePipeline,
+    upsample: wgpu::ComputePipeline,
+    direct_light: wgpu::ComputePipeline,
+    brute_force: wgpu::ComputePipeline,
+    rsm_sampling: wgpu::ComputePipeline,
+    light_layout: wgpu::BindGroupLayout,
+    frame_layout: wgpu::BindGroupLayout,
+    light: wgpu::Buffer,
+    outputs: Outputs,
+    slots: Slots,
+    /// Per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
+    light_group: wgpu::BindGroup,
+    /// Per frame: the sizes, the G-buffer and the outputs.
+    frame_group: wgpu::BindGroup,
+    /// Per dispatch: a level and a slice.
+    dispatch_group: wgpu::BindGroup,
+}
+
+impl Gather {
+    /// The gather of `settings` (sizes, samples, subsampling) reading `quadtree`, the RSM it was
+    /// built from and the caller's G-buffer (`settings.width` x `settings.height`).
+    pub fn new(
+        device: &wgpu::Device,
+        settings: &Settings,
+        quadtree: &LightQuadtree,
+        rsm: RsmViews,
+        gbuffer: GBufferViews,
+    ) -> Result<Self, IndirectError> {
+        settings.validate().map_err(IndirectError::Settings)?;
+        let s = settings;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let light_layout = layout(
+            device,
+            "gather light",
+            &[
+                uniform_entry::<ClusterUniform>(0, compute, false),
+                uniform_entry::<LightUniform>(1, compute, false),
+                texture_entry(2),
+                texture_entry(3),
+                texture_entry(4),
+                storage_entry::<GpuNode>(5, true),
+                storage_entry::<GpuNode>(6, true),
+                storage_entry::<u32>(7, true),
+            ],
+        );
+        let frame_layout = layout(
+            device,
+            "gather frame",
+            &[
+                uniform_entry::<ShadeUniform>(0, compute, false),
+                texture_entry(1),
+                texture_entry(2),
+                texture_entry(3),
+                storage_entry::<[f32; 4]>(4, false),
+                storage_entry::<[f32; 4]>(5, false),
+                storage_entry::<[f32; 4]>(6, false),
+                storage_entry::<[f32; 4]>(7, true),
+            ],
+        );
+        let dispatch_layout = layout(
+            device,
+            "gather dispatch",
+            &[
+                uniform_entry::<LevelSlot>(0, compute, true),
+                uniform_entry::<LevelSlot>(1, compute, true),
+            ],
+        );
+        let module = shader_module(device, "gather", &SOURCES);
+        let pipelines = pipeline_layout(device, &[&light_layout, &frame_layout, &dispatch_layout]);
+        let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry);
+        let pixels = u64::from(s.width) * u64::from(s.height);
+        let (lw, lh) = low_size(s);
+        let samples = baselines::rsm_samples(
+            s.samples,
+            s.rsm_radius * s.rsm_size as f32 * std::f32::consts::SQRT_2,
+            0x5eed,
+        );
+        let light = uniform_buffer::<LightUniform>(device, "gather light");
+        let outputs = Outputs {
+            shade: uniform_buffer::<ShadeUniform>(device, "shade"),
+            indirect: storage_buffer(device, "indirect", pixels * 16),
+            direct: storage_buffer(device, "direct", pixels * 16),
+            low: storage_buffer(device, "low-resolution indirect", u64::from(lw * lh) * 16),
+            samples: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("rsm samples"),
+                contents: bytemuck::cast_slice(&samples),
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
+        };
+        let slots = Slots::new(device, "gather slots", MAX_SLICES);
+        Ok(Self {
+            settings: s.clone(),
+            indirect_cut: pipeline("indirect_cut"),
+            indirect_level: pipeline("indirect_level"),
+            indirect_low: pipeline("indirect_low"),
+            upsample: pipeline("upsample"),
+            direct_light: pipeline("direct_light"),
+            brute_force: pipeline("brute_force"),
+            rsm_sampling: pipeline("rsm_sampling"),
+            light_group: Self::light_group(device, &light_layout, &light, quadtree, rsm),
+            frame_group: outputs.frame_group(device, &frame_layout, gbuffer),
+            dispatch_group: bind_group(
+                device,
+                "gather dispatch",
+                &dispatch_layout,
+                vec![slots.binding(), slots.binding()],
+            ),
+            light_layout,
+            frame_layout,
+            light,
+            outputs,
+            slots,
+        })
+    }
+
+    fn light_group(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        light: &wgpu::Buffer,
+        quadtree: &LightQuadtree,
+        rsm: RsmViews,
+    ) -> wgpu::BindGroup {
+        bind_group(
+            device,
+            "gather light",
+            layout,
+            vec![
+                whole(quadtree.params()),
+                whole(light),
+                tex(rsm.flux),
+                tex(rsm.position),
+                tex(rsm.normal),
+                whole(quadtree.nodes()),
+                whole(quadtree.cut()),
+                whole(quadtree.cut_count()),
+            ],
+        )
+    }
+
+    /// Reads another quadtree or RSM from now on (when the caller's RSM textures change).
+    pub fn bind_rsm(&mut self, device: &wgpu::Device, quadtree: &LightQuadtree, rsm: RsmViews) {
+        self.light_group =
+            Self::light_group(device, &self.light_layout, &self.light, quadtree, rsm);
+    }
+
+    /// Shades another G-buffer of the same size from now on (when the caller's targets change).
+    pub fn bind_gbuffer(&mut self, device: &wgpu::Device, gbuffer: GBufferViews) {
+        self.frame_group = self
+            .outputs
+            .frame_group(device, &self.frame_layout, gbuffer);
+    }
+
+    /// Sets the light (per light update) and the clamp `r_min` of the VPL kernel's 1/r^4
+    /// (world units).
+    pub fn set_light(&self, queue: &wgpu::Queue, spot: &Spot, r_min: f32) {
+        let s = &self.settings;
+        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&spot.uniform()));
+        let texel_side = spot.texel_side(s.rsm_size);
+        let (low_width, low_height) = low_size(s);
+        queue.write_buffer(
+            &self.outputs.shade,
+            0,
+            bytemuck::bytes_of(&ShadeUniform {
+                width: s.width,
+                height: s.height,
+                r_min,
+                sample_count: s.samples,
+                subsample: s.subsample,
+                low_width,
+                low_height,
+                // a few shadow-map texels' worth of depth at the far side of the scene
+                depth_bias: 0.005 + 3.0 * texel_side * spot.far / spot.extent,
+                normal_agreement: 0.9,
+                plane_agreement: 0.02 * spot.extent,
+                pad0: 0,
+                pad1: 0,
+            }),
+        );
+    }
+
+    fn bind(&self, pass: &mut wgpu::ComputePass, level: u32, slice: u32) {
+        pass.set_bind_group(
+            2,
+            &self.dispatch_group,
+            &[self.slots.offset(level), self.slots.offset(slice)],
+        );
+    }
+
+    /// Records the indirect light of `method` (after `quadtree`'s build, and its cut for
+    /// [`Method::Quadtree`]) into `timer`'s `indirect` and `upsample` slots.
+    pub fn record_indirect(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        method: Method,
+        quadtree: &LightQuadtree,
+        timer: Option<(&GpuTimer, u32, u32)>,
+    ) {
+        let s = &self.settings;
+        let c = quadtree.cluster();
+        let subsampled = method == Method::Quadtree && s.subsample > 1;
+        let rsm_texels = u64::from(s.rsm_size).pow(2);
+        // a cut partitions the RSM into nodes no finer than the limit level
+        let cut_slices = slices(u64::from(s.rsm_size >> c.limit_level).pow(2), SLICE);
+        if method == Method::QuadtreePasses {
+            encoder.clear_buffer(&self.outputs.indirect, 0, None);
+        }
+        {
+            let stamps = timer.and_then(|(t, slot, _)| t.compute_pass(slot));
+            let mut pass = compute_pass(encoder, "indirect", stamps);
+            pass.set_bind_group(0, &self.light_group, &[]);
+            pass.set_bind_group(1, &self.frame_group, &[]);
+            // the sum over `items` in slices; the first slice writes, the others add
+            let sliced = |pass: &mut wgpu::ComputePass, level: u32, count: u32, w, h| {
+                for slice in 0..count {
+                    self.bind(pass, level, slice);
+                    dispatch_2d(pass, w, h);
+                }
+            };
+            let (w, h) = (s.width, s.height);
+            match method {
+                Method::Quadtree if subsampled => {
+                    pass.set_pipeline(&self.indirect_low);
+                    let (lw, lh) = low_size(s);
+                    sliced(&mut pass, 0, cut_slices, lw, lh);
+                }
+                Method::Quadtree => {
+                    pass.set_pipeline(&self.indirect_cut);
+                    sliced(&mut pass, 0, cut_slices, w, h);
+                }
+                Method::QuadtreePasses => {
+                    pass.set_pipeline(&self.indirect_level);
+                    for level in (c.limit_level..=c.start_level).rev() {
+                        let nodes = u64::from(s.rsm_size >> level).pow(2);
+                        sliced(&mut pass, level, slices(nodes, LEVEL_SLICE), w, h);
+                    }
+                }
+                Method::Rsm => {
+                    pass.set_pipeline(&self.rsm_sampling);
+                    sliced(&mut pass, 0, slices(u64::from(s.samples), SLICE), w, h);
+                }
+                Method::Reference => {
+                    pass.set_pipeline(&self.brute_force);
+                    sliced(&mut pass, 0, slices(rsm_texels, SLICE), w, h);
+                }
+            }
+        }
+        if subsampled {
+            // where the upsampler recomputes a pixel it sums the cut, in the same slices
+            let stamps = timer.and_then(|(t, _, slot)| t.compute_pass(slot));
+            let mut pass = compute_pass(encoder, "upsample", stamps);
+            pass.set_bind_group(0, &self.light_group, &[]);
+            pass.set_bind_group(1, &self.frame_group, &[]);
+            pass.set_pipeline(&self.upsample);
+            for slice in 0..cut_slices {
+                self.bind(&mut pass, 0, slice);
+                dispatch_2d(&mut pass, s.width, s.height);
+            }
+        }
+    }
+
+    /// Records the direct light of the spot, shadowed by the RSM depth, into `timer`'s `slot`.
+    pub fn record_direct(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<(&GpuTimer, u32)>,
+    ) {
+        let stamps = timer.and_then(|(t, slot)| t.compute_pass(slot));
+        let mut pass = compute_pass(encoder, "direct", stamps);
+        pass.set_bind_group(0, &self.light_group, &[]);
+        pass.set_bind_group(1, &self.frame_group, &[]);
+        self.bind(&mut pass, 0, 0);
+        pass.set_pipeline(&self.direct_light);
+        dispatch_2d(&mut pass, self.settings.width, self.settings.height);
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Indirect radiance per pixel, row-major: rgb, and w = 1 where the upsampler recomputed it.
+    pub(crate) fn indirect(&self) -> &wgpu::Buffer {
+        &self.outputs.indirect
+    }
+
+    /// Direct radiance per pixel, row-major (rgb, w = 1).
+    pub(crate) fn direct(&self) -> &wgpu::Buffer {
+        &self.outputs.direct
+    }
+}

@@ -1,0 +1,65 @@
+//! The spot light as the passes see it: plain values a renderer fills from its own scene.
+
+use super::contract::LightUniform;
+use crate::scene::Scene;
+use glam::{Mat4, Vec3};
+
+/// A spot light and the projection of its reflective shadow map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// World -> light clip space (a perspective of twice the cone, square): the RSM's projection.
+    pub view_proj: Mat4,
+    /// Where the light is (world units).
+    pub position: Vec3,
+    /// Unit axis of the cone.
+    pub direction: Vec3,
+    /// Half-angle of the cone (degrees); also half the RSM's field of view.
+    pub cone_deg: f32,
+    /// Full intensity inside `cone_deg - falloff_deg`, fading to zero at `cone_deg`.
+    pub falloff_deg: f32,
+    /// Radiant intensity on the axis (W/sr per channel).
+    pub intensity: [f32; 3],
+    /// The scene's size (its bounds' diagonal): the unit of RSM depth, in which the validity
+    /// thresholds are given.
+    pub extent: f32,
+    /// The light's far plane: everything lit is closer.
+    pub far: f32,
+}
+
+impl Spot {
+    /// The light of a quadray [`Scene`].
+    pub fn of_scene(scene: &Scene) -> Self {
+        let l = &scene.light;
+        Self {
+            view_proj: scene.light_view_proj(),
+            position: l.position.into(),
+            direction: Vec3::from(l.direction).normalize(),
+            cone_deg: l.cone_deg,
+            falloff_deg: l.falloff_deg,
+            intensity: l.intensity,
+            extent: scene.extent(),
+            far: scene.light_far(),
+        }
+    }
+
+    /// Side of an RSM texel on the plane at unit distance along the axis.
+    pub(crate) fn texel_side(&self, rsm_size: u32) -> f32 {
+        2.0 * self.cone_deg.to_radians().tan() / rsm_size as f32
+    }
+
+    pub(crate) fn uniform(&self) -> LightUniform {
+        let cone = self.cone_deg.to_radians();
+        let (p, d, i) = (self.position, self.direction, self.intensity);
+        LightUniform {
+            view_proj: self.view_proj.to_cols_array_2d(),
+            position: [p.x, p.y, p.z, 1.0 / self.extent],
+            direction: [d.x, d.y, d.z, cone.cos()],
+            intensity: [
+                i[0],
+                i[1],
+                i[2],
+                (cone - self.falloff_deg.to_radians()).cos(),
+            ],
+        }
+    }
+}

@@ -1,0 +1,259 @@
+//! The light-quadtree pass: the RSM packed into a pyramid of clusters (summed flux, weighted
+//! means), the validity of every cluster, and the compacted cut. Its buffers are what the gather
+//! reads.
+
+use super::contract::{
+    ClusterUniform, GpuNode, LevelSlot, MAX_LEVELS, Slots, bind_group, compute_pass,
+    compute_pipeline, dispatch_2d, layout, pipeline_layout, shader_module, storage_buffer,
+    storage_entry, tex, texture_entry, uniform_buffer, uniform_entry, whole,
+};
+use super::rsm::RsmViews;
+use super::{ClusterSettings, Validity};
+use quadray_gpu::GpuTimer;
+
+pub(crate) const COMMON_WGSL: &str = include_str!("common.wgsl");
+pub(crate) const CUT_RULE_WGSL: &str = include_str!("cut_rule.wgsl");
+/// The quadtree pass's shader, in order.
+pub(crate) const SOURCES: [&str; 3] = [COMMON_WGSL, CUT_RULE_WGSL, include_str!("cluster.wgsl")];
+
+/// Total nodes of the pyramid of an RSM of side `rsm_size`.
+pub(crate) fn node_count(rsm_size: u32) -> u64 {
+    level_offset(rsm_size, rsm_size.ilog2() + 1)
+}
+
+/// Index of the first node of `level`.
+pub(crate) fn level_offset(rsm_size: u32, level: u32) -> u64 {
+    (0..level).map(|l| u64::from(rsm_size >> l).pow(2)).sum()
+}
+
+/// The quadtree over an RSM of a fixed side, and the pipelines that build it and its cut.
+pub struct LightQuadtree {
+    rsm_size: u32,
+    cluster: ClusterSettings,
+    pack: wgpu::ComputePipeline,
+    reduce: wgpu::ComputePipeline,
+    validity: wgpu::ComputePipeline,
+    select_cut: wgpu::ComputePipeline,
+    group_layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    cut: wgpu::Buffer,
+    cut_count: wgpu::Buffer,
+    levels: Slots,
+    /// Per light update: settings, RSM, nodes and cut.
+    group: wgpu::BindGroup,
+    /// Per dispatch: the level.
+    level_group: wgpu::BindGroup,
+}
+
+impl LightQuadtree {
+    /// A quadtree over `rsm` (textures of side `rsm_size`, a power of two, the RSM's side) with the
+    /// settings `cluster` (check them with [`super::Settings::validate`]).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        rsm_size: u32,
+        cluster: ClusterSettings,
+        rsm: RsmViews,
+    ) -> Self {
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let group_layout = layout(
+            device,
+            "quadtree",
+            &[
+                uniform_entry::<ClusterUniform>(0, compute, false),
+                texture_entry(1),
+                texture_entry(2),
+                texture_entry(3),
+                storage_entry::<GpuNode>(4, false),
+                storage_entry::<GpuNode>(5, false),
+                storage_entry::<u32>(6, false),
+            ],
+        );
+        let level_layout = layout(
+            device,
+            "quadtree level",
+            &[uniform_entry::<LevelSlot>(0, compute, true)],
+        );
+        let module = shader_module(device, "quadtree", &SOURCES);
+        let pipelines = pipeline_layout(device, &[&group_layout, &level_layout]);
+        let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry);
+        let node_size = size_of::<GpuNode>() as u64;
+        let params = uniform_buffer::<ClusterUniform>(device, "cluster settings");
+        let nodes = storage_buffer(device, "nodes", node_count(rsm_size) * node_size);
+        // a cut partitions the RSM: at most one cluster per texel
+        let cut = storage_buffer(device, "cut", u64::from(rsm_size).pow(2) * node_size);
+        let cut_count = storage_buffer(device, "cut count", 4);
+        let levels = Slots::new(device, "levels", MAX_LEVELS);
+        let level_group = bind_group(
+            device,
+            "quadtree level",
+            &level_layout,
+            vec![levels.binding()],
+        );
+        let group = Self::rsm_group(
+            device,
+            &group_layout,
+            &params,
+            &nodes,
+            &cut,
+            &cut_count,
+            rsm,
+        );
+        let quadtree = Self {
+            rsm_size,
+            cluster,
+            pack: pipeline("pack"),
+            reduce: pipeline("reduce"),
+            validity: pipeline("validity"),
+            select_cut: pipeline("select_cut"),
+            group_layout,
+            params,
+            nodes,
+            cut,
+            cut_count,
+            levels,
+            group,
+            level_group,
+        };
+        quadtree.write_cluster(queue);
+        quadtree
+    }
+
+    fn rsm_group(
+        device: &wgpu::Device,
+        group_layout: &wgpu::BindGroupLayout,
+        params: &wgpu::Buffer,
+        nodes: &wgpu::Buffer,
+        cut: &wgpu::Buffer,
+        cut_count: &wgpu::Buffer,
+        rsm: RsmViews,
+    ) -> wgpu::BindGroup {
+        bind_group(
+            device,
+            "quadtree",
+            group_layout,
+            vec![
+                whole(params),
+                tex(rsm.flux),
+                tex(rsm.position),
+                tex(rsm.normal),
+                whole(nodes),
+                whole(cut),
+                whole(cut_count),
+            ],
+        )
+    }
+
+    /// Reads another RSM of the same side from now on (when the caller's RSM textures change).
+    pub fn bind_rsm(&mut self, device: &wgpu::Device, rsm: RsmViews) {
+        self.group = Self::rsm_group(
+            device,
+            &self.group_layout,
+            &self.params,
+            &self.nodes,
+            &self.cut,
+            &self.cut_count,
+            rsm,
+        );
+    }
+
+    /// New settings for the next build and cut (check them with [`super::Settings::validate`]).
+    pub fn set_cluster(&mut self, queue: &wgpu::Queue, cluster: ClusterSettings) {
+        self.cluster = cluster;
+        self.write_cluster(queue);
+    }
+
+    fn write_cluster(&self, queue: &wgpu::Queue) {
+        let c = &self.cluster;
+        queue.write_buffer(
+            &self.params,
+            0,
+            bytemuck::bytes_of(&ClusterUniform {
+                rsm_size: self.rsm_size,
+                levels: self.rsm_size.ilog2() + 1,
+                start_level: c.start_level,
+                limit_level: c.limit_level,
+                recursive: u32::from(c.validity == Validity::Recursive),
+                flux_weighted: u32::from(c.flux_weighted),
+                depth_threshold: c.depth_threshold,
+                normal_threshold: c.normal_threshold,
+            }),
+        );
+    }
+
+    /// Records the pyramid (pack + one reduce per level) into `timer`'s `pyramid` slot and the
+    /// validity (one dispatch per level, finest first, so the recursive rule sees its children's
+    /// verdicts) into its `validity` slot.
+    pub fn record_build(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<(&GpuTimer, u32, u32)>,
+    ) {
+        let top = self.rsm_size.ilog2();
+        let side = |level: u32| self.rsm_size >> level;
+        {
+            let stamps = timer.and_then(|(t, slot, _)| t.compute_pass(slot));
+            let mut pass = compute_pass(encoder, "pyramid", stamps);
+            pass.set_bind_group(0, &self.group, &[]);
+            pass.set_pipeline(&self.pack);
+            pass.set_bind_group(1, &self.level_group, &[self.levels.offset(0)]);
+            dispatch_2d(&mut pass, side(0), side(0));
+            pass.set_pipeline(&self.reduce);
+            for level in 1..=top {
+                pass.set_bind_group(1, &self.level_group, &[self.levels.offset(level)]);
+                dispatch_2d(&mut pass, side(level), side(level));
+            }
+        }
+        let stamps = timer.and_then(|(t, _, slot)| t.compute_pass(slot));
+        let mut pass = compute_pass(encoder, "validity", stamps);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_pipeline(&self.validity);
+        for level in 1..=top {
+            pass.set_bind_group(1, &self.level_group, &[self.levels.offset(level)]);
+            dispatch_2d(&mut pass, side(level), side(level));
+        }
+    }
+
+    /// Records the compacted cut (after [`Self::record_build`]): one thread per node of the
+    /// levels limit..start, atomic append.
+    pub fn record_cut(&self, encoder: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+        encoder.clear_buffer(&self.cut_count, 0, None);
+        let c = &self.cluster;
+        let nodes = level_offset(self.rsm_size, c.start_level + 1)
+            - level_offset(self.rsm_size, c.limit_level);
+        let stamps = timer.and_then(|(t, slot)| t.compute_pass(slot));
+        let mut pass = compute_pass(encoder, "cut", stamps);
+        pass.set_pipeline(&self.select_cut);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_bind_group(1, &self.level_group, &[self.levels.offset(0)]);
+        pass.dispatch_workgroups(nodes.div_ceil(256) as u32, 1, 1);
+    }
+
+    pub fn rsm_size(&self) -> u32 {
+        self.rsm_size
+    }
+
+    pub fn cluster(&self) -> ClusterSettings {
+        self.cluster
+    }
+
+    pub(crate) fn params(&self) -> &wgpu::Buffer {
+        &self.params
+    }
+
+    /// Every node, finest level first: [`GpuNode`]s.
+    pub(crate) fn nodes(&self) -> &wgpu::Buffer {
+        &self.nodes
+    }
+
+    /// The compacted cut's clusters ([`GpuNode`]s, `normal.w` the node's index as bits).
+    pub(crate) fn cut(&self) -> &wgpu::Buffer {
+        &self.cut
+    }
+
+    /// How many clusters the cut holds (one `u32`).
+    pub(crate) fn cut_count(&self) -> &wgpu::Buffer {
+        &self.cut_count
+    }
+}

@@ -1,0 +1,301 @@
+//! quadray's own renderer of a [`Scene`]: its triangles in a vertex buffer, its G-buffer, and
+//! the public passes (RSM, light quadtree, gather) recorded in one encoder per frame, timed per
+//! pass. The CLI, the viewer and the benchmarks render through it.
+
+use super::gbuffer::GBufferPass;
+use super::light::Spot;
+use super::quadtree::LightQuadtree;
+use super::rsm::RsmPass;
+use super::{
+    ClusterSettings, CutNode, Frame, FrameTiming, Gather, Method, Pass, Receiver, Settings, Vpl,
+};
+use crate::IndirectError;
+use crate::scene::Scene;
+use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
+use std::collections::BTreeMap;
+use wgpu::util::DeviceExt;
+
+/// Everything one scene needs on the GPU at one set of sizes.
+pub struct Renderer<'g> {
+    gpu: &'g Gpu,
+    settings: Settings,
+    vertices: wgpu::Buffer,
+    vertex_count: u32,
+    rsm: RsmPass,
+    quadtree: LightQuadtree,
+    gbuffer: GBufferPass,
+    gather: Gather,
+    /// A timer for all passes; `None` when the adapter has no timestamp queries.
+    timer: GpuTimer,
+}
+
+impl<'g> Renderer<'g> {
+    pub fn new(gpu: &'g Gpu, scene: &Scene, settings: Settings) -> Result<Self, IndirectError> {
+        settings.validate().map_err(IndirectError::Settings)?;
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let renderer = gpu.checked(|| {
+            let rsm = RsmPass::new(d, settings.rsm_size);
+            let quadtree =
+                LightQuadtree::new(d, q, settings.rsm_size, settings.cluster, rsm.views());
+            let gbuffer = GBufferPass::new(d, (settings.width, settings.height));
+            let gather = Gather::new(d, &settings, &quadtree, rsm.views(), gbuffer.views())?;
+            let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("vertices"),
+                contents: bytemuck::cast_slice(&scene.triangles),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            Ok::<_, IndirectError>(Self {
+                gpu,
+                settings: settings.clone(),
+                vertices,
+                vertex_count: (scene.triangles.len() * 3) as u32,
+                rsm,
+                quadtree,
+                gbuffer,
+                gather,
+                timer: GpuTimer::new(gpu, Pass::ALL.len() as u32),
+            })
+        })??;
+        renderer.set_view(scene);
+        Ok(renderer)
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Moves the camera and the light to the scene's (its geometry must be the one the renderer
+    /// was made with); the next frame must `rebuild` if the light moved.
+    pub fn set_view(&self, scene: &Scene) {
+        let q = &self.gpu.queue;
+        let spot = Spot::of_scene(scene);
+        self.rsm.set_light(q, &spot);
+        self.gather.set_light(q, &spot, scene.r_min);
+        let s = self.settings();
+        self.gbuffer.set_camera(
+            q,
+            scene.camera_view_proj(s.width as f32 / s.height as f32),
+            scene.camera.position.into(),
+        );
+    }
+
+    /// Changes the quadtree's parameters; the next frame with `rebuild` uses them.
+    pub fn set_cluster(&mut self, cluster: ClusterSettings) -> Result<(), IndirectError> {
+        let settings = Settings {
+            cluster,
+            ..self.settings().clone()
+        };
+        settings.validate().map_err(IndirectError::Settings)?;
+        self.quadtree.set_cluster(&self.gpu.queue, cluster);
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Renders one frame of `method`. With `rebuild` the light-dependent work (RSM, pyramid,
+    /// validity, cut) is redone, as when the light moves; without it those buffers are reused.
+    /// With `timed` the passes' GPU times are recorded.
+    pub fn render(
+        &mut self,
+        method: Method,
+        rebuild: bool,
+        timed: bool,
+    ) -> Result<(), IndirectError> {
+        let gpu = self.gpu;
+        let run = self.passes_run(method, rebuild);
+        gpu.checked(|| {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let timer = timed.then_some(&self.timer);
+            let slot = |pass: Pass| timer.map(|t| (t, pass as u32));
+            let slots = |a: Pass, b: Pass| timer.map(|t| (t, a as u32, b as u32));
+            if run.contains(&Pass::Rsm) {
+                let vertices = self.vertices.slice(..);
+                self.rsm
+                    .record(&mut encoder, vertices, self.vertex_count, slot(Pass::Rsm));
+            }
+            if run.contains(&Pass::Pyramid) {
+                self.quadtree
+                    .record_build(&mut encoder, slots(Pass::Pyramid, Pass::Validity));
+            }
+            if run.contains(&Pass::Cut) {
+                self.quadtree.record_cut(&mut encoder, slot(Pass::Cut));
+            }
+            self.gbuffer.record(
+                &mut encoder,
+                self.vertices.slice(..),
+                self.vertex_count,
+                timer.and_then(|t| t.render_pass(Pass::GBuffer as u32)),
+            );
+            self.gather.record_indirect(
+                &mut encoder,
+                method,
+                &self.quadtree,
+                slots(Pass::Indirect, Pass::Upsample),
+            );
+            self.gather.record_direct(&mut encoder, slot(Pass::Direct));
+            if let Some(timer) = timer {
+                timer.resolve(&mut encoder);
+            }
+            gpu.queue.submit([encoder.finish()]);
+        })?;
+        if timed {
+            self.timer.collect(gpu)?;
+        }
+        Ok(())
+    }
+
+    /// The passes a frame of `method` records (the timer's slots of the others hold stale times).
+    pub fn passes_run(&self, method: Method, rebuild: bool) -> Vec<Pass> {
+        let mut passes = Vec::new();
+        if rebuild {
+            passes.push(Pass::Rsm);
+            if method.uses_quadtree() {
+                passes.extend([Pass::Pyramid, Pass::Validity]);
+            }
+            if method == Method::Quadtree {
+                passes.push(Pass::Cut);
+            }
+        }
+        passes.extend([Pass::GBuffer, Pass::Indirect, Pass::Direct]);
+        if method == Method::Quadtree && self.settings().subsample > 1 {
+            passes.push(Pass::Upsample);
+        }
+        passes
+    }
+
+    /// Renders `frames` timed frames of `method` (rebuilding the light's buffers each frame with
+    /// `rebuild`) and returns the median GPU time of each pass; `None` without timestamp queries.
+    pub fn time(
+        &mut self,
+        method: Method,
+        rebuild: bool,
+        frames: u32,
+    ) -> Result<Option<FrameTiming>, IndirectError> {
+        self.timer.clear();
+        for _ in 0..frames {
+            self.render(method, rebuild, true)?;
+        }
+        if !self.timer.enabled() || frames == 0 {
+            return Ok(None);
+        }
+        let run = self.passes_run(method, rebuild);
+        let passes: BTreeMap<&'static str, f64> = Pass::ALL
+            .into_iter()
+            .zip(self.timer.summaries())
+            .filter(|(p, _)| run.contains(p))
+            .filter_map(|(p, s)| s.map(|s| (p.name(), s.median_ms)))
+            .collect();
+        Ok(Some(FrameTiming {
+            total_ms: passes.values().sum(),
+            passes,
+            frames,
+        }))
+    }
+
+    pub fn has_timestamps(&self) -> bool {
+        self.timer.enabled()
+    }
+
+    /// Renders one frame of `method` from scratch, untimed, and reads it back.
+    pub fn render_frame(&mut self, method: Method) -> Result<Frame, IndirectError> {
+        self.render(method, true, false)?;
+        self.read_frame()
+    }
+
+    fn read_vec4(&self, buffer: &wgpu::Buffer) -> Result<Vec<[f32; 4]>, IndirectError> {
+        let bytes = quadray_gpu::read_buffer(self.gpu, buffer)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    fn read_texture(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, IndirectError> {
+        let texels = read_texture_f32(self.gpu, texture, 0, 4)?;
+        Ok(texels
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]])
+            .collect())
+    }
+
+    /// The last frame's indirect and direct light.
+    pub fn read_frame(&self) -> Result<Frame, IndirectError> {
+        let indirect = self.read_vec4(self.gather.indirect())?;
+        let direct = self.read_vec4(self.gather.direct())?;
+        let rgb = |v: &[[f32; 4]]| v.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let s = self.settings();
+        Ok(Frame {
+            width: s.width,
+            height: s.height,
+            recomputed: indirect.iter().filter(|p| p[3] > 0.5).count() as u32,
+            indirect: rgb(&indirect),
+            direct: rgb(&direct),
+        })
+    }
+
+    /// Number of clusters in the compacted cut (after a `Quadtree` frame with rebuild).
+    pub fn clusters_in_cut(&self) -> Result<u32, IndirectError> {
+        let bytes = quadray_gpu::read_buffer(self.gpu, self.quadtree.cut_count())?;
+        Ok(bytemuck::pod_read_unaligned(&bytes[..4]))
+    }
+
+    /// The clusters of the compacted cut (after a `Quadtree` frame with rebuild), in no order.
+    pub fn read_cut(&self) -> Result<Vec<CutNode>, IndirectError> {
+        let count = self.clusters_in_cut()? as usize;
+        let clusters = self.read_vec4(self.quadtree.cut())?;
+        // three vec4 a cluster; the normal's w holds the node's index
+        Ok(clusters
+            .chunks_exact(3)
+            .take(count)
+            .map(|c| CutNode::at(self.settings().rsm_size, c[2][3].to_bits()))
+            .collect())
+    }
+
+    /// The RSM's flux per texel, row-major (what the cut clusters).
+    pub fn read_rsm_flux(&self) -> Result<Vec<[f32; 3]>, IndirectError> {
+        let flux = self.read_texture(&self.rsm.textures()[0])?;
+        Ok(flux.iter().map(|p| [p[0], p[1], p[2]]).collect())
+    }
+
+    /// The quadtree as built: per node (flux rgb + texel count, position + depth, normal +
+    /// validity), finest level first.
+    pub fn read_nodes(&self) -> Result<Vec<[[f32; 4]; 3]>, IndirectError> {
+        let flat = self.read_vec4(self.quadtree.nodes())?;
+        Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    }
+
+    /// The RSM's VPLs (texels that see geometry), for the CPU reference.
+    pub fn read_vpls(&self) -> Result<Vec<Vpl>, IndirectError> {
+        let [flux, pos, normal] = self.rsm.textures();
+        let (flux, pos, normal) = (
+            self.read_texture(flux)?,
+            self.read_texture(pos)?,
+            self.read_texture(normal)?,
+        );
+        let v3 = |p: &[f32; 4]| [p[0], p[1], p[2]];
+        Ok((0..flux.len())
+            .filter(|&i| normal[i][3] > 0.5)
+            .map(|i| Vpl {
+                flux: v3(&flux[i]),
+                position: v3(&pos[i]),
+                normal: v3(&normal[i]),
+            })
+            .collect())
+    }
+
+    /// The G-buffer, for the CPU reference.
+    pub fn read_receivers(&self) -> Result<Vec<Option<Receiver>>, IndirectError> {
+        let [pos, normal, albedo] = &self.gbuffer.targets.colors;
+        let (pos, normal, albedo) = (
+            self.read_texture(pos)?,
+            self.read_texture(normal)?,
+            self.read_texture(albedo)?,
+        );
+        let v3 = |p: &[f32; 4]| [p[0], p[1], p[2]];
+        Ok((0..pos.len())
+            .map(|i| {
+                (pos[i][3] > 0.5).then(|| Receiver {
+                    position: v3(&pos[i]),
+                    normal: v3(&normal[i]),
+                    albedo: v3(&albedo[i]),
+                })
+            })
+            .collect())
+    }
+}
