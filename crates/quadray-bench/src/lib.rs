@@ -4,4 +4,5 @@
 
 pub mod displace;
 pub mod indirect;
+pub mod report;
 pub mod shadows;

@@ -4,7 +4,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use quadray_bench::indirect::run::{RunOptions, run};
-use quadray_core::bench::write_json;
+use quadray_core::write_json;
 use quadray_gpu::Gpu;
 use quadray_indirect::{ClusterSettings, Method, Scene, Settings, Validity};
 use std::path::{Path, PathBuf};

@@ -49,7 +49,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         let text = serde_json::to_string_pretty(&costs)?;
         println!("{text}");
         if let Some(path) = &args.stats {
-            quadray_core::bench::write_text(path, &text)?;
+            quadray_core::write_text(path, &text)?;
         }
         return Ok(());
     }
@@ -128,7 +128,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         );
     }
     if let Some(path) = &args.stats {
-        quadray_core::bench::write_json(path, &report)?;
+        quadray_core::write_json(path, &report)?;
     }
     Ok(())
 }

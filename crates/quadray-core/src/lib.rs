@@ -1,13 +1,13 @@
-//! What quadray's techniques share: image output and error heat maps, medians of timings, and the
-//! results files (JSON, markdown, SVG plots) every benchmark writes, and the mesh loader (OBJ, glTF,
-//! PLY) the renderers share.
+//! What quadray's techniques share: image output and error heat maps, medians of timings, the
+//! JSON and text files the programs write, and the mesh loader (OBJ, glTF, PLY) the renderers
+//! share.
 
-pub mod bench;
 pub mod image_out;
 pub mod mesh;
 pub mod stats;
 
-use std::path::PathBuf;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// An I/O failure with the file it concerns.
@@ -25,6 +25,20 @@ impl FileError {
             reason: reason.to_string(),
         }
     }
+}
+
+/// Writes `value` as pretty JSON (stats and results files), creating the folder.
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), FileError> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| FileError::new(path, e))?;
+    write_text(path, &text)
+}
+
+/// Writes `text` to `path`, creating the folder.
+pub fn write_text(path: &Path, text: &str) -> Result<(), FileError> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| FileError::new(dir, e))?;
+    }
+    std::fs::write(path, text).map_err(|e| FileError::new(path, e))
 }
 
 /// Parses `X,Y,Z` (a point or direction on a command line); every coordinate must be finite.

@@ -2,7 +2,7 @@
 //! how many POM layers match the pyramid.
 
 use super::{AccuracyRow, Bench, Ratios, addressing, fixed_layers, ms, ratio, ratio_text};
-use quadray_core::bench::{PlotSpec, Series, Table, line_plot};
+use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::maps::{BUNDLED, resized};

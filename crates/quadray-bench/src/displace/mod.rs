@@ -7,7 +7,8 @@ pub mod accuracy;
 pub mod demo;
 pub mod timing;
 
-use quadray_core::bench::{Table, write_json, write_text};
+use crate::report::Table;
+use quadray_core::{write_json, write_text};
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::maps::BundledMap;
 use quadray_displace::pyramid::Addressing;

@@ -2,7 +2,7 @@
 //! and today's frame size, each as the rows it measured.
 
 use super::{Bench, Ratios, fixed_layers, ms, ratio, ratio_text};
-use quadray_core::bench::{PlotSpec, Series, Table, line_plot};
+use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_core::stats::time_cpu;
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::maps::{BUNDLED, resized};

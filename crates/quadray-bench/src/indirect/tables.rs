@@ -3,7 +3,8 @@
 //! error-vs-time plot, and the speed ratios (compacted cut vs per-level passes, quadtree vs RSM at
 //! equal error). GPU times are medians of timestamp queries; ratios come from one run.
 
-use quadray_core::bench::{PlotSpec, Series, Table, line_plot, write_json, write_text};
+use crate::report::{PlotSpec, Series, Table, line_plot};
+use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::compare;
 use quadray_indirect::scene::scenes_dir;

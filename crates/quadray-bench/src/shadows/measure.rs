@@ -5,7 +5,7 @@
 
 use super::tables::{figure6, markdown};
 use quadray_core::FileError;
-use quadray_core::bench::{write_json, write_text};
+use quadray_core::{write_json, write_text};
 use quadray_shadows::cost::{self, MachineCosts, SceneStats};
 use quadray_shadows::scene::{BUILTINS, Scene, SceneError, assets_dir};
 use quadray_shadows::{

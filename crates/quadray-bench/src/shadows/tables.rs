@@ -2,8 +2,8 @@
 //! each, from the measurements of [`super::measure`].
 
 use super::measure::{BenchResults, SceneResult};
+use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_core::FileError;
-use quadray_core::bench::{PlotSpec, Series, Table, line_plot};
 use quadray_shadows::scene::BUILTINS;
 use std::path::Path;
 

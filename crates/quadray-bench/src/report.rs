@@ -1,8 +1,8 @@
-//! What every benchmark writes: `results.json` (the data), markdown tables and SVG plots made
-//! from the same data.
+//! What every benchmark writes beside its `results.json`: markdown tables and SVG plots made from
+//! the same data.
 
-use crate::FileError;
 use plotters::prelude::*;
+use quadray_core::FileError;
 use serde::Serialize;
 use std::path::Path;
 
@@ -52,18 +52,6 @@ pub struct PlotSpec<'a> {
     pub y_label: &'a str,
     pub log_x: bool,
     pub log_y: bool,
-}
-
-pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), FileError> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| FileError::new(path, e))?;
-    write_text(path, &text)
-}
-
-pub fn write_text(path: &Path, text: &str) -> Result<(), FileError> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| FileError::new(dir, e))?;
-    }
-    std::fs::write(path, text).map_err(|e| FileError::new(path, e))
 }
 
 /// Draws `series` as lines with markers into an SVG file.
