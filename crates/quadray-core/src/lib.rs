@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod image_out;
 pub mod mesh;
+pub mod scene;
 pub mod stats;
 
 use std::path::PathBuf;
