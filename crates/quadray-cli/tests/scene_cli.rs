@@ -106,37 +106,26 @@ fn raytrace_renders_the_gltf_scene_lit_and_shadowed() {
 fn bad_scene_files_are_refused_naming_the_file() {
     let dir = scratch("scene-bad");
     let out = dir.join("x.png");
-    let out = out.to_str().unwrap();
-    let recursive = assets().join("malformed/gltf2/RecursiveNodes/RecursiveNodes.gltf");
-    let recursive = recursive.to_str().unwrap();
-    quadray_refuses(
-        &["raytrace", "--scene", recursive, "--out", out],
-        "RecursiveNodes.gltf",
-    );
-    quadray_refuses(
-        &["indirect", "--scene", recursive, "--out", out],
-        "RecursiveNodes.gltf",
-    );
-    let points = assets().join("scenes/shadows-demo.toml");
-    quadray_refuses(
-        &[
+    let recursive = "malformed/gltf2/RecursiveNodes/RecursiveNodes.gltf";
+    let cases = [
+        ("raytrace", recursive, "RecursiveNodes.gltf: node"),
+        ("indirect", recursive, "RecursiveNodes.gltf: node"),
+        // Point lights only.
+        (
             "indirect",
-            "--scene",
-            points.to_str().unwrap(),
-            "--out",
-            out,
-        ],
-        "shadows-demo.toml: no spot light",
-    );
-    let builtin = assets().join("scenes/cornell.toml");
-    quadray_refuses(
-        &[
+            "scenes/shadows-demo.toml",
+            "shadows-demo.toml: no spot light",
+        ),
+        // quadray indirect's builtin meshes.
+        (
             "raytrace",
-            "--scene",
-            builtin.to_str().unwrap(),
-            "--out",
-            out,
-        ],
-        "cornell.toml: object 0: builtin",
-    );
+            "scenes/cornell.toml",
+            "cornell.toml: object 0: builtin",
+        ),
+    ];
+    for (command, scene, needle) in cases {
+        let scene = assets().join(scene);
+        let args = [command, "--scene", scene.to_str().unwrap(), "--out"];
+        quadray_refuses(&[&args[..], &[out.to_str().unwrap()]].concat(), needle);
+    }
 }

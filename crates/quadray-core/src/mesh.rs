@@ -1,6 +1,6 @@
 //! Triangle meshes and their materials, loaded from OBJ (+MTL), glTF 2.0 (.gltf/.glb) and PLY.
 //!
-//! Every loader ends in the same checks ([`MeshBuilder::finish`]): positions must be finite,
+//! Every loader ends in the same checks (`MeshBuilder::finish`): positions must be finite,
 //! indices in range; faces with a repeated vertex or zero area are dropped (and counted in a
 //! warning); a file with no triangle left is an error. Normals missing from the file are generated,
 //! area-weighted.

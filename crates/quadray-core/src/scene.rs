@@ -75,11 +75,14 @@ use std::path::{Path, PathBuf};
 pub struct SceneDescription {
     /// The file's `name`, else its stem.
     pub name: String,
+    /// The view.
     pub camera: Camera,
     /// Point and spot lights in file order.
     pub lights: Vec<Light>,
-    /// Named materials, sorted by name; objects refer to them by index.
+    /// Named materials, sorted by name, then the anonymous ones of `albedo = [...]`; objects
+    /// refer to them by index.
     pub materials: Vec<(String, Material)>,
+    /// Everything that is drawn.
     pub objects: Vec<Object>,
     /// quadray indirect's clamp of the VPL kernel's 1/r^4 (world units), when the file sets it.
     pub r_min: Option<f32>,
@@ -92,8 +95,11 @@ pub struct SceneDescription {
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Where the eye is.
     pub position: Vec3,
+    /// A point the camera looks at.
     pub target: Vec3,
+    /// Up on the screen (need not be at right angles to the view direction).
     pub up: Vec3,
     /// Vertical field of view, in (0, 180).
     pub fov_y_deg: f32,
@@ -102,8 +108,11 @@ pub struct Camera {
 /// A point light, or a spot light when `spot` is set.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
+    /// Where the light is.
     pub position: Vec3,
+    /// Per RGB channel, on the axis for a spot light.
     pub intensity: Intensity,
+    /// The cone, for a spot light.
     pub spot: Option<Spot>,
 }
 
@@ -150,14 +159,19 @@ impl Intensity {
 pub struct Material {
     /// Linear RGB albedo.
     pub diffuse: Vec3,
+    /// Blinn-Phong specular weight (default 0).
     #[serde(default)]
     pub specular: f32,
+    /// Blinn-Phong exponent (default 32).
     #[serde(default = "default_shininess")]
     pub shininess: f32,
+    /// Weight of the mirror reflection (default 0).
     #[serde(default)]
     pub reflect: f32,
+    /// Weight of the refracted ray (default 0).
     #[serde(default)]
     pub transmit: f32,
+    /// Index of refraction (default 1).
     #[serde(default = "default_ior")]
     pub ior: f32,
 }
@@ -186,6 +200,7 @@ impl Material {
 /// One shape placed in the scene.
 #[derive(Clone, Debug)]
 pub struct Object {
+    /// What it is made of.
     pub shape: Shape,
     /// Identity for boxes and polygons (written in world coordinates).
     pub transform: Transform,
@@ -199,9 +214,19 @@ pub enum Shape {
     /// A technique's procedural mesh, by name; the technique says which names it knows.
     Builtin(String),
     /// A mesh file, loaded (glTF node transforms already applied).
-    Mesh { path: PathBuf, model: Box<Model> },
+    Mesh {
+        /// The file, as the scene names it (joined to the scene's directory).
+        path: PathBuf,
+        /// Its meshes and materials.
+        model: Box<Model>,
+    },
     /// An axis-aligned box, closed.
-    Box { min: Vec3, max: Vec3 },
+    Box {
+        /// The lowest corner.
+        min: Vec3,
+        /// The highest corner.
+        max: Vec3,
+    },
     /// Convex planar polygons, vertices in order.
     Polygons(Vec<Vec<Vec3>>),
 }
@@ -209,8 +234,11 @@ pub enum Shape {
 /// Uniform scale, then a turn about +y, then a translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
+    /// Uniform scale, > 0.
     pub scale: f32,
+    /// Turn about +y, counter-clockwise seen from above.
     pub rotate_y_deg: f32,
+    /// Offset.
     pub translate: Vec3,
 }
 

@@ -165,10 +165,13 @@ fn edited_gltf(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)
     path
 }
 
+/// A change made to the bundled glTF scene's JSON.
+type Edit = fn(&mut serde_json::Value);
+
 #[test]
 fn bad_gltf_scenes_are_refused_with_the_file_named() {
     let dir = scratch("bad-gltf");
-    let cases: [(&str, fn(&mut serde_json::Value), &str); 6] = [
+    let cases: [(&str, Edit, &str); 6] = [
         (
             "no-camera.gltf",
             |j| {
