@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct IndirectArgs {
-    /// Scene file (TOML); default: the bundled Cornell box.
+    /// Scene file: TOML, or glTF 2.0 (.gltf, .glb); default: the bundled Cornell box.
     #[arg(long)]
     scene: Option<PathBuf>,
     /// quadtree (compacted cut), quadtree-passes (the paper's per-level passes), rsm (RSM

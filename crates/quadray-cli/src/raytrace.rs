@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct RaytraceArgs {
-    /// A TOML scene file.
+    /// A scene file: TOML, or glTF 2.0 (.gltf, .glb).
     #[arg(long, conflicts_with = "builtin")]
     scene: Option<PathBuf>,
     /// A builtin look-alike of the paper's scenes: glasses, desk, stars, kaist.

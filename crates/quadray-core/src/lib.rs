@@ -4,6 +4,7 @@
 
 pub mod image_out;
 pub mod mesh;
+pub mod scene;
 pub mod stats;
 
 use serde::Serialize;

@@ -5,7 +5,7 @@
 //! warning); a file with no triangle left is an error. Normals missing from the file are generated,
 //! area-weighted.
 
-mod gltf;
+pub(crate) mod gltf;
 mod obj;
 mod ply;
 

@@ -1,11 +1,15 @@
-//! Scenes: a TOML file naming meshes (built-in procedural ones for now), their transforms and
-//! colours, the camera and one spot light. Everything is flattened into one triangle list with a
-//! per-vertex albedo, which is all the RSM and G-buffer passes need.
+//! Scenes: built from the shared scene description (`quadray_core::scene`: a TOML or glTF file)
+//! with its camera, its first spot light and its objects (mesh files, the builtin meshes of
+//! `scene/builtin.rs`, boxes, polygons), flattened into one triangle list with a per-vertex
+//! albedo, which is all the RSM and G-buffer passes need.
 
+mod builtin;
+
+use builtin::{builtin_triangles, cuboid};
 use glam::{Mat4, Vec3};
 use quadray_core::FileError;
-use quadray_core::mesh::load_model;
-use serde::Deserialize;
+use quadray_core::mesh::Model;
+use quadray_core::scene::{Object, SceneDescription, Shape};
 use std::path::{Path, PathBuf};
 
 /// One vertex as the raster passes read it.
@@ -17,12 +21,10 @@ pub struct Vertex {
     pub albedo: [f32; 3],
 }
 
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug)]
 pub struct Camera {
     pub position: [f32; 3],
     pub target: [f32; 3],
-    #[serde(default = "default_up")]
     pub up: [f32; 3],
     /// Vertical field of view.
     pub fov_deg: f32,
@@ -30,59 +32,15 @@ pub struct Camera {
 
 /// A spot light: full intensity inside `cone_deg - falloff_deg` of its axis, fading smoothly to
 /// zero at `cone_deg`.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug)]
 pub struct SpotLight {
     pub position: [f32; 3],
     pub direction: [f32; 3],
     /// Half-angle of the cone; also half the field of view of the RSM.
     pub cone_deg: f32,
-    #[serde(default)]
     pub falloff_deg: f32,
     /// Radiant intensity on the axis (W/sr per channel).
     pub intensity: [f32; 3],
-}
-
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MeshEntry {
-    /// A procedural mesh: `cornell` (the box with two blocks), `room` (the box alone), `blocks`
-    /// (the two blocks alone) or `atrium` (a Sponza-like courtyard, about 25k triangles).
-    pub builtin: Option<String>,
-    /// Or a mesh file (OBJ + MTL, glTF 2.0, PLY), relative to the scene file.
-    pub path: Option<PathBuf>,
-    #[serde(default = "default_translate")]
-    pub translate: [f32; 3],
-    #[serde(default = "default_scale")]
-    pub scale: f32,
-    #[serde(default)]
-    pub rotate_y_deg: f32,
-    /// Replaces the mesh's own colours.
-    pub albedo: Option<[f32; 3]>,
-}
-
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SceneFile {
-    /// Clamp of the VPL kernel's 1/r^4 (world units); shared by every method.
-    #[serde(default = "default_r_min")]
-    r_min: f32,
-    camera: Camera,
-    light: SpotLight,
-    mesh: Vec<MeshEntry>,
-}
-
-fn default_up() -> [f32; 3] {
-    [0.0, 1.0, 0.0]
-}
-fn default_translate() -> [f32; 3] {
-    [0.0; 3]
-}
-fn default_scale() -> f32 {
-    1.0
-}
-fn default_r_min() -> f32 {
-    0.05
 }
 
 /// A loaded scene, checked and flattened.
@@ -96,14 +54,10 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Reads a scene file: TOML, or glTF 2.0 for `.gltf` and `.glb`.
     pub fn load(path: &Path) -> Result<Self, FileError> {
-        let text = std::fs::read_to_string(path).map_err(|e| FileError::new(path, e))?;
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "scene".into());
-        let dir = path.parent().unwrap_or(Path::new("."));
-        Self::parse_in(&text, &name, dir).map_err(|reason| FileError::new(path, reason))
+        let description = SceneDescription::load(path)?;
+        Self::from_description(&description).map_err(|reason| FileError::new(path, reason))
     }
 
     /// Parses scene text without mesh files; the error says what is wrong.
@@ -113,20 +67,55 @@ impl Scene {
 
     /// Parses scene text whose mesh paths are relative to `dir`.
     pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Self, String> {
-        let file: SceneFile = toml::from_str(text).map_err(|e| e.to_string())?;
-        if file.mesh.is_empty() {
-            return Err("the scene has no [[mesh]]".into());
+        let description =
+            SceneDescription::from_toml(text, &dir.join(name)).map_err(|e| e.reason)?;
+        Ok(Self {
+            name: name.to_string(),
+            ..Self::from_description(&description)?
+        })
+    }
+
+    /// This renderer's scene: the camera, the first spot light (a warning names the lights left
+    /// out: further spots, point lights) and every object as triangles. A material gives an
+    /// object its albedo (its diffuse colour; the other fields are the ray tracer's); without
+    /// one, mesh files keep their base colours (times their texture at each vertex) and builtin
+    /// meshes their own. A photometric intensity (candela, glTF's) becomes radiant intensity:
+    /// `I / 683` W/sr.
+    pub fn from_description(d: &SceneDescription) -> Result<Self, String> {
+        let mut spots = d.lights.iter().filter_map(|l| l.spot.map(|spot| (l, spot)));
+        let (light, spot) = spots.next().ok_or(
+            "no spot light (quadray indirect renders one: a light with direction and cone_deg, \
+             or a glTF spot light)",
+        )?;
+        let left_out = d.lights.len() - 1;
+        if left_out > 0 {
+            tracing::warn!(
+                "scene {}: {left_out} more lights left out (quadray indirect renders the first \
+                 spot light)",
+                d.name
+            );
         }
         let mut triangles = Vec::new();
-        for (i, entry) in file.mesh.iter().enumerate() {
-            let tris = mesh_triangles(entry, dir).map_err(|e| format!("mesh {}: {e}", i + 1))?;
-            triangles.extend(tris);
+        for (i, object) in d.objects.iter().enumerate() {
+            triangles.extend(object_triangles(object, d).map_err(|e| format!("object {i}: {e}"))?);
         }
+        let c = &d.camera;
         let scene = Self {
-            name: name.to_string(),
-            camera: file.camera,
-            light: file.light,
-            r_min: file.r_min,
+            name: d.name.clone(),
+            camera: Camera {
+                position: c.position.into(),
+                target: c.target.into(),
+                up: c.up.into(),
+                fov_deg: c.fov_y_deg,
+            },
+            light: SpotLight {
+                position: light.position.into(),
+                direction: spot.direction.into(),
+                cone_deg: spot.cone_deg,
+                falloff_deg: spot.falloff_deg,
+                intensity: light.intensity.watts_per_sr().into(),
+            },
+            r_min: d.r_min.unwrap_or(DEFAULT_R_MIN),
             triangles,
         };
         scene.validate()?;
@@ -240,12 +229,13 @@ impl Scene {
 pub const CORNELL_TOML: &str = include_str!("../../../assets/scenes/cornell.toml");
 
 /// The bundled scene files of this technique, in `scenes_dir()`.
-pub const BUNDLED_SCENES: [&str; 5] = [
+pub const BUNDLED_SCENES: [&str; 6] = [
     "cornell.toml",
     "cornell_obj.toml",
     "cornell_bunny.toml",
     "cornell_buddha.toml",
     "atrium.toml",
+    "cornell_spot.gltf",
 ];
 
 /// Directory of the bundled scene files.
@@ -253,14 +243,12 @@ pub fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes")
 }
 
-const WHITE: [f32; 3] = [0.73, 0.73, 0.73];
-const RED: [f32; 3] = [0.63, 0.065, 0.05];
-const GREEN: [f32; 3] = [0.14, 0.45, 0.091];
+/// Clamp of the VPL kernel's 1/r^4 (world units) of a scene that does not set `r_min`.
+pub const DEFAULT_R_MIN: f32 = 0.05;
 
 /// Triangles of a mesh file with per-vertex albedo: the material's base colour times its texture
 /// sampled at the vertex (the RSM and G-buffer carry albedo per vertex, not per texel).
-fn file_triangles(path: &Path) -> Result<Vec<[Vertex; 3]>, String> {
-    let model = load_model(path).map_err(|e| e.to_string())?;
+fn model_triangles(model: &Model) -> Vec<[Vertex; 3]> {
     let mut out = Vec::new();
     for mesh in &model.meshes {
         let material = model.materials.get(mesh.material);
@@ -283,7 +271,7 @@ fn file_triangles(path: &Path) -> Result<Vec<[Vertex; 3]>, String> {
             }));
         }
     }
-    Ok(out)
+    out
 }
 
 /// Nearest texel at `uv` (wrapping; (0, 0) is the top-left corner), decoded from sRGB.
@@ -301,233 +289,65 @@ fn texture_at(tex: &quadray_core::image_out::Rgba8Image, uv: glam::Vec2) -> Vec3
     Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))
 }
 
-fn builtin_triangles(name: &str) -> Result<Vec<[Vertex; 3]>, String> {
-    Ok(match name {
-        "cornell" => {
-            let mut t = cornell_room();
-            t.extend(cornell_blocks());
-            t
+/// Convex polygons as triangle fans, each with its plane's normal (Newell's, so the winding
+/// decides the side); zero-area polygons are left out.
+fn polygon_triangles(polygons: &[Vec<Vec3>]) -> Vec<[Vertex; 3]> {
+    let mut out = Vec::new();
+    for polygon in polygons {
+        let n = polygon.len();
+        let normal = (0..n)
+            .map(|i| polygon[i].cross(polygon[(i + 1) % n]))
+            .sum::<Vec3>()
+            .normalize_or_zero();
+        if normal == Vec3::ZERO {
+            continue;
         }
-        "room" => cornell_room(),
-        "blocks" => cornell_blocks(),
-        "atrium" => atrium(),
-        other => {
-            return Err(format!(
-                "unknown builtin `{other}` (known: cornell, room, blocks, atrium)"
-            ));
+        let v = |p: Vec3| Vertex {
+            position: p.into(),
+            normal: normal.into(),
+            albedo: [1.0; 3],
+        };
+        for i in 1..n.saturating_sub(1) {
+            out.push([v(polygon[0]), v(polygon[i]), v(polygon[i + 1])]);
         }
-    })
+    }
+    out
 }
 
-fn mesh_triangles(entry: &MeshEntry, dir: &Path) -> Result<Vec<[Vertex; 3]>, String> {
-    let mut tris = match (&entry.builtin, &entry.path) {
-        (Some(_), Some(_)) => return Err("has both `builtin` and `path`".into()),
-        (None, None) => return Err("needs `builtin` or `path`".into()),
-        (None, Some(path)) => file_triangles(&dir.join(path))?,
-        (Some(builtin), None) => builtin_triangles(builtin)?,
+/// One object's triangles in world space, with its material's albedo when it has one.
+fn object_triangles(object: &Object, d: &SceneDescription) -> Result<Vec<[Vertex; 3]>, String> {
+    let mut tris = match &object.shape {
+        Shape::Builtin(name) => builtin_triangles(name)?,
+        Shape::Mesh { model, .. } => model_triangles(model),
+        Shape::Box { min, max } => cuboid(*min, *max, [1.0; 3]),
+        Shape::Polygons(polygons) => polygon_triangles(polygons),
     };
-    if !(entry.scale.is_finite() && entry.scale > 0.0) {
-        return Err(format!("scale {} must be positive", entry.scale));
-    }
-    if !entry.translate.iter().all(|x| x.is_finite()) || !entry.rotate_y_deg.is_finite() {
-        return Err("transform has a non-finite value".into());
-    }
-    if let Some(a) = entry.albedo
-        && !a.iter().all(|x| (0.0..=1.0).contains(x))
-    {
-        return Err(format!("albedo {a:?} is outside [0, 1]"));
-    }
-    let rotation = Mat4::from_rotation_y(entry.rotate_y_deg.to_radians());
-    let model = Mat4::from_translation(entry.translate.into())
-        * rotation
-        * Mat4::from_scale(Vec3::splat(entry.scale));
+    let albedo = match object.material {
+        Some(m) => {
+            let (name, material) = d
+                .materials
+                .get(m)
+                .ok_or_else(|| format!("material {m} does not exist"))?;
+            let albedo = material.diffuse;
+            if !(albedo.cmpge(Vec3::ZERO).all() && albedo.cmple(Vec3::ONE).all()) {
+                return Err(format!(
+                    "material {name}: diffuse {albedo} is outside [0, 1] (an albedo here)"
+                ));
+            }
+            Some(albedo.to_array())
+        }
+        None => None,
+    };
+    let model = object.transform.matrix();
+    let rotation = object.transform.rotation();
     for v in tris.iter_mut().flatten() {
         v.position = model.transform_point3(v.position.into()).into();
         v.normal = rotation.transform_vector3(v.normal.into()).into();
-        if let Some(a) = entry.albedo {
+        if let Some(a) = albedo {
             v.albedo = a;
         }
     }
     Ok(tris)
-}
-
-/// Two triangles of the quad a, b, c, d (counter-clockwise seen from the side `normal` faces).
-fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2] {
-    let normal = (b - a).cross(d - a).normalize();
-    let v = |p: Vec3| Vertex {
-        position: p.into(),
-        normal: normal.into(),
-        albedo,
-    };
-    [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
-}
-
-/// Corner `i` of the box spanned by `lo` and `hi`: bits 0, 1, 2 of `i` pick `hi` in x, y, z.
-fn box_corner(lo: Vec3, hi: Vec3, i: usize) -> Vec3 {
-    let pick = |bit: usize, lo: f32, hi: f32| if i & bit == 0 { lo } else { hi };
-    Vec3::new(
-        pick(1, lo.x, hi.x),
-        pick(2, lo.y, hi.y),
-        pick(4, lo.z, hi.z),
-    )
-}
-
-// The faces of a box seen from outside, as corners of `box_corner` in quad order.
-const TOP: [usize; 4] = [6, 7, 3, 2];
-const BOTTOM: [usize; 4] = [0, 1, 5, 4];
-const FRONT: [usize; 4] = [4, 5, 7, 6]; // +z
-const BACK: [usize; 4] = [1, 0, 2, 3]; // -z
-const LEFT: [usize; 4] = [0, 4, 6, 2]; // -x
-const RIGHT: [usize; 4] = [5, 1, 3, 7]; // +x
-
-/// The two triangles of each face, the face's corners numbered as in [`box_corner`].
-fn box_faces(corners: [Vec3; 8], faces: &[([usize; 4], [f32; 3])]) -> Vec<[Vertex; 3]> {
-    faces
-        .iter()
-        .flat_map(|&([a, b, c, d], albedo)| {
-            quad(corners[a], corners[b], corners[c], corners[d], albedo)
-        })
-        .collect()
-}
-
-/// The unit room [0,1]^3 open towards +z: red wall at x = 0, green at x = 1.
-fn cornell_room() -> Vec<[Vertex; 3]> {
-    let corners = std::array::from_fn(|i| box_corner(Vec3::ZERO, Vec3::ONE, i));
-    // seen from inside
-    let floor = [4, 5, 1, 0];
-    let ceiling = [2, 3, 7, 6];
-    let back = [0, 1, 3, 2];
-    let left = [4, 0, 2, 6];
-    let right = [1, 5, 7, 3];
-    box_faces(
-        corners,
-        &[
-            (floor, WHITE),
-            (ceiling, WHITE),
-            (back, WHITE),
-            (left, RED),
-            (right, GREEN),
-        ],
-    )
-}
-
-/// The short and the tall block of the Cornell box, turned as in the original.
-fn cornell_blocks() -> Vec<[Vertex; 3]> {
-    let mut out = block(Vec3::new(0.66, 0.0, 0.62), 0.3, 0.3, -17.0);
-    out.extend(block(Vec3::new(0.32, 0.0, 0.33), 0.3, 0.6, 17.0));
-    out
-}
-
-/// An upright box of footprint `side` and `height` standing on y = 0 at `centre` (no bottom).
-fn block(centre: Vec3, side: f32, height: f32, turn_deg: f32) -> Vec<[Vertex; 3]> {
-    let r = Mat4::from_translation(centre) * Mat4::from_rotation_y(turn_deg.to_radians());
-    let h = side * 0.5;
-    let (lo, hi) = (Vec3::new(-h, 0.0, -h), Vec3::new(h, height, h));
-    let corners = std::array::from_fn(|i| r.transform_point3(box_corner(lo, hi, i)));
-    box_faces(
-        corners,
-        &[TOP, FRONT, RIGHT, BACK, LEFT].map(|f| (f, WHITE)),
-    )
-}
-
-/// An axis-aligned box, faces outwards.
-fn cuboid(lo: Vec3, hi: Vec3, albedo: [f32; 3]) -> Vec<[Vertex; 3]> {
-    let corners = std::array::from_fn(|i| box_corner(lo, hi, i));
-    box_faces(
-        corners,
-        &[TOP, BOTTOM, FRONT, BACK, LEFT, RIGHT].map(|f| (f, albedo)),
-    )
-}
-
-/// A vertical cylinder (no caps) with smooth normals, `segments` around and `rings` high.
-fn column(base: Vec3, radius: f32, height: f32, segments: u32, rings: u32) -> Vec<[Vertex; 3]> {
-    let albedo = [0.75, 0.72, 0.66];
-    let at = |i: u32, j: u32| {
-        let a = std::f32::consts::TAU * i as f32 / segments as f32;
-        let n = Vec3::new(a.cos(), 0.0, a.sin());
-        Vertex {
-            position: (base + n * radius + Vec3::Y * height * j as f32 / rings as f32).into(),
-            normal: n.into(),
-            albedo,
-        }
-    };
-    (0..segments)
-        .flat_map(|i| (0..rings).map(move |j| (i, j)))
-        .flat_map(|(i, j)| {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            [[a, c, b], [a, d, c]]
-        })
-        .collect()
-}
-
-/// A Sponza-like courtyard, 30 x 15 x 13 m, open to the sky: stone floor, two storeys of
-/// galleries on columns along both long sides, coloured banners hanging between the columns.
-fn atrium() -> Vec<[Vertex; 3]> {
-    const STONE: [f32; 3] = [0.62, 0.57, 0.48];
-    const PLASTER: [f32; 3] = [0.74, 0.68, 0.58];
-    const BANNERS: [[f32; 3]; 3] = [[0.7, 0.08, 0.06], [0.08, 0.15, 0.6], [0.1, 0.5, 0.12]];
-    let (length, width, height) = (30.0, 13.0, 15.0);
-    let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
-    let mut out: Vec<[Vertex; 3]> = Vec::new();
-    out.extend(quad(
-        p(0., 0., width),
-        p(length, 0., width),
-        p(length, 0., 0.),
-        p(0., 0., 0.),
-        STONE,
-    ));
-    out.extend(quad(
-        p(0., 0., 0.),
-        p(length, 0., 0.),
-        p(length, height, 0.),
-        p(0., height, 0.),
-        PLASTER,
-    ));
-    out.extend(quad(
-        p(length, 0., width),
-        p(0., 0., width),
-        p(0., height, width),
-        p(length, height, width),
-        PLASTER,
-    ));
-    out.extend(quad(
-        p(0., 0., width),
-        p(0., 0., 0.),
-        p(0., height, 0.),
-        p(0., height, width),
-        PLASTER,
-    ));
-    out.extend(quad(
-        p(length, 0., 0.),
-        p(length, 0., width),
-        p(length, height, width),
-        p(length, height, 0.),
-        PLASTER,
-    ));
-    for (side, z) in [(0.0f32, 3.0f32), (1.0, width - 3.0)] {
-        let (z0, z1) = if side == 0.0 { (0.0, z) } else { (z, width) };
-        for storey in 0..2 {
-            let floor = 5.0 * (storey as f32 + 1.0);
-            out.extend(cuboid(p(0.0, floor - 0.4, z0), p(length, floor, z1), STONE));
-            for i in 0..12 {
-                let x = 1.5 + 2.45 * i as f32;
-                out.extend(column(p(x, floor - 5.0, z), 0.35, 4.6, 32, 8));
-                if storey == 1 && i < 11 {
-                    let banner = BANNERS[i % 3];
-                    let (bz, x0, x1) =
-                        (z + if side == 0.0 { 0.2 } else { -0.2 }, x + 0.5, x + 1.95);
-                    out.extend(quad(
-                        p(x0, 5.0, bz),
-                        p(x1, 5.0, bz),
-                        p(x1, 9.0, bz),
-                        p(x0, 9.0, bz),
-                        banner,
-                    ));
-                }
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]
@@ -535,21 +355,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn cornell_room_normals_face_inwards_and_blocks_outwards() {
+    fn the_cornell_scene_is_the_room_and_its_blocks() {
         let scene = Scene::cornell();
-        let centre = Vec3::new(0.5, 0.5, 0.5);
-        for t in cornell_room() {
-            let n = Vec3::from(t[0].normal);
-            assert!(n.dot(centre - Vec3::from(t[0].position)) > 0.0);
-        }
-        let centre = Vec3::new(0.4, 0.0, 0.3);
-        for t in block(centre, 0.3, 0.6, 17.0) {
-            let mid =
-                (Vec3::from(t[0].position) + Vec3::from(t[1].position) + Vec3::from(t[2].position))
-                    / 3.0;
-            let inside = centre + Vec3::new(0.0, 0.3, 0.0);
-            assert!(Vec3::from(t[0].normal).dot(mid - inside) > 0.0);
-        }
         assert_eq!(scene.triangles.len(), 10 + 20);
         assert!((scene.extent() - 3f32.sqrt()).abs() < 1e-4);
     }
@@ -596,7 +403,8 @@ mod tests {
             "builtin = \"cornell\"",
             "builtin = \"room\"\npath = \"x.obj\"",
         );
-        assert!(Scene::parse(&both, "bad").unwrap_err().contains("both"));
+        let err = Scene::parse(&both, "bad").unwrap_err();
+        assert!(err.contains("more than one"), "{err}");
     }
 
     #[test]
@@ -611,7 +419,7 @@ mod tests {
                 good.replace("builtin = \"cornell\"", "builtin = \"sponza\""),
                 "unknown builtin",
             ),
-            (good.replace("fov_deg = 39.0", "fov_deg = nan"), "fov_deg"),
+            (good.replace("fov_deg = 39.0", "fov_deg = nan"), "fov_y_deg"),
             (good.replace("[light]", "[lamp]"), "light"),
             ("r_min = 0.1".to_string(), "camera"),
         ];
@@ -619,5 +427,86 @@ mod tests {
             let err = Scene::parse(&text, "bad").unwrap_err();
             assert!(err.contains(needle), "{err} should mention {needle}");
         }
+    }
+
+    #[test]
+    fn the_gltf_scene_matches_the_cornell_scene() {
+        let gltf = Scene::load(&scenes_dir().join("cornell_spot.gltf")).unwrap();
+        let toml = Scene::cornell();
+        assert_eq!(gltf.triangles.len(), toml.triangles.len());
+        let close = |a: [f32; 3], b: [f32; 3], tolerance: f32| {
+            Vec3::from(a).abs_diff_eq(Vec3::from(b), tolerance)
+        };
+        assert!(close(gltf.camera.position, toml.camera.position, 1e-6));
+        assert!((gltf.camera.fov_deg - toml.camera.fov_deg).abs() < 1e-4);
+        let direction = Vec3::from(toml.light.direction).normalize().to_array();
+        assert!(close(gltf.light.direction, direction, 1e-5));
+        assert_eq!(gltf.light.intensity, toml.light.intensity);
+        assert!((gltf.light.cone_deg - toml.light.cone_deg).abs() < 1e-4);
+        assert!((gltf.light.falloff_deg - toml.light.falloff_deg).abs() < 1e-4);
+        assert_eq!(gltf.r_min, toml.r_min);
+        let (lo, hi) = gltf.bounds();
+        assert!(close(lo.to_array(), [0.0; 3], 1e-6) && close(hi.to_array(), [1.0; 3], 1e-6));
+        // The same albedos on the same area.
+        let albedo_area = |s: &Scene| -> Vec3 {
+            s.triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| Vec3::from(v.position));
+                    Vec3::from(t[0].albedo) * (b - a).cross(c - a).length() * 0.5
+                })
+                .sum()
+        };
+        assert!(albedo_area(&gltf).abs_diff_eq(albedo_area(&toml), 1e-4));
+    }
+
+    #[test]
+    fn the_first_spot_light_is_used_and_a_scene_without_one_is_refused() {
+        let two_spots = CORNELL_TOML.replace(
+            "[[mesh]]",
+            "[[lights]]\nposition = [0.2, 0.9, 0.5]\ndirection = [0, -1, 0]\ncone_deg = 30\n\
+             intensity = [9, 9, 9]\n[[lights]]\nposition = [0.5, 0.5, 0.5]\n\
+             intensity = [1, 1, 1]\n[[mesh]]",
+        );
+        let scene = Scene::parse(&two_spots, "two").unwrap();
+        assert_eq!(scene.light.intensity, [2.0; 3]);
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes");
+        let points = std::fs::read_to_string(dir.join("shadows-demo.toml")).unwrap();
+        let err = Scene::parse_in(&points, "shadows-demo", &dir).unwrap_err();
+        assert!(err.contains("no spot light"), "{err}");
+        let missing = Scene::load(&dir.join("shadows-demo.toml")).unwrap_err();
+        assert!(
+            missing.to_string().contains("shadows-demo.toml"),
+            "{missing}"
+        );
+    }
+
+    /// The ray tracer's shapes: a box and polygons (with their materials' diffuse colours).
+    #[test]
+    fn boxes_and_polygons_become_triangles_along_their_winding() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes");
+        let demo = std::fs::read_to_string(dir.join("shadows-demo.toml")).unwrap();
+        let with_spot = demo.replacen(
+            "intensity = [0.7, 0.7, 0.7]",
+            "intensity = [0.7, 0.7, 0.7]\ndirection = [-1.5, -3.5, -1.0]\ncone_deg = 40",
+            1,
+        );
+        let scene = Scene::parse_in(&with_spot, "demo", &dir).unwrap();
+        // Two boxes (12 triangles each), a tetrahedron (4) and two floor quads (2 each).
+        assert_eq!(scene.triangles.len(), 2 * 12 + 4 + 2 * 2);
+        for t in &scene.triangles {
+            let [a, b, c] = t.map(|v| Vec3::from(v.position));
+            let geometric = (b - a).cross(c - a).normalize();
+            assert!(geometric.dot(Vec3::from(t[0].normal)) > 0.999, "{t:?}");
+        }
+        let red = [0.7, 0.15, 0.1];
+        assert_eq!(
+            scene
+                .triangles
+                .iter()
+                .filter(|t| t[0].albedo == red)
+                .count(),
+            12 + 4
+        );
     }
 }

@@ -56,42 +56,62 @@ pub(super) fn load(path: &Path) -> Result<(Model, usize), MeshError> {
     materials.push(Material::default());
 
     let mut builders = Vec::new();
-    // A file without a default scene shows its first one; one without scenes shows nothing.
-    if let Some(scene) = document
-        .default_scene()
-        .or_else(|| document.scenes().next())
-    {
-        let mut visited = vec![false; document.nodes().len()];
-        // Depth-first with an explicit stack, so a deep or cyclic graph cannot overflow the call
-        // stack; pushed in reverse so meshes come out in document order.
-        let mut stack: Vec<(gltf::Node, Mat4)> =
-            scene.nodes().map(|node| (node, Mat4::IDENTITY)).collect();
-        stack.reverse();
-        while let Some((node, parent)) = stack.pop() {
-            if std::mem::replace(&mut visited[node.index()], true) {
-                return Err(MeshError::NodeCycle {
-                    path: path.to_owned(),
-                    node: node.index(),
-                });
-            }
-            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-            if let Some(mesh) = node.mesh() {
-                for primitive in mesh.primitives() {
-                    if let Some(mut builder) =
-                        file.primitive(&mesh, &primitive, default_material)?
-                    {
-                        builder.to_world = world;
-                        builders.push(builder);
-                    }
+    walk_nodes(path, &document, |node, world| {
+        if let Some(mesh) = node.mesh() {
+            for primitive in mesh.primitives() {
+                if let Some(mut builder) = file.primitive(&mesh, &primitive, default_material)? {
+                    builder.to_world = world;
+                    builders.push(builder);
                 }
             }
-            let first_child = stack.len();
-            stack.extend(node.children().map(|child| (child, world)));
-            stack[first_child..].reverse();
         }
-    }
+        Ok(())
+    })?;
     let (meshes, dropped) = finish_all(path, builders)?;
     Ok((Model { meshes, materials }, dropped))
+}
+
+/// Reads and validates a .gltf or .glb file's JSON (the scene reader's cameras and lights).
+pub(crate) fn document(path: &Path) -> Result<gltf::Document, MeshError> {
+    let bytes = read_file(path)?;
+    reject_utf16(path, &bytes)?;
+    Ok(parse(path, &bytes)?.0)
+}
+
+/// Calls `visit` with every node of the shown scene and its node-to-world matrix, parents before
+/// children, in document order. A file without a default scene shows its first one; one without
+/// scenes shows nothing. A node reached twice (a cycle or a shared child) is an error.
+pub(crate) fn walk_nodes(
+    path: &Path,
+    document: &gltf::Document,
+    mut visit: impl FnMut(&gltf::Node, Mat4) -> Result<(), MeshError>,
+) -> Result<(), MeshError> {
+    let Some(scene) = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    else {
+        return Ok(());
+    };
+    let mut visited = vec![false; document.nodes().len()];
+    // Depth-first with an explicit stack, so a deep or cyclic graph cannot overflow the call
+    // stack; pushed in reverse so nodes come out in document order.
+    let mut stack: Vec<(gltf::Node, Mat4)> =
+        scene.nodes().map(|node| (node, Mat4::IDENTITY)).collect();
+    stack.reverse();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            return Err(MeshError::NodeCycle {
+                path: path.to_owned(),
+                node: node.index(),
+            });
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        visit(&node, world)?;
+        let first_child = stack.len();
+        stack.extend(node.children().map(|child| (child, world)));
+        stack[first_child..].reverse();
+    }
+    Ok(())
 }
 
 /// Splits a GLB into JSON and BIN chunks (a .gltf is all JSON), then parses and validates the

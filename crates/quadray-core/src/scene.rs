@@ -1,0 +1,340 @@
+//! One scene description for every technique: a camera, point and spot lights, named materials
+//! and objects (mesh files, a technique's builtin meshes, boxes, polygons) with their transforms,
+//! plus the few per-scene settings. Read from TOML ([`SceneDescription::from_toml`]) or glTF 2.0
+//! ([`SceneDescription::load`] on a `.gltf` or `.glb`); each technique builds its own runtime scene
+//! from it.
+//!
+//! # TOML
+//!
+//! The canonical spelling for new files (`assets/scenes/shadows-demo.toml` is a full example):
+//!
+//! ```toml
+//! name = "demo"                  # default: the file's stem
+//! r_min = 0.05                   # quadray indirect: clamp of the VPL kernel (default 0.05)
+//! ambient = [0.08, 0.08, 0.08]   # quadray raytrace: ambient light (default 0.08)
+//! background = [0.0, 0.0, 0.0]   # quadray raytrace: colour of rays that leave (default dark blue)
+//!
+//! [camera]
+//! position = [0.5, 0.5, 2.4]
+//! target = [0.5, 0.5, 0.0]
+//! up = [0.0, 1.0, 0.0]           # default +y
+//! fov_y_deg = 39.0               # vertical field of view
+//!
+//! [[lights]]                     # a point light; any number
+//! position = [0.5, 0.97, 0.85]
+//! intensity = [2.0, 2.0, 2.0]    # in the renderer's own units, or `candela = [...]` (as glTF)
+//! direction = [-0.25, -1.0, -0.55]  # these three make it a spot light:
+//! cone_deg = 55.0                #   half-angle where the light ends
+//! falloff_deg = 15.0             #   width of the smooth edge inside the cone (default 0)
+//!
+//! [materials.porcelain]          # Whitted surfaces, referred to by name
+//! diffuse = [0.8, 0.75, 0.65]
+//! specular = 0.5                 # default 0; shininess 32, reflect 0, transmit 0, ior 1
+//!
+//! [[objects]]                    # one shape each: mesh, builtin, box or polygons
+//! mesh = "../meshes/stanford_bunny/stanford-bunny.obj"  # OBJ, glTF or PLY, relative to the file
+//! material = "porcelain"         # or `albedo = [r, g, b]`; none keeps the mesh's own colours
+//! scale = 2.5                    # uniform; then rotate_y_deg, then translate
+//! rotate_y_deg = 0.0
+//! translate = [0.54, -0.08, 0.5]
+//!
+//! [[objects]]
+//! builtin = "room"               # a technique's procedural mesh (quadray indirect: cornell,
+//!                                # room, blocks, atrium)
+//! [[objects]]
+//! box = { min = [0, 0, 0], max = [1, 1, 1] }  # world coordinates, no transform
+//! material = "porcelain"
+//! [[objects]]
+//! polygons = [[[0, 0, 0], [1, 0, 0], [1, 1, 0]]]  # convex, planar, world coordinates
+//! material = "porcelain"
+//! ```
+//!
+//! The older spellings stay accepted, so every bundled file loads unchanged: `eye`, `look_at`,
+//! `fov_deg` in `[camera]`; a single `[light]` table (listed before `[[lights]]`); `[[mesh]]` for
+//! `[[objects]]` and `path` for `mesh`.
+//!
+//! # glTF
+//!
+//! A `.gltf` or `.glb` scene gives one object (every mesh of the shown scene, placed by its node
+//! transforms, with its materials' base colours), the first perspective camera met in the node
+//! tree (required; its aspect ratio is ignored, the image size decides), and every
+//! `KHR_lights_punctual` point and spot light (directional lights are skipped with a warning;
+//! `range` is ignored). Their intensities are [`Intensity::Candela`]: colour times intensity.
+
+mod read_gltf;
+mod read_toml;
+
+use crate::FileError;
+use crate::mesh::Model;
+use glam::{Mat4, Vec3};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// A scene as read from a file, before a technique builds its own geometry from it.
+#[derive(Clone, Debug)]
+pub struct SceneDescription {
+    /// The file's `name`, else its stem.
+    pub name: String,
+    /// The view.
+    pub camera: Camera,
+    /// Point and spot lights in file order.
+    pub lights: Vec<Light>,
+    /// Named materials, sorted by name, then the anonymous ones of `albedo = [...]`; objects
+    /// refer to them by index.
+    pub materials: Vec<(String, Material)>,
+    /// Everything that is drawn.
+    pub objects: Vec<Object>,
+    /// quadray indirect's clamp of the VPL kernel's 1/r^4 (world units), when the file sets it.
+    pub r_min: Option<f32>,
+    /// quadray raytrace's ambient light, when the file sets it.
+    pub ambient: Option<Vec3>,
+    /// quadray raytrace's background colour, when the file sets it.
+    pub background: Option<Vec3>,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Where the eye is.
+    pub position: Vec3,
+    /// A point the camera looks at.
+    pub target: Vec3,
+    /// Up on the screen (need not be at right angles to the view direction).
+    pub up: Vec3,
+    /// Vertical field of view, in (0, 180).
+    pub fov_y_deg: f32,
+}
+
+/// A point light, or a spot light when `spot` is set.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Where the light is.
+    pub position: Vec3,
+    /// Per RGB channel, on the axis for a spot light.
+    pub intensity: Intensity,
+    /// The cone, for a spot light.
+    pub spot: Option<Spot>,
+}
+
+/// The cone of a spot light: full intensity inside `cone_deg - falloff_deg` of its axis, fading
+/// smoothly to zero at `cone_deg`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// Direction of the axis (not necessarily unit length).
+    pub direction: Vec3,
+    /// Half-angle of the cone, in (0, 90].
+    pub cone_deg: f32,
+    /// In [0, cone_deg].
+    pub falloff_deg: f32,
+}
+
+/// A light's intensity per RGB channel (for a spot light: on its axis).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Intensity {
+    /// As a TOML file's `intensity` gives it: in the units of the renderer it is written for.
+    Native(Vec3),
+    /// Photometric, as glTF's `KHR_lights_punctual` (or a TOML file's `candela`) gives it; each
+    /// renderer documents how it converts candela to its own units.
+    Candela(Vec3),
+}
+
+/// Luminous efficacy of 555 nm light (lm/W): the factor between candela and W/sr.
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+impl Intensity {
+    /// Radiant intensity (W/sr per channel): native values as given, candela divided by
+    /// [`LUMENS_PER_WATT`].
+    pub fn watts_per_sr(self) -> Vec3 {
+        match self {
+            Intensity::Native(v) => v,
+            Intensity::Candela(cd) => cd / LUMENS_PER_WATT,
+        }
+    }
+}
+
+/// Whitted's surface: local diffuse + Blinn-Phong specular, mirror reflection and refraction.
+/// A renderer without some of these (quadray indirect: diffuse only) ignores them.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Linear RGB albedo.
+    pub diffuse: Vec3,
+    /// Blinn-Phong specular weight (default 0).
+    #[serde(default)]
+    pub specular: f32,
+    /// Blinn-Phong exponent (default 32).
+    #[serde(default = "default_shininess")]
+    pub shininess: f32,
+    /// Weight of the mirror reflection (default 0).
+    #[serde(default)]
+    pub reflect: f32,
+    /// Weight of the refracted ray (default 0).
+    #[serde(default)]
+    pub transmit: f32,
+    /// Index of refraction (default 1).
+    #[serde(default = "default_ior")]
+    pub ior: f32,
+}
+
+fn default_shininess() -> f32 {
+    32.0
+}
+fn default_ior() -> f32 {
+    1.0
+}
+
+impl Material {
+    /// A plain diffuse surface (what `albedo = [...]` means).
+    pub fn diffuse(diffuse: Vec3) -> Self {
+        Self {
+            diffuse,
+            specular: 0.0,
+            shininess: default_shininess(),
+            reflect: 0.0,
+            transmit: 0.0,
+            ior: default_ior(),
+        }
+    }
+}
+
+/// One shape placed in the scene.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// What it is made of.
+    pub shape: Shape,
+    /// Identity for boxes and polygons (written in world coordinates).
+    pub transform: Transform,
+    /// Index into [`SceneDescription::materials`]; `None` keeps the shape's own colours.
+    pub material: Option<usize>,
+}
+
+/// What an object is made of.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    /// A technique's procedural mesh, by name; the technique says which names it knows.
+    Builtin(String),
+    /// A mesh file, loaded (glTF node transforms already applied).
+    Mesh {
+        /// The file, as the scene names it (joined to the scene's directory).
+        path: PathBuf,
+        /// Its meshes and materials.
+        model: Box<Model>,
+    },
+    /// An axis-aligned box, closed.
+    Box {
+        /// The lowest corner.
+        min: Vec3,
+        /// The highest corner.
+        max: Vec3,
+    },
+    /// Convex planar polygons, vertices in order.
+    Polygons(Vec<Vec<Vec3>>),
+}
+
+/// Uniform scale, then a turn about +y, then a translation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    /// Uniform scale, > 0.
+    pub scale: f32,
+    /// Turn about +y, counter-clockwise seen from above.
+    pub rotate_y_deg: f32,
+    /// Offset.
+    pub translate: Vec3,
+}
+
+impl Transform {
+    /// Leaves everything where it is.
+    pub const IDENTITY: Transform = Transform {
+        scale: 1.0,
+        rotate_y_deg: 0.0,
+        translate: Vec3::ZERO,
+    };
+
+    /// Object -> world for points.
+    pub fn matrix(&self) -> Mat4 {
+        Mat4::from_translation(self.translate)
+            * self.rotation()
+            * Mat4::from_scale(Vec3::splat(self.scale))
+    }
+
+    /// Object -> world for normals (the scale is uniform, so the turn alone).
+    pub fn rotation(&self) -> Mat4 {
+        Mat4::from_rotation_y(self.rotate_y_deg.to_radians())
+    }
+}
+
+impl SceneDescription {
+    /// Reads a scene file: glTF 2.0 for `.gltf` and `.glb`, TOML otherwise. Errors name the file.
+    pub fn load(path: &Path) -> Result<Self, FileError> {
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if matches!(extension.as_deref(), Some("gltf" | "glb")) {
+            return read_gltf::load(path);
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| FileError::new(path, e))?;
+        Self::from_toml(&text, path)
+    }
+
+    /// Parses TOML scene text. `path` names the scene in errors, its directory is where mesh
+    /// paths start, and its stem is the default name.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Self, FileError> {
+        read_toml::parse(text, path).map_err(|reason| FileError::new(path, reason))
+    }
+}
+
+/// The default name of a scene read from `path`.
+fn stem(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into())
+}
+
+/// Checks what holds for every scene, whatever file it came from.
+fn check_camera(c: &Camera) -> Result<(), String> {
+    if !(c.position.is_finite() && c.target.is_finite() && c.up.is_finite()) {
+        return Err("camera: a coordinate is not finite".into());
+    }
+    if c.position.distance(c.target) < 1e-6 {
+        return Err("camera: position and target are the same point".into());
+    }
+    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+        return Err(format!(
+            "camera: fov_y_deg {} is not in (0, 180)",
+            c.fov_y_deg
+        ));
+    }
+    Ok(())
+}
+
+fn check_light(l: &Light) -> Result<(), String> {
+    let (Intensity::Native(i) | Intensity::Candela(i)) = l.intensity;
+    if !(l.position.is_finite() && i.is_finite()) {
+        return Err(format!("light at {} is not finite", l.position));
+    }
+    if i.min_element() < 0.0 {
+        return Err(format!("light at {}: intensity is negative", l.position));
+    }
+    if let Some(s) = l.spot {
+        if !(s.direction.is_finite() && s.direction.length() > 1e-6) {
+            return Err(format!(
+                "light at {}: direction must be finite and not zero",
+                l.position
+            ));
+        }
+        if !(s.cone_deg > 0.0 && s.cone_deg <= 90.0) {
+            return Err(format!(
+                "light at {}: cone_deg {} is not in (0, 90]",
+                l.position, s.cone_deg
+            ));
+        }
+        if !(s.falloff_deg >= 0.0 && s.falloff_deg <= s.cone_deg) {
+            return Err(format!(
+                "light at {}: falloff_deg {} is not in [0, cone_deg]",
+                l.position, s.falloff_deg
+            ));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,310 @@
+//! The scene description: every bundled scene file, the two older TOML spellings against the
+//! canonical one, the bundled glTF scene, and bad input (malformed glTF, no camera, transforms
+//! that overflow, bad values) refused with the file named, never a panic.
+
+use glam::Vec3;
+use quadray_core::scene::{Intensity, SceneDescription, Shape, Transform};
+use std::path::{Path, PathBuf};
+
+const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+
+fn asset(relative: &str) -> PathBuf {
+    Path::new(ASSETS).join(relative)
+}
+
+/// A fresh directory for this test's files.
+fn scratch(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("scene")
+        .join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn refused(path: &Path) -> String {
+    match SceneDescription::load(path) {
+        Ok(_) => panic!("{} loaded, expected an error", path.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn every_bundled_scene_file_loads() {
+    // (file, lights, spot lights, objects, named materials)
+    let expected = [
+        ("atrium.toml", 1, 1, 1, 0),
+        ("cornell.toml", 1, 1, 1, 0),
+        ("cornell_buddha.toml", 1, 1, 2, 1),
+        ("cornell_bunny.toml", 1, 1, 2, 1),
+        ("cornell_obj.toml", 1, 1, 1, 0),
+        ("cornell_spot.gltf", 1, 1, 1, 0),
+        ("shadows-bunny.toml", 3, 0, 2, 1),
+        ("shadows-cornell.toml", 3, 0, 1, 0),
+        ("shadows-demo.toml", 2, 0, 4, 3),
+    ];
+    let mut files: Vec<String> = std::fs::read_dir(asset("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    let listed: Vec<&str> = expected.iter().map(|e| e.0).collect();
+    assert_eq!(files, listed, "every file in assets/scenes is checked here");
+    for (file, lights, spots, objects, materials) in expected {
+        let d = SceneDescription::load(&asset("scenes").join(file)).unwrap();
+        assert_eq!(d.lights.len(), lights, "{file}");
+        let spot_count = d.lights.iter().filter(|l| l.spot.is_some()).count();
+        assert_eq!(spot_count, spots, "{file}");
+        assert_eq!(d.objects.len(), objects, "{file}");
+        assert_eq!(d.materials.len(), materials, "{file}");
+    }
+}
+
+#[test]
+fn the_older_spellings_read_as_the_canonical_one() {
+    let canonical = r#"
+        [camera]
+        position = [0.5, 0.5, 2.4]
+        target = [0.5, 0.5, 0.0]
+        fov_y_deg = 39.0
+        [[lights]]
+        position = [0.5, 0.97, 0.85]
+        intensity = [2.0, 2.0, 2.0]
+        direction = [-0.25, -1.0, -0.55]
+        cone_deg = 55.0
+        falloff_deg = 15.0
+        [[objects]]
+        builtin = "room"
+        albedo = [0.5, 0.5, 0.5]
+        [[objects]]
+        mesh = "../meshes/cornell_box/cornell_box.obj"
+        scale = 0.002
+        rotate_y_deg = 180.0
+    "#;
+    let indirect = r#"
+        [camera]
+        position = [0.5, 0.5, 2.4]
+        target = [0.5, 0.5, 0.0]
+        fov_deg = 39.0
+        [light]
+        position = [0.5, 0.97, 0.85]
+        direction = [-0.25, -1.0, -0.55]
+        cone_deg = 55.0
+        falloff_deg = 15.0
+        intensity = [2.0, 2.0, 2.0]
+        [[mesh]]
+        builtin = "room"
+        albedo = [0.5, 0.5, 0.5]
+        [[mesh]]
+        path = "../meshes/cornell_box/cornell_box.obj"
+        scale = 0.002
+        rotate_y_deg = 180.0
+    "#;
+    let raytrace = canonical
+        .replace("position = [0.5, 0.5, 2.4]", "eye = [0.5, 0.5, 2.4]")
+        .replace("target =", "look_at =")
+        .replace("mesh = ", "path = ");
+    let file = asset("scenes/new.toml");
+    let a = SceneDescription::from_toml(canonical, &file).unwrap();
+    for other in [indirect, &raytrace] {
+        let b = SceneDescription::from_toml(other, &file).unwrap();
+        assert_eq!(a.camera, b.camera);
+        assert_eq!(a.lights, b.lights);
+        assert_eq!(a.materials, b.materials);
+        assert_eq!(a.name, "new");
+        for (x, y) in a.objects.iter().zip(&b.objects) {
+            assert_eq!((x.transform, x.material), (y.transform, y.material));
+        }
+    }
+    let Shape::Mesh { model, .. } = &a.objects[1].shape else {
+        panic!("object 1 is the mesh file");
+    };
+    assert_eq!(model.triangle_count(), 36);
+    assert_eq!(a.objects[0].transform, Transform::IDENTITY);
+}
+
+#[test]
+fn the_bundled_gltf_scene_has_the_camera_and_spot_of_cornell_toml() {
+    let gltf = SceneDescription::load(&asset("scenes/cornell_spot.gltf")).unwrap();
+    let toml = SceneDescription::load(&asset("scenes/cornell.toml")).unwrap();
+    assert_eq!(gltf.name, "cornell_spot");
+    let (c, t) = (gltf.camera, toml.camera);
+    assert!(c.position.abs_diff_eq(t.position, 1e-6), "{c:?}");
+    let (forward, expected) = (c.target - c.position, (t.target - t.position).normalize());
+    assert!(forward.abs_diff_eq(expected, 1e-6), "{c:?}");
+    assert!(c.up.abs_diff_eq(Vec3::Y, 1e-6));
+    assert!((c.fov_y_deg - t.fov_y_deg).abs() < 1e-4);
+    let (light, spot) = (gltf.lights[0], gltf.lights[0].spot.unwrap());
+    let expected = toml.lights[0].spot.unwrap();
+    assert!(light.position.abs_diff_eq(toml.lights[0].position, 1e-6));
+    assert!(
+        spot.direction
+            .abs_diff_eq(expected.direction.normalize(), 1e-5),
+        "{spot:?}"
+    );
+    assert!((spot.cone_deg - expected.cone_deg).abs() < 1e-4);
+    assert!((spot.falloff_deg - expected.falloff_deg).abs() < 1e-4);
+    assert_eq!(light.intensity, Intensity::Candela(Vec3::splat(1366.0)));
+    assert_eq!(light.intensity.watts_per_sr(), Vec3::splat(2.0));
+    // The room (10 triangles) and one block mesh placed twice by node transforms (10 each).
+    let Shape::Mesh { model, .. } = &gltf.objects[0].shape else {
+        panic!("a glTF scene is one mesh object");
+    };
+    assert_eq!(model.triangle_count(), 30);
+    let (lo, hi) = model.bounds();
+    assert!(lo.abs_diff_eq(Vec3::ZERO, 1e-6) && hi.abs_diff_eq(Vec3::ONE, 1e-6));
+}
+
+/// The bundled glTF scene's JSON, changed by `edit`, written to `dir/name`.
+fn edited_gltf(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let text = std::fs::read_to_string(asset("scenes/cornell_spot.gltf")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    edit(&mut json);
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+    path
+}
+
+/// A change made to the bundled glTF scene's JSON.
+type Edit = fn(&mut serde_json::Value);
+
+#[test]
+fn bad_gltf_scenes_are_refused_with_the_file_named() {
+    let dir = scratch("bad-gltf");
+    let cases: [(&str, Edit, &str); 6] = [
+        (
+            "no-camera.gltf",
+            |j| {
+                j["nodes"][3].as_object_mut().unwrap().remove("camera");
+            },
+            "no camera",
+        ),
+        (
+            "orthographic.gltf",
+            |j| {
+                j["cameras"][0] = serde_json::json!({"type": "orthographic",
+                    "orthographic": {"xmag": 1.0, "ymag": 1.0, "znear": 0.1, "zfar": 10.0}});
+            },
+            "perspective",
+        ),
+        (
+            // 3e38 x 10 overflows f32: the light's world position is infinite.
+            "overflow.gltf",
+            |j| {
+                j["nodes"][4]["translation"] = serde_json::json!([3e38, 0.0, 0.0]);
+                j["nodes"].as_array_mut().unwrap().push(serde_json::json!(
+                    {"scale": [10.0, 10.0, 10.0], "children": [4]}));
+                j["scenes"][0]["nodes"] = serde_json::json!([0, 1, 2, 3, 5]);
+            },
+            "not finite",
+        ),
+        (
+            "cone.gltf",
+            |j| {
+                j["extensions"]["KHR_lights_punctual"]["lights"][0]["spot"]["innerConeAngle"] =
+                    serde_json::json!(1.2);
+            },
+            "cone angles",
+        ),
+        (
+            "light-index.gltf",
+            |j| {
+                j["nodes"][4]["extensions"]["KHR_lights_punctual"]["light"] =
+                    serde_json::json!(4000000000u64);
+            },
+            "light",
+        ),
+        (
+            "fov.gltf",
+            |j| j["cameras"][0]["perspective"]["yfov"] = serde_json::json!(3.5),
+            "fov_y_deg",
+        ),
+    ];
+    for (name, edit, why) in cases {
+        let path = edited_gltf(&dir, name, edit);
+        let e = refused(&path);
+        assert!(
+            e.starts_with(&path.display().to_string()) && e.contains(why),
+            "{name}: {e}"
+        );
+    }
+}
+
+#[test]
+fn malformed_gltf_files_are_errors_as_scenes_too() {
+    for file in [
+        "gltf2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb",
+        "gltf2/IncorrectVertexArrays/Cube.gltf",
+        "gltf2/IndexOutOfRange/IndexOutOfRange.gltf",
+        "gltf2/MissingBin/BoxTextured.gltf",
+        "gltf2/RecursiveNodes/RecursiveNodes.gltf",
+        "gltf2/TestNoRootNode/NoScene.gltf",
+        "gltf2/wrongTypes/badArray.gltf",
+        "gltf2/wrongTypes/badExtension.gltf",
+        "gltf2/wrongTypes/badUint.gltf",
+    ] {
+        let path = asset("malformed").join(file);
+        let e = refused(&path);
+        assert!(e.starts_with(&path.display().to_string()), "{e}");
+        // The file name once, not the loader's prefix again.
+        assert_eq!(e.matches(&path.display().to_string()).count(), 1, "{e}");
+    }
+}
+
+#[test]
+fn bad_toml_values_are_refused_with_the_reason() {
+    let good = std::fs::read_to_string(asset("scenes/shadows-demo.toml")).unwrap();
+    let file = asset("scenes/bad.toml");
+    let cases = [
+        (
+            "eye = [0.3, 1.6, 4.2]",
+            "eye = [nan, 1.6, 4.2]",
+            "not finite",
+        ),
+        ("fov_y_deg = 50", "fov_y_deg = 0", "fov_y_deg"),
+        (
+            "intensity = [0.7, 0.7, 0.7]",
+            "candela = [1, 1, 1]\nintensity = [1, 1, 1]",
+            "one of",
+        ),
+        (
+            "intensity = [0.7, 0.7, 0.7]",
+            "intensity = [-1, 1, 1]",
+            "negative",
+        ),
+        (
+            "intensity = [0.7, 0.7, 0.7]",
+            "intensity = [1, 1, 1]\ncone_deg = 30",
+            "spot light",
+        ),
+        ("ior = 1.5", "ior = 0", "ior"),
+        (
+            "material = \"glass\"",
+            "material = \"glass\"\nscale = 2",
+            "world coordinates",
+        ),
+        ("material = \"glass\"", "", "need a `material`"),
+        (
+            "max = [0.4, 1.1, 0.3]",
+            "max = [-0.4, 1.1, 0.3]",
+            "below max",
+        ),
+        (
+            "material = \"glass\"",
+            "material = \"glass\"\nbuiltin = \"room\"",
+            "more than one",
+        ),
+        ("[[lights]]", "[[lamps]]", "lamps"),
+    ];
+    for (from, to, why) in cases {
+        assert!(good.contains(from), "{from}");
+        let text = good.replacen(from, to, 1);
+        let e = SceneDescription::from_toml(&text, &file)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&file.display().to_string()) && e.contains(why),
+            "{why}: {e}"
+        );
+    }
+}
