@@ -39,6 +39,7 @@ fn every_bundled_scene_file_loads() {
         ("cornell_bunny.toml", 1, 1, 2, 1),
         ("cornell_obj.toml", 1, 1, 1, 0),
         ("cornell_spot.gltf", 1, 1, 1, 0),
+        ("example-hst.toml", 2, 0, 5, 4),
         ("shadows-bunny.toml", 3, 0, 2, 1),
         ("shadows-cornell.toml", 3, 0, 1, 0),
         ("shadows-demo.toml", 2, 0, 4, 3),
