@@ -83,12 +83,7 @@ impl Method {
 impl std::str::FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Method::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                format!("unknown method `{s}` (quadtree, quadtree-passes, rsm, reference)")
-            })
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "method")
     }
 }
 
