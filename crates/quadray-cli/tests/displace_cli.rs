@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{assets, quadray_ok, quadray_refuses, read_json, scratch};
+use common::{assets, quadray_refuses, quadray_writes, read_json, scratch};
 
 #[test]
 fn displace_writes_the_picture_the_stats_and_the_error_map() {
@@ -11,26 +11,26 @@ fn displace_writes_the_picture_the_stats_and_the_error_map() {
     let map = assets().join("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
     let out = dir.join("tiles.png");
     let stats = dir.join("tiles.json");
-    quadray_ok(&[
-        "displace",
-        "--map",
-        map.to_str().unwrap(),
-        "--method",
-        "pom",
-        "--layers",
-        "1,16",
-        "--view-angle",
-        "80",
-        "--size",
-        "96x64",
-        "--frames",
-        "3",
-        "--reference",
-        "--out",
-        out.to_str().unwrap(),
-        "--stats",
-        stats.to_str().unwrap(),
-    ]);
+    quadray_writes(
+        &[
+            "displace",
+            "--map",
+            map.to_str().unwrap(),
+            "--method",
+            "pom",
+            "--layers",
+            "1,16",
+            "--view-angle",
+            "80",
+            "--size",
+            "96x64",
+            "--frames",
+            "3",
+            "--reference",
+        ],
+        &out,
+        &stats,
+    );
     let json = read_json(&stats);
     for field in [
         "method",

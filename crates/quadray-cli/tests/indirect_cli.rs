@@ -3,31 +3,31 @@
 
 mod common;
 
-use common::{quadray_ok, quadray_refuses, read_json, scratch};
+use common::{quadray_ok, quadray_refuses, quadray_writes, read_json, scratch};
 
 #[test]
 fn indirect_writes_pictures_stats_and_the_error_map() {
     let dir = scratch("indirect-ok");
     let out = dir.join("cornell.png");
     let stats = dir.join("cornell.json");
-    quadray_ok(&[
-        "indirect",
-        "--method",
-        "quadtree-passes",
-        "--rsm-size",
-        "32",
-        "--size",
-        "48x32",
-        "--validity",
-        "recursive",
-        "--frames",
-        "2",
-        "--reference",
-        "--out",
-        out.to_str().unwrap(),
-        "--stats",
-        stats.to_str().unwrap(),
-    ]);
+    quadray_writes(
+        &[
+            "indirect",
+            "--method",
+            "quadtree-passes",
+            "--rsm-size",
+            "32",
+            "--size",
+            "48x32",
+            "--validity",
+            "recursive",
+            "--frames",
+            "2",
+            "--reference",
+        ],
+        &out,
+        &stats,
+    );
     for name in [
         "cornell.png",
         "cornell.direct.png",

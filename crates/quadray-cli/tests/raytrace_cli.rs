@@ -3,31 +3,31 @@
 
 mod common;
 
-use common::{assets, quadray_ok, quadray_refuses, read_json, scratch};
+use common::{assets, quadray_refuses, quadray_writes, read_json, scratch};
 
 #[test]
 fn raytrace_writes_the_picture_and_the_stats() {
     let dir = scratch("raytrace-ok");
     let (out, stats) = (dir.join("demo.png"), dir.join("demo.json"));
     let scene = assets().join("scenes/shadows-demo.toml");
-    quadray_ok(&[
-        "raytrace",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--shadows",
-        "hst",
-        "--nth",
-        "6",
-        "--size",
-        "64x48",
-        "--depth",
-        "4",
-        "--out",
-        out.to_str().unwrap(),
-        "--stats",
-        stats.to_str().unwrap(),
-        "--check",
-    ]);
+    quadray_writes(
+        &[
+            "raytrace",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--shadows",
+            "hst",
+            "--nth",
+            "6",
+            "--size",
+            "64x48",
+            "--depth",
+            "4",
+            "--check",
+        ],
+        &out,
+        &stats,
+    );
     let img = image::open(&out).unwrap();
     assert_eq!((img.width(), img.height()), (64, 48));
     let json = read_json(&stats);

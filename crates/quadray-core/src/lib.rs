@@ -28,6 +28,20 @@ impl FileError {
     }
 }
 
+/// The `FromStr` of a named choice (a method, a convention, ...): the one of `all` whose `name` is
+/// `s`, else an error that says what `s` was meant to be and lists the names.
+pub fn parse_named<T: Copy>(
+    s: &str,
+    all: &[T],
+    name: impl Fn(T) -> &'static str,
+    what: &str,
+) -> Result<T, String> {
+    all.iter().copied().find(|&t| name(t) == s).ok_or_else(|| {
+        let names: Vec<_> = all.iter().map(|&t| name(t)).collect();
+        format!("unknown {what} `{s}` (one of: {})", names.join(", "))
+    })
+}
+
 /// Writes `value` as pretty JSON (stats and results files), creating the folder.
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), FileError> {
     let text = serde_json::to_string_pretty(value).map_err(|e| FileError::new(path, e))?;

@@ -38,10 +38,7 @@ impl Convention {
 impl std::str::FromStr for Convention {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|c| c.name() == s)
-            .ok_or_else(|| format!("unknown convention `{s}` (height, depth, depth-photo)"))
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "convention")
     }
 }
 

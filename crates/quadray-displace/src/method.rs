@@ -100,12 +100,6 @@ impl fmt::Display for Method {
 impl FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-                format!("unknown method `{s}` (one of: {})", names.join(", "))
-            })
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "method")
     }
 }

@@ -286,32 +286,33 @@ mod tests {
     fn point_sampled_dda_matches_fine_marching() {
         for sharp in [false, true] {
             let map = random_map(16, 7, sharp);
-            for ray in random_rays(400, 11) {
-                let dz = 2e-5;
-                let expected = march(ray, dz, |p| point_depth(&map, p));
-                let hit = intersect(&map, Addressing::Wrap, Surface::Point, ray).unwrap();
-                assert!(
-                    (hit.z - expected).abs() <= dz * 1.01,
-                    "ray {ray:?}: dda {} march {expected}",
-                    hit.z
-                );
-            }
+            matches_marching(&map, 11, Surface::Point, point_depth);
+        }
+    }
+
+    /// `intersect` on `surface` against fine marching of `depth` along 400 random rays.
+    fn matches_marching(
+        map: &HeightMap,
+        seed: u64,
+        surface: Surface,
+        depth: impl Fn(&HeightMap, DVec2) -> f64,
+    ) {
+        for ray in random_rays(400, seed) {
+            let dz = 2e-5;
+            let expected = march(ray, dz, |p| depth(map, p));
+            let hit = intersect(map, Addressing::Wrap, surface, ray).unwrap();
+            assert!(
+                (hit.z - expected).abs() <= dz * 1.01,
+                "ray {ray:?}: {surface:?} {} march {expected}",
+                hit.z
+            );
         }
     }
 
     #[test]
     fn bilinear_roots_match_fine_marching() {
         let map = random_map(16, 3, false);
-        for ray in random_rays(400, 5) {
-            let dz = 2e-5;
-            let expected = march(ray, dz, |p| bilinear_depth(&map, p));
-            let hit = intersect(&map, Addressing::Wrap, Surface::Bilinear, ray).unwrap();
-            assert!(
-                (hit.z - expected).abs() <= dz * 1.01,
-                "ray {ray:?}: roots {} march {expected}",
-                hit.z
-            );
-        }
+        matches_marching(&map, 5, Surface::Bilinear, bilinear_depth);
     }
 
     #[test]

@@ -93,10 +93,7 @@ impl SurfaceKind {
 impl std::str::FromStr for SurfaceKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| format!("unknown surface `{s}` (one of: wall, terrain, photo, torus)"))
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "surface")
     }
 }
 

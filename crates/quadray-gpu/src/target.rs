@@ -1,16 +1,15 @@
 //! Render targets and the pass state every raster technique sets up the same way.
 
-use crate::Gpu;
-
-/// A single-sample 2-D texture of `size` (width, height) with one mip level.
+/// A single-sample 2-D texture of `size` (width, height) with one mip level. Takes the bare
+/// device so that passes recorded on a caller's own device can use it too.
 pub fn texture_2d(
-    gpu: &Gpu,
+    device: &wgpu::Device,
     label: &str,
     (width, height): (u32, u32),
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
+    device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d {
             width,

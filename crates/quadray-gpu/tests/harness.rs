@@ -7,7 +7,7 @@ use quadray_gpu::{Gpu, GpuTimer, cleared_attachment, read_texture_rgba8, texture
 fn clear_reads_back_and_timestamps_time_the_pass() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     let texture = texture_2d(
-        &gpu,
+        &gpu.device,
         "target",
         (70, 3),
         wgpu::TextureFormat::Rgba8Unorm,

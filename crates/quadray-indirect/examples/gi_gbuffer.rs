@@ -7,6 +7,7 @@
 //! `cargo run --release -p quadray-indirect --example gi_gbuffer`
 
 use glam::Vec3;
+use quadray_gpu::{nearest_depth, texture_2d};
 use quadray_indirect::scene::{Camera, Scene, SpotLight, Vertex};
 use quadray_indirect::{
     ClusterSettings, FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, OutputPass,
@@ -46,81 +47,76 @@ fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2
 /// under the ceiling and the camera in front.
 pub fn scene() -> Scene {
     let (white, red, green) = ([0.73; 3], [0.63, 0.065, 0.05], [0.14, 0.45, 0.091]);
-    let p = |x, y, z| Vec3::new(x, y, z);
     let mut triangles = Vec::new();
-    for (a, b, c, d, albedo) in [
+    for ([a, b, c, d], albedo) in [
         (
-            p(0., 0., 1.),
-            p(1., 0., 1.),
-            p(1., 0., 0.),
-            p(0., 0., 0.),
+            [[0., 0., 1.], [1., 0., 1.], [1., 0., 0.], [0., 0., 0.]],
             white,
         ), // floor
         (
-            p(0., 1., 0.),
-            p(1., 1., 0.),
-            p(1., 1., 1.),
-            p(0., 1., 1.),
+            [[0., 1., 0.], [1., 1., 0.], [1., 1., 1.], [0., 1., 1.]],
             white,
         ), // ceiling
         (
-            p(0., 0., 0.),
-            p(1., 0., 0.),
-            p(1., 1., 0.),
-            p(0., 1., 0.),
+            [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
             white,
         ), // back
         (
-            p(0., 0., 1.),
-            p(0., 0., 0.),
-            p(0., 1., 0.),
-            p(0., 1., 1.),
+            [[0., 0., 1.], [0., 0., 0.], [0., 1., 0.], [0., 1., 1.]],
             red,
         ), // left
         (
-            p(1., 0., 0.),
-            p(1., 0., 1.),
-            p(1., 1., 1.),
-            p(1., 1., 0.),
+            [[1., 0., 0.], [1., 0., 1.], [1., 1., 1.], [1., 1., 0.]],
             green,
         ), // right
         // the block: 0.3 wide, 0.5 high, its top and four sides
         (
-            p(0.2, 0.5, 0.6),
-            p(0.5, 0.5, 0.6),
-            p(0.5, 0.5, 0.3),
-            p(0.2, 0.5, 0.3),
+            [
+                [0.2, 0.5, 0.6],
+                [0.5, 0.5, 0.6],
+                [0.5, 0.5, 0.3],
+                [0.2, 0.5, 0.3],
+            ],
             white,
         ),
         (
-            p(0.2, 0., 0.6),
-            p(0.5, 0., 0.6),
-            p(0.5, 0.5, 0.6),
-            p(0.2, 0.5, 0.6),
+            [
+                [0.2, 0., 0.6],
+                [0.5, 0., 0.6],
+                [0.5, 0.5, 0.6],
+                [0.2, 0.5, 0.6],
+            ],
             white,
         ),
         (
-            p(0.5, 0., 0.6),
-            p(0.5, 0., 0.3),
-            p(0.5, 0.5, 0.3),
-            p(0.5, 0.5, 0.6),
+            [
+                [0.5, 0., 0.6],
+                [0.5, 0., 0.3],
+                [0.5, 0.5, 0.3],
+                [0.5, 0.5, 0.6],
+            ],
             white,
         ),
         (
-            p(0.5, 0., 0.3),
-            p(0.2, 0., 0.3),
-            p(0.2, 0.5, 0.3),
-            p(0.5, 0.5, 0.3),
+            [
+                [0.5, 0., 0.3],
+                [0.2, 0., 0.3],
+                [0.2, 0.5, 0.3],
+                [0.5, 0.5, 0.3],
+            ],
             white,
         ),
         (
-            p(0.2, 0., 0.3),
-            p(0.2, 0., 0.6),
-            p(0.2, 0.5, 0.6),
-            p(0.2, 0.5, 0.3),
+            [
+                [0.2, 0., 0.3],
+                [0.2, 0., 0.6],
+                [0.2, 0.5, 0.6],
+                [0.2, 0.5, 0.3],
+            ],
             white,
         ),
     ] {
+        let [a, b, c, d] = [a, b, c, d].map(Vec3::from_array);
         triangles.extend(quad(a, b, c, d, albedo));
     }
     Scene {
@@ -154,28 +150,6 @@ pub fn settings() -> Settings {
     }
 }
 
-fn texture(
-    device: &wgpu::Device,
-    size: (u32, u32),
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: None,
-        size: wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
-}
-
 /// Renders the scene (direct + one bounce) and returns linear radiance, rgba per pixel.
 pub fn render(
     device: &wgpu::Device,
@@ -192,7 +166,9 @@ pub fn render(
 
     // Our own G-buffer pass.
     let target = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-    let view = |format| texture(device, size, format, target).create_view(&Default::default());
+    let view = |format| {
+        texture_2d(device, "gbuffer", size, format, target).create_view(&Default::default())
+    };
     let gbuffer = [(); 3].map(|_| view(FLOAT_FORMAT));
     let depth = view(wgpu::TextureFormat::Depth32Float);
     let camera = scene
@@ -208,6 +184,7 @@ pub fn render(
         label: Some("gbuffer"),
         source: wgpu::ShaderSource::Wgsl(GBUFFER_WGSL.into()),
     });
+    let gbuffer_targets = [(); 3].map(|_| Some(FLOAT_FORMAT.into()));
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("gbuffer"),
         layout: None,
@@ -222,23 +199,13 @@ pub fn render(
             })],
         },
         primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: wgpu::TextureFormat::Depth32Float,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
+        depth_stencil: Some(nearest_depth(wgpu::TextureFormat::Depth32Float)),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("fs"),
             compilation_options: Default::default(),
-            targets: &[
-                Some(FLOAT_FORMAT.into()),
-                Some(FLOAT_FORMAT.into()),
-                Some(FLOAT_FORMAT.into()),
-            ],
+            targets: &gbuffer_targets,
         }),
         multiview_mask: None,
         cache: None,
@@ -266,7 +233,7 @@ pub fn render(
     gather.set_light(queue, &spot, scene.r_min);
     let output_pass = OutputPass::new(device, FLOAT_FORMAT, OutputTerm::Combined)?;
     let output_usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
-    let output = texture(device, size, FLOAT_FORMAT, output_usage);
+    let output = texture_2d(device, "output", size, FLOAT_FORMAT, output_usage);
 
     let mut encoder = device.create_command_encoder(&Default::default());
     {

@@ -36,6 +36,7 @@ pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> 
 /// Error of an image against a reference (both linear RGB, same size).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ImageError {
+    /// Root mean square of the differences over every pixel and channel.
     pub rmse: f64,
     /// sum |a - b| / sum |b| over every pixel and channel.
     pub rel_l1: f64,
@@ -43,6 +44,7 @@ pub struct ImageError {
     pub rel_max: f64,
 }
 
+/// How far `image` is from `reference`; panics when their sizes differ.
 pub fn compare(image: &[[f32; 3]], reference: &[[f32; 3]]) -> ImageError {
     assert_eq!(image.len(), reference.len(), "images of different sizes");
     let (mut sq, mut abs, mut norm, mut max_diff, mut max_ref) = (0.0, 0.0, 0.0, 0.0f64, 0.0f64);

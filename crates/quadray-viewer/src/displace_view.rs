@@ -112,7 +112,13 @@ impl DisplaceView {
             !matches!(&self.target, Some((t, ..)) if t.width() == size[0] && t.height() == size[1]);
         if resized {
             let make = |format, usage| {
-                quadray_gpu::texture_2d(gpu, "viewer frame", (size[0], size[1]), format, usage)
+                quadray_gpu::texture_2d(
+                    &gpu.device,
+                    "viewer frame",
+                    (size[0], size[1]),
+                    format,
+                    usage,
+                )
             };
             let color = make(
                 wgpu::TextureFormat::Rgba8UnormSrgb,

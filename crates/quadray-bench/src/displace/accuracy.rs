@@ -24,29 +24,18 @@ pub fn by_view_angle(
     } else {
         &[0.0, 15.0, 30.0, 45.0, 60.0, 70.0, 75.0, 80.0, 85.0]
     };
+    let default_with = |method| Settings {
+        method,
+        ..Default::default()
+    };
     let candidates = [
-        Settings {
-            method: Method::Pyramid,
-            ..Default::default()
-        },
-        Settings {
-            method: Method::PyramidAscend,
-            ..Default::default()
-        },
-        Settings {
-            method: Method::PyramidBilinear,
-            ..Default::default()
-        },
+        default_with(Method::Pyramid),
+        default_with(Method::PyramidAscend),
+        default_with(Method::PyramidBilinear),
         Settings::bevy_pom(),
         Settings::threejs_relief(),
-        Settings {
-            method: Method::Parallax,
-            ..Default::default()
-        },
-        Settings {
-            method: Method::Bump,
-            ..Default::default()
-        },
+        default_with(Method::Parallax),
+        default_with(Method::Bump),
     ];
     let label = |s: &Settings| match s.method {
         Method::Pom | Method::Relief => format!("{} {}-{}", s.method, s.layers.0, s.layers.1),

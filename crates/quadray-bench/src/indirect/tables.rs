@@ -83,12 +83,14 @@ const RSM_SAMPLES: [u32; 9] = [16, 64, 216, 256, 1024, 2040, 4096, 8192, 16384];
 const LIMIT_SIDES: [u32; 3] = [16, 32, 64];
 const THRESHOLDS: [(f32, f32); 3] = [(0.45, 0.3), (0.25, 0.6), (0.05, 0.9)];
 
-struct Measure<'a> {
-    brute: &'a [[f32; 3]],
+/// A scene's brute-force indirect light and the frames per median: what every row of it is
+/// measured against.
+struct Measure {
+    brute: Vec<[f32; 3]>,
     frames: u32,
 }
 
-impl Measure<'_> {
+impl Measure {
     fn row(
         &self,
         r: &mut Renderer,
@@ -103,7 +105,7 @@ impl Measure<'_> {
         } else {
             None
         };
-        let e = compare(&frame.indirect, self.brute);
+        let e = compare(&frame.indirect, &self.brute);
         let moving = r.time(method, true, self.frames)?;
         let still = r.time(method, false, self.frames)?;
         Ok(Row {
@@ -118,6 +120,31 @@ impl Measure<'_> {
             rel_l1: e.rel_l1,
             rmse: e.rmse,
         })
+    }
+
+    /// Table 2's rows for one validity rule: each of [`THRESHOLDS`] at the 32^2 limit, labelled
+    /// after `scene` ("" for the Cornell box).
+    fn threshold_rows(
+        &self,
+        r: &mut Renderer,
+        rsm_size: u32,
+        scene: &str,
+        validity: Validity,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<Vec<Row>, IndirectError> {
+        let mut rows = Vec::new();
+        for (depth, normal) in THRESHOLDS {
+            progress(&format!("table 2: {scene}{depth}/{normal} {validity:?}"));
+            r.set_cluster(ClusterSettings {
+                depth_threshold: depth,
+                normal_threshold: normal,
+                validity,
+                ..ClusterSettings::with_limit_side(rsm_size, 32)
+            })?;
+            let label = format!("{scene}depth {depth} normal {normal} {validity:?}, limit 32^2");
+            rows.push(self.row(r, "2", Method::Quadtree, label)?);
+        }
+        Ok(rows)
     }
 }
 
@@ -134,27 +161,23 @@ fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
 
 /// The Cornell box's renderer at the benchmark's sizes, its brute force, and the frames per median.
 struct Bench<'g> {
+    gpu: &'g Gpu,
     scene: Scene,
     base: Settings,
     renderer: Renderer<'g>,
-    brute: Vec<[f32; 3]>,
-    frames: u32,
+    m: Measure,
 }
 
 /// Table 1: the limit level (16^2, 32^2, 64^2 nodes), compacted cut and per-level passes.
 fn table1(b: &mut Bench, progress: &mut dyn FnMut(&str)) -> Result<Vec<Row>, IndirectError> {
     let rsm_size = b.base.rsm_size;
-    let m = Measure {
-        brute: &b.brute,
-        frames: b.frames,
-    };
     let mut rows = Vec::new();
     for side in LIMIT_SIDES.into_iter().filter(|&s| s < rsm_size) {
         b.renderer
             .set_cluster(ClusterSettings::with_limit_side(rsm_size, side))?;
         for method in [Method::Quadtree, Method::QuadtreePasses] {
             progress(&format!("table 1: limit {side}^2, {}", method.name()));
-            rows.push(m.row(&mut b.renderer, "1", method, format!("limit {side}^2"))?);
+            rows.push(b.m.row(&mut b.renderer, "1", method, format!("limit {side}^2"))?);
         }
     }
     Ok(rows)
@@ -162,68 +185,43 @@ fn table1(b: &mut Bench, progress: &mut dyn FnMut(&str)) -> Result<Vec<Row>, Ind
 
 /// Table 2: the thresholds under both validity rules on the Cornell box, then the local rule on
 /// the Buddha (100k triangles) in the Cornell room.
-fn table2(
-    gpu: &Gpu,
-    b: &mut Bench,
-    progress: &mut dyn FnMut(&str),
-) -> Result<Vec<Row>, IndirectError> {
-    let rsm_size = b.base.rsm_size;
-    let m = Measure {
-        brute: &b.brute,
-        frames: b.frames,
-    };
+fn table2(b: &mut Bench, progress: &mut dyn FnMut(&str)) -> Result<Vec<Row>, IndirectError> {
     let mut rows = Vec::new();
     for validity in [Validity::Local, Validity::Recursive] {
-        for (depth, normal) in THRESHOLDS {
-            progress(&format!("table 2: {depth}/{normal} {validity:?}"));
-            b.renderer.set_cluster(ClusterSettings {
-                depth_threshold: depth,
-                normal_threshold: normal,
-                validity,
-                ..ClusterSettings::with_limit_side(rsm_size, 32)
-            })?;
-            let label = format!("depth {depth} normal {normal} {validity:?}, limit 32^2");
-            rows.push(m.row(&mut b.renderer, "2", Method::Quadtree, label)?);
-        }
+        rows.extend(b.m.threshold_rows(
+            &mut b.renderer,
+            b.base.rsm_size,
+            "",
+            validity,
+            progress,
+        )?);
     }
     let buddha = Scene::load(&scenes_dir().join("cornell_buddha.toml"))?;
-    let mut rb = Renderer::new(gpu, &buddha, b.base.clone())?;
+    let mut rb = Renderer::new(b.gpu, &buddha, b.base.clone())?;
     progress("table 2: Buddha brute force");
     let buddha_brute = rb.render_frame(Method::Reference)?.indirect;
     let mb = Measure {
-        brute: &buddha_brute,
-        frames: b.frames,
+        brute: buddha_brute,
+        frames: b.m.frames,
     };
-    for (depth, normal) in THRESHOLDS {
-        progress(&format!("table 2: Buddha {depth}/{normal}"));
-        rb.set_cluster(ClusterSettings {
-            depth_threshold: depth,
-            normal_threshold: normal,
-            ..ClusterSettings::with_limit_side(rsm_size, 32)
-        })?;
-        let label = format!("Buddha: depth {depth} normal {normal} Local, limit 32^2");
-        rows.push(mb.row(&mut rb, "2", Method::Quadtree, label)?);
-    }
+    rows.extend(mb.threshold_rows(
+        &mut rb,
+        b.base.rsm_size,
+        "Buddha: ",
+        Validity::Local,
+        progress,
+    )?);
     Ok(rows)
 }
 
 /// Table 3: the quadtree at limits 16^2 and 32^2 against RSM sampling at every sample count.
-fn table3(
-    gpu: &Gpu,
-    b: &mut Bench,
-    progress: &mut dyn FnMut(&str),
-) -> Result<Vec<Row>, IndirectError> {
-    let rsm_size = b.base.rsm_size;
-    let m = Measure {
-        brute: &b.brute,
-        frames: b.frames,
-    };
+fn table3(b: &mut Bench, progress: &mut dyn FnMut(&str)) -> Result<Vec<Row>, IndirectError> {
     let mut rows = Vec::new();
     for side in [16, 32] {
         b.renderer
-            .set_cluster(ClusterSettings::with_limit_side(rsm_size, side))?;
+            .set_cluster(ClusterSettings::with_limit_side(b.base.rsm_size, side))?;
         progress(&format!("table 3: quadtree limit {side}^2"));
-        rows.push(m.row(
+        rows.push(b.m.row(
             &mut b.renderer,
             "3",
             Method::Quadtree,
@@ -233,14 +231,14 @@ fn table3(
     for samples in RSM_SAMPLES {
         progress(&format!("table 3: RSM {samples} samples"));
         let mut rs = Renderer::new(
-            gpu,
+            b.gpu,
             &b.scene,
             Settings {
                 samples,
                 ..b.base.clone()
             },
         )?;
-        rows.push(m.row(&mut rs, "3", Method::Rsm, format!("{samples} samples"))?);
+        rows.push(b.m.row(&mut rs, "3", Method::Rsm, format!("{samples} samples"))?);
     }
     Ok(rows)
 }
@@ -268,15 +266,15 @@ pub fn run(
     progress("brute force");
     let brute = renderer.render_frame(Method::Reference)?.indirect;
     let mut b = Bench {
+        gpu,
         scene,
         base,
         renderer,
-        brute,
-        frames,
+        m: Measure { brute, frames },
     };
     let mut rows = table1(&mut b, &mut progress)?;
-    rows.extend(table2(gpu, &mut b, &mut progress)?);
-    rows.extend(table3(gpu, &mut b, &mut progress)?);
+    rows.extend(table2(&mut b, &mut progress)?);
+    rows.extend(table3(&mut b, &mut progress)?);
     let ratios = ratios(&rows);
     let results = BenchResults {
         adapter: gpu.describe(),

@@ -28,6 +28,13 @@ pub fn quadray_ok(args: &[&str]) {
     );
 }
 
+/// Runs `quadray` with `args` and `--out out --stats stats` and checks that it succeeded: the
+/// call of each command's test that writes everything.
+pub fn quadray_writes(args: &[&str], out: &Path, stats: &Path) {
+    let (out, stats) = (out.to_str().unwrap(), stats.to_str().unwrap());
+    quadray_ok(&[args, &["--out", out, "--stats", stats]].concat());
+}
+
 /// Runs `quadray` with `args` and checks that it failed with an error that mentions `needle`
 /// (and no panic); returns the exit code.
 pub fn quadray_refuses(args: &[&str], needle: &str) -> Option<i32> {

@@ -176,7 +176,7 @@ impl Renderer {
     fn targets(gpu: &Gpu, s: &Settings, debug_outputs: bool) -> Vec<wgpu::Texture> {
         let make = |format, label| {
             let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-            texture_2d(gpu, label, (s.width, s.height), format, usage)
+            texture_2d(&gpu.device, label, (s.width, s.height), format, usage)
         };
         let mut t = vec![make(COLOR_FORMAT, "color"), make(DEPTH_FORMAT, "depth")];
         if debug_outputs {

@@ -362,6 +362,7 @@ impl Gather {
         dispatch_2d(&mut pass, self.settings.width, self.settings.height);
     }
 
+    /// The settings the gather was built or last reconfigured with.
     pub fn settings(&self) -> &Settings {
         &self.settings
     }

@@ -55,6 +55,7 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method, in the order the CLI and the benchmark list them.
     pub const ALL: [Method; 4] = [
         Method::Quadtree,
         Method::QuadtreePasses,
@@ -62,6 +63,7 @@ impl Method {
         Method::Reference,
     ];
 
+    /// The method's name on the command line and in the stats (`--method`), kebab-case.
     pub fn name(self) -> &'static str {
         match self {
             Method::Quadtree => "quadtree",
@@ -71,6 +73,8 @@ impl Method {
         }
     }
 
+    /// Whether the method builds the light quadtree and a cut (so a cluster count means
+    /// something for it).
     pub fn uses_quadtree(self) -> bool {
         matches!(self, Method::Quadtree | Method::QuadtreePasses)
     }
@@ -79,12 +83,7 @@ impl Method {
 impl std::str::FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Method::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                format!("unknown method `{s}` (quadtree, quadtree-passes, rsm, reference)")
-            })
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "method")
     }
 }
 
@@ -113,10 +112,17 @@ impl std::str::FromStr for Validity {
 /// node), each level halves the side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ClusterSettings {
+    /// The coarsest level a cluster may be: the cut starts from this level's nodes.
     pub start_level: u32,
+    /// The finest level a cluster may be: nodes below it are never visited (0: single VPLs).
     pub limit_level: u32,
+    /// A node is valid only where each child's depth (along the light's axis, in units of the
+    /// spot's extent) is closer than this to the node's mean.
     pub depth_threshold: f32,
+    /// A node is valid only where each child's normal has a dot product above this with the
+    /// node's mean normal.
     pub normal_threshold: f32,
+    /// Which nodes' validity a node's own depends on.
     pub validity: Validity,
     /// Means weighted by flux luminance (else by texel count).
     pub flux_weighted: bool,
@@ -162,9 +168,13 @@ impl ClusterSettings {
 /// Sizes and the parameters of every method.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Settings {
+    /// Picture width in pixels.
     pub width: u32,
+    /// Picture height in pixels.
     pub height: u32,
+    /// Side of the square RSM in texels (a power of two): how many VPLs the spot makes.
     pub rsm_size: u32,
+    /// The quadtree's parameters, for the quadtree methods.
     pub cluster: ClusterSettings,
     /// RSM-sampling samples per pixel.
     pub samples: u32,
@@ -239,17 +249,26 @@ impl Settings {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Pass {
+    /// The reflective shadow map from the spot.
     Rsm,
+    /// The quadtree's levels: VPL means and spreads, coarser level from finer.
     Pyramid,
+    /// Each node's validity under the thresholds.
     Validity,
+    /// The cut: the valid clusters that replace the VPLs.
     Cut,
+    /// The camera's G-buffer.
     GBuffer,
+    /// The gather: each (sub-sampled) pixel sums the cut or its VPL samples.
     Indirect,
+    /// Sub-sampled indirect light brought to full resolution.
     Upsample,
+    /// The spot's direct light on the G-buffer.
     Direct,
 }
 
 impl Pass {
+    /// Every pass, in the order a frame records them.
     pub const ALL: [Pass; 8] = [
         Pass::Rsm,
         Pass::Pyramid,
@@ -261,6 +280,7 @@ impl Pass {
         Pass::Direct,
     ];
 
+    /// The pass's key in [`FrameTiming::passes`] and the stats JSON.
     pub fn name(self) -> &'static str {
         match self {
             Pass::Rsm => "rsm",
@@ -278,17 +298,24 @@ impl Pass {
 /// Median GPU time per pass (ms) over some frames; `total_ms` is the sum of the medians.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FrameTiming {
+    /// Median ms of each pass the method ran, by [`Pass::name`].
     pub passes: BTreeMap<&'static str, f64>,
+    /// Sum of the passes' medians, ms.
     pub total_ms: f64,
+    /// Frames the medians are taken over.
     pub frames: u32,
 }
 
 /// One frame read back: linear radiance per pixel, row-major, top row first.
 #[derive(Clone, Debug)]
 pub struct Frame {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// One-bounce indirect radiance, what the methods differ in.
     pub indirect: Vec<[f32; 3]>,
+    /// The spot's direct radiance, the same for every method.
     pub direct: Vec<[f32; 3]>,
     /// Pixels the upsampler recomputed at full resolution.
     pub recomputed: u32,
@@ -308,8 +335,11 @@ impl Frame {
 /// A cluster of the cut: its level (0 = one RSM texel) and its node's column and row there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CutNode {
+    /// Quadtree level, 0 being the RSM itself.
     pub level: u32,
+    /// Column of the node at its level.
     pub x: u32,
+    /// Row of the node at its level.
     pub y: u32,
 }
 
@@ -333,16 +363,22 @@ impl CutNode {
 /// A VPL as the RSM stores it (the CPU reference's input).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vpl {
+    /// Flux the VPL's surface reflects (W).
     pub flux: [f32; 3],
+    /// World position.
     pub position: [f32; 3],
+    /// Unit normal facing the light.
     pub normal: [f32; 3],
 }
 
 /// A G-buffer texel (the CPU reference's receivers); `None` where the camera sees nothing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Receiver {
+    /// World position.
     pub position: [f32; 3],
+    /// Unit normal facing the camera.
     pub normal: [f32; 3],
+    /// Diffuse albedo the gathered light is multiplied by.
     pub albedo: [f32; 3],
 }
 

@@ -230,10 +230,12 @@ impl LightQuadtree {
         pass.dispatch_workgroups(nodes.div_ceil(256) as u32, 1, 1);
     }
 
+    /// Side of the RSM the quadtree was built for; its levels follow from it.
     pub fn rsm_size(&self) -> u32 {
         self.rsm_size
     }
 
+    /// The parameters the next cut is made with.
     pub fn cluster(&self) -> ClusterSettings {
         self.cluster
     }

@@ -30,6 +30,8 @@ pub struct Renderer<'g> {
 }
 
 impl<'g> Renderer<'g> {
+    /// Uploads `scene` and builds every pass for `settings`; refuses settings that make no
+    /// picture with [`IndirectError::Settings`].
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: Settings) -> Result<Self, IndirectError> {
         settings.validate().map_err(IndirectError::Settings)?;
         let (d, q) = (&gpu.device, &gpu.queue);
@@ -60,6 +62,7 @@ impl<'g> Renderer<'g> {
         Ok(renderer)
     }
 
+    /// The settings frames are rendered with.
     pub fn settings(&self) -> &Settings {
         &self.settings
     }
@@ -191,6 +194,7 @@ impl<'g> Renderer<'g> {
         }))
     }
 
+    /// Whether the adapter has timestamp queries, so that timings can be taken at all.
     pub fn has_timestamps(&self) -> bool {
         self.timer.enabled()
     }

@@ -8,7 +8,7 @@ use super::contract::{
 };
 use super::light::Spot;
 use crate::scene::Vertex;
-use quadray_gpu::{GpuTimer, cleared_attachment, nearest_depth};
+use quadray_gpu::{GpuTimer, cleared_attachment, nearest_depth, texture_2d};
 
 /// Format of every RSM and G-buffer colour target.
 pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -39,25 +39,13 @@ pub struct RsmViews<'a> {
 pub(crate) fn target(
     device: &wgpu::Device,
     label: &str,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+        | wgpu::TextureUsages::TEXTURE_BINDING
+        | wgpu::TextureUsages::COPY_SRC;
+    texture_2d(device, label, size, format, usage)
 }
 
 pub(crate) fn view(texture: &wgpu::Texture) -> wgpu::TextureView {
