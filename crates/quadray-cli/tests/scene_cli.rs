@@ -37,14 +37,7 @@ fn indirect_renders_the_gltf_scene_as_its_toml_twin() {
     indirect(&assets().join("scenes/cornell_spot.gltf"), &from_gltf);
     indirect(&assets().join("scenes/cornell.toml"), &from_toml);
     let (a, b) = (rgb(&from_gltf), rgb(&from_toml));
-    let diffs: Vec<u8> = a
-        .as_raw()
-        .iter()
-        .zip(b.as_raw())
-        .map(|(x, y)| x.abs_diff(*y))
-        .collect();
-    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
-    let large = diffs.iter().filter(|&&d| d > 24).count() as f64 / diffs.len() as f64;
+    let (mean, large) = quadray_core::image_out::channel_difference(a.as_raw(), b.as_raw(), 24);
     assert!(
         mean < 1.0 && large < 0.01,
         "mean {mean}, {large} of values off by > 24"

@@ -91,6 +91,21 @@ fn bytemuck_flat(pixels: &[[u8; 4]]) -> &[u8] {
     pixels.as_flattened()
 }
 
+/// How far two pictures of one size are apart, channel value by channel value (8-bit): the mean
+/// absolute difference, and the fraction of values that differ by more than `far`. Tests hold
+/// two renders of one setup to these two figures.
+///
+/// # Panics
+/// When the two differ in length (pictures of different sizes).
+pub fn channel_difference(a: &[u8], b: &[u8], far: u8) -> (f64, f64) {
+    assert_eq!(a.len(), b.len(), "pictures of different sizes");
+    let diffs = || a.iter().zip(b).map(|(x, y)| x.abs_diff(*y));
+    let count = a.len().max(1) as f64;
+    let mean = diffs().map(f64::from).sum::<f64>() / count;
+    let far_off = diffs().filter(|&d| d > far).count() as f64 / count;
+    (mean, far_off)
+}
+
 /// Maps `values` (NaN = no data, drawn dark grey) to a heat map: black at 0 through red and
 /// yellow to white at `max`.
 pub fn heat_map(width: u32, height: u32, values: &[f32], max: f32) -> Rgba8Image {

@@ -149,14 +149,7 @@ fn replay(txt: &Path) -> String {
 fn assert_matches(shot: &Path, headless: &Path) {
     let (a, b) = (rgb(shot), rgb(headless));
     assert_eq!(a.dimensions(), b.dimensions(), "{}", shot.display());
-    let diffs: Vec<u8> = a
-        .as_raw()
-        .iter()
-        .zip(b.as_raw())
-        .map(|(x, y)| x.abs_diff(*y))
-        .collect();
-    let mean = diffs.iter().map(|&d| d as f64).sum::<f64>() / diffs.len() as f64;
-    let far = diffs.iter().filter(|&&d| d > 16).count() as f64 / diffs.len() as f64;
+    let (mean, far) = quadray_core::image_out::channel_difference(a.as_raw(), b.as_raw(), 16);
     assert!(
         mean <= 2.0 && far <= 0.01,
         "{} vs {}: mean difference {mean:.2}, {:.2}% far off",
