@@ -5,21 +5,9 @@ use glam::{Mat4, Vec3};
 use quadray_core::mesh::{Mesh, MeshError, load_model};
 use std::path::{Path, PathBuf};
 
-const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+mod common;
 
-fn asset(relative: &str) -> PathBuf {
-    Path::new(ASSETS).join(relative)
-}
-
-/// A fresh directory for this test's files.
-fn scratch(test: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("mesh")
-        .join(test);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{asset, scratch};
 
 fn write(dir: &Path, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
     let path = dir.join(name);

@@ -6,21 +6,9 @@ use glam::Vec3;
 use quadray_core::scene::{Intensity, SceneDescription, Shape, Transform};
 use std::path::{Path, PathBuf};
 
-const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+mod common;
 
-fn asset(relative: &str) -> PathBuf {
-    Path::new(ASSETS).join(relative)
-}
-
-/// A fresh directory for this test's files.
-fn scratch(test: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("scene")
-        .join(test);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{asset, scratch};
 
 fn refused(path: &Path) -> String {
     match SceneDescription::load(path) {
@@ -82,32 +70,19 @@ fn the_older_spellings_read_as_the_canonical_one() {
         scale = 0.002
         rotate_y_deg = 180.0
     "#;
-    let indirect = r#"
-        [camera]
-        position = [0.5, 0.5, 2.4]
-        target = [0.5, 0.5, 0.0]
-        fov_deg = 39.0
-        [light]
-        position = [0.5, 0.97, 0.85]
-        direction = [-0.25, -1.0, -0.55]
-        cone_deg = 55.0
-        falloff_deg = 15.0
-        intensity = [2.0, 2.0, 2.0]
-        [[mesh]]
-        builtin = "room"
-        albedo = [0.5, 0.5, 0.5]
-        [[mesh]]
-        path = "../meshes/cornell_box/cornell_box.obj"
-        scale = 0.002
-        rotate_y_deg = 180.0
-    "#;
+    // The indirect dialect: one `[light]`, `[[mesh]]` entries with `path`, `fov_deg`.
+    let indirect = canonical
+        .replace("fov_y_deg", "fov_deg")
+        .replace("[[lights]]", "[light]")
+        .replace("[[objects]]", "[[mesh]]")
+        .replace("mesh = ", "path = ");
     let raytrace = canonical
         .replace("position = [0.5, 0.5, 2.4]", "eye = [0.5, 0.5, 2.4]")
         .replace("target =", "look_at =")
         .replace("mesh = ", "path = ");
     let file = asset("scenes/new.toml");
     let a = SceneDescription::from_toml(canonical, &file).unwrap();
-    for other in [indirect, &raytrace] {
+    for other in [&indirect, &raytrace] {
         let b = SceneDescription::from_toml(other, &file).unwrap();
         assert_eq!(a.camera, b.camera);
         assert_eq!(a.lights, b.lights);

@@ -45,7 +45,7 @@ pub struct Args {
     map: Option<PathBuf>,
     /// How --map stores its values: height, depth or depth-photo.
     #[arg(long, default_value = "height")]
-    convention: String,
+    convention: Convention,
     /// Start with this bundled map (tiles, bevy-cube, puget-sound, tum-photo).
     #[arg(long, default_value = "tiles")]
     bundled: String,
@@ -97,18 +97,12 @@ fn main() -> Result<()> {
         .position(|m| m.name == args.bundled)
         .with_context(|| format!("no bundled map `{}`", args.bundled))?;
     if let Some(path) = &args.map {
-        let convention = match args.convention.as_str() {
-            "height" => Convention::Height,
-            "depth" => Convention::Depth,
-            "depth-photo" => Convention::DepthPhoto,
-            c => anyhow::bail!("unknown convention `{c}` (height, depth, depth-photo)"),
-        };
         maps.push(MapChoice {
             name: path
                 .file_name()
                 .map_or("map".into(), |n| n.to_string_lossy().into_owned()),
             path: absolute(path.clone()),
-            convention,
+            convention: args.convention,
             color: None,
             surface: SurfaceKind::Wall,
         });
