@@ -159,9 +159,6 @@ impl HeightMap {
                 reason: e.to_string(),
             })?;
         let (w, h) = (img.width(), img.height());
-        if w == 0 || h == 0 {
-            return Err(HeightMapError::Empty { path: path.into() });
-        }
         // The first channel, normalised to [0,1] for integer formats and as stored for floats.
         let raw: Vec<f32> = img.to_luma32f().into_raw();
         let values = match img.color() {
@@ -173,8 +170,29 @@ impl HeightMap {
                 .collect(),
             _ => raw,
         };
-        all_finite(path, &values, w)?;
-        let depth = to_depth(path, &values, convention)?;
+        Self::from_values(path, w, h, &values, convention, fit)
+    }
+
+    /// Builds a map from a decoded `width` x `height` grid of values (row-major, row 0 at v = 0)
+    /// stored in `convention`: what [`HeightMap::load`] does after decoding, for images that
+    /// arrive by other means (an engine's asset loader). `path` names the map in errors.
+    ///
+    /// # Panics
+    /// If `values` does not hold `w * h` entries.
+    pub fn from_values(
+        path: &Path,
+        w: u32,
+        h: u32,
+        values: &[f32],
+        convention: Convention,
+        fit: Fit,
+    ) -> Result<Self, HeightMapError> {
+        if w == 0 || h == 0 || values.is_empty() {
+            return Err(HeightMapError::Empty { path: path.into() });
+        }
+        assert_eq!(values.len(), (w as usize) * (h as usize), "value grid size");
+        all_finite(path, values, w)?;
+        let depth = to_depth(path, values, convention)?;
         let (size, depth) = if w == h && w.is_power_of_two() {
             (w, depth)
         } else if fit == Fit::Resample {

@@ -1,0 +1,331 @@
+//! Bevy's own parallax-mapping example scene (a spinning cube with Bevy's maps, a point light, a
+//! floor) with the pyramid as one more method: Space cycles Bevy's parallax occlusion mapping,
+//! Bevy's relief mapping and quadray's pyramid tracing; 1/2 lower/raise the depth scale; a click
+//! moves the camera. The line at the top says which method is shown.
+//!
+//! `cargo run --release -p quadray-bevy --example parallax`
+//! Without a display: `... --example parallax -- --screenshot out.png [--method pom|relief|pyramid]`
+//! renders a few frames off screen and saves the picture.
+
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::image::ImageLoaderSettings;
+use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
+use std::time::Duration;
+
+const ASSETS: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../assets/heightmaps/bevy_parallax"
+);
+const METHODS: [&str; 3] = [
+    "Bevy parallax occlusion mapping",
+    "Bevy relief mapping",
+    "quadray pyramid tracing",
+];
+const CAMERAS: [Vec3; 3] = [
+    Vec3::new(1.5, 1.5, 1.5),
+    Vec3::new(2.4, 0.0, 0.2),
+    Vec3::new(-1.0, 0.8, -1.2),
+];
+
+#[derive(Resource)]
+struct Materials {
+    bevy: Handle<StandardMaterial>,
+    pyramid: Handle<PyramidMaterial>,
+    method: usize,
+}
+
+#[derive(Component)]
+struct Cube;
+
+/// The method shown first (`--method`).
+#[derive(Resource)]
+struct FirstMethod(usize);
+
+#[derive(Resource)]
+struct Offscreen {
+    path: String,
+    target: Handle<Image>,
+    frames: u32,
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    let method = match value("--method").as_deref() {
+        None | Some("pyramid") => 2,
+        Some("pom") => 0,
+        Some("relief") => 1,
+        Some(other) => {
+            eprintln!("--method {other}: expected pom, relief or pyramid");
+            std::process::exit(2);
+        }
+    };
+    let mut app = App::new();
+    let assets = AssetPlugin {
+        file_path: ASSETS.into(),
+        ..default()
+    };
+    if let Some(path) = value("--screenshot") {
+        let window = WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            ..default()
+        };
+        app.add_plugins(
+            DefaultPlugins
+                .set(assets)
+                .set(window)
+                .disable::<WinitPlugin>(),
+        )
+        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(1)))
+        .insert_resource(Offscreen {
+            path,
+            target: Handle::default(),
+            frames: 0,
+        })
+        .add_systems(Update, save_when_ready);
+    } else {
+        app.add_plugins(DefaultPlugins.set(assets));
+    }
+    app.add_plugins(PyramidDisplacementPlugin)
+        .insert_resource(FirstMethod(method))
+        .add_systems(Startup, setup)
+        .add_systems(
+            Update,
+            (
+                spin.run_if(not(resource_exists::<Offscreen>)),
+                switch_method,
+                change_depth,
+                move_camera,
+                show_method,
+            ),
+        )
+        .run();
+}
+
+#[allow(clippy::too_many_arguments)]
+fn setup(
+    mut commands: Commands,
+    assets: Res<AssetServer>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut standard: ResMut<Assets<StandardMaterial>>,
+    mut pyramid: ResMut<Assets<PyramidMaterial>>,
+    mut images: ResMut<Assets<Image>>,
+    offscreen: Option<ResMut<Offscreen>>,
+    first: Res<FirstMethod>,
+) {
+    let method = first.0;
+    let linear = |s: &mut ImageLoaderSettings| s.is_srgb = false;
+    let normal = assets
+        .load_builder()
+        .with_settings(linear)
+        .load("cube_normal.png");
+    let depth: Handle<Image> = assets.load("cube_depth.png");
+    // Bevy's example material, parallax and all: the pyramid material is the same minus Bevy's parallax.
+    let base = StandardMaterial {
+        perceptual_roughness: 0.4,
+        base_color_texture: Some(assets.load("cube_color.png")),
+        normal_map_texture: Some(normal),
+        ..default()
+    };
+    let bevy = standard.add(StandardMaterial {
+        depth_map: Some(depth.clone()),
+        parallax_depth_scale: 0.09,
+        parallax_mapping_method: parallax_method(method),
+        max_parallax_layer_count: 32.0,
+        ..base.clone()
+    });
+    let mut extension = PyramidExtension::new(depth, 0.09);
+    extension.shadow_strength = 0.6;
+    extension.light = Vec4::new(2.0, 1.0, -1.1, 1.0);
+    let pyramid = pyramid.add(PyramidMaterial { base, extension });
+
+    // AgX and TonyMcMapface need the tonemapping_luts feature; ACES does not.
+    let mut camera = commands.spawn((
+        Camera3d::default(),
+        Tonemapping::AcesFitted,
+        Transform::from_translation(CAMERAS[0]).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    if let Some(mut offscreen) = offscreen {
+        offscreen.target = images.add(Image::new_target_texture(
+            960,
+            540,
+            TextureFormat::Rgba8UnormSrgb,
+            None,
+        ));
+        camera.insert(RenderTarget::Image(offscreen.target.clone().into()));
+    }
+    commands.spawn((
+        PointLight {
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_xyz(2.0, 1.0, -1.1),
+        children![(
+            Mesh3d(meshes.add(Sphere::new(0.05).mesh().ico(3).unwrap())),
+            MeshMaterial3d(standard.add(Color::WHITE))
+        )],
+    ));
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(10.0, 10.0))),
+        MeshMaterial3d(standard.add(StandardMaterial {
+            perceptual_roughness: 0.45,
+            reflectance: 0.18,
+            ..Color::srgb_u8(0, 80, 0).into()
+        })),
+        Transform::from_xyz(0.0, -1.0, 0.0),
+    ));
+    let cube = meshes.add(
+        Mesh::from(Cuboid::default())
+            .with_generated_tangents()
+            .unwrap(),
+    );
+    // Turned so that three faces show (the off-screen pictures hold still here).
+    let turned = Transform::from_rotation(Quat::from_rotation_y(-0.35));
+    let mut entity = commands.spawn((Mesh3d(cube), turned, Cube));
+    if method == 2 {
+        entity.insert(MeshMaterial3d(pyramid.clone()));
+    } else {
+        entity.insert(MeshMaterial3d(bevy.clone()));
+    }
+    commands.spawn((
+        Text::new(""),
+        Node {
+            position_type: PositionType::Absolute,
+            top: px(12),
+            left: px(12),
+            ..default()
+        },
+    ));
+    commands.insert_resource(Materials {
+        bevy,
+        pyramid,
+        method,
+    });
+}
+
+fn parallax_method(method: usize) -> ParallaxMappingMethod {
+    if method == 1 {
+        ParallaxMappingMethod::Relief { max_steps: 8 }
+    } else {
+        ParallaxMappingMethod::Occlusion
+    }
+}
+
+fn spin(time: Res<Time>, mut cubes: Query<&mut Transform, With<Cube>>) {
+    for mut t in &mut cubes {
+        t.rotate_local_y(0.3 * time.delta_secs());
+        t.rotate_local_x(0.3 * time.delta_secs());
+    }
+}
+
+fn switch_method(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut commands: Commands,
+    mut materials: ResMut<Materials>,
+    mut standard: ResMut<Assets<StandardMaterial>>,
+    cubes: Query<Entity, With<Cube>>,
+) {
+    if !keys.just_pressed(KeyCode::Space) {
+        return;
+    }
+    materials.method = (materials.method + 1) % METHODS.len();
+    if let Some(mut m) = standard.get_mut(&materials.bevy) {
+        m.parallax_mapping_method = parallax_method(materials.method);
+    }
+    for cube in &cubes {
+        let mut cube = commands.entity(cube);
+        if materials.method == 2 {
+            cube.remove::<MeshMaterial3d<StandardMaterial>>()
+                .insert(MeshMaterial3d(materials.pyramid.clone()));
+        } else {
+            cube.remove::<MeshMaterial3d<PyramidMaterial>>()
+                .insert(MeshMaterial3d(materials.bevy.clone()));
+        }
+    }
+}
+
+fn change_depth(
+    keys: Res<ButtonInput<KeyCode>>,
+    materials: Res<Materials>,
+    mut standard: ResMut<Assets<StandardMaterial>>,
+    mut pyramid: ResMut<Assets<PyramidMaterial>>,
+) {
+    let step = if keys.just_pressed(KeyCode::Digit1) {
+        -0.03
+    } else if keys.just_pressed(KeyCode::Digit2) {
+        0.03
+    } else {
+        return;
+    };
+    if let (Some(mut b), Some(mut p)) = (
+        standard.get_mut(&materials.bevy),
+        pyramid.get_mut(&materials.pyramid),
+    ) {
+        b.parallax_depth_scale = (b.parallax_depth_scale + step).clamp(0.0, 0.3);
+        p.extension.depth_scale = b.parallax_depth_scale;
+    }
+}
+
+fn move_camera(
+    buttons: Res<ButtonInput<MouseButton>>,
+    mut view: Local<usize>,
+    mut camera: Single<&mut Transform, With<Camera3d>>,
+) {
+    if buttons.just_pressed(MouseButton::Left) {
+        *view = (*view + 1) % CAMERAS.len();
+        **camera = Transform::from_translation(CAMERAS[*view]).looking_at(Vec3::ZERO, Vec3::Y);
+    }
+}
+
+fn show_method(
+    materials: Res<Materials>,
+    standard: Res<Assets<StandardMaterial>>,
+    mut text: Single<&mut Text>,
+) {
+    let depth = standard
+        .get(&materials.bevy)
+        .map_or(0.0, |m| m.parallax_depth_scale);
+    text.0 = format!(
+        "{} (Space: next method, 1/2: depth scale {depth:.2}, click: view)",
+        METHODS[materials.method]
+    );
+}
+
+/// Off screen: save the target once the cube's maps are loaded and the pipelines warm, then quit.
+fn save_when_ready(
+    mut commands: Commands,
+    mut offscreen: ResMut<Offscreen>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    offscreen.frames += 1;
+    match offscreen.frames {
+        300 => {
+            let path = offscreen.path.clone();
+            commands
+                .spawn(Screenshot::image(offscreen.target.clone()))
+                .observe(save_to_disk(path))
+                .observe(
+                    |_: On<ScreenshotCaptured>, mut offscreen: ResMut<Offscreen>| {
+                        offscreen.frames = 10_000
+                    },
+                );
+        }
+        n if n > 10_000 => {
+            exit.write(AppExit::Success);
+        }
+        _ => {}
+    }
+}

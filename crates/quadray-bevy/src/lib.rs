@@ -1,0 +1,257 @@
+//! quadray's pyramid displacement mapping as a Bevy material: exact ray casting through a
+//! max-height pyramid (Oh & Ki 2007) in place of `StandardMaterial`'s parallax mapping, with Bevy's
+//! PBR lighting and shadows kept, self-shadowing, level-of-detail, and the traced depth written so
+//! displaced surfaces intersect other geometry where they really are.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
+//!
+//! fn setup(
+//!     mut commands: Commands,
+//!     assets: Res<AssetServer>,
+//!     mut meshes: ResMut<Assets<Mesh>>,
+//!     mut materials: ResMut<Assets<PyramidMaterial>>,
+//! ) {
+//!     let mesh = Mesh::from(Cuboid::default()).with_generated_tangents().unwrap();
+//!     commands.spawn((
+//!         Mesh3d(meshes.add(mesh)),
+//!         MeshMaterial3d(materials.add(PyramidMaterial {
+//!             base: StandardMaterial::from(assets.load::<Image>("cube_color.png")),
+//!             extension: PyramidExtension::new(assets.load("cube_depth.png"), 0.09),
+//!         })),
+//!     ));
+//! }
+//!
+//! App::new()
+//!     .add_plugins((DefaultPlugins, PyramidDisplacementPlugin))
+//!     .add_systems(Startup, setup)
+//!     .run();
+//! ```
+//!
+//! The depth map is the image a Bevy user already has for `StandardMaterial::depth_map` (0 at the
+//! surface, 1 deepest; any size, 8- or 16-bit, grey or colour: the first channel). Its pyramid is
+//! built on the CPU by `quadray_displace` when the image loads, and the WGSL tracing module is
+//! quadray_displace's own `TRACE_WGSL`, imported as `quadray::trace`.
+
+#![warn(missing_docs)]
+
+mod pyramid_image;
+
+pub use pyramid_image::{PyramidImageError, depth_map, pyramid_image};
+
+use bevy::asset::{AssetEvent, AssetId, uuid_handle};
+use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialPlugin, StandardMaterial};
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::render::render_resource::{AsBindGroup, ShaderType};
+use bevy::render::storage::ShaderBuffer;
+use bevy::shader::{Shader, ShaderRef};
+use quadray_displace::pyramid::Addressing;
+use quadray_displace::{PyramidInfo, TRACE_WGSL};
+
+/// `StandardMaterial` with its parallax replaced by the pyramid trace.
+pub type PyramidMaterial = ExtendedMaterial<StandardMaterial, PyramidExtension>;
+
+const TRACE_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d01");
+const MATERIAL_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d02");
+/// The debug buffer bound when a material records no hits.
+const NO_HITS: Handle<ShaderBuffer> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d03");
+
+/// Registers [`PyramidMaterial`], its shaders, and the system that builds each depth map's
+/// pyramid when the image loads (and again when it changes). Add it after `DefaultPlugins`.
+pub struct PyramidDisplacementPlugin;
+
+impl Plugin for PyramidDisplacementPlugin {
+    fn build(&self, app: &mut App) {
+        let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
+        let trace = format!("#define_import_path quadray::trace\n{TRACE_WGSL}");
+        let _ = shaders.insert(
+            &TRACE_SHADER,
+            Shader::from_wgsl(trace, "quadray/trace.wgsl"),
+        );
+        let _ = shaders.insert(
+            &MATERIAL_SHADER,
+            Shader::from_wgsl(
+                include_str!("pyramid_material.wgsl"),
+                "quadray/pyramid_material.wgsl",
+            ),
+        );
+        let no_hits = ShaderBuffer::with_size(32, default());
+        let _ = app
+            .world_mut()
+            .resource_mut::<Assets<ShaderBuffer>>()
+            .insert(&NO_HITS, no_hits);
+        app.add_plugins(MaterialPlugin::<PyramidMaterial>::default())
+            .init_resource::<Pyramids>()
+            .add_systems(PostUpdate, build_pyramids);
+    }
+}
+
+/// The pyramid tracing that replaces `StandardMaterial`'s parallax (leave the base material's
+/// `depth_map` empty so Bevy's own parallax does not run as well).
+#[derive(Asset, AsBindGroup, Reflect, Debug, Clone)]
+#[uniform(100, PyramidUniform)]
+pub struct PyramidExtension {
+    /// The depth map: 0 at the polygon, 1 deepest (Bevy's `depth_map` convention); first channel.
+    pub depth_map: Handle<Image>,
+    /// uv units per unit of depth (Bevy's `parallax_depth_scale`).
+    pub depth_scale: f32,
+    /// Stop the descent at the pyramid level whose texels match the pixel's footprint
+    /// (section 3.4 of the paper): cheaper far away, exact up close.
+    pub lod: bool,
+    /// `true`: rays that leave [0, 1)^2 miss and the pixel is discarded (a terrain patch);
+    /// `false`: the map tiles.
+    pub clamp_to_map: bool,
+    /// Self-shadowing: the share of the lit colour a pixel loses when the height field hides
+    /// [`PyramidExtension::light`] from it (0 turns it off).
+    pub shadow_strength: f32,
+    /// The self-shadowing light: world direction towards it (w = 0) or its position (w = 1).
+    pub light: Vec4,
+    /// The pyramid built from `depth_map` (set by [`PyramidDisplacementPlugin`]).
+    #[texture(101, sample_type = "float", filterable = false)]
+    pub pyramid: Option<Handle<Image>>,
+    /// Levels of `pyramid` above its finest (set with it).
+    pub levels: u32,
+    /// Debug output: per pixel the ray and the hit, for `debug_width`-wide targets.
+    #[storage(102, visibility(fragment))]
+    pub debug_hits: Handle<ShaderBuffer>,
+    /// The render target's width when `debug_hits` records; 0 records nothing.
+    pub debug_width: u32,
+}
+
+impl PyramidExtension {
+    /// A tiling material over `depth_map` with Bevy's depth scale, level-of-detail on and no
+    /// self-shadowing.
+    pub fn new(depth_map: Handle<Image>, depth_scale: f32) -> Self {
+        Self {
+            depth_map,
+            depth_scale,
+            lod: true,
+            clamp_to_map: false,
+            shadow_strength: 0.0,
+            light: Vec4::new(0.0, 1.0, 0.0, 0.0),
+            pyramid: None,
+            levels: 0,
+            debug_hits: NO_HITS,
+            debug_width: 0,
+        }
+    }
+
+    fn addressing(&self) -> Addressing {
+        if self.clamp_to_map {
+            Addressing::Clamp
+        } else {
+            Addressing::Wrap
+        }
+    }
+}
+
+impl MaterialExtension for PyramidExtension {
+    fn fragment_shader() -> ShaderRef {
+        MATERIAL_SHADER.into()
+    }
+
+    // The depth prepass would draw the undisplaced polygon; the main pass writes the traced depth.
+    fn enable_prepass() -> bool {
+        false
+    }
+}
+
+/// The uniform the shader reads (`PyramidParams` in pyramid_material.wgsl).
+#[derive(ShaderType, Clone, Copy, Debug)]
+pub struct PyramidUniform {
+    levels: i32,
+    clamp_to_map: u32,
+    iteration_cap: u32,
+    refine_cap: u32,
+    depth_scale: f32,
+    flags: u32,
+    debug_width: u32,
+    shadow_strength: f32,
+    light: Vec4,
+}
+
+impl From<&PyramidExtension> for PyramidUniform {
+    fn from(m: &PyramidExtension) -> Self {
+        let info = PyramidInfo::new(m.levels, m.addressing());
+        let ready = u32::from(m.pyramid.is_some());
+        Self {
+            levels: info.levels,
+            clamp_to_map: info.clamp_to_map,
+            iteration_cap: info.iteration_cap,
+            refine_cap: info.refine_cap,
+            depth_scale: m.depth_scale,
+            flags: ready | (u32::from(m.lod) << 1),
+            debug_width: m.debug_width,
+            shadow_strength: m.shadow_strength,
+            light: m.light,
+        }
+    }
+}
+
+/// Each depth map's pyramid image and level count, or `None` once the map proved unusable.
+#[derive(Resource, Default)]
+struct Pyramids(HashMap<AssetId<Image>, Option<BuiltPyramid>>);
+
+type BuiltPyramid = (Handle<Image>, u32);
+
+/// Builds the pyramid of every depth map a material uses once the image is loaded (and again when
+/// it changes), and points the materials at it. An unusable map is logged once, naming the asset.
+fn build_pyramids(
+    mut image_events: MessageReader<AssetEvent<Image>>,
+    mut pyramids: ResMut<Pyramids>,
+    mut images: ResMut<Assets<Image>>,
+    mut materials: ResMut<Assets<PyramidMaterial>>,
+    assets: Res<AssetServer>,
+) {
+    for event in image_events.read() {
+        if let AssetEvent::Modified { id } | AssetEvent::Removed { id } = event {
+            pyramids.0.remove(id);
+        }
+    }
+    let stale: Vec<_> = materials
+        .iter()
+        .filter(|(_, m)| {
+            let wanted = pyramids.0.get(&m.extension.depth_map.id());
+            let current = m
+                .extension
+                .pyramid
+                .as_ref()
+                .map(|p| (p.id(), m.extension.levels));
+            match wanted {
+                Some(Some((handle, levels))) => current != Some((handle.id(), *levels)),
+                Some(None) => false,
+                None => images.contains(&m.extension.depth_map),
+            }
+        })
+        .map(|(id, _)| id)
+        .collect();
+    for id in stale {
+        let Some(mut material) = materials.get_mut(id) else {
+            continue;
+        };
+        let source = material.extension.depth_map.id();
+        let built = pyramids.0.entry(source).or_insert_with(|| {
+            let name = assets
+                .get_path(source)
+                .map_or_else(|| format!("{source:?}"), |p| p.to_string());
+            let map = images.get(source).map(|image| depth_map(&name, image));
+            match map {
+                Some(Ok(map)) => {
+                    let (pyramid, levels) = pyramid_image(&map);
+                    Some((images.add(pyramid), levels))
+                }
+                Some(Err(e)) => {
+                    error!("quadray-bevy: {e}");
+                    None
+                }
+                None => None,
+            }
+        });
+        if let Some((handle, levels)) = built {
+            material.extension.pyramid = Some(handle.clone());
+            material.extension.levels = *levels;
+        }
+    }
+}
