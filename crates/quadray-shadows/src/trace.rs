@@ -169,14 +169,9 @@ pub fn render_region(
         "at most {MAX_LIGHTS} lights"
     );
     let volumes = || prep.volumes.as_ref().expect("shadow volumes prepared");
+    let grid_rays = || ShadowRays(prep.grid_occluder());
     match settings.scheme {
-        Scheme::Conventional => render_with(
-            prep,
-            settings,
-            region,
-            ShadowRays(prep.grid_occluder()),
-            on_tile,
-        ),
+        Scheme::Conventional => render_with(prep, settings, region, grid_rays(), on_tile),
         Scheme::Bvh => {
             let bvh = prep.bvh_occluder().expect("BVH prepared");
             render_with(prep, settings, region, ShadowRays(bvh), on_tile)
@@ -187,13 +182,7 @@ pub fn render_region(
             render_with(prep, settings, region, ShadowRays(embree), on_tile)
         }
         #[cfg(not(feature = "embree"))]
-        Scheme::Embree => render_with(
-            prep,
-            settings,
-            region,
-            ShadowRays(prep.grid_occluder()),
-            on_tile,
-        ),
+        Scheme::Embree => render_with(prep, settings, region, grid_rays(), on_tile),
         Scheme::Volume => render_with(prep, settings, region, Volumes(volumes()), on_tile),
         Scheme::Hst { nth } => {
             let test = Hybrid {
