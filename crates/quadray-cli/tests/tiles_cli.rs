@@ -158,6 +158,13 @@ fn work_items_need_a_valid_index_and_one_nth() {
     quadray_refuses(&[&auto[..], &["--tile", "0"]].concat(), "--print-nth");
     let too_many = [&SCENE[..], &["--tiles", "31", "--tile", "0", "--out", "t"]].concat();
     quadray_refuses(&too_many, "--tiles 31");
+    let mut no_index = Command::new(env!("CARGO_BIN_EXE_quadray"));
+    for v in ["JOB_COMPLETION_INDEX", "SLURM_ARRAY_TASK_ID"] {
+        no_index.env_remove(v);
+    }
+    let refused = no_index.args(&item).output().unwrap();
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success() && stderr.contains("a work item index is needed"));
     let nth = Command::new(env!("CARGO_BIN_EXE_quadray"))
         .args([
             "raytrace",
