@@ -3,7 +3,9 @@
 
 mod displace;
 mod indirect;
+mod merge;
 mod raytrace;
+mod tiles;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -29,6 +31,8 @@ enum Command {
     Displace(displace::DisplaceArgs),
     /// Whitted ray tracing on a uniform grid with hybrid shadow testing.
     Raytrace(raytrace::RaytraceArgs),
+    /// Assemble the tiles of `quadray raytrace --tiles N` (or `--frames A..B`) into pictures.
+    Merge(merge::MergeArgs),
     /// One-bounce indirect light from a light quadtree, its baselines and reference.
     Indirect(indirect::IndirectArgs),
     /// Open the interactive viewer: runs the `quadray-view` program installed beside this one
@@ -120,6 +124,7 @@ fn main() -> Result<()> {
         }
         Command::Displace(args) => displace::run(args)?,
         Command::Raytrace(args) => raytrace::run(args)?,
+        Command::Merge(args) => merge::run(args)?,
         Command::Bench {
             what: Bench::Shadows { quick, out },
         } => raytrace::bench(quick, &out)?,
