@@ -16,8 +16,6 @@ pub mod baselines;
 pub mod gpu;
 pub mod picture;
 pub mod reference;
-// Its items are documented with the scene-loading change under way in another branch.
-#[allow(missing_docs)]
 pub mod scene;
 
 /// Anything that can go wrong between a scene file and a measured picture.

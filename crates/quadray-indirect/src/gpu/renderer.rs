@@ -194,6 +194,12 @@ impl<'g> Renderer<'g> {
         }))
     }
 
+    /// The gather the frames are shaded with (to write them into your own texture with an
+    /// [`super::OutputPass`]).
+    pub fn gather(&self) -> &Gather {
+        &self.gather
+    }
+
     /// Whether the adapter has timestamp queries, so that timings can be taken at all.
     pub fn has_timestamps(&self) -> bool {
         self.timer.enabled()
