@@ -41,7 +41,15 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
     assert_eq!(json["width"], 48);
     assert_eq!(json["height"], 32);
     assert_eq!(json["rsm_size"], 32);
-    assert!(json["clusters_in_cut"].as_u64().unwrap() > 0);
+    let clusters = json["clusters_in_cut"].as_f64().unwrap();
+    assert!(clusters > 0.0);
+    // the per-level passes sum exactly the cut's clusters at every shaded pixel
+    assert_eq!(
+        json["vpl_evaluations_per_pixel"].as_f64().unwrap(),
+        clusters
+    );
+    assert!(json["texel_fetches_per_pixel"].as_f64().unwrap() > clusters);
+    assert!(json["work"]["shaded_pixels"].as_u64().unwrap() > 0);
     let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
     assert!(rel_l1 > 0.0 && rel_l1 < 0.1, "{rel_l1}");
     assert!(json["error"]["rmse"].as_f64().is_some());

@@ -6,7 +6,9 @@ use quadray_core::image_out::{Rgba8Image, heat_map};
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, mean_flip, tone_map};
 use quadray_indirect::reference::{self, ImageError};
-use quadray_indirect::{Frame, FrameTiming, IndirectError, Method, Renderer, Scene, Settings};
+use quadray_indirect::{
+    Frame, FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts,
+};
 use serde::Serialize;
 
 /// What to do besides rendering.
@@ -34,6 +36,13 @@ pub struct Stats {
     pub clusters_in_cut: Option<u32>,
     /// Pixels the upsampler recomputed at full resolution (sub-sampled quadtree).
     pub recomputed_pixels: u32,
+    /// VPL kernels evaluated per shaded pixel (clusters or RSM samples summed), counted in the
+    /// shaders: the hardware-independent cost of the method.
+    pub vpl_evaluations_per_pixel: f64,
+    /// G-buffer and RSM texels, node records and low-resolution samples read per shaded pixel.
+    pub texel_fetches_per_pixel: f64,
+    /// The totals the two means come from.
+    pub work: WorkCounts,
     /// The light moves: RSM, pyramid, validity and cut rebuilt every frame.
     pub gpu_time_ms_moving: Option<FrameTiming>,
     /// The light stays: those buffers reused.
@@ -112,6 +121,9 @@ pub fn run(
             rsm_size: s.rsm_size,
             clusters_in_cut,
             recomputed_pixels: frame.recomputed,
+            vpl_evaluations_per_pixel: frame.counts.vpl_evaluations_per_pixel(),
+            texel_fetches_per_pixel: frame.counts.texel_fetches_per_pixel(),
+            work: frame.counts,
             gpu_time_ms_moving: moving,
             gpu_time_ms_static: still,
             error,

@@ -48,13 +48,15 @@ fn low_size(s: &Settings) -> (u32, u32) {
     )
 }
 
-/// The per-frame buffers: sizes, radiance out, RSM samples.
+/// The per-frame buffers: sizes, radiance out, RSM samples, work counts.
 struct Outputs {
     shade: wgpu::Buffer,
     indirect: wgpu::Buffer,
     direct: wgpu::Buffer,
     low: wgpu::Buffer,
     samples: wgpu::Buffer,
+    /// Per pixel: VPL evaluations and texel fetches of the last indirect passes (two `u32`).
+    counts: wgpu::Buffer,
 }
 
 impl Outputs {
@@ -77,6 +79,7 @@ impl Outputs {
                 whole(&self.direct),
                 whole(&self.low),
                 whole(&self.samples),
+                whole(&self.counts),
             ],
         )
     }
@@ -144,6 +147,7 @@ impl Gather {
                 storage_entry::<[f32; 4]>(5, false),
                 storage_entry::<[f32; 4]>(6, false),
                 storage_entry::<[f32; 4]>(7, true),
+                storage_entry::<[u32; 2]>(8, false),
             ],
         );
         let dispatch_layout = layout(
@@ -162,7 +166,7 @@ impl Gather {
         let samples = baselines::rsm_samples(
             s.samples,
             s.rsm_radius * s.rsm_size as f32 * std::f32::consts::SQRT_2,
-            0x5eed,
+            baselines::SAMPLE_SEED,
         );
         let light = uniform_buffer::<LightUniform>(device, "gather light");
         let outputs = Outputs {
@@ -175,6 +179,7 @@ impl Gather {
                 contents: bytemuck::cast_slice(&samples),
                 usage: wgpu::BufferUsages::STORAGE,
             }),
+            counts: storage_buffer(device, "work counts", pixels * 8),
         };
         let slots = Slots::new(device, "gather slots", MAX_SLICES);
         Ok(Self {
@@ -293,6 +298,7 @@ impl Gather {
         if method == Method::QuadtreePasses {
             encoder.clear_buffer(&self.outputs.indirect, 0, None);
         }
+        encoder.clear_buffer(&self.outputs.counts, 0, None);
         {
             let stamps = timer.and_then(|(t, slot, _)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "indirect", stamps);
@@ -372,8 +378,13 @@ impl Gather {
         &self.outputs.indirect
     }
 
-    /// Direct radiance per pixel, row-major (rgb, w = 1).
+    /// Direct radiance per pixel, row-major (rgb, w = 1 where the G-buffer has geometry).
     pub(crate) fn direct(&self) -> &wgpu::Buffer {
         &self.outputs.direct
+    }
+
+    /// Per pixel, the last indirect passes' VPL evaluations and texel fetches (`[u32; 2]`).
+    pub(crate) fn counts(&self) -> &wgpu::Buffer {
+        &self.outputs.counts
     }
 }

@@ -319,6 +319,36 @@ pub struct Frame {
     pub direct: Vec<[f32; 3]>,
     /// Pixels the upsampler recomputed at full resolution.
     pub recomputed: u32,
+    /// The work the indirect passes did, counted in the shaders.
+    pub counts: WorkCounts,
+}
+
+/// The work of a frame's indirect passes, counted by the shaders themselves: hardware-independent
+/// figures to compare methods by. Every dispatch's work is counted, so a sum split into slices
+/// reads the G-buffer once per slice, and the sub-sampled quadtree counts its low-resolution
+/// samples and the pixels the upsampler recomputed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct WorkCounts {
+    /// Pixels where the G-buffer has geometry: the ones shaded, what the means are over.
+    pub shaded_pixels: u32,
+    /// VPL kernels evaluated (a cluster counts one, an RSM sample one where its texel is a
+    /// VPL), over all pixels.
+    pub vpl_evaluations: u64,
+    /// Reads of G-buffer texels, RSM texels, quadtree node records and low-resolution samples,
+    /// over all pixels.
+    pub texel_fetches: u64,
+}
+
+impl WorkCounts {
+    /// Mean VPL evaluations per shaded pixel.
+    pub fn vpl_evaluations_per_pixel(&self) -> f64 {
+        self.vpl_evaluations as f64 / f64::from(self.shaded_pixels.max(1))
+    }
+
+    /// Mean texel fetches per shaded pixel.
+    pub fn texel_fetches_per_pixel(&self) -> f64 {
+        self.texel_fetches as f64 / f64::from(self.shaded_pixels.max(1))
+    }
 }
 
 impl Frame {

@@ -8,6 +8,7 @@ use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
 use super::{
     ClusterSettings, CutNode, Frame, FrameTiming, Gather, Method, Pass, Receiver, Settings, Vpl,
+    WorkCounts,
 };
 use crate::IndirectError;
 use crate::scene::Scene;
@@ -228,9 +229,18 @@ impl<'g> Renderer<'g> {
     pub fn read_frame(&self) -> Result<Frame, IndirectError> {
         let indirect = self.read_vec4(self.gather.indirect())?;
         let direct = self.read_vec4(self.gather.direct())?;
+        let counts: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&quadray_gpu::read_buffer(
+            self.gpu,
+            self.gather.counts(),
+        )?);
         let rgb = |v: &[[f32; 4]]| v.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let s = self.settings();
         Ok(Frame {
+            counts: WorkCounts {
+                shaded_pixels: direct.iter().filter(|p| p[3] > 0.5).count() as u32,
+                vpl_evaluations: counts.iter().map(|c| u64::from(c[0])).sum(),
+                texel_fetches: counts.iter().map(|c| u64::from(c[1])).sum(),
+            },
             width: s.width,
             height: s.height,
             recomputed: indirect.iter().filter(|p| p[3] > 0.5).count() as u32,

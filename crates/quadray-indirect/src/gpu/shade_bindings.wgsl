@@ -38,6 +38,8 @@ struct Shade {
 @group(1) @binding(6) var<storage, read_write> low: array<vec4<f32>>;
 // xy: offset in RSM texels, z: weight, w: the pattern's radius
 @group(1) @binding(7) var<storage, read> samples: array<vec4<f32>>;
+// per pixel: VPL evaluations and fetches of the indirect passes (cleared before them)
+@group(1) @binding(8) var<storage, read_write> counts: array<vec2<u32>>;
 // Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
@@ -52,6 +54,7 @@ struct Receiver {
 
 fn receiver(pixel: vec2<u32>) -> Receiver {
     let t = vec2<i32>(pixel);
+    fetches += 3u;
     let p = textureLoad(g_pos, t, 0);
     var r: Receiver;
     r.x = p.xyz;
@@ -63,6 +66,11 @@ fn receiver(pixel: vec2<u32>) -> Receiver {
 
 fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
     return vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, shade.r_min);
+}
+
+// Adds this invocation's work to pixel `index`'s counts.
+fn store_counts(index: u32) {
+    counts[index] += vec2<u32>(evaluations, fetches);
 }
 
 fn pixel_index(pixel: vec2<u32>) -> u32 {
