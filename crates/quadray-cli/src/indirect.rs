@@ -164,6 +164,21 @@ pub fn bench(options: quadray_bench::indirect::tables::BenchOptions, out: &Path)
     Ok(())
 }
 
+/// `quadray bench indirect --equal-error`.
+pub fn bench_equal_error(
+    options: &quadray_bench::indirect::equal_error::EqualErrorOptions,
+    out: &Path,
+) -> Result<()> {
+    let gpu = Gpu::new()?;
+    let bar = crate::spinner("bench indirect --equal-error");
+    quadray_bench::indirect::equal_error::run(&gpu, out, options, |m| {
+        bar.set_message(format!("bench indirect --equal-error: {m}"))
+    })?;
+    bar.finish_and_clear();
+    println!("{}", std::fs::read_to_string(out.join("equal_error.md"))?);
+    Ok(())
+}
+
 /// The indirect-light pictures of `quadray demo`.
 pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
     let bar = crate::spinner("indirect light");

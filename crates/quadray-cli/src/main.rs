@@ -78,9 +78,13 @@ enum Bench {
         /// Image side (default 512, quick 64).
         #[arg(long)]
         size: Option<u32>,
-        /// RSM side (default 512, quick 64).
+        /// RSM side (default 512, quick 64; with --equal-error: 256 and 512, quick 64).
         #[arg(long)]
         rsm_size: Option<u32>,
+        /// Only the quadtree against RSM sampling at equal error, in VPL evaluations, texel
+        /// fetches and time, on every bundled scene (image side 128, quick 64).
+        #[arg(long)]
+        equal_error: bool,
         #[arg(long, default_value = "out/bench/indirect")]
         out: PathBuf,
     },
@@ -168,6 +172,20 @@ fn main() -> Result<()> {
                     quick,
                     size,
                     rsm_size,
+                    equal_error: true,
+                    out,
+                },
+        } => indirect::bench_equal_error(
+            &quadray_bench::indirect::equal_error::EqualErrorOptions::new(quick, size, rsm_size),
+            &out,
+        )?,
+        Command::Bench {
+            what:
+                Bench::Indirect {
+                    quick,
+                    size,
+                    rsm_size,
+                    equal_error: false,
                     out,
                 },
         } => indirect::bench(
