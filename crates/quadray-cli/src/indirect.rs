@@ -53,6 +53,11 @@ pub struct IndirectArgs {
     /// beside --out.
     #[arg(long)]
     reference: bool,
+    /// Also compute one bounce from every VPL with exact visibility on the CPU (ray traced);
+    /// adds ground_truth {rel_l1, rmse, flip} to the stats. Traces a ray per pixel and VPL:
+    /// small --size and --rsm-size (at most 2^30 rays).
+    #[arg(long)]
+    ground_truth: bool,
     /// Frames timed per light mode (median).
     #[arg(long, default_value_t = 20)]
     frames: u32,
@@ -131,6 +136,7 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             method: args.method,
             frames: args.frames,
             reference: args.reference,
+            ground_truth: args.ground_truth,
             exposure: args.exposure,
         },
     )
@@ -140,6 +146,9 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     outcome.indirect.save_png(&beside(&args.out, "indirect"))?;
     if let Some(map) = &outcome.error_map {
         map.save_png(&beside(&args.out, "error"))?;
+    }
+    if let Some(truth) = &outcome.ground_truth {
+        truth.save_png(&beside(&args.out, "ground-truth"))?;
     }
     if let Some(cut) = &outcome.cut_view {
         cut.save_png(&beside(&args.out, "cut"))?;

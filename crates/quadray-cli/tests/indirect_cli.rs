@@ -24,6 +24,7 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
             "--frames",
             "2",
             "--reference",
+            "--ground-truth",
         ],
         &out,
         &stats,
@@ -33,6 +34,7 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
         "cornell.direct.png",
         "cornell.indirect.png",
         "cornell.error.png",
+        "cornell.ground-truth.png",
     ] {
         assert!(dir.join(name).exists(), "{name}");
     }
@@ -55,6 +57,12 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
     assert!(json["error"]["rmse"].as_f64().is_some());
     let flip = json["flip"].as_f64().unwrap();
     assert!(flip > 0.0 && flip < 0.2, "{flip}");
+    // the Cornell box's blocks shadow some VPLs: the ground truth differs from the brute force
+    let truth = &json["ground_truth"];
+    let truth_l1 = truth["rel_l1"].as_f64().unwrap();
+    assert!(truth_l1 > rel_l1 && truth_l1 < 0.5, "{truth_l1}");
+    assert!(truth["rmse"].as_f64().unwrap() > 0.0);
+    assert!(truth["flip"].as_f64().unwrap() > 0.0);
     if !json["gpu_time_ms_moving"].is_null() {
         assert!(json["gpu_time_ms_moving"]["total_ms"].as_f64().unwrap() > 0.0);
         assert!(json["gpu_time_ms_static"]["passes"]["pyramid"].is_null());
@@ -90,6 +98,12 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         args.extend(extra);
         quadray_refuses(&args, needle);
     }
+    // a ground truth of 512x512 pixels x 512^2 VPLs would trace 6.9e10 rays
+    let out = out.to_str().unwrap();
+    quadray_refuses(
+        &["indirect", "--out", out, "--ground-truth"],
+        "--size or --rsm-size",
+    );
 }
 
 #[test]

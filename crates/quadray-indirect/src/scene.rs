@@ -245,13 +245,14 @@ impl Scene {
 pub const CORNELL_TOML: &str = include_str!("../../../assets/scenes/cornell.toml");
 
 /// The bundled scene files of this technique, in `scenes_dir()`.
-pub const BUNDLED_SCENES: [&str; 6] = [
+pub const BUNDLED_SCENES: [&str; 7] = [
     "cornell.toml",
     "cornell_obj.toml",
     "cornell_bunny.toml",
     "cornell_buddha.toml",
     "atrium.toml",
     "cornell_spot.gltf",
+    "leak.toml",
 ];
 
 /// Directory of the bundled scene files.
