@@ -46,6 +46,17 @@ pub struct IndirectArgs {
     /// Indirect at one sample per KxK pixels, upsampled where the geometry agrees (quadtree).
     #[arg(long, default_value_t = Settings::default().subsample)]
     subsample: u32,
+    /// Indirect shadows (quadtree methods): march between each receiver and cluster against the
+    /// camera's and the light's depth.
+    #[arg(long)]
+    indirect_shadows: bool,
+    /// Points marched per receiver and cluster with --indirect-shadows.
+    #[arg(long, default_value_t = 8)]
+    shadow_steps: u32,
+    /// Depth behind a seen surface that counts as inside an occluder (fraction of the scene's
+    /// extent), with --indirect-shadows.
+    #[arg(long, default_value_t = Settings::default().shadow_thickness)]
+    shadow_thickness: f32,
     /// Image size WxH.
     #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
     size: (u32, u32),
@@ -122,6 +133,12 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         },
         samples: args.samples,
         subsample: args.subsample,
+        shadow_steps: if args.indirect_shadows {
+            args.shadow_steps
+        } else {
+            0
+        },
+        shadow_thickness: args.shadow_thickness,
         ..Settings::default()
     };
     if !(args.exposure.is_finite() && args.exposure > 0.0) {

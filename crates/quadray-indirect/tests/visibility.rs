@@ -48,3 +48,47 @@ fn the_leak_scene_leaks_without_visibility_and_the_ground_truth_stops_it() {
     println!("no visibility vs ground truth: {e:?}");
     assert!(e.rel_l1 > 0.05, "{e:?}");
 }
+
+/// Indirect shadows (marching against the camera's and the light's depth) bring the quadtree
+/// closer to the ground truth on the leak scene and the Cornell box, with the same cut.
+#[test]
+fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    for file in ["leak.toml", "cornell.toml"] {
+        let scene = Scene::load(&scenes_dir().join(file)).unwrap();
+        let settings = Settings {
+            width: 48,
+            height: 48,
+            rsm_size: 32,
+            cluster: ClusterSettings::defaults(32),
+            ..Settings::default()
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
+        let plain = r.render_frame(Method::Quadtree).unwrap();
+        let truth = ground_truth(
+            &r.read_vpls().unwrap(),
+            &r.read_receivers().unwrap(),
+            &scene,
+        );
+        let shadowed_settings = Settings {
+            shadow_steps: 8,
+            ..settings
+        };
+        let mut s = Renderer::new(&gpu, &scene, shadowed_settings).unwrap();
+        let shadowed = s.render_frame(Method::Quadtree).unwrap();
+        let passes = s.render_frame(Method::QuadtreePasses).unwrap();
+        let (before, after) = (
+            compare(&plain.indirect, &truth).rel_l1,
+            compare(&shadowed.indirect, &truth).rel_l1,
+        );
+        println!("{file}: rel_l1 to the ground truth {before:.4} -> {after:.4}");
+        assert!(after < 0.7 * before, "{file}: {before} -> {after}");
+        assert_eq!(
+            shadowed.counts.vpl_evaluations,
+            plain.counts.vpl_evaluations
+        );
+        assert!(shadowed.counts.texel_fetches > plain.counts.texel_fetches);
+        // the per-level passes shadow the same clusters the same way
+        assert!(compare(&passes.indirect, &shadowed.indirect).rel_max < 1e-4);
+    }
+}

@@ -40,6 +40,9 @@ pub struct GBufferViews<'a> {
     pub albedo: &'a wgpu::TextureView,
 }
 
+/// Where the camera starts in the shading uniform: `set_light` writes what comes before.
+const CAMERA_OFFSET: usize = std::mem::offset_of!(ShadeUniform, camera);
+
 /// Where a low-resolution indirect sample's pixel is (one sample per `subsample`^2 pixels).
 fn low_size(s: &Settings) -> (u32, u32) {
     (
@@ -254,7 +257,7 @@ impl Gather {
         queue.write_buffer(
             &self.outputs.shade,
             0,
-            bytemuck::bytes_of(&ShadeUniform {
+            &bytemuck::bytes_of(&ShadeUniform {
                 width: s.width,
                 height: s.height,
                 r_min,
@@ -266,9 +269,27 @@ impl Gather {
                 depth_bias: 0.005 + 3.0 * texel_side * spot.far / spot.extent,
                 normal_agreement: 0.9,
                 plane_agreement: 0.02 * spot.extent,
-                pad0: 0,
-                pad1: 0,
-            }),
+                shadow_steps: s.shadow_steps,
+                shadow_thickness: s.shadow_thickness * spot.extent,
+                camera: [[0.0; 4]; 4],
+                eye: [0.0; 4],
+            })[..CAMERA_OFFSET],
+        );
+    }
+
+    /// Sets the camera the G-buffer is rendered from (`view_proj`: world -> clip, `eye`: its
+    /// position): indirect shadows read the G-buffer as a depth map.
+    pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
+        let camera = (view_proj.to_cols_array_2d(), eye.extend(1.0).to_array());
+        queue.write_buffer(
+            &self.outputs.shade,
+            CAMERA_OFFSET as u64,
+            bytemuck::bytes_of(&camera.0),
+        );
+        queue.write_buffer(
+            &self.outputs.shade,
+            (CAMERA_OFFSET + size_of::<[[f32; 4]; 4]>()) as u64,
+            bytemuck::bytes_of(&camera.1),
         );
     }
 

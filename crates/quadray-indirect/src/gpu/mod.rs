@@ -182,6 +182,12 @@ pub struct Settings {
     pub rsm_radius: f32,
     /// Indirect at one sample per `subsample`^2 pixels (1: full resolution).
     pub subsample: u32,
+    /// Indirect shadows for the quadtree methods: points marched between each receiver and
+    /// cluster, tested against the camera's and the light's depth (0: none, as in the paper).
+    pub shadow_steps: u32,
+    /// How far behind a surface a depth map sees a marched point counts as inside an occluder,
+    /// as a fraction of the scene's extent.
+    pub shadow_thickness: f32,
 }
 
 impl Default for Settings {
@@ -194,6 +200,8 @@ impl Default for Settings {
             samples: 256,
             rsm_radius: 1.0,
             subsample: 1,
+            shadow_steps: 0,
+            shadow_thickness: 0.1,
         }
     }
 }
@@ -240,6 +248,18 @@ impl Settings {
         }
         if !(1..=64).contains(&s.subsample) {
             return Err(format!("subsample {} is outside 1..64", s.subsample));
+        }
+        if s.shadow_steps > 64 {
+            return Err(format!("{} shadow steps is over 64", s.shadow_steps));
+        }
+        if !(s.shadow_thickness.is_finite()
+            && s.shadow_thickness > 0.0
+            && s.shadow_thickness <= 1.0)
+        {
+            return Err(format!(
+                "shadow thickness {} is outside (0, 1]",
+                s.shadow_thickness
+            ));
         }
         Ok(())
     }

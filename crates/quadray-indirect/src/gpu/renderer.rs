@@ -76,11 +76,10 @@ impl<'g> Renderer<'g> {
         self.rsm.set_light(q, &spot);
         self.gather.set_light(q, &spot, scene.r_min);
         let s = self.settings();
-        self.gbuffer.set_camera(
-            q,
-            scene.camera_view_proj(s.width as f32 / s.height as f32),
-            scene.camera.position.into(),
-        );
+        let view_proj = scene.camera_view_proj(s.width as f32 / s.height as f32);
+        let eye = scene.camera.position.into();
+        self.gbuffer.set_camera(q, view_proj, eye);
+        self.gather.set_camera(q, view_proj, eye);
     }
 
     /// Changes the quadtree's parameters; the next frame with `rebuild` uses them.
