@@ -69,9 +69,13 @@ pub struct IndirectArgs {
     /// small --size and --rsm-size (at most 2^30 rays).
     #[arg(long)]
     ground_truth: bool,
-    /// Frames timed per light mode (median).
+    /// Frames timed per light mode (median); with --light-orbit also the frames of the sequence.
     #[arg(long, default_value_t = 20)]
     frames: u32,
+    /// Render a sequence of --frames frames with the spot turning DEG a frame about the
+    /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio} to the stats.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    light_orbit: Option<f32>,
     /// Radiance scale before tone mapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
@@ -141,6 +145,14 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         shadow_thickness: args.shadow_thickness,
         ..Settings::default()
     };
+    if let Some(degrees) = args.light_orbit {
+        if !(degrees.is_finite() && degrees.abs() <= 180.0) {
+            anyhow::bail!("--light-orbit {degrees} must be a finite angle within [-180, 180]");
+        }
+        if args.frames < 2 {
+            anyhow::bail!("--light-orbit needs --frames 2 or more (a sequence)");
+        }
+    }
     if !(args.exposure.is_finite() && args.exposure > 0.0) {
         anyhow::bail!("--exposure {} must be positive", args.exposure);
     }
@@ -154,6 +166,7 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             frames: args.frames,
             reference: args.reference,
             ground_truth: args.ground_truth,
+            light_orbit: args.light_orbit,
             exposure: args.exposure,
         },
     )

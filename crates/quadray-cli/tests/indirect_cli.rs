@@ -145,3 +145,43 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     let cut = image::open(dir.join("base.cut.png")).unwrap();
     assert_eq!((cut.width(), cut.height()), (512, 512));
 }
+
+#[test]
+fn a_turning_light_gives_the_temporal_figures() {
+    let dir = scratch("indirect-orbit");
+    let out = dir.join("orbit.png");
+    let stats = dir.join("orbit.json");
+    let args = [
+        "indirect",
+        "--rsm-size",
+        "32",
+        "--size",
+        "32x32",
+        "--frames",
+        "3",
+        "--light-orbit",
+        "2",
+    ];
+    quadray_writes(&args, &out, &stats);
+    let t = &read_json(&stats)["temporal"];
+    assert_eq!(t["frames"], 3);
+    let changed = t["cut_changed_fraction"].as_f64().unwrap();
+    assert!((0.0..=2.0).contains(&changed), "{changed}");
+    // the light moves, so both images change; the ratio of their changes is near 1
+    let ratio = t["flicker_ratio"].as_f64().unwrap();
+    assert!(ratio > 0.2 && ratio < 5.0, "{ratio}");
+    assert!(t["reference_flicker"].as_f64().unwrap() > 0.0);
+    let out = out.to_str().unwrap();
+    let one_frame = [
+        "indirect",
+        "--out",
+        out,
+        "--light-orbit",
+        "1",
+        "--frames",
+        "1",
+    ];
+    quadray_refuses(&one_frame, "--frames 2 or more");
+    let nan = ["indirect", "--out", out, "--light-orbit", "nan"];
+    quadray_refuses(&nan, "--light-orbit");
+}

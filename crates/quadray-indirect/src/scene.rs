@@ -183,6 +183,15 @@ impl Scene {
         Ok(())
     }
 
+    /// The scene with its spot turned `degrees` about the vertical axis (counter-clockwise seen
+    /// from above), as `--light-orbit` turns it a frame at a time.
+    pub fn light_turned(&self, degrees: f32) -> Self {
+        let turn = glam::Quat::from_rotation_y(degrees.to_radians());
+        let mut out = self.clone();
+        out.light.direction = (turn * Vec3::from(self.light.direction)).into();
+        out
+    }
+
     /// Axis-aligned bounds of the geometry.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::MAX);
@@ -376,6 +385,18 @@ mod tests {
         let scene = Scene::cornell();
         assert_eq!(scene.triangles.len(), 10 + 20);
         assert!((scene.extent() - 3f32.sqrt()).abs() < 1e-4);
+    }
+
+    #[test]
+    fn the_light_turns_about_the_vertical_axis() {
+        let scene = Scene::cornell();
+        let d = Vec3::from(scene.light.direction);
+        let t = Vec3::from(scene.light_turned(90.0).light.direction);
+        assert!((t.y - d.y).abs() < 1e-6, "{d} -> {t}");
+        assert!(
+            (t.x - d.z).abs() < 1e-5 && (t.z + d.x).abs() < 1e-5,
+            "{d} -> {t}"
+        );
     }
 
     #[test]

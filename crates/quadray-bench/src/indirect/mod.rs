@@ -5,3 +5,4 @@ pub mod demo;
 pub mod equal_error;
 pub mod run;
 pub mod tables;
+pub mod temporal;

@@ -2,6 +2,7 @@
 //! error heat map) and the stats (GPU time per pass with a moving and a static light, clusters in
 //! the cut, error against the brute force).
 
+use super::temporal::{self, Temporal};
 use quadray_core::image_out::{Rgba8Image, heat_map};
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, mean_flip, tone_map};
@@ -21,6 +22,9 @@ pub struct RunOptions {
     pub reference: bool,
     /// Also compute the CPU ground truth with visibility and measure the error against it.
     pub ground_truth: bool,
+    /// Also render a sequence with the light turning this many degrees a frame (`frames`
+    /// frames) and measure its stability.
+    pub light_orbit: Option<f32>,
     /// Radiance scale before tone mapping.
     pub exposure: f32,
 }
@@ -55,6 +59,8 @@ pub struct Stats {
     pub flip: Option<f32>,
     /// Error against one bounce from every VPL with exact visibility (with `--ground-truth`).
     pub ground_truth: Option<TruthError>,
+    /// Stability under a turning light (with `--light-orbit`).
+    pub temporal: Option<Temporal>,
 }
 
 /// Error of the indirect term against the ground truth with visibility, and the FLIP of the
@@ -158,6 +164,16 @@ pub fn run(
     } else {
         None
     };
+    let temporal = match options.light_orbit {
+        Some(degrees) => Some(temporal::measure(
+            &mut renderer,
+            scene,
+            method,
+            degrees,
+            options.frames,
+        )?),
+        None => None,
+    };
     let ground_truth = truth.as_ref().map(|truth| {
         let e = reference::compare(&frame.indirect, truth);
         TruthError {
@@ -184,6 +200,7 @@ pub fn run(
             error,
             flip,
             ground_truth,
+            temporal,
             settings: s,
         },
         direct: tone_map(w, h, &frame.direct, options.exposure),
