@@ -167,12 +167,9 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
     let l1 = |v: &[[f32; 3]]| compare(v, &truth).rel_l1;
     let picture = montage(
         &[
-            (format!("quadtree, L1 {:.3}", l1(&leaky)), tile(&leaky)),
-            (
-                format!("+ indirect shadows, L1 {:.3}", l1(&shadowed)),
-                tile(&shadowed),
-            ),
-            ("ground truth (ray traced)".into(), tile(&truth)),
+            (format!("no shadow L1 {:.2}", l1(&leaky)), tile(&leaky)),
+            (format!("shadows L1 {:.2}", l1(&shadowed)), tile(&shadowed)),
+            ("ground truth".into(), tile(&truth)),
         ],
         3,
     );
