@@ -172,30 +172,24 @@ fn main() -> Result<()> {
                     quick,
                     size,
                     rsm_size,
-                    equal_error: true,
+                    equal_error,
                     out,
                 },
-        } => indirect::bench_equal_error(
-            &quadray_bench::indirect::equal_error::EqualErrorOptions::new(quick, size, rsm_size),
-            &out,
-        )?,
-        Command::Bench {
-            what:
-                Bench::Indirect {
+        } => {
+            if equal_error {
+                let options = quadray_bench::indirect::equal_error::EqualErrorOptions::new(
+                    quick, size, rsm_size,
+                );
+                indirect::bench_equal_error(&options, &out)?
+            } else {
+                let options = quadray_bench::indirect::tables::BenchOptions {
                     quick,
                     size,
                     rsm_size,
-                    equal_error: false,
-                    out,
-                },
-        } => indirect::bench(
-            quadray_bench::indirect::tables::BenchOptions {
-                quick,
-                size,
-                rsm_size,
-            },
-            &out,
-        )?,
+                };
+                indirect::bench(options, &out)?
+            }
+        }
     }
     Ok(())
 }

@@ -7,18 +7,22 @@ use quadray_indirect::reference::{brute_force, compare, ground_truth};
 use quadray_indirect::scene::scenes_dir;
 use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings};
 
-#[test]
-fn the_leak_scene_leaks_without_visibility_and_the_ground_truth_stops_it() {
-    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
-    let scene = Scene::load(&scenes_dir().join("leak.toml")).unwrap();
-    let settings = Settings {
+/// 48x48 pixels and a 32^2 RSM: the ground truth traces 2.4M rays.
+fn small() -> Settings {
+    Settings {
         width: 48,
         height: 48,
         rsm_size: 32,
         cluster: ClusterSettings::defaults(32),
         ..Settings::default()
-    };
-    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    }
+}
+
+#[test]
+fn the_leak_scene_leaks_without_visibility_and_the_ground_truth_stops_it() {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let scene = Scene::load(&scenes_dir().join("leak.toml")).unwrap();
+    let mut r = Renderer::new(&gpu, &scene, small()).unwrap();
     let frame = r.render_frame(Method::Reference).unwrap();
     let (vpls, receivers) = (r.read_vpls().unwrap(), r.read_receivers().unwrap());
     let cpu = brute_force(&vpls, &receivers, scene.r_min);
@@ -56,13 +60,7 @@ fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     for file in ["leak.toml", "cornell.toml"] {
         let scene = Scene::load(&scenes_dir().join(file)).unwrap();
-        let settings = Settings {
-            width: 48,
-            height: 48,
-            rsm_size: 32,
-            cluster: ClusterSettings::defaults(32),
-            ..Settings::default()
-        };
+        let settings = small();
         let mut r = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
         let plain = r.render_frame(Method::Quadtree).unwrap();
         let truth = ground_truth(
