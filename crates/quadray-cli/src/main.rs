@@ -82,9 +82,13 @@ enum Bench {
         /// Image side (default 512, quick 64).
         #[arg(long)]
         size: Option<u32>,
-        /// RSM side (default 512, quick 64).
+        /// RSM side (default 512, quick 64; with --equal-error: 256 and 512, quick 64).
         #[arg(long)]
         rsm_size: Option<u32>,
+        /// Only the quadtree against RSM sampling at equal error, in VPL evaluations, texel
+        /// fetches and time, on every bundled scene (image side 128, quick 64).
+        #[arg(long)]
+        equal_error: bool,
         #[arg(long, default_value = "out/bench/indirect")]
         out: PathBuf,
     },
@@ -173,16 +177,24 @@ fn main() -> Result<()> {
                     quick,
                     size,
                     rsm_size,
+                    equal_error,
                     out,
                 },
-        } => indirect::bench(
-            quadray_bench::indirect::tables::BenchOptions {
-                quick,
-                size,
-                rsm_size,
-            },
-            &out,
-        )?,
+        } => {
+            if equal_error {
+                let options = quadray_bench::indirect::equal_error::EqualErrorOptions::new(
+                    quick, size, rsm_size,
+                );
+                indirect::bench_equal_error(&options, &out)?
+            } else {
+                let options = quadray_bench::indirect::tables::BenchOptions {
+                    quick,
+                    size,
+                    rsm_size,
+                };
+                indirect::bench(options, &out)?
+            }
+        }
     }
     Ok(())
 }
