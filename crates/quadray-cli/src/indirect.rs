@@ -46,6 +46,17 @@ pub struct IndirectArgs {
     /// Indirect at one sample per KxK pixels, upsampled where the geometry agrees (quadtree).
     #[arg(long, default_value_t = Settings::default().subsample)]
     subsample: u32,
+    /// Indirect shadows (quadtree methods): march between each receiver and cluster against the
+    /// camera's and the light's depth.
+    #[arg(long)]
+    indirect_shadows: bool,
+    /// Points marched per receiver and cluster with --indirect-shadows.
+    #[arg(long, default_value_t = 8)]
+    shadow_steps: u32,
+    /// Depth behind a seen surface that counts as inside an occluder (fraction of the scene's
+    /// extent), with --indirect-shadows.
+    #[arg(long, default_value_t = Settings::default().shadow_thickness)]
+    shadow_thickness: f32,
     /// Image size WxH.
     #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
     size: (u32, u32),
@@ -53,9 +64,18 @@ pub struct IndirectArgs {
     /// beside --out.
     #[arg(long)]
     reference: bool,
-    /// Frames timed per light mode (median).
+    /// Also compute one bounce from every VPL with exact visibility on the CPU (ray traced);
+    /// adds ground_truth {rel_l1, rmse, flip} to the stats. Traces a ray per pixel and VPL:
+    /// small --size and --rsm-size (at most 2^30 rays).
+    #[arg(long)]
+    ground_truth: bool,
+    /// Frames timed per light mode (median); with --light-orbit also the frames of the sequence.
     #[arg(long, default_value_t = 20)]
     frames: u32,
+    /// Render a sequence of --frames frames with the spot turning DEG a frame about the
+    /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio} to the stats.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    light_orbit: Option<f32>,
     /// Radiance scale before tone mapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
@@ -117,8 +137,22 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         },
         samples: args.samples,
         subsample: args.subsample,
+        shadow_steps: if args.indirect_shadows {
+            args.shadow_steps
+        } else {
+            0
+        },
+        shadow_thickness: args.shadow_thickness,
         ..Settings::default()
     };
+    if let Some(degrees) = args.light_orbit {
+        if !(degrees.is_finite() && degrees.abs() <= 180.0) {
+            anyhow::bail!("--light-orbit {degrees} must be a finite angle within [-180, 180]");
+        }
+        if args.frames < 2 {
+            anyhow::bail!("--light-orbit needs --frames 2 or more (a sequence)");
+        }
+    }
     if !(args.exposure.is_finite() && args.exposure > 0.0) {
         anyhow::bail!("--exposure {} must be positive", args.exposure);
     }
@@ -131,6 +165,8 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             method: args.method,
             frames: args.frames,
             reference: args.reference,
+            ground_truth: args.ground_truth,
+            light_orbit: args.light_orbit,
             exposure: args.exposure,
         },
     )
@@ -140,6 +176,9 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     outcome.indirect.save_png(&beside(&args.out, "indirect"))?;
     if let Some(map) = &outcome.error_map {
         map.save_png(&beside(&args.out, "error"))?;
+    }
+    if let Some(truth) = &outcome.ground_truth {
+        truth.save_png(&beside(&args.out, "ground-truth"))?;
     }
     if let Some(cut) = &outcome.cut_view {
         cut.save_png(&beside(&args.out, "cut"))?;
@@ -161,6 +200,21 @@ pub fn bench(options: quadray_bench::indirect::tables::BenchOptions, out: &Path)
     bar.finish_and_clear();
     println!("{}", std::fs::read_to_string(out.join("results.md"))?);
     println!("ratios: {}", serde_json::to_string_pretty(&results.ratios)?);
+    Ok(())
+}
+
+/// `quadray bench indirect --equal-error`.
+pub fn bench_equal_error(
+    options: &quadray_bench::indirect::equal_error::EqualErrorOptions,
+    out: &Path,
+) -> Result<()> {
+    let gpu = Gpu::new()?;
+    let bar = crate::spinner("bench indirect --equal-error");
+    quadray_bench::indirect::equal_error::run(&gpu, out, options, |m| {
+        bar.set_message(format!("bench indirect --equal-error: {m}"))
+    })?;
+    bar.finish_and_clear();
+    println!("{}", std::fs::read_to_string(out.join("equal_error.md"))?);
     Ok(())
 }
 

@@ -3,7 +3,9 @@
 
 mod displace;
 mod indirect;
+mod merge;
 mod raytrace;
+mod tiles;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -29,6 +31,8 @@ enum Command {
     Displace(displace::DisplaceArgs),
     /// Whitted ray tracing on a uniform grid with hybrid shadow testing.
     Raytrace(raytrace::RaytraceArgs),
+    /// Assemble the tiles of `quadray raytrace --tiles N` (or `--frames A..B`) into pictures.
+    Merge(merge::MergeArgs),
     /// One-bounce indirect light from a light quadtree, its baselines and reference.
     Indirect(indirect::IndirectArgs),
     /// Open the interactive viewer: runs the `quadray-view` program installed beside this one
@@ -78,9 +82,13 @@ enum Bench {
         /// Image side (default 512, quick 64).
         #[arg(long)]
         size: Option<u32>,
-        /// RSM side (default 512, quick 64).
+        /// RSM side (default 512, quick 64; with --equal-error: 256 and 512, quick 64).
         #[arg(long)]
         rsm_size: Option<u32>,
+        /// Only the quadtree against RSM sampling at equal error, in VPL evaluations, texel
+        /// fetches and time, on every bundled scene (image side 128, quick 64).
+        #[arg(long)]
+        equal_error: bool,
         #[arg(long, default_value = "out/bench/indirect")]
         out: PathBuf,
     },
@@ -120,6 +128,7 @@ fn main() -> Result<()> {
         }
         Command::Displace(args) => displace::run(args)?,
         Command::Raytrace(args) => raytrace::run(args)?,
+        Command::Merge(args) => merge::run(args)?,
         Command::Bench {
             what: Bench::Shadows { quick, out },
         } => raytrace::bench(quick, &out)?,
@@ -168,16 +177,24 @@ fn main() -> Result<()> {
                     quick,
                     size,
                     rsm_size,
+                    equal_error,
                     out,
                 },
-        } => indirect::bench(
-            quadray_bench::indirect::tables::BenchOptions {
-                quick,
-                size,
-                rsm_size,
-            },
-            &out,
-        )?,
+        } => {
+            if equal_error {
+                let options = quadray_bench::indirect::equal_error::EqualErrorOptions::new(
+                    quick, size, rsm_size,
+                );
+                indirect::bench_equal_error(&options, &out)?
+            } else {
+                let options = quadray_bench::indirect::tables::BenchOptions {
+                    quick,
+                    size,
+                    rsm_size,
+                };
+                indirect::bench(options, &out)?
+            }
+        }
     }
     Ok(())
 }

@@ -1,9 +1,11 @@
 //! `quadray raytrace`: the Whitted ray tracer with hybrid shadow testing (quadray-shadows).
 
-use anyhow::{Context, bail};
+use crate::tiles::{self, Fingerprint, TileHeader, WorkItems};
+use anyhow::{Context, bail, ensure};
 use indicatif::{ProgressBar, ProgressStyle};
 use quadray_shadows::scene::{BUILTINS, Scene};
-use quadray_shadows::{Nth, RunOptions, SchemeChoice, cost};
+use quadray_shadows::{Nth, Region, RunOptions, SchemeChoice, cost};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -29,7 +31,8 @@ pub struct RaytraceArgs {
     /// Recursion depth of reflection and refraction.
     #[arg(long, default_value_t = 5)]
     depth: u32,
-    /// Output PNG.
+    /// Output PNG, or EXR for the radiance as 32-bit floats; with --tiles or --frames, the folder
+    /// the work item's tile goes to (frameFFFF-tileTTTT.exr, its stats beside it).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Statistics JSON (times, sub-schemes, N_th, p, alpha, ...).
@@ -41,6 +44,50 @@ pub struct RaytraceArgs {
     /// Only measure the machine constants C_s, C_i, C_c, C_o (nanoseconds) and print them.
     #[arg(long)]
     calibrate: bool,
+    /// Only predict HST's N_th (`--nth auto`) and print it: compute it once and give it to every
+    /// work item with --nth, so that all tiles make the same shadow decisions.
+    #[arg(long)]
+    print_nth: bool,
+    /// Render one of N horizontal bands of the picture as a work item (see --tile).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    tiles: Option<u32>,
+    /// The work item to render, 0-based, frame by frame (item = (frame - A) * N + tile); else
+    /// from JOB_COMPLETION_INDEX (Kubernetes Indexed Job) or SLURM_ARRAY_TASK_ID (Slurm array).
+    #[arg(long)]
+    tile: Option<u64>,
+    /// A turntable: frames A to B-1 as work items (with --tiles, every frame's tiles).
+    #[arg(long, value_parser = tiles::parse_frames, requires = "orbit")]
+    frames: Option<Range<u32>>,
+    /// Degrees the camera turns about the scene's centre (around its up axis) per frame.
+    #[arg(long, allow_hyphen_values = true)]
+    orbit: Option<f32>,
+    /// Render this frame of the turntable in one process.
+    #[arg(long, requires = "orbit", conflicts_with = "frames")]
+    frame: Option<u32>,
+}
+
+/// Whether `path` names an EXR (radiance) rather than a tone-mapped picture.
+pub fn is_exr(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// `scene` seen from its camera turned `degrees` about the centre of its bounds, around the
+/// camera's up axis.
+fn orbit(mut scene: Scene, degrees: f32) -> Scene {
+    if degrees == 0.0 {
+        return scene;
+    }
+    let (lo, hi) = scene.vertices.iter().fold(
+        (glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY),
+        |(lo, hi), &v| (lo.min(v), hi.max(v)),
+    );
+    let centre = (lo + hi) * 0.5;
+    let turn = glam::Quat::from_axis_angle(scene.camera.up.normalize(), degrees.to_radians());
+    let cam = &mut scene.camera;
+    cam.eye = centre + turn * (cam.eye - centre);
+    cam.look_at = centre + turn * (cam.look_at - centre);
+    scene
 }
 
 pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
@@ -71,7 +118,6 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     // Named like the loader's errors: "FILE: reason".
     let invalid = |e: quadray_shadows::BuildError| anyhow::anyhow!("{source}: {e}");
     scene.validate().map_err(invalid)?;
-    let out = args.out.context("--out FILE.png is required")?;
     let nth = match args.nth.as_str() {
         "auto" => Nth::Auto,
         n => match n.parse::<f32>() {
@@ -86,6 +132,25 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     if args.spp == 0 || args.spp > 1024 || args.depth > 64 {
         bail!("--spp must be 1..=1024 and --depth at most 64");
     }
+    let degrees = args.orbit.unwrap_or(0.0);
+    ensure!(
+        degrees.is_finite(),
+        "--orbit {degrees}: not a number of degrees"
+    );
+    if args.print_nth {
+        let frame = args
+            .frames
+            .as_ref()
+            .map_or(args.frame.unwrap_or(0), |f| f.start);
+        let prep =
+            quadray_shadows::prepare(orbit(scene, degrees * frame as f32), SchemeChoice::Hst)
+                .map_err(invalid)?;
+        let (predicted, _) = prep.predicted_nth(&cost::calibrate(), args.depth);
+        // Exactly the f32 that --nth auto uses; Display prints it so that it parses back exactly.
+        println!("{}", predicted as f32);
+        return Ok(());
+    }
+    let out = args.out.context("--out FILE.png is required")?;
     let opts = RunOptions {
         scheme: args.shadows,
         nth,
@@ -96,20 +161,103 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         check: args.check,
         costs: None,
     };
-    let tiles = width.div_ceil(16) as u64 * height.div_ceil(16) as u64;
+    let job = (args.tiles.is_some() || args.frames.is_some()).then(|| WorkItems {
+        tiles: args.tiles.unwrap_or(1),
+        frames: args.frames.clone().unwrap_or_else(|| {
+            let f = args.frame.unwrap_or(0);
+            f..f + 1
+        }),
+    });
+    let Some(items) = job else {
+        if args.tile.is_some() {
+            bail!("--tile needs --tiles N or --frames A..B");
+        }
+        let scene = orbit(scene, degrees * args.frame.unwrap_or(0) as f32);
+        let full = Region::full(width, height);
+        let (radiance, report) = render(scene, &opts, full, &invalid)?;
+        if is_exr(&out) {
+            tiles::write_exr(&out, &radiance, (width, height), None)?;
+        } else {
+            radiance.to_rgba8().save_png(&out)?;
+        }
+        if let Some(path) = &args.stats {
+            quadray_core::write_json(path, &report)?;
+        }
+        return Ok(());
+    };
+    ensure!(
+        items.tiles <= height,
+        "--tiles {}: at most one tile per row ({height})",
+        items.tiles
+    );
+    ensure!(
+        !(opts.scheme == SchemeChoice::Hst && nth == Nth::Auto),
+        "work items with --shadows hst need one N_th for all: compute it once with --print-nth \
+         and give it with --nth"
+    );
+    ensure!(
+        args.stats.is_none(),
+        "--stats: each work item writes its stats beside its tile"
+    );
+    ensure!(
+        out.extension().is_none(),
+        "--out {}: with --tiles or --frames, the folder the tiles go to",
+        out.display()
+    );
+    let nth_text = match (opts.scheme, nth) {
+        (SchemeChoice::Hst, Nth::Fixed(n)) => n.to_string(),
+        _ => "-".into(),
+    };
+    let settings = format!(
+        "{} nth {nth_text} {width}x{height} spp {} depth {} orbit {degrees}",
+        format!("{:?}", opts.scheme).to_lowercase(),
+        args.spp,
+        args.depth
+    );
+    let fingerprint = Fingerprint::of(&scene, &settings);
+    let (frame, tile) = items.item(items.index_from(args.tile)?);
+    let region = tiles::band(width, height, tile, items.tiles);
+    let scene = orbit(scene, degrees * frame as f32);
+    let (radiance, report) = render(scene, &opts, region, &invalid)?;
+    let header = TileHeader {
+        image: (width, height),
+        region,
+        tile,
+        items,
+        frame,
+        settings,
+        fingerprint,
+    };
+    let path = out.join(tiles::tile_file_name(frame, tile));
+    tiles::write_exr(&path, &radiance, (width, height), Some(&header))?;
+    quadray_core::write_json(&path.with_extension("json"), &report)?;
+    println!("{}", path.display());
+    Ok(())
+}
+
+/// Prepares `scene`, renders `region` of the picture with a progress bar and prints the times.
+fn render(
+    scene: Scene,
+    opts: &RunOptions,
+    region: Region,
+    invalid: &dyn Fn(quadray_shadows::BuildError) -> anyhow::Error,
+) -> anyhow::Result<(quadray_shadows::Radiance, quadray_shadows::RunReport)> {
+    let prep = quadray_shadows::prepare(scene, opts.scheme).map_err(invalid)?;
+    let costs = opts.costs.unwrap_or_else(cost::calibrate);
+    let tiles = region.width.div_ceil(16) as u64 * region.height.div_ceil(16) as u64;
     let bar = ProgressBar::new(tiles).with_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} tiles {elapsed}",
     )?);
-    let (image, report) = quadray_shadows::run(scene, &opts, &|| bar.inc(1)).map_err(invalid)?;
+    let (radiance, report) =
+        quadray_shadows::render_prepared_region(&prep, opts, &costs, region, &|| bar.inc(1));
     bar.finish_and_clear();
-    image.save_png(&out)?;
     let t = &report.times_s;
     println!(
         "{} {} {}x{}: preprocess {:.3}s shadow {:.3}s other {:.3}s total {:.3}s, N_th predicted {:.2}{}",
         report.scene,
         report.scheme,
-        width,
-        height,
+        opts.width,
+        opts.height,
         t.preprocess,
         t.shadow,
         t.other,
@@ -127,10 +275,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
             report.shading_points
         );
     }
-    if let Some(path) = &args.stats {
-        quadray_core::write_json(path, &report)?;
-    }
-    Ok(())
+    Ok((radiance, report))
 }
 
 /// `quadray bench shadows`: the paper's tables and figure 6 into `out`, the headline ratios printed.

@@ -24,6 +24,7 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
             "--frames",
             "2",
             "--reference",
+            "--ground-truth",
         ],
         &out,
         &stats,
@@ -33,6 +34,7 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
         "cornell.direct.png",
         "cornell.indirect.png",
         "cornell.error.png",
+        "cornell.ground-truth.png",
     ] {
         assert!(dir.join(name).exists(), "{name}");
     }
@@ -41,12 +43,26 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
     assert_eq!(json["width"], 48);
     assert_eq!(json["height"], 32);
     assert_eq!(json["rsm_size"], 32);
-    assert!(json["clusters_in_cut"].as_u64().unwrap() > 0);
+    let clusters = json["clusters_in_cut"].as_f64().unwrap();
+    assert!(clusters > 0.0);
+    // the per-level passes sum exactly the cut's clusters at every shaded pixel
+    assert_eq!(
+        json["vpl_evaluations_per_pixel"].as_f64().unwrap(),
+        clusters
+    );
+    assert!(json["texel_fetches_per_pixel"].as_f64().unwrap() > clusters);
+    assert!(json["work"]["shaded_pixels"].as_u64().unwrap() > 0);
     let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
     assert!(rel_l1 > 0.0 && rel_l1 < 0.1, "{rel_l1}");
     assert!(json["error"]["rmse"].as_f64().is_some());
     let flip = json["flip"].as_f64().unwrap();
     assert!(flip > 0.0 && flip < 0.2, "{flip}");
+    // the Cornell box's blocks shadow some VPLs: the ground truth differs from the brute force
+    let truth = &json["ground_truth"];
+    let truth_l1 = truth["rel_l1"].as_f64().unwrap();
+    assert!(truth_l1 > rel_l1 && truth_l1 < 0.5, "{truth_l1}");
+    assert!(truth["rmse"].as_f64().unwrap() > 0.0);
+    assert!(truth["flip"].as_f64().unwrap() > 0.0);
     if !json["gpu_time_ms_moving"].is_null() {
         assert!(json["gpu_time_ms_moving"]["total_ms"].as_f64().unwrap() > 0.0);
         assert!(json["gpu_time_ms_static"]["passes"]["pyramid"].is_null());
@@ -82,6 +98,12 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         args.extend(extra);
         quadray_refuses(&args, needle);
     }
+    // a ground truth of 512x512 pixels x 512^2 VPLs would trace 6.9e10 rays
+    let out = out.to_str().unwrap();
+    quadray_refuses(
+        &["indirect", "--out", out, "--ground-truth"],
+        "--size or --rsm-size",
+    );
 }
 
 #[test]
@@ -122,4 +144,44 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     assert_ne!(base, moved);
     let cut = image::open(dir.join("base.cut.png")).unwrap();
     assert_eq!((cut.width(), cut.height()), (512, 512));
+}
+
+#[test]
+fn a_turning_light_gives_the_temporal_figures() {
+    let dir = scratch("indirect-orbit");
+    let out = dir.join("orbit.png");
+    let stats = dir.join("orbit.json");
+    let args = [
+        "indirect",
+        "--rsm-size",
+        "32",
+        "--size",
+        "32x32",
+        "--frames",
+        "3",
+        "--light-orbit",
+        "2",
+    ];
+    quadray_writes(&args, &out, &stats);
+    let t = &read_json(&stats)["temporal"];
+    assert_eq!(t["frames"], 3);
+    let changed = t["cut_changed_fraction"].as_f64().unwrap();
+    assert!((0.0..=2.0).contains(&changed), "{changed}");
+    // the light moves, so both images change; the ratio of their changes is near 1
+    let ratio = t["flicker_ratio"].as_f64().unwrap();
+    assert!(ratio > 0.2 && ratio < 5.0, "{ratio}");
+    assert!(t["reference_flicker"].as_f64().unwrap() > 0.0);
+    let out = out.to_str().unwrap();
+    let one_frame = [
+        "indirect",
+        "--out",
+        out,
+        "--light-orbit",
+        "1",
+        "--frames",
+        "1",
+    ];
+    quadray_refuses(&one_frame, "--frames 2 or more");
+    let nan = ["indirect", "--out", out, "--light-orbit", "nan"];
+    quadray_refuses(&nan, "--light-orbit");
 }

@@ -16,8 +16,6 @@ pub mod baselines;
 pub mod gpu;
 pub mod picture;
 pub mod reference;
-// Its items are documented with the scene-loading change under way in another branch.
-#[allow(missing_docs)]
 pub mod scene;
 
 /// Anything that can go wrong between a scene file and a measured picture.
@@ -37,6 +35,6 @@ pub enum IndirectError {
 pub use gpu::{
     ClusterSettings, CutNode, FLOAT_FORMAT, Frame, FrameTiming, GBufferViews, Gather,
     LightQuadtree, Method, OutputPass, OutputTerm, Pass, Renderer, RsmPass, RsmViews, Settings,
-    Spot, Validity,
+    Spot, Validity, WorkCounts,
 };
 pub use scene::Scene;

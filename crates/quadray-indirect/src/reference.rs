@@ -1,19 +1,87 @@
 //! Ground truth on the CPU: the indirect radiance of every receiver from every VPL, with the same
-//! kernel (including the r_min clamp) as the GPU, summed in f64. For small RSMs and images only.
+//! kernel (including the r_min clamp) as the GPU, summed in f64; without visibility (what every
+//! GPU method approximates) or with exact visibility by ray tracing (what the light really
+//! does). For small RSMs and images only.
 
 use crate::gpu::{Receiver, Vpl};
+use crate::scene::Scene;
+use glam::Vec3;
+use quadray_shadows::bvh::Bvh;
+use quadray_shadows::geom::{ConvexPolygon, Ray};
 use rayon::prelude::*;
 
 /// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none), with
 /// E_p = flux_p / pi * cos_p * cos / max(r^2, r_min^2) (the spec's kernel with a diffuse VPL's 1/pi).
 pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> Vec<[f32; 3]> {
+    sum_vpls(vpls, receivers, r_min, |_, _| true)
+}
+
+/// Rays a ground truth with visibility may trace (shaded pixels x VPLs): about a minute or two
+/// on two cores.
+pub const MAX_GROUND_TRUTH_RAYS: u64 = 1 << 30;
+
+/// [`brute_force`] with each VPL's light reaching a receiver only where nothing of `scene` lies
+/// between them: one ray per receiver and VPL that face each other.
+pub fn ground_truth(vpls: &[Vpl], receivers: &[Option<Receiver>], scene: &Scene) -> Vec<[f32; 3]> {
+    let visibility = Visibility::new(scene);
+    sum_vpls(vpls, receivers, scene.r_min, |p, r| {
+        visibility.between(p, r)
+    })
+}
+
+/// The scene's triangles in a BVH, for visibility between VPLs and receivers.
+struct Visibility {
+    polygons: Vec<ConvexPolygon>,
+    bvh: Bvh,
+    /// How far ray ends are lifted off their surfaces (world units).
+    offset: f32,
+}
+
+impl Visibility {
+    fn new(scene: &Scene) -> Self {
+        let polygons: Vec<ConvexPolygon> = scene
+            .triangles
+            .iter()
+            .map(|t| ConvexPolygon::new(t.iter().map(|v| Vec3::from(v.position)).collect()))
+            .collect();
+        Self {
+            bvh: Bvh::build(&polygons),
+            polygons,
+            offset: 1e-3 * scene.extent(),
+        }
+    }
+
+    /// Whether the segment between the VPL and the receiver, each end lifted along its normal,
+    /// is free.
+    fn between(&self, vpl: &Vpl, receiver: &Receiver) -> bool {
+        let lift = |p: [f32; 3], n: [f32; 3]| Vec3::from(p) + self.offset * Vec3::from(n);
+        let from = lift(receiver.position, receiver.normal);
+        let to = lift(vpl.position, vpl.normal);
+        if from.distance_squared(to) < self.offset * self.offset {
+            return true;
+        }
+        !self
+            .bvh
+            .occluded(&self.polygons, &Ray::segment(from, to - from, 0.0), None)
+    }
+}
+
+/// The sum of [`brute_force`] over the VPLs each receiver `visible` says it sees (asked only where
+/// the kernel is not zero).
+fn sum_vpls(
+    vpls: &[Vpl],
+    receivers: &[Option<Receiver>],
+    r_min: f32,
+    visible: impl Fn(&Vpl, &Receiver) -> bool + Sync,
+) -> Vec<[f32; 3]> {
     let r_min2 = f64::from(r_min).powi(2);
     receivers
         .par_iter()
         .map(|r| {
-            let Some(r) = r else {
+            let Some(receiver) = r else {
                 return [0.0; 3];
             };
+            let r = receiver;
             let v = |a: [f32; 3]| a.map(f64::from);
             let (x, n) = (v(r.position), v(r.normal));
             let mut e = [0.0f64; 3];
@@ -24,6 +92,9 @@ pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> 
                 let emit = (np[0] * d[0] + np[1] * d[1] + np[2] * d[2]).max(0.0);
                 let receive = -(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
                 let g = emit * receive.max(0.0) / (std::f64::consts::PI * d2 * d2);
+                if g == 0.0 || !visible(p, receiver) {
+                    continue;
+                }
                 for (e, flux) in e.iter_mut().zip(p.flux) {
                     *e += f64::from(flux) * g;
                 }
@@ -109,6 +180,42 @@ mod tests {
         };
         let out = brute_force(&[vpl], &[Some(near)], 0.1);
         assert!((out[0][0] - 4.0 * 0.0025 / 1e-4 / (pi * pi)).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_ground_truth_drops_exactly_the_vpls_an_occluder_hides() {
+        // two VPLs facing a receiver at distance 2; a small square at z = 1 hides only the first
+        let vpls = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]].map(|position| Vpl {
+            flux: [1.0; 3],
+            position,
+            normal: [0.0, 0.0, 1.0],
+        });
+        let receiver = Some(Receiver {
+            position: [0.0, 0.0, 2.0],
+            normal: [0.0, 0.0, -1.0],
+            albedo: [1.0; 3],
+        });
+        let vertex = |x: f32, y: f32| crate::scene::Vertex {
+            position: [x, y, 1.0],
+            normal: [0.0, 0.0, 1.0],
+            albedo: [1.0; 3],
+        };
+        let mut scene = crate::Scene::cornell();
+        scene.triangles = vec![
+            [vertex(-0.2, -0.2), vertex(0.2, -0.2), vertex(0.2, 0.2)],
+            [vertex(-0.2, -0.2), vertex(0.2, 0.2), vertex(-0.2, 0.2)],
+        ];
+        let truth = ground_truth(&vpls, &[receiver, None], &scene);
+        let second = brute_force(&vpls[1..], &[receiver], scene.r_min);
+        assert!(second[0][0] > 0.0);
+        assert_eq!(truth[0], second[0], "only the second VPL is seen");
+        assert_eq!(truth[1], [0.0; 3]);
+        // moved behind the receiver, the square hides nothing
+        for v in scene.triangles.iter_mut().flatten() {
+            v.position[2] = 3.0;
+        }
+        let all = brute_force(&vpls, &[receiver], scene.r_min);
+        assert_eq!(ground_truth(&vpls, &[receiver], &scene)[0], all[0]);
     }
 
     #[test]

@@ -16,15 +16,22 @@ use std::path::{Path, PathBuf};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Vertex {
+    /// World position.
     pub position: [f32; 3],
+    /// Unit normal (the front side, which the G-buffer turns towards the viewer).
     pub normal: [f32; 3],
+    /// Diffuse albedo in [0, 1] per channel.
     pub albedo: [f32; 3],
 }
 
+/// The pinhole camera pictures are rendered from.
 #[derive(Clone, Debug)]
 pub struct Camera {
+    /// Eye position (world).
     pub position: [f32; 3],
+    /// The point looked at (world).
     pub target: [f32; 3],
+    /// Up direction of the picture.
     pub up: [f32; 3],
     /// Vertical field of view.
     pub fov_deg: f32,
@@ -34,10 +41,13 @@ pub struct Camera {
 /// zero at `cone_deg`.
 #[derive(Clone, Debug)]
 pub struct SpotLight {
+    /// Apex of the cone (world).
     pub position: [f32; 3],
+    /// Axis of the cone (any length but zero).
     pub direction: [f32; 3],
     /// Half-angle of the cone; also half the field of view of the RSM.
     pub cone_deg: f32,
+    /// Width of the smooth edge inside the cone, degrees.
     pub falloff_deg: f32,
     /// Radiant intensity on the axis (W/sr per channel).
     pub intensity: [f32; 3],
@@ -46,10 +56,15 @@ pub struct SpotLight {
 /// A loaded scene, checked and flattened.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The scene's name (its file's stem), in stats and captions.
     pub name: String,
+    /// The camera pictures are rendered from.
     pub camera: Camera,
+    /// The spot light whose RSM makes the VPLs.
     pub light: SpotLight,
+    /// Clamp of the VPL kernel's distance (world units): 1/r^4 is taken at no less than this.
     pub r_min: f32,
+    /// Every object's triangles in world space.
     pub triangles: Vec<[Vertex; 3]>,
 }
 
@@ -168,6 +183,15 @@ impl Scene {
         Ok(())
     }
 
+    /// The scene with its spot turned `degrees` about the vertical axis (counter-clockwise seen
+    /// from above), as `--light-orbit` turns it a frame at a time.
+    pub fn light_turned(&self, degrees: f32) -> Self {
+        let turn = glam::Quat::from_rotation_y(degrees.to_radians());
+        let mut out = self.clone();
+        out.light.direction = (turn * Vec3::from(self.light.direction)).into();
+        out
+    }
+
     /// Axis-aligned bounds of the geometry.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::MAX);
@@ -212,6 +236,7 @@ impl Scene {
         p.distance(centre) + self.extent()
     }
 
+    /// World -> camera clip space for a picture of this aspect ratio (width / height).
     pub fn camera_view_proj(&self, aspect: f32) -> Mat4 {
         let c = &self.camera;
         let far = Vec3::from(c.position).distance(self.bounds().0.midpoint(self.bounds().1))
@@ -229,13 +254,14 @@ impl Scene {
 pub const CORNELL_TOML: &str = include_str!("../../../assets/scenes/cornell.toml");
 
 /// The bundled scene files of this technique, in `scenes_dir()`.
-pub const BUNDLED_SCENES: [&str; 6] = [
+pub const BUNDLED_SCENES: [&str; 7] = [
     "cornell.toml",
     "cornell_obj.toml",
     "cornell_bunny.toml",
     "cornell_buddha.toml",
     "atrium.toml",
     "cornell_spot.gltf",
+    "leak.toml",
 ];
 
 /// Directory of the bundled scene files.
@@ -359,6 +385,18 @@ mod tests {
         let scene = Scene::cornell();
         assert_eq!(scene.triangles.len(), 10 + 20);
         assert!((scene.extent() - 3f32.sqrt()).abs() < 1e-4);
+    }
+
+    #[test]
+    fn the_light_turns_about_the_vertical_axis() {
+        let scene = Scene::cornell();
+        let d = Vec3::from(scene.light.direction);
+        let t = Vec3::from(scene.light_turned(90.0).light.direction);
+        assert!((t.y - d.y).abs() < 1e-6, "{d} -> {t}");
+        assert!(
+            (t.x - d.z).abs() < 1e-5 && (t.z + d.x).abs() < 1e-5,
+            "{d} -> {t}"
+        );
     }
 
     #[test]

@@ -106,6 +106,7 @@ pub use scene::{BuildError, Camera, Light, Material, Scene};
 use serde::Serialize;
 use stats::RenderStats;
 use trace::Settings;
+pub use trace::{Radiance, Region};
 
 /// How the HST threshold is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -300,6 +301,20 @@ pub fn render_prepared(
     costs: &MachineCosts,
     on_tile: &(dyn Fn() + Sync),
 ) -> (Rgba8Image, RunReport) {
+    let full = Region::full(opts.width, opts.height);
+    let (radiance, report) = render_prepared_region(prep, opts, costs, full, on_tile);
+    (radiance.to_rgba8(), report)
+}
+
+/// [`render_prepared`] of one rectangle of the image, as radiance ([`trace::render_region`]):
+/// the report's counts and times are the region's.
+pub fn render_prepared_region(
+    prep: &Prepared,
+    opts: &RunOptions,
+    costs: &MachineCosts,
+    region: Region,
+    on_tile: &(dyn Fn() + Sync),
+) -> (Radiance, RunReport) {
     let stats = *prep.stats();
     let equation_12 = cost::predicted_nth(costs, &stats);
     let (predicted, follow_up) = prep.predicted_nth(costs, opts.depth);
@@ -323,7 +338,7 @@ pub fn render_prepared(
         check: opts.check,
         time_decisions: false,
     };
-    let (image, r) = trace::render(prep, settings, on_tile);
+    let (image, r) = trace::render_region(prep, settings, region, on_tile);
     let nth = NthReport {
         predicted,
         equation_12,

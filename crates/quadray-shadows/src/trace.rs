@@ -78,6 +78,64 @@ struct Tracer<'a, S> {
     test: S,
 }
 
+/// A rectangle of the image, in pixels from the top-left corner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Region {
+    /// Left column.
+    pub x: u32,
+    /// Top row.
+    pub y: u32,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
+
+impl Region {
+    /// The whole of a `width` x `height` image.
+    pub fn full(width: u32, height: u32) -> Self {
+        Self {
+            x: 0,
+            y: 0,
+            width,
+            height,
+        }
+    }
+}
+
+/// The linear RGB radiance of a region of the image, row-major, before tone mapping: what a
+/// render computes, so that regions rendered apart assemble into exactly the whole render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Radiance {
+    /// Where the pixels lie in the image.
+    pub region: Region,
+    /// `region.width * region.height` pixels, top row first.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl Radiance {
+    /// The displayed picture: clamped to [0, 1], gamma 2.2, rounded to 8 bits.
+    pub fn to_rgba8(&self) -> Rgba8Image {
+        let pixels = self
+            .pixels
+            .iter()
+            .map(|&p| {
+                let c = Vec3::from_array(p)
+                    .clamp(Vec3::ZERO, Vec3::ONE)
+                    .powf(1.0 / 2.2)
+                    * 255.0
+                    + 0.5;
+                [c.x as u8, c.y as u8, c.z as u8, 255]
+            })
+            .collect();
+        Rgba8Image {
+            width: self.region.width,
+            height: self.region.height,
+            pixels,
+        }
+    }
+}
+
 /// Renders the scene; `on_tile` is called after each finished tile (for a progress bar). The
 /// scene must have at most [`MAX_LIGHTS`] lights and the structures `settings.scheme` needs must
 /// have been prepared.
@@ -86,27 +144,46 @@ pub fn render(
     settings: Settings,
     on_tile: &(dyn Fn() + Sync),
 ) -> (Rgba8Image, RenderStats) {
+    let full = Region::full(settings.width, settings.height);
+    let (radiance, stats) = render_region(prep, settings, full, on_tile);
+    (radiance.to_rgba8(), stats)
+}
+
+/// [`render`] of the pixels in `region` alone (inside the `settings.width` x `settings.height`
+/// image), as radiance: every pixel depends only on its own rays, so regions rendered apart are
+/// bit for bit the same pixels as the whole render.
+pub fn render_region(
+    prep: &Prepared,
+    settings: Settings,
+    region: Region,
+    on_tile: &(dyn Fn() + Sync),
+) -> (Radiance, RenderStats) {
+    assert!(
+        region.x + region.width <= settings.width && region.y + region.height <= settings.height,
+        "region {region:?} outside the {}x{} image",
+        settings.width,
+        settings.height
+    );
     assert!(
         prep.scene.lights.len() <= MAX_LIGHTS,
         "at most {MAX_LIGHTS} lights"
     );
     let volumes = || prep.volumes.as_ref().expect("shadow volumes prepared");
+    let grid_rays = || ShadowRays(prep.grid_occluder());
     match settings.scheme {
-        Scheme::Conventional => {
-            render_with(prep, settings, ShadowRays(prep.grid_occluder()), on_tile)
-        }
+        Scheme::Conventional => render_with(prep, settings, region, grid_rays(), on_tile),
         Scheme::Bvh => {
             let bvh = prep.bvh_occluder().expect("BVH prepared");
-            render_with(prep, settings, ShadowRays(bvh), on_tile)
+            render_with(prep, settings, region, ShadowRays(bvh), on_tile)
         }
         #[cfg(feature = "embree")]
         Scheme::Embree => {
             let embree = prep.embree.as_ref().expect("Embree scene prepared");
-            render_with(prep, settings, ShadowRays(embree), on_tile)
+            render_with(prep, settings, region, ShadowRays(embree), on_tile)
         }
         #[cfg(not(feature = "embree"))]
-        Scheme::Embree => render_with(prep, settings, ShadowRays(prep.grid_occluder()), on_tile),
-        Scheme::Volume => render_with(prep, settings, Volumes(volumes()), on_tile),
+        Scheme::Embree => render_with(prep, settings, region, grid_rays(), on_tile),
+        Scheme::Volume => render_with(prep, settings, region, Volumes(volumes()), on_tile),
         Scheme::Hst { nth } => {
             let test = Hybrid {
                 volumes: volumes(),
@@ -114,33 +191,40 @@ pub fn render(
                 nth,
                 time_decisions: settings.time_decisions,
             };
-            render_with(prep, settings, test, on_tile)
+            render_with(prep, settings, region, test, on_tile)
         }
     }
 }
 
-/// [`render`] with the shadow test chosen.
+/// [`render_region`] with the shadow test chosen.
 fn render_with<S: ShadowTest>(
     prep: &Prepared,
     settings: Settings,
+    region: Region,
     test: S,
     on_tile: &(dyn Fn() + Sync),
-) -> (Rgba8Image, RenderStats) {
+) -> (Radiance, RenderStats) {
     let tracer = Tracer {
         prep,
         settings,
         test,
     };
-    let (w, h) = (settings.width, settings.height);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
+    let tiles: Vec<Region> = (0..region.height.div_ceil(TILE))
+        .flat_map(|ty| {
+            (0..region.width.div_ceil(TILE)).map(move |tx| Region {
+                x: region.x + tx * TILE,
+                y: region.y + ty * TILE,
+                width: (region.width - tx * TILE).min(TILE),
+                height: (region.height - ty * TILE).min(TILE),
+            })
+        })
         .collect();
     let start = Instant::now();
     let cpu_start = crate::process_cpu_s();
-    let done: Vec<(Vec<[u8; 4]>, RenderStats)> = tiles
+    let done: Vec<(Vec<[f32; 3]>, RenderStats)> = tiles
         .par_iter()
-        .map(|&(tx, ty)| {
-            let out = tracer.tile(tx, ty);
+        .map(|&tile| {
+            let out = tracer.tile(tile);
             on_tile();
             out
         })
@@ -150,20 +234,23 @@ fn render_with<S: ShadowTest>(
         render_cpu_s: crate::process_cpu_s() - cpu_start,
         ..Default::default()
     };
-    let mut image = Rgba8Image::new(w, h, [0, 0, 0, 255]);
-    for (&(tx, ty), (pixels, s)) in tiles.iter().zip(&done) {
+    let mut radiance = Radiance {
+        region,
+        pixels: vec![[0.0; 3]; (region.width * region.height) as usize],
+    };
+    for (tile, (pixels, s)) in tiles.iter().zip(&done) {
         stats.add(s);
-        let tw = (w - tx * TILE).min(TILE);
         for (i, p) in pixels.iter().enumerate() {
-            let (x, y) = (tx * TILE + i as u32 % tw, ty * TILE + i as u32 / tw);
-            image.pixels[(y * w + x) as usize] = *p;
+            let x = tile.x - region.x + i as u32 % tile.width;
+            let y = tile.y - region.y + i as u32 / tile.width;
+            radiance.pixels[(y * region.width + x) as usize] = *p;
         }
     }
-    (image, stats)
+    (radiance, stats)
 }
 
 impl<S: ShadowTest> Tracer<'_, S> {
-    fn tile(&self, tx: u32, ty: u32) -> (Vec<[u8; 4]>, RenderStats) {
+    fn tile(&self, tile: Region) -> (Vec<[f32; 3]>, RenderStats) {
         let start = crate::ticks();
         let prep = self.prep;
         let (w, h) = (self.settings.width, self.settings.height);
@@ -185,8 +272,8 @@ impl<S: ShadowTest> Tracer<'_, S> {
         }
         let spp = self.settings.spp.max(1);
         let mut pixels = Vec::new();
-        for y in ty * TILE..((ty + 1) * TILE).min(h) {
-            for x in tx * TILE..((tx + 1) * TILE).min(w) {
+        for y in tile.y..tile.y + tile.height {
+            for x in tile.x..tile.x + tile.width {
                 let mut sum = Vec3::ZERO;
                 for s in 0..spp {
                     // A fixed rotated-grid pattern: deterministic antialiasing.
@@ -208,12 +295,7 @@ impl<S: ShadowTest> Tracer<'_, S> {
                         eye_states,
                     );
                 }
-                let c = (sum / spp as f32)
-                    .clamp(Vec3::ZERO, Vec3::ONE)
-                    .powf(1.0 / 2.2)
-                    * 255.0
-                    + 0.5;
-                pixels.push([c.x as u8, c.y as u8, c.z as u8, 255]);
+                pixels.push((sum / spp as f32).to_array());
             }
         }
         scratch.stats.tile_ticks = crate::ticks().wrapping_sub(start);

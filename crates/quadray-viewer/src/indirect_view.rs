@@ -327,6 +327,12 @@ impl IndirectView {
         if !c.flux_weighted {
             cmd += " --unweighted-means";
         }
+        if s.shadow_steps > 0 {
+            cmd += &format!(
+                " --indirect-shadows --shadow-steps {} --shadow-thickness {}",
+                s.shadow_steps, s.shadow_thickness
+            );
+        }
         Some(cmd + &format!(" --out {}", shell_word(out)))
     }
 
@@ -426,6 +432,11 @@ impl IndirectView {
                 .text("RSM samples"),
         );
         ui.add(egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling"));
+        // marching 8 points per receiver and cluster halves the error to the ground truth with
+        // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
+        let mut shadows = s.shadow_steps > 0;
+        ui.checkbox(&mut shadows, "indirect shadows (quadtree)");
+        s.shadow_steps = if shadows { 8 } else { 0 };
         ui.checkbox(&mut self.animate_light, "animate light (L)");
         if self.method == Method::Reference {
             let work = f64::from(s.width) * f64::from(s.height) * f64::from(s.rsm_size).powi(2);

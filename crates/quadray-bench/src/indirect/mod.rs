@@ -2,5 +2,7 @@
 //! `quadray bench indirect` and the pictures of `quadray demo`.
 
 pub mod demo;
+pub mod equal_error;
 pub mod run;
 pub mod tables;
+pub mod temporal;

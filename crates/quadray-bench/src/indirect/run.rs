@@ -2,11 +2,14 @@
 //! error heat map) and the stats (GPU time per pass with a moving and a static light, clusters in
 //! the cut, error against the brute force).
 
+use super::temporal::{self, Temporal};
 use quadray_core::image_out::{Rgba8Image, heat_map};
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, mean_flip, tone_map};
 use quadray_indirect::reference::{self, ImageError};
-use quadray_indirect::{Frame, FrameTiming, IndirectError, Method, Renderer, Scene, Settings};
+use quadray_indirect::{
+    Frame, FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts,
+};
 use serde::Serialize;
 
 /// What to do besides rendering.
@@ -17,6 +20,11 @@ pub struct RunOptions {
     pub frames: u32,
     /// Also render the GPU brute force and measure the error against it.
     pub reference: bool,
+    /// Also compute the CPU ground truth with visibility and measure the error against it.
+    pub ground_truth: bool,
+    /// Also render a sequence with the light turning this many degrees a frame (`frames`
+    /// frames) and measure its stability.
+    pub light_orbit: Option<f32>,
     /// Radiance scale before tone mapping.
     pub exposure: f32,
 }
@@ -34,6 +42,13 @@ pub struct Stats {
     pub clusters_in_cut: Option<u32>,
     /// Pixels the upsampler recomputed at full resolution (sub-sampled quadtree).
     pub recomputed_pixels: u32,
+    /// VPL kernels evaluated per shaded pixel (clusters or RSM samples summed), counted in the
+    /// shaders: the hardware-independent cost of the method.
+    pub vpl_evaluations_per_pixel: f64,
+    /// G-buffer and RSM texels, node records and low-resolution samples read per shaded pixel.
+    pub texel_fetches_per_pixel: f64,
+    /// The totals the two means come from.
+    pub work: WorkCounts,
     /// The light moves: RSM, pyramid, validity and cut rebuilt every frame.
     pub gpu_time_ms_moving: Option<FrameTiming>,
     /// The light stays: those buffers reused.
@@ -42,6 +57,49 @@ pub struct Stats {
     pub error: Option<ImageError>,
     /// Mean FLIP of the tone-mapped combined picture against direct + brute-force indirect.
     pub flip: Option<f32>,
+    /// Error against one bounce from every VPL with exact visibility (with `--ground-truth`).
+    pub ground_truth: Option<TruthError>,
+    /// Stability under a turning light (with `--light-orbit`).
+    pub temporal: Option<Temporal>,
+}
+
+/// Error of the indirect term against the ground truth with visibility, and the FLIP of the
+/// combined picture against direct + that indirect light.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct TruthError {
+    /// sum |ours - truth| / sum |truth| over the indirect term.
+    pub rel_l1: f64,
+    /// Root mean square difference of the indirect term.
+    pub rmse: f64,
+    /// Mean FLIP of the tone-mapped combined pictures.
+    pub flip: f32,
+}
+
+/// Refuses a ground truth that would trace more than [`reference::MAX_GROUND_TRUTH_RAYS`].
+pub fn check_ground_truth_size(settings: &Settings) -> Result<(), IndirectError> {
+    let rays = u64::from(settings.width)
+        * u64::from(settings.height)
+        * u64::from(settings.rsm_size).pow(2);
+    if rays > reference::MAX_GROUND_TRUTH_RAYS {
+        return Err(IndirectError::Settings(format!(
+            "the ground truth traces a ray per pixel and VPL: {}x{} pixels x {}^2 VPLs is {rays:.3e}              rays, over the limit of {:.3e}; use a smaller --size or --rsm-size",
+            settings.width,
+            settings.height,
+            settings.rsm_size,
+            reference::MAX_GROUND_TRUTH_RAYS as f64,
+        )));
+    }
+    Ok(())
+}
+
+/// The mean FLIP of `frame`'s combined picture against the same direct light plus `indirect`.
+fn flip_against(frame: &Frame, indirect: &[[f32; 3]], picture: &Rgba8Image, exposure: f32) -> f32 {
+    let truth = Frame {
+        indirect: indirect.to_vec(),
+        ..frame.clone()
+    };
+    let (w, h) = (frame.width, frame.height);
+    mean_flip(&tone_map(w, h, &truth.combined(), exposure), picture)
 }
 
 pub struct Outcome {
@@ -53,6 +111,8 @@ pub struct Outcome {
     pub error_map: Option<Rgba8Image>,
     /// The cut over the RSM (quadtree methods), see [`cut_view`].
     pub cut_view: Option<Rgba8Image>,
+    /// The ground truth's indirect light (with `ground_truth`).
+    pub ground_truth: Option<Rgba8Image>,
 }
 
 /// Renders `options.method` on `scene`, times it and measures it.
@@ -62,6 +122,9 @@ pub fn run(
     settings: Settings,
     options: &RunOptions,
 ) -> Result<Outcome, IndirectError> {
+    if options.ground_truth {
+        check_ground_truth_size(&settings)?;
+    }
     let mut renderer = Renderer::new(gpu, scene, settings)?;
     let method = options.method;
     let reference = if options.reference {
@@ -92,15 +155,32 @@ pub fn run(
         .as_ref()
         .map(|r| heat_map(w, h, &reference::error_map(&frame.indirect, r), 0.5));
     let combined_image = tone_map(w, h, &combined, options.exposure);
-    let flip = reference.as_ref().map(|r| {
-        let truth = Frame {
-            indirect: r.clone(),
-            ..frame.clone()
-        };
-        mean_flip(
-            &tone_map(w, h, &truth.combined(), options.exposure),
-            &combined_image,
-        )
+    let flip = reference
+        .as_ref()
+        .map(|r| flip_against(&frame, r, &combined_image, options.exposure));
+    let truth = if options.ground_truth {
+        let (vpls, receivers) = (renderer.read_vpls()?, renderer.read_receivers()?);
+        Some(reference::ground_truth(&vpls, &receivers, scene))
+    } else {
+        None
+    };
+    let temporal = match options.light_orbit {
+        Some(degrees) => Some(temporal::measure(
+            &mut renderer,
+            scene,
+            method,
+            degrees,
+            options.frames,
+        )?),
+        None => None,
+    };
+    let ground_truth = truth.as_ref().map(|truth| {
+        let e = reference::compare(&frame.indirect, truth);
+        TruthError {
+            rel_l1: e.rel_l1,
+            rmse: e.rmse,
+            flip: flip_against(&frame, truth, &combined_image, options.exposure),
+        }
     });
     Ok(Outcome {
         stats: Stats {
@@ -112,10 +192,15 @@ pub fn run(
             rsm_size: s.rsm_size,
             clusters_in_cut,
             recomputed_pixels: frame.recomputed,
+            vpl_evaluations_per_pixel: frame.counts.vpl_evaluations_per_pixel(),
+            texel_fetches_per_pixel: frame.counts.texel_fetches_per_pixel(),
+            work: frame.counts,
             gpu_time_ms_moving: moving,
             gpu_time_ms_static: still,
             error,
             flip,
+            ground_truth,
+            temporal,
             settings: s,
         },
         direct: tone_map(w, h, &frame.direct, options.exposure),
@@ -123,5 +208,6 @@ pub fn run(
         combined: combined_image,
         error_map,
         cut_view: cut,
+        ground_truth: truth.map(|t| tone_map(w, h, &t, options.exposure)),
     })
 }

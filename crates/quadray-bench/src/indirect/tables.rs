@@ -3,6 +3,7 @@
 //! error-vs-time plot, and the speed ratios (compacted cut vs per-level passes, quadtree vs RSM at
 //! equal error). GPU times are medians of timestamp queries; ratios come from one run.
 
+use super::equal_error::at_error;
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
@@ -353,19 +354,12 @@ fn ratios(rows: &[Row]) -> Ratios {
 /// Samples and static-light time at which RSM sampling's error falls to `error`: log-log
 /// interpolation between the consecutive sample counts (rows in increasing order) that bracket it.
 fn rsm_at_error(rsm: &[&Row], error: f64) -> Option<(f64, f64)> {
-    let samples = |r: &Row| r.label.trim_end_matches(" samples").parse::<f64>().ok();
-    rsm.windows(2).find_map(|pair| {
-        let (a, b) = (pair[0], pair[1]);
-        if !(a.rel_l1 > error && b.rel_l1 <= error) {
-            return None;
-        }
-        let f = (error.ln() - a.rel_l1.ln()) / (b.rel_l1.ln() - a.rel_l1.ln());
-        let lerp = |x: f64, y: f64| (x.ln() + f * (y.ln() - x.ln())).exp();
-        Some((
-            lerp(samples(a)?, samples(b)?),
-            lerp(a.static_ms?, b.static_ms?),
-        ))
-    })
+    let curve = |value: &dyn Fn(&Row) -> Option<f64>| -> Option<Vec<(f64, f64)>> {
+        rsm.iter().map(|r| Some((r.rel_l1, value(r)?))).collect()
+    };
+    let samples = curve(&|r| r.label.trim_end_matches(" samples").parse::<f64>().ok())?;
+    let times = curve(&|r| r.static_ms)?;
+    Some((at_error(&samples, error)?, at_error(&times, error)?))
 }
 
 fn write_outputs(out: &Path, results: &BenchResults) -> Result<(), IndirectError> {

@@ -151,6 +151,24 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<(gltf::Document, Option<Vec<u8>>),
         }
         _ => serde_json::from_slice(&json).map_err(|e| error(&e))?,
     };
+    // gltf-json 1.4.1 validates POSITION's min/max by indexing `accessors` with the attribute's
+    // index before checking it (a panic on a bad index): check every attribute's index first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(bad) = primitive
+                .attributes
+                .values()
+                .find(|a| a.value() >= root.accessors.len())
+            {
+                return Err(error(&format!(
+                    "meshes[{m}].primitives[{p}].attributes: accessor {} out of range ({} \
+                     accessors)",
+                    bad.value(),
+                    root.accessors.len()
+                )));
+            }
+        }
+    }
     // POSITION's min/max are required by the spec but unused here (bounds are computed from the
     // data), and many exporters leave them out: their absence is not an error.
     let mut problems = Vec::new();

@@ -4,8 +4,10 @@
 // Irradiance at `r` from the VPL of RSM texel `t`; an empty texel gives none.
 fn texel_irradiance(t: vec2<i32>, r: Receiver) -> vec3<f32> {
     var e = vec3<f32>(0.0);
+    fetches++;
     let n = textureLoad(rsm_normal, t, 0);
     if (n.w > 0.5) {
+        fetches += 2u;
         let p = textureLoad(rsm_pos, t, 0);
         let flux = textureLoad(rsm_flux, t, 0).rgb;
         e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, shade.r_min);
@@ -29,6 +31,7 @@ fn brute_force(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
+    store_counts(pixel_index(id.xy));
 }
 
 @compute @workgroup_size(8, 8)
@@ -64,4 +67,5 @@ fn rsm_sampling(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
+    store_counts(pixel_index(id.xy));
 }

@@ -5,6 +5,9 @@
 /// WGSL of the GPU reference and of RSM sampling.
 pub const WGSL: &str = include_str!("baselines.wgsl");
 
+/// The seed of the RSM-sampling pattern the gather uses.
+pub const SAMPLE_SEED: u64 = 0x5eed;
+
 /// A small deterministic generator (SplitMix64), so every run samples the same pattern.
 struct SplitMix(u64);
 

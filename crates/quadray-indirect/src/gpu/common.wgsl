@@ -5,6 +5,12 @@
 //   flux.rgb: summed flux, flux.w: number of texels that see geometry
 //   pos.xyz: mean position, pos.w: mean RSM depth (light-axis distance / scene extent)
 //   normal.xyz: renormalised mean normal, normal.w: 1 when the cluster is valid
+// The work one invocation did, for the counts the stats report (see `WorkCounts`): VPLs or
+// clusters summed, and texels or node records read (G-buffer, RSM, quadtree, low-resolution
+// samples). The shading passes store them per pixel; elsewhere they are dropped.
+var<private> evaluations: u32;
+var<private> fetches: u32;
+
 struct Node {
     flux: vec4<f32>,
     pos: vec4<f32>,
@@ -51,6 +57,7 @@ fn node_index(p: ClusterParams, level: u32, xy: vec2<u32>) -> u32 {
 // flux / pi * cos: the 1/pi the spec's formula (after the RSM paper) leaves out is put back so
 // that indirect and direct light are on the same scale; errors are ratios and do not change.
 fn vpl_irradiance(flux: vec3<f32>, xp: vec3<f32>, np: vec3<f32>, x: vec3<f32>, n: vec3<f32>, r_min: f32) -> vec3<f32> {
+    evaluations++;
     let d = x - xp;
     let d2 = max(dot(d, d), r_min * r_min);
     return flux * (max(0.0, dot(np, d)) * max(0.0, dot(n, -d)) / (PI * d2 * d2));

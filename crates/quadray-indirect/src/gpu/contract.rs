@@ -103,8 +103,11 @@ pub(crate) struct ShadeUniform {
     pub depth_bias: f32,
     pub normal_agreement: f32,
     pub plane_agreement: f32,
-    pub pad0: u32,
-    pub pad1: u32,
+    pub shadow_steps: u32,
+    pub shadow_thickness: f32,
+    /// Written by `Gather::set_camera`, the fields before by `Gather::set_light`.
+    pub camera: [[f32; 4]; 4],
+    pub eye: [f32; 4],
 }
 
 /// WGSL `Level`: one slot of the per-dispatch uniforms (a level, or a slice of a long sum).
@@ -402,8 +405,10 @@ mod tests {
                     depth_bias,
                     normal_agreement,
                     plane_agreement,
-                    pad0,
-                    pad1
+                    shadow_steps,
+                    shadow_thickness,
+                    camera,
+                    eye
                 ]
             ),
             shared!("Level", LevelSlot, [level]),

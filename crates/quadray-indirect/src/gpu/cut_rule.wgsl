@@ -2,13 +2,18 @@
 // (shade.wgsl): a node is used when it is accepted (valid, or at the limit level) and none of its
 // ancestors up to the start level was. This is the paper's "revisit" of ancestors.
 fn accepted(p: ClusterParams, level: u32, xy: vec2<u32>) -> bool {
-    return level == p.limit_level || nodes[node_index(p, level, xy)].normal.w > 0.5;
+    if (level == p.limit_level) {
+        return true;
+    }
+    fetches++;
+    return nodes[node_index(p, level, xy)].normal.w > 0.5;
 }
 
 fn in_cut(p: ClusterParams, level: u32, xy: vec2<u32>) -> bool {
     if (level < p.limit_level || level > p.start_level) {
         return false;
     }
+    fetches++;
     if (nodes[node_index(p, level, xy)].flux.w < 0.5 || !accepted(p, level, xy)) {
         return false;
     }

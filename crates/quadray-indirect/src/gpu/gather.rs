@@ -40,6 +40,9 @@ pub struct GBufferViews<'a> {
     pub albedo: &'a wgpu::TextureView,
 }
 
+/// Where the camera starts in the shading uniform: `set_light` writes what comes before.
+const CAMERA_OFFSET: usize = std::mem::offset_of!(ShadeUniform, camera);
+
 /// Where a low-resolution indirect sample's pixel is (one sample per `subsample`^2 pixels).
 fn low_size(s: &Settings) -> (u32, u32) {
     (
@@ -48,13 +51,15 @@ fn low_size(s: &Settings) -> (u32, u32) {
     )
 }
 
-/// The per-frame buffers: sizes, radiance out, RSM samples.
+/// The per-frame buffers: sizes, radiance out, RSM samples, work counts.
 struct Outputs {
     shade: wgpu::Buffer,
     indirect: wgpu::Buffer,
     direct: wgpu::Buffer,
     low: wgpu::Buffer,
     samples: wgpu::Buffer,
+    /// Per pixel: VPL evaluations and texel fetches of the last indirect passes (two `u32`).
+    counts: wgpu::Buffer,
 }
 
 impl Outputs {
@@ -77,6 +82,7 @@ impl Outputs {
                 whole(&self.direct),
                 whole(&self.low),
                 whole(&self.samples),
+                whole(&self.counts),
             ],
         )
     }
@@ -144,6 +150,7 @@ impl Gather {
                 storage_entry::<[f32; 4]>(5, false),
                 storage_entry::<[f32; 4]>(6, false),
                 storage_entry::<[f32; 4]>(7, true),
+                storage_entry::<[u32; 2]>(8, false),
             ],
         );
         let dispatch_layout = layout(
@@ -162,7 +169,7 @@ impl Gather {
         let samples = baselines::rsm_samples(
             s.samples,
             s.rsm_radius * s.rsm_size as f32 * std::f32::consts::SQRT_2,
-            0x5eed,
+            baselines::SAMPLE_SEED,
         );
         let light = uniform_buffer::<LightUniform>(device, "gather light");
         let outputs = Outputs {
@@ -175,6 +182,7 @@ impl Gather {
                 contents: bytemuck::cast_slice(&samples),
                 usage: wgpu::BufferUsages::STORAGE,
             }),
+            counts: storage_buffer(device, "work counts", pixels * 8),
         };
         let slots = Slots::new(device, "gather slots", MAX_SLICES);
         Ok(Self {
@@ -249,7 +257,7 @@ impl Gather {
         queue.write_buffer(
             &self.outputs.shade,
             0,
-            bytemuck::bytes_of(&ShadeUniform {
+            &bytemuck::bytes_of(&ShadeUniform {
                 width: s.width,
                 height: s.height,
                 r_min,
@@ -261,9 +269,27 @@ impl Gather {
                 depth_bias: 0.005 + 3.0 * texel_side * spot.far / spot.extent,
                 normal_agreement: 0.9,
                 plane_agreement: 0.02 * spot.extent,
-                pad0: 0,
-                pad1: 0,
-            }),
+                shadow_steps: s.shadow_steps,
+                shadow_thickness: s.shadow_thickness * spot.extent,
+                camera: [[0.0; 4]; 4],
+                eye: [0.0; 4],
+            })[..CAMERA_OFFSET],
+        );
+    }
+
+    /// Sets the camera the G-buffer is rendered from (`view_proj`: world -> clip, `eye`: its
+    /// position): indirect shadows read the G-buffer as a depth map.
+    pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
+        let camera = (view_proj.to_cols_array_2d(), eye.extend(1.0).to_array());
+        queue.write_buffer(
+            &self.outputs.shade,
+            CAMERA_OFFSET as u64,
+            bytemuck::bytes_of(&camera.0),
+        );
+        queue.write_buffer(
+            &self.outputs.shade,
+            (CAMERA_OFFSET + size_of::<[[f32; 4]; 4]>()) as u64,
+            bytemuck::bytes_of(&camera.1),
         );
     }
 
@@ -293,6 +319,7 @@ impl Gather {
         if method == Method::QuadtreePasses {
             encoder.clear_buffer(&self.outputs.indirect, 0, None);
         }
+        encoder.clear_buffer(&self.outputs.counts, 0, None);
         {
             let stamps = timer.and_then(|(t, slot, _)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "indirect", stamps);
@@ -372,8 +399,13 @@ impl Gather {
         &self.outputs.indirect
     }
 
-    /// Direct radiance per pixel, row-major (rgb, w = 1).
+    /// Direct radiance per pixel, row-major (rgb, w = 1 where the G-buffer has geometry).
     pub(crate) fn direct(&self) -> &wgpu::Buffer {
         &self.outputs.direct
+    }
+
+    /// Per pixel, the last indirect passes' VPL evaluations and texel fetches (`[u32; 2]`).
+    pub(crate) fn counts(&self) -> &wgpu::Buffer {
+        &self.outputs.counts
     }
 }

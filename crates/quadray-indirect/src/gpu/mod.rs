@@ -182,6 +182,12 @@ pub struct Settings {
     pub rsm_radius: f32,
     /// Indirect at one sample per `subsample`^2 pixels (1: full resolution).
     pub subsample: u32,
+    /// Indirect shadows for the quadtree methods: points marched between each receiver and
+    /// cluster, tested against the camera's and the light's depth (0: none, as in the paper).
+    pub shadow_steps: u32,
+    /// How far behind a surface a depth map sees a marched point counts as inside an occluder,
+    /// as a fraction of the scene's extent.
+    pub shadow_thickness: f32,
 }
 
 impl Default for Settings {
@@ -194,6 +200,8 @@ impl Default for Settings {
             samples: 256,
             rsm_radius: 1.0,
             subsample: 1,
+            shadow_steps: 0,
+            shadow_thickness: 0.1,
         }
     }
 }
@@ -240,6 +248,18 @@ impl Settings {
         }
         if !(1..=64).contains(&s.subsample) {
             return Err(format!("subsample {} is outside 1..64", s.subsample));
+        }
+        if s.shadow_steps > 64 {
+            return Err(format!("{} shadow steps is over 64", s.shadow_steps));
+        }
+        if !(s.shadow_thickness.is_finite()
+            && s.shadow_thickness > 0.0
+            && s.shadow_thickness <= 1.0)
+        {
+            return Err(format!(
+                "shadow thickness {} is outside (0, 1]",
+                s.shadow_thickness
+            ));
         }
         Ok(())
     }
@@ -319,6 +339,36 @@ pub struct Frame {
     pub direct: Vec<[f32; 3]>,
     /// Pixels the upsampler recomputed at full resolution.
     pub recomputed: u32,
+    /// The work the indirect passes did, counted in the shaders.
+    pub counts: WorkCounts,
+}
+
+/// The work of a frame's indirect passes, counted by the shaders themselves: hardware-independent
+/// figures to compare methods by. Every dispatch's work is counted, so a sum split into slices
+/// reads the G-buffer once per slice, and the sub-sampled quadtree counts its low-resolution
+/// samples and the pixels the upsampler recomputed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct WorkCounts {
+    /// Pixels where the G-buffer has geometry: the ones shaded, what the means are over.
+    pub shaded_pixels: u32,
+    /// VPL kernels evaluated (a cluster counts one, an RSM sample one where its texel is a
+    /// VPL), over all pixels.
+    pub vpl_evaluations: u64,
+    /// Reads of G-buffer texels, RSM texels, quadtree node records and low-resolution samples,
+    /// over all pixels.
+    pub texel_fetches: u64,
+}
+
+impl WorkCounts {
+    /// Mean VPL evaluations per shaded pixel.
+    pub fn vpl_evaluations_per_pixel(&self) -> f64 {
+        self.vpl_evaluations as f64 / f64::from(self.shaded_pixels.max(1))
+    }
+
+    /// Mean texel fetches per shaded pixel.
+    pub fn texel_fetches_per_pixel(&self) -> f64 {
+        self.texel_fetches as f64 / f64::from(self.shaded_pixels.max(1))
+    }
 }
 
 impl Frame {

@@ -8,6 +8,7 @@ use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
 use super::{
     ClusterSettings, CutNode, Frame, FrameTiming, Gather, Method, Pass, Receiver, Settings, Vpl,
+    WorkCounts,
 };
 use crate::IndirectError;
 use crate::scene::Scene;
@@ -75,11 +76,10 @@ impl<'g> Renderer<'g> {
         self.rsm.set_light(q, &spot);
         self.gather.set_light(q, &spot, scene.r_min);
         let s = self.settings();
-        self.gbuffer.set_camera(
-            q,
-            scene.camera_view_proj(s.width as f32 / s.height as f32),
-            scene.camera.position.into(),
-        );
+        let view_proj = scene.camera_view_proj(s.width as f32 / s.height as f32);
+        let eye = scene.camera.position.into();
+        self.gbuffer.set_camera(q, view_proj, eye);
+        self.gather.set_camera(q, view_proj, eye);
     }
 
     /// Changes the quadtree's parameters; the next frame with `rebuild` uses them.
@@ -194,6 +194,12 @@ impl<'g> Renderer<'g> {
         }))
     }
 
+    /// The gather the frames are shaded with (to write them into your own texture with an
+    /// [`super::OutputPass`]).
+    pub fn gather(&self) -> &Gather {
+        &self.gather
+    }
+
     /// Whether the adapter has timestamp queries, so that timings can be taken at all.
     pub fn has_timestamps(&self) -> bool {
         self.timer.enabled()
@@ -222,9 +228,18 @@ impl<'g> Renderer<'g> {
     pub fn read_frame(&self) -> Result<Frame, IndirectError> {
         let indirect = self.read_vec4(self.gather.indirect())?;
         let direct = self.read_vec4(self.gather.direct())?;
+        let counts: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&quadray_gpu::read_buffer(
+            self.gpu,
+            self.gather.counts(),
+        )?);
         let rgb = |v: &[[f32; 4]]| v.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let s = self.settings();
         Ok(Frame {
+            counts: WorkCounts {
+                shaded_pixels: direct.iter().filter(|p| p[3] > 0.5).count() as u32,
+                vpl_evaluations: counts.iter().map(|c| u64::from(c[0])).sum(),
+                texel_fetches: counts.iter().map(|c| u64::from(c[1])).sum(),
+            },
             width: s.width,
             height: s.height,
             recomputed: indirect.iter().filter(|p| p[3] > 0.5).count() as u32,

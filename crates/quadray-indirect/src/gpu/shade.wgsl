@@ -9,6 +9,7 @@ fn cut_irradiance(r: Receiver) -> vec3<f32> {
     for (var i = range.x; i < range.y; i++) {
         e += node_irradiance(cut[i], r);
     }
+    fetches += range.y - min(range.x, range.y);
     return e;
 }
 
@@ -23,6 +24,7 @@ fn indirect_cut(@builtin(global_invocation_id) id: vec3<u32>) {
         e = cut_irradiance(r);
     }
     add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
+    store_counts(pixel_index(id.xy));
 }
 
 // One level of the paper's traversal: every node of the level, used when the top-down rule says
@@ -33,7 +35,9 @@ fn indirect_level(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let r = receiver(id.xy);
+    let index = pixel_index(id.xy);
     if (!r.covered) {
+        store_counts(index);
         return;
     }
     let level = current.level;
@@ -43,11 +47,12 @@ fn indirect_level(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = range.x; i < range.y; i++) {
         let xy = vec2<u32>(i % size, i / size);
         if (in_cut(params, level, xy)) {
+            fetches++;
             e += node_irradiance(nodes[level_offset(params, level) + i], r);
         }
     }
-    let index = pixel_index(id.xy);
     indirect[index] += vec4<f32>(r.albedo / PI * e, 0.0);
+    store_counts(index);
 }
 
 // The full-resolution pixel a low-resolution sample stands for.
@@ -72,6 +77,8 @@ fn indirect_low(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         low[index] += vec4<f32>(e, 0.0);
     }
+    let full = low_pixel(id.xy);
+    store_counts(full.y * shade.width + full.x);
 }
 
 // Bilinear over the four nearest low-resolution samples that lie on the same surface (normals
@@ -86,6 +93,7 @@ fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = pixel_index(id.xy);
     if (!r.covered) {
         add_indirect(index, vec4<f32>(0.0));
+        store_counts(index);
         return;
     }
     let k = f32(shade.subsample);
@@ -102,6 +110,7 @@ fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
             && abs(dot(q.x - r.x, r.n)) < shade.plane_agreement;
         let w = select(1.0 - t.x, t.x, o.x == 1) * select(1.0 - t.y, t.y, o.y == 1);
         if (agree && w > 0.0) {
+            fetches++;
             e += w * low[u32(s.y) * shade.low_width + u32(s.x)].rgb;
             weight += w;
         }
@@ -113,6 +122,7 @@ fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         add_indirect(index, vec4<f32>(r.albedo / PI * cut_irradiance(r), 1.0));
     }
+    store_counts(index);
 }
 
 // Direct light from the spot, shadowed by the RSM depth.
@@ -140,5 +150,5 @@ fn direct_light(@builtin(global_invocation_id) id: vec3<u32>) {
             l = r.albedo / PI * spot_intensity(light, -w) * max(0.0, dot(r.n, w)) / d2;
         }
     }
-    direct[pixel_index(id.xy)] = vec4<f32>(l, 1.0);
+    direct[pixel_index(id.xy)] = vec4<f32>(l, select(0.0, 1.0, r.covered));
 }

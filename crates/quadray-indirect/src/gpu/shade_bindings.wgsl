@@ -14,8 +14,13 @@ struct Shade {
     // geometry agreement for upsampling: normals' dot and plane distance (world units)
     normal_agreement: f32,
     plane_agreement: f32,
-    pad0: u32,
-    pad1: u32,
+    // indirect shadows: points marched between a receiver and a cluster (0: none), and how deep
+    // behind a depth map's surface a point counts as inside the occluder (world units)
+    shadow_steps: u32,
+    shadow_thickness: f32,
+    // the camera the G-buffer was rendered from (set with the camera, not with the light)
+    camera: mat4x4<f32>,
+    eye: vec4<f32>,
 }
 
 // Group 0, per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
@@ -38,6 +43,8 @@ struct Shade {
 @group(1) @binding(6) var<storage, read_write> low: array<vec4<f32>>;
 // xy: offset in RSM texels, z: weight, w: the pattern's radius
 @group(1) @binding(7) var<storage, read> samples: array<vec4<f32>>;
+// per pixel: VPL evaluations and fetches of the indirect passes (cleared before them)
+@group(1) @binding(8) var<storage, read_write> counts: array<vec2<u32>>;
 // Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
@@ -52,6 +59,7 @@ struct Receiver {
 
 fn receiver(pixel: vec2<u32>) -> Receiver {
     let t = vec2<i32>(pixel);
+    fetches += 3u;
     let p = textureLoad(g_pos, t, 0);
     var r: Receiver;
     r.x = p.xyz;
@@ -62,7 +70,54 @@ fn receiver(pixel: vec2<u32>) -> Receiver {
 }
 
 fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
-    return vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, shade.r_min);
+    let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, shade.r_min);
+    if (shade.shadow_steps == 0u || all(e == vec3<f32>(0.0)) || !visible(r.x, node.pos.xyz)) {
+        return select(vec3<f32>(0.0), e, shade.shadow_steps == 0u);
+    }
+    return e;
+}
+
+// Whether `p` lies in the thin layer (bias, thickness) behind the surface a depth map sees in
+// its direction: the G-buffer from the camera or the RSM from the light (world units).
+fn inside_occluder(p: vec3<f32>) -> bool {
+    let bias = 0.1 * shade.shadow_thickness;
+    let c = shade.camera * vec4<f32>(p, 1.0);
+    let uv = vec2<f32>(c.x / c.w * 0.5 + 0.5, 0.5 - c.y / c.w * 0.5);
+    if (c.w > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0))) {
+        fetches++;
+        let size = vec2<f32>(f32(shade.width), f32(shade.height));
+        let seen = textureLoad(g_pos, vec2<i32>(uv * size), 0);
+        let behind = distance(p, shade.eye.xyz) - distance(seen.xyz, shade.eye.xyz);
+        if (seen.w > 0.5 && behind > bias && behind < shade.shadow_thickness) {
+            return true;
+        }
+    }
+    let l = light.view_proj * vec4<f32>(p, 1.0);
+    let st = vec2<f32>(l.x / l.w * 0.5 + 0.5, 0.5 - l.y / l.w * 0.5);
+    if (l.w > 0.0 && all(st >= vec2<f32>(0.0)) && all(st < vec2<f32>(1.0))) {
+        fetches++;
+        let seen = textureLoad(rsm_pos, vec2<i32>(st * f32(params.rsm_size)), 0);
+        let behind = (light_depth(light, p) - seen.w) / light.position.w;
+        if (seen.w > 0.0 && behind > bias && behind < shade.shadow_thickness) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Approximate visibility between a receiver and a cluster: no point marched between them is
+// inside an occluder as the camera's or the light's depth sees it.
+fn visible(x: vec3<f32>, xp: vec3<f32>) -> bool {
+    for (var i = 1u; i <= shade.shadow_steps; i++) {
+        if (inside_occluder(mix(x, xp, f32(i) / f32(shade.shadow_steps + 1u)))) {
+            return false;
+        }
+    }
+    return true;
+}
+// Adds this invocation's work to pixel `index`'s counts.
+fn store_counts(index: u32) {
+    counts[index] += vec2<u32>(evaluations, fetches);
 }
 
 fn pixel_index(pixel: vec2<u32>) -> u32 {

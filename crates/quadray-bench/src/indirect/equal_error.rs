@@ -1,0 +1,369 @@
+//! `quadray bench indirect --equal-error`: the light quadtree against RSM sampling at the same
+//! error, in the work counts the shaders report (VPL evaluations and texel fetches per shaded
+//! pixel, the same on any hardware) and in GPU time, on every bundled scene of the technique at
+//! several RSM sizes. RSM sampling is swept over sample counts; its cost at the quadtree's error
+//! is interpolated log-log between the two counts whose errors bracket it.
+
+use crate::report::{PlotSpec, Series, Table, line_plot};
+use quadray_core::{write_json, write_text};
+use quadray_gpu::Gpu;
+use quadray_indirect::reference::compare;
+use quadray_indirect::scene::scenes_dir;
+use quadray_indirect::{ClusterSettings, IndirectError, Method, Renderer, Scene, Settings};
+use serde::Serialize;
+use std::path::Path;
+
+/// The scenes compared: the Cornell box, the bunny and the Buddha in it, the atrium.
+const SCENES: [&str; 4] = [
+    "cornell.toml",
+    "cornell_bunny.toml",
+    "cornell_buddha.toml",
+    "atrium.toml",
+];
+/// RSM sample counts swept, up to where sampling reaches the quadtree's error.
+const SAMPLES: [u32; 10] = [16, 64, 216, 512, 1024, 2040, 4096, 8192, 16384, 32768];
+
+/// What to run.
+pub struct EqualErrorOptions {
+    /// Image side (square).
+    pub size: u32,
+    /// RSM sides, one comparison per scene each.
+    pub rsm_sizes: Vec<u32>,
+    /// Timed frames per median (0: counts and errors only).
+    pub frames: u32,
+}
+
+impl EqualErrorOptions {
+    /// The setting: 128x128 images, 256^2 and 512^2 RSMs; quick: 64x64 and 64^2.
+    pub fn new(quick: bool, size: Option<u32>, rsm_size: Option<u32>) -> Self {
+        let rsm_sizes = match (rsm_size, quick) {
+            (Some(s), _) => vec![s],
+            (None, true) => vec![64],
+            (None, false) => vec![256, 512],
+        };
+        Self {
+            size: size.unwrap_or(if quick { 64 } else { 128 }),
+            rsm_sizes,
+            frames: if quick { 2 } else { 5 },
+        }
+    }
+}
+
+/// One method at one setting: its error and its cost.
+#[derive(Clone, Debug, Serialize)]
+pub struct Point {
+    /// The method's setting ("default", "paper", "N samples").
+    pub label: String,
+    /// Relative L1 error of the indirect term against the brute force.
+    pub rel_l1: f64,
+    /// VPL kernels evaluated per shaded pixel, counted in the shaders.
+    pub vpl_evaluations_per_pixel: f64,
+    /// Texels and node records read per shaded pixel.
+    pub texel_fetches_per_pixel: f64,
+    /// Median GPU time of a frame with a static light (ms), when timestamps exist.
+    pub static_ms: Option<f64>,
+}
+
+/// A quadtree setting against RSM sampling at its error.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// The quadtree's point.
+    pub quadtree: Point,
+    /// RSM samples per pixel that reach the quadtree's error; `None` when no swept count does.
+    pub rsm_samples: Option<f64>,
+    /// RSM sampling's evaluations per pixel there over the quadtree's.
+    pub evaluation_ratio: Option<f64>,
+    /// RSM sampling's texel fetches per pixel there over the quadtree's.
+    pub fetch_ratio: Option<f64>,
+    /// RSM sampling's static-light frame time there over the quadtree's.
+    pub time_ratio: Option<f64>,
+}
+
+/// One scene at one RSM size.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneResult {
+    /// The scene's name.
+    pub scene: String,
+    /// RSM side.
+    pub rsm_size: u32,
+    /// The quadtree settings, each against RSM sampling.
+    pub comparisons: Vec<Comparison>,
+    /// RSM sampling at every swept sample count.
+    pub rsm: Vec<Point>,
+}
+
+/// Everything measured, as `equal_error.json` holds it.
+#[derive(Clone, Debug, Serialize)]
+pub struct EqualErrorResults {
+    /// The adapter the times were taken on.
+    pub adapter: String,
+    /// Image side.
+    pub size: u32,
+    /// Frames per median.
+    pub frames: u32,
+    /// Per scene and RSM size.
+    pub scenes: Vec<SceneResult>,
+}
+
+/// `x` at `error` on a curve of (error, x) points whose errors fall as it goes: log-log
+/// interpolation between the consecutive points that bracket `error`.
+pub(crate) fn at_error(curve: &[(f64, f64)], error: f64) -> Option<f64> {
+    curve.windows(2).find_map(|pair| {
+        let ((ea, xa), (eb, xb)) = (pair[0], pair[1]);
+        if !(ea > error && eb <= error) {
+            return None;
+        }
+        let f = (error.ln() - ea.ln()) / (eb.ln() - ea.ln());
+        Some((xa.ln() + f * (xb.ln() - xa.ln())).exp())
+    })
+}
+
+fn measure(
+    r: &mut Renderer,
+    method: Method,
+    label: String,
+    brute: &[[f32; 3]],
+    frames: u32,
+) -> Result<Point, IndirectError> {
+    let frame = r.render_frame(method)?;
+    let timing = r.time(method, false, frames)?;
+    Ok(Point {
+        label,
+        rel_l1: compare(&frame.indirect, brute).rel_l1,
+        vpl_evaluations_per_pixel: frame.counts.vpl_evaluations_per_pixel(),
+        texel_fetches_per_pixel: frame.counts.texel_fetches_per_pixel(),
+        static_ms: timing.map(|t| t.total_ms),
+    })
+}
+
+fn compare_at_error(quadtree: Point, rsm: &[Point]) -> Comparison {
+    let curve = |value: &dyn Fn(&Point) -> Option<f64>| -> Vec<(f64, f64)> {
+        rsm.iter()
+            .filter_map(|p| value(p).map(|v| (p.rel_l1, v)))
+            .collect()
+    };
+    let at = |value: &dyn Fn(&Point) -> Option<f64>| at_error(&curve(value), quadtree.rel_l1);
+    let ratio = |value: &dyn Fn(&Point) -> Option<f64>| {
+        at(value)
+            .zip(value(&quadtree))
+            .filter(|(_, q)| *q > 0.0)
+            .map(|(r, q)| r / q)
+    };
+    let samples = |p: &Point| p.label.trim_end_matches(" samples").parse::<f64>().ok();
+    Comparison {
+        rsm_samples: at(&samples),
+        evaluation_ratio: ratio(&|p| Some(p.vpl_evaluations_per_pixel)),
+        fetch_ratio: ratio(&|p| Some(p.texel_fetches_per_pixel)),
+        time_ratio: ratio(&|p| p.static_ms),
+        quadtree,
+    }
+}
+
+fn scene_result(
+    gpu: &Gpu,
+    scene: &Scene,
+    base: Settings,
+    frames: u32,
+    progress: &mut dyn FnMut(&str),
+) -> Result<SceneResult, IndirectError> {
+    let name = format!("{} {}^2", scene.name, base.rsm_size);
+    let mut r = Renderer::new(gpu, scene, base.clone())?;
+    progress(&format!("{name}: brute force"));
+    let brute = r.render_frame(Method::Reference)?.indirect;
+    let mut quadtree = Vec::new();
+    for (label, cluster) in [
+        ("default", ClusterSettings::defaults(base.rsm_size)),
+        ("paper", ClusterSettings::with_limit_side(base.rsm_size, 32)),
+    ] {
+        progress(&format!("{name}: quadtree {label}"));
+        r.set_cluster(cluster)?;
+        quadtree.push(measure(
+            &mut r,
+            Method::Quadtree,
+            label.into(),
+            &brute,
+            frames,
+        )?);
+    }
+    let mut rsm: Vec<Point> = Vec::new();
+    for samples in SAMPLES {
+        // past the best quadtree's error there is nothing more to interpolate
+        let best = quadtree.iter().map(|p| p.rel_l1).fold(f64::MAX, f64::min);
+        if rsm.last().is_some_and(|p| p.rel_l1 <= best) {
+            break;
+        }
+        progress(&format!("{name}: RSM {samples} samples"));
+        let mut rs = Renderer::new(
+            gpu,
+            scene,
+            Settings {
+                samples,
+                ..base.clone()
+            },
+        )?;
+        let label = format!("{samples} samples");
+        rsm.push(measure(&mut rs, Method::Rsm, label, &brute, frames)?);
+    }
+    Ok(SceneResult {
+        scene: scene.name.clone(),
+        rsm_size: base.rsm_size,
+        comparisons: quadtree
+            .into_iter()
+            .map(|q| compare_at_error(q, &rsm))
+            .collect(),
+        rsm,
+    })
+}
+
+/// Every scene at every RSM size; writes `equal_error.md`, `.json` and the error-vs-evaluations
+/// plot into `out`.
+pub fn run(
+    gpu: &Gpu,
+    out: &Path,
+    options: &EqualErrorOptions,
+    mut progress: impl FnMut(&str),
+) -> Result<EqualErrorResults, IndirectError> {
+    let mut scenes = Vec::new();
+    for file in SCENES {
+        let scene = Scene::load(&scenes_dir().join(file))?;
+        for &rsm_size in &options.rsm_sizes {
+            let base = Settings {
+                width: options.size,
+                height: options.size,
+                rsm_size,
+                cluster: ClusterSettings::defaults(rsm_size),
+                ..Settings::default()
+            };
+            scenes.push(scene_result(
+                gpu,
+                &scene,
+                base,
+                options.frames,
+                &mut progress,
+            )?);
+        }
+    }
+    let results = EqualErrorResults {
+        adapter: gpu.describe(),
+        size: options.size,
+        frames: options.frames,
+        scenes,
+    };
+    write_outputs(out, &results)?;
+    Ok(results)
+}
+
+fn fixed(v: Option<f64>, digits: usize) -> String {
+    v.map_or("-".into(), |v| format!("{v:.digits$}"))
+}
+
+fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), IndirectError> {
+    let mut table = Table::new(
+        format!(
+            "Quadtree vs RSM sampling at equal error, {0}x{0} image ({1}, {2} frames per median)",
+            results.size, results.adapter, results.frames
+        ),
+        &[
+            "scene",
+            "RSM",
+            "quadtree",
+            "rel L1",
+            "evals/px",
+            "fetches/px",
+            "ms",
+            "RSM samples at that error",
+            "evals ratio",
+            "fetches ratio",
+            "time ratio",
+        ],
+    );
+    for s in &results.scenes {
+        for c in &s.comparisons {
+            let q = &c.quadtree;
+            table.row(vec![
+                s.scene.clone(),
+                format!("{}^2", s.rsm_size),
+                q.label.clone(),
+                format!("{:.4}", q.rel_l1),
+                format!("{:.0}", q.vpl_evaluations_per_pixel),
+                format!("{:.0}", q.texel_fetches_per_pixel),
+                fixed(q.static_ms, 2),
+                fixed(c.rsm_samples, 0),
+                fixed(c.evaluation_ratio, 2),
+                fixed(c.fetch_ratio, 2),
+                fixed(c.time_ratio, 2),
+            ]);
+        }
+    }
+    let mut sweep = Table::new(
+        "RSM sampling sweep",
+        &[
+            "scene",
+            "RSM",
+            "samples",
+            "rel L1",
+            "evals/px",
+            "fetches/px",
+            "ms",
+        ],
+    );
+    for s in &results.scenes {
+        for p in &s.rsm {
+            sweep.row(vec![
+                s.scene.clone(),
+                format!("{}^2", s.rsm_size),
+                p.label.trim_end_matches(" samples").into(),
+                format!("{:.4}", p.rel_l1),
+                format!("{:.0}", p.vpl_evaluations_per_pixel),
+                format!("{:.0}", p.texel_fetches_per_pixel),
+                fixed(p.static_ms, 2),
+            ]);
+        }
+    }
+    let md = format!("{}\n{}", table.to_markdown(), sweep.to_markdown());
+    write_text(&out.join("equal_error.md"), &md)?;
+    write_json(&out.join("equal_error.json"), results)?;
+    let mut series = Vec::new();
+    for s in &results.scenes {
+        let points = |ps: &mut dyn Iterator<Item = &Point>| {
+            ps.map(|p| (p.vpl_evaluations_per_pixel, p.rel_l1))
+                .collect()
+        };
+        series.push(Series {
+            name: format!("{} {}^2 RSM sampling", s.scene, s.rsm_size),
+            points: points(&mut s.rsm.iter()),
+        });
+        series.push(Series {
+            name: format!("{} {}^2 quadtree", s.scene, s.rsm_size),
+            points: points(&mut s.comparisons.iter().map(|c| &c.quadtree)),
+        });
+    }
+    line_plot(
+        &out.join("equal_error.svg"),
+        &PlotSpec {
+            title: "Indirect light: error against VPL evaluations per pixel",
+            x_label: "VPL evaluations per shaded pixel",
+            y_label: "rel. L1 error of the indirect term",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::at_error;
+
+    #[test]
+    fn a_value_at_an_error_is_interpolated_log_log_between_the_bracketing_points() {
+        // error halves with every 4x the value
+        let curve = [(0.2, 100.0), (0.1, 400.0), (0.05, 1600.0)];
+        assert!((at_error(&curve, 0.1).unwrap() - 400.0).abs() < 1e-9);
+        let mid = at_error(&curve, (0.1f64 * 0.05).sqrt()).unwrap();
+        assert!((mid - 800.0).abs() < 1e-6, "{mid}");
+        assert!(at_error(&curve, 0.01).is_none());
+        assert!(at_error(&curve, 0.5).is_none());
+    }
+}

@@ -1,0 +1,176 @@
+//! The work counts the shaders report (`Frame::counts`) against an independent count on the CPU
+//! from what the frame read: the cut, the quadtree's nodes, the RSM's VPLs, the sample pattern and
+//! the G-buffer. A 32^2 RSM keeps every per-pixel sum in one dispatch (one slice), so each indirect
+//! dispatch reads a pixel's three G-buffer texels once.
+
+use glam::{Vec2, Vec3, Vec4};
+use quadray_gpu::Gpu;
+use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
+use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings, Validity, WorkCounts};
+
+const RSM: u32 = 32;
+
+fn settings() -> Settings {
+    Settings {
+        width: 40,
+        height: 32,
+        rsm_size: RSM,
+        cluster: ClusterSettings {
+            validity: Validity::Recursive,
+            ..ClusterSettings::defaults(RSM)
+        },
+        samples: 48,
+        ..Settings::default()
+    }
+}
+
+/// The top-down cut rule of `cut_rule.wgsl` over the nodes read back, with the node records it
+/// reads: (in the cut, reads).
+fn in_cut(nodes: &[[[f32; 4]; 3]], c: &ClusterSettings, level: u32, x: u32, y: u32) -> (bool, u64) {
+    let index = |level: u32, x: u32, y: u32| {
+        let offset: u32 = (0..level).map(|l| (RSM >> l).pow(2)).sum();
+        (offset + y * (RSM >> level) + x) as usize
+    };
+    let mut reads = 1;
+    let mut accepted = |level: u32, x: u32, y: u32| {
+        if level == c.limit_level {
+            return true;
+        }
+        reads += 1;
+        nodes[index(level, x, y)][2][3] > 0.5
+    };
+    let used = nodes[index(level, x, y)][0][3] >= 0.5
+        && accepted(level, x, y)
+        && (level + 1..=c.start_level).all(|a| !accepted(a, x >> (a - level), y >> (a - level)));
+    (used, reads)
+}
+
+fn counted(r: &mut Renderer, method: Method) -> WorkCounts {
+    let frame = r.render_frame(method).unwrap();
+    println!("{method:?}: {:?}", frame.counts);
+    frame.counts
+}
+
+#[test]
+fn shader_counts_match_a_cpu_count_for_every_method() {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let scene = Scene::cornell();
+    let s = settings();
+    let mut r = Renderer::new(&gpu, &scene, s.clone()).unwrap();
+    r.render(Method::Quadtree, true, false).unwrap();
+    let cut = u64::from(r.clusters_in_cut().unwrap());
+    let nodes = r.read_nodes().unwrap();
+    let vpls = r.read_vpls().unwrap().len() as u64;
+    let receivers = r.read_receivers().unwrap();
+    let pixels = u64::from(s.width * s.height);
+    let shaded = receivers.iter().filter(|r| r.is_some()).count() as u64;
+    assert!(
+        shaded > pixels / 2 && shaded < pixels,
+        "{shaded} of {pixels}"
+    );
+    assert!(cut > 16 && vpls > 500, "{cut} clusters, {vpls} VPLs");
+    let expect = |evaluations: u64, fetches: u64| WorkCounts {
+        shaded_pixels: shaded as u32,
+        vpl_evaluations: evaluations,
+        texel_fetches: fetches,
+    };
+
+    // the cut: every shaded pixel sums every cluster, reading its record
+    let quadtree = counted(&mut r, Method::Quadtree);
+    assert_eq!(quadtree, expect(shaded * cut, 3 * pixels + shaded * cut));
+
+    // the per-level passes: one dispatch per level; each node's cut test reads records
+    let c = s.cluster;
+    let mut level_reads = 0;
+    for level in c.limit_level..=c.start_level {
+        let side = RSM >> level;
+        for i in 0..side * side {
+            let (used, reads) = in_cut(&nodes, &c, level, i % side, i / side);
+            level_reads += reads + u64::from(used);
+        }
+    }
+    let levels = u64::from(c.start_level - c.limit_level + 1);
+    let passes = counted(&mut r, Method::QuadtreePasses);
+    assert_eq!(
+        passes,
+        expect(shaded * cut, 3 * pixels * levels + shaded * level_reads)
+    );
+
+    // the brute force: every texel's normal, the VPLs' flux and position
+    let reference = counted(&mut r, Method::Reference);
+    let rsm_texels = u64::from(RSM * RSM);
+    assert_eq!(
+        reference,
+        expect(shaded * vpls, 3 * pixels + shaded * (rsm_texels + 2 * vpls))
+    );
+
+    // RSM sampling: the shader's disk around each receiver's projection, in f32 as there
+    let samples = rsm_samples(
+        s.samples,
+        s.rsm_radius * RSM as f32 * std::f32::consts::SQRT_2,
+        SAMPLE_SEED,
+    );
+    let view_proj = scene.light_view_proj();
+    let side = RSM as f32;
+    let (mut evaluations, mut fetches) = (0, 3 * pixels);
+    for receiver in receivers.iter().flatten() {
+        let clip = view_proj * Vec3::from(receiver.position).extend(1.0);
+        let ndc = Vec2::new(clip.x, clip.y) / clip.w.max(1e-6);
+        let projected = Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * side;
+        let centre = if clip.w <= 0.0 {
+            Vec2::splat(0.5 * side)
+        } else {
+            projected.clamp(Vec2::ZERO, Vec2::splat(side))
+        };
+        let corner = centre.max(Vec2::splat(side) - centre);
+        for sample in &samples {
+            let sample = Vec4::from(*sample);
+            let scale = (corner.length() / sample.w).min(1.0);
+            let t = (centre + Vec2::new(sample.x, sample.y) * scale).floor();
+            if t.cmpge(Vec2::ZERO).all() && t.cmplt(Vec2::splat(side)).all() {
+                fetches += 1;
+                let texel = (t.y as u32 * RSM + t.x as u32) as usize;
+                if nodes[texel][0][3] > 0.5 {
+                    evaluations += 1;
+                    fetches += 2;
+                }
+            }
+        }
+    }
+    let rsm = counted(&mut r, Method::Rsm);
+    // a sample on a texel border may floor differently than on the GPU: 0.1% slack
+    let close = |a: u64, b: u64| (a as f64 - b as f64).abs() <= 1e-3 * b as f64;
+    assert!(
+        close(rsm.vpl_evaluations, evaluations) && close(rsm.texel_fetches, fetches),
+        "{rsm:?} against {evaluations} evaluations, {fetches} fetches"
+    );
+    assert!(evaluations > shaded * u64::from(s.samples) / 4);
+
+    // sub-sampled: the low-resolution samples sum the cut, and so do the recomputed pixels
+    let k = 4;
+    let mut sub = Renderer::new(
+        &gpu,
+        &scene,
+        Settings {
+            subsample: k,
+            ..s.clone()
+        },
+    )
+    .unwrap();
+    let frame = sub.render_frame(Method::Quadtree).unwrap();
+    let low_shaded = (0..s.height.div_ceil(k))
+        .flat_map(|y| (0..s.width.div_ceil(k)).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = |v: u32, n: u32| (v * k + k / 2).min(n - 1);
+            receivers[(p(y, s.height) * s.width + p(x, s.width)) as usize].is_some()
+        })
+        .count() as u64;
+    let recomputed = u64::from(frame.recomputed);
+    assert!(recomputed > 0 && recomputed < shaded / 2, "{recomputed}");
+    println!("sub-sampled: {:?}", frame.counts);
+    assert_eq!(
+        frame.counts.vpl_evaluations,
+        (low_shaded + recomputed) * cut
+    );
+    assert_eq!(frame.counts.shaded_pixels as u64, shaded);
+}

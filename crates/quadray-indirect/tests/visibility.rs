@@ -1,0 +1,92 @@
+//! The leak scene against the ground truth with visibility: the right room gets no direct light,
+//! and without visibility the left room's VPLs light it through the partition; the ground truth
+//! keeps only what comes through the doorway.
+
+use quadray_gpu::Gpu;
+use quadray_indirect::reference::{brute_force, compare, ground_truth};
+use quadray_indirect::scene::scenes_dir;
+use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings};
+
+/// 48x48 pixels and a 32^2 RSM: the ground truth traces 2.4M rays.
+fn small() -> Settings {
+    Settings {
+        width: 48,
+        height: 48,
+        rsm_size: 32,
+        cluster: ClusterSettings::defaults(32),
+        ..Settings::default()
+    }
+}
+
+#[test]
+fn the_leak_scene_leaks_without_visibility_and_the_ground_truth_stops_it() {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let scene = Scene::load(&scenes_dir().join("leak.toml")).unwrap();
+    let mut r = Renderer::new(&gpu, &scene, small()).unwrap();
+    let frame = r.render_frame(Method::Reference).unwrap();
+    let (vpls, receivers) = (r.read_vpls().unwrap(), r.read_receivers().unwrap());
+    let cpu = brute_force(&vpls, &receivers, scene.r_min);
+    assert!(compare(&frame.indirect, &cpu).rel_l1 < 1e-5);
+    let truth = ground_truth(&vpls, &receivers, &scene);
+    // summed red over the pixels of a room (by the receiver's x)
+    let room = |image: &[[f32; 3]], right: bool| -> f64 {
+        receivers
+            .iter()
+            .zip(image)
+            .filter(|(r, _)| r.is_some_and(|r| (r.position[0] > 1.03) == right))
+            .map(|(_, p)| f64::from(p[0]))
+            .sum()
+    };
+    let direct_right = room(&frame.direct, true);
+    assert_eq!(direct_right, 0.0, "the right room has no direct light");
+    let (leaky, exact) = (room(&cpu, true), room(&truth, true));
+    let (left_leaky, left_exact) = (room(&cpu, false), room(&truth, false));
+    println!(
+        "right room: {leaky} without visibility, {exact} with; left: {left_leaky}, {left_exact}"
+    );
+    assert!(exact > 0.0, "light comes through the doorway");
+    assert!(exact < 0.5 * leaky, "{exact} vs {leaky}");
+    // the left room is a convex box: nothing in it hides a VPL (no ray hits its own surfaces)
+    assert!((left_exact - left_leaky).abs() <= 1e-6 * left_leaky);
+    let e = compare(&cpu, &truth);
+    println!("no visibility vs ground truth: {e:?}");
+    assert!(e.rel_l1 > 0.05, "{e:?}");
+}
+
+/// Indirect shadows (marching against the camera's and the light's depth) bring the quadtree
+/// closer to the ground truth on the leak scene and the Cornell box, with the same cut.
+#[test]
+fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    for file in ["leak.toml", "cornell.toml"] {
+        let scene = Scene::load(&scenes_dir().join(file)).unwrap();
+        let settings = small();
+        let mut r = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
+        let plain = r.render_frame(Method::Quadtree).unwrap();
+        let truth = ground_truth(
+            &r.read_vpls().unwrap(),
+            &r.read_receivers().unwrap(),
+            &scene,
+        );
+        let shadowed_settings = Settings {
+            shadow_steps: 8,
+            ..settings
+        };
+        let mut s = Renderer::new(&gpu, &scene, shadowed_settings).unwrap();
+        let shadowed = s.render_frame(Method::Quadtree).unwrap();
+        let passes = s.render_frame(Method::QuadtreePasses).unwrap();
+        let (before, after) = (
+            compare(&plain.indirect, &truth).rel_l1,
+            compare(&shadowed.indirect, &truth).rel_l1,
+        );
+        println!("{file}: rel_l1 to the ground truth {before:.4} -> {after:.4}");
+        assert!(after < 0.7 * before, "{file}: {before} -> {after}");
+        assert_eq!(
+            shadowed.counts.vpl_evaluations,
+            plain.counts.vpl_evaluations
+        );
+        assert!(shadowed.counts.texel_fetches > plain.counts.texel_fetches);
+        // the per-level passes shadow the same clusters the same way
+        assert!(compare(&passes.indirect, &shadowed.indirect).rel_max < 1e-4);
+    }
+}
