@@ -10,8 +10,8 @@ use glam::Vec3;
 use quadray_gpu::{nearest_depth, texture_2d};
 use quadray_indirect::scene::{Camera, Scene, SpotLight, Vertex};
 use quadray_indirect::{
-    ClusterSettings, FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, OutputPass,
-    OutputTerm, RsmPass, Settings, Spot,
+    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, OutputPass, OutputTerm, RsmPass,
+    Settings, Spot,
 };
 use wgpu::util::DeviceExt;
 
@@ -43,81 +43,60 @@ fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2
     [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
 }
 
+/// The six faces of the box `min`..`max`, wound outwards: bottom, top, then the sides facing
+/// +z, +x, -z and -x.
+fn box_faces(min: Vec3, max: Vec3) -> [[Vec3; 4]; 6] {
+    let around = [
+        (min.x, max.z),
+        (max.x, max.z),
+        (max.x, min.z),
+        (min.x, min.z),
+    ];
+    let at = |i: usize, y: f32| {
+        let (x, z) = around[i % 4];
+        Vec3::new(x, y, z)
+    };
+    let side = |i| {
+        [
+            at(i, min.y),
+            at(i + 1, min.y),
+            at(i + 1, max.y),
+            at(i, max.y),
+        ]
+    };
+    [
+        [at(3, min.y), at(2, min.y), at(1, min.y), at(0, min.y)],
+        [at(0, max.y), at(1, max.y), at(2, max.y), at(3, max.y)],
+        side(0),
+        side(1),
+        side(2),
+        side(3),
+    ]
+}
+
 /// A unit room open towards +z (red wall left, green right) with a white block, a spot light
 /// under the ceiling and the camera in front.
 pub fn scene() -> Scene {
     let (white, red, green) = ([0.73; 3], [0.63, 0.065, 0.05], [0.14, 0.45, 0.091]);
     let mut triangles = Vec::new();
-    for ([a, b, c, d], albedo) in [
-        (
-            [[0., 0., 1.], [1., 0., 1.], [1., 0., 0.], [0., 0., 0.]],
-            white,
-        ), // floor
-        (
-            [[0., 1., 0.], [1., 1., 0.], [1., 1., 1.], [0., 1., 1.]],
-            white,
-        ), // ceiling
-        (
-            [[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
-            white,
-        ), // back
-        (
-            [[0., 0., 1.], [0., 0., 0.], [0., 1., 0.], [0., 1., 1.]],
-            red,
-        ), // left
-        (
-            [[1., 0., 0.], [1., 0., 1.], [1., 1., 1.], [1., 1., 0.]],
-            green,
-        ), // right
-        // the block: 0.3 wide, 0.5 high, its top and four sides
-        (
-            [
-                [0.2, 0.5, 0.6],
-                [0.5, 0.5, 0.6],
-                [0.5, 0.5, 0.3],
-                [0.2, 0.5, 0.3],
-            ],
-            white,
-        ),
-        (
-            [
-                [0.2, 0., 0.6],
-                [0.5, 0., 0.6],
-                [0.5, 0.5, 0.6],
-                [0.2, 0.5, 0.6],
-            ],
-            white,
-        ),
-        (
-            [
-                [0.5, 0., 0.6],
-                [0.5, 0., 0.3],
-                [0.5, 0.5, 0.3],
-                [0.5, 0.5, 0.6],
-            ],
-            white,
-        ),
-        (
-            [
-                [0.5, 0., 0.3],
-                [0.2, 0., 0.3],
-                [0.2, 0.5, 0.3],
-                [0.5, 0.5, 0.3],
-            ],
-            white,
-        ),
-        (
-            [
-                [0.2, 0., 0.3],
-                [0.2, 0., 0.6],
-                [0.2, 0.5, 0.6],
-                [0.2, 0.5, 0.3],
-            ],
-            white,
-        ),
-    ] {
-        let [a, b, c, d] = [a, b, c, d].map(Vec3::from_array);
-        triangles.extend(quad(a, b, c, d, albedo));
+    // the room's faces wound inwards; no wall on the camera's side
+    let walls = [
+        Some(white),
+        Some(white),
+        None,
+        Some(green),
+        Some(white),
+        Some(red),
+    ];
+    for ([a, b, c, d], albedo) in box_faces(Vec3::ZERO, Vec3::ONE).into_iter().zip(walls) {
+        if let Some(albedo) = albedo {
+            triangles.extend(quad(d, c, b, a, albedo));
+        }
+    }
+    // the block: 0.3 wide, 0.5 high, standing on the floor (its bottom unseen)
+    let block = box_faces(Vec3::new(0.2, 0.0, 0.3), Vec3::new(0.5, 0.5, 0.6));
+    for [a, b, c, d] in block.into_iter().skip(1) {
+        triangles.extend(quad(a, b, c, d, white));
     }
     Scene {
         name: "gi_gbuffer".into(),
@@ -141,13 +120,7 @@ pub fn scene() -> Scene {
 
 /// The picture's size and the quadtree's defaults for a 128^2 RSM.
 pub fn settings() -> Settings {
-    Settings {
-        width: 256,
-        height: 256,
-        rsm_size: 128,
-        cluster: ClusterSettings::defaults(128),
-        ..Settings::default()
-    }
+    Settings::sized(256, 256, 128)
 }
 
 /// Renders the scene (direct + one bounce) and returns linear radiance, rgba per pixel.

@@ -4,22 +4,29 @@
 //! the default thresholds.
 
 use quadray_gpu::Gpu;
-use quadray_indirect::reference::{self, compare};
+use quadray_indirect::reference::{self, ImageError, compare};
 use quadray_indirect::{ClusterSettings, CutNode, Method, Renderer, Scene, Settings, Validity};
 
 fn settings(rsm_size: u32) -> Settings {
     Settings {
-        width: 64,
-        height: 64,
-        rsm_size,
-        cluster: ClusterSettings::defaults(rsm_size),
         samples: 64,
-        ..Settings::default()
+        ..Settings::sized(64, 64, rsm_size)
     }
 }
 
 fn gpu() -> Gpu {
     Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)")
+}
+
+fn cornell(gpu: &Gpu, settings: Settings) -> Renderer<'_> {
+    Renderer::new(gpu, &Scene::cornell(), settings).unwrap()
+}
+
+/// The error of `image` against `truth`, printed after `what` for the test's log.
+fn logged_error(what: &str, image: &[[f32; 3]], truth: &[[f32; 3]]) -> ImageError {
+    let e = compare(image, truth);
+    println!("{what}: {e:?}");
+    e
 }
 
 fn render(r: &mut Renderer, method: Method) -> Vec<[f32; 3]> {
@@ -46,8 +53,7 @@ fn gpu_brute_force_matches_the_cpu_reference() {
         .filter(|p| p.iter().sum::<f32>() > 0.0)
         .count();
     assert!(lit > 2000, "indirect light reaches most pixels ({lit})");
-    let e = compare(&gpu_image, &cpu_image);
-    println!("GPU vs CPU brute force: {e:?}");
+    let e = logged_error("GPU vs CPU brute force", &gpu_image, &cpu_image);
     assert!(e.rel_l1 < 1e-5 && e.rel_max < 1e-4, "{e:?}");
 }
 
@@ -67,26 +73,23 @@ fn gpu_brute_force_sums_every_vpl_of_the_largest_rsm() {
     let vpls = r.read_vpls().unwrap();
     assert!(vpls.len() > 500_000, "{} VPLs", vpls.len());
     let cpu_image = reference::brute_force(&vpls, &r.read_receivers().unwrap(), scene.r_min);
-    let e = compare(&gpu_image, &cpu_image);
-    println!("GPU vs CPU brute force, 1024^2 RSM: {e:?}");
+    let e = logged_error("GPU vs CPU brute force, 1024^2 RSM", &gpu_image, &cpu_image);
     assert!(e.rel_l1 < 1e-4, "{e:?}");
     // every cluster a single VPL: a cut of a million clusters, and the per-level passes
     r.set_cluster(ClusterSettings::every_vpl(1024)).unwrap();
     for method in [Method::Quadtree, Method::QuadtreePasses] {
-        let image = render(&mut r, method);
-        let e = compare(&image, &gpu_image);
-        println!("{method:?} with every VPL a cluster vs brute force: {e:?}");
-        assert!(e.rel_l1 < 1e-4, "{method:?}: {e:?}");
+        let what = format!("{method:?} with every VPL a cluster vs brute force");
+        let e = logged_error(&what, &render(&mut r, method), &gpu_image);
+        assert!(e.rel_l1 < 1e-4, "{e:?}");
     }
 }
 
 #[test]
 fn quadtree_with_every_cluster_one_vpl_equals_the_brute_force() {
     let gpu = gpu();
-    let scene = Scene::cornell();
     let mut s = settings(32);
     s.cluster = ClusterSettings::every_vpl(32);
-    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    let mut r = cornell(&gpu, s);
     let brute = render(&mut r, Method::Reference);
     for validity in [Validity::Local, Validity::Recursive] {
         r.set_cluster(ClusterSettings {
@@ -102,9 +105,8 @@ fn quadtree_with_every_cluster_one_vpl_equals_the_brute_force() {
         );
         let passes = render(&mut r, Method::QuadtreePasses);
         for (name, image) in [("cut", cut), ("passes", passes)] {
-            let e = compare(&image, &brute);
-            println!("{validity:?} {name} with every VPL vs brute force: {e:?}");
-            assert!(e.rel_max < 1e-5, "{name}: {e:?}");
+            let what = format!("{validity:?} {name} with every VPL vs brute force");
+            assert!(logged_error(&what, &image, &brute).rel_max < 1e-5, "{what}");
         }
     }
 }
@@ -112,8 +114,7 @@ fn quadtree_with_every_cluster_one_vpl_equals_the_brute_force() {
 #[test]
 fn per_level_passes_give_the_compacted_cut_image() {
     let gpu = gpu();
-    let scene = Scene::cornell();
-    let mut r = Renderer::new(&gpu, &scene, settings(64)).unwrap();
+    let mut r = cornell(&gpu, settings(64));
     for (validity, depth, normal) in [
         (Validity::Local, 0.05, 0.9),
         (Validity::Recursive, 0.05, 0.9),
@@ -139,9 +140,8 @@ fn per_level_passes_give_the_compacted_cut_image() {
 #[test]
 fn the_cut_covers_every_lit_rsm_texel_exactly_once() {
     let gpu = gpu();
-    let scene = Scene::cornell();
     let size = 64;
-    let mut r = Renderer::new(&gpu, &scene, settings(size)).unwrap();
+    let mut r = cornell(&gpu, settings(size));
     r.render(Method::Quadtree, true, false).unwrap();
     let cut = r.read_cut().unwrap();
     assert_eq!(cut.len() as u32, r.clusters_in_cut().unwrap());
@@ -176,9 +176,8 @@ fn the_cut_covers_every_lit_rsm_texel_exactly_once() {
 #[test]
 fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
     let gpu = gpu();
-    let scene = Scene::cornell();
     let size = 256;
-    let mut r = Renderer::new(&gpu, &scene, settings(size)).unwrap();
+    let mut r = cornell(&gpu, settings(size));
     let brute = render(&mut r, Method::Reference);
     // the defaults meet the target; the paper's settings (local rule) are faster and coarser
     for (name, cluster, bound) in [
@@ -196,8 +195,8 @@ fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
     ] {
         r.set_cluster(cluster).unwrap();
         let image = render(&mut r, Method::Quadtree);
-        let e = compare(&image, &brute);
-        println!("{name}, {} clusters: {e:?}", r.clusters_in_cut().unwrap());
+        let what = format!("{name}, {} clusters", r.clusters_in_cut().unwrap());
+        let e = logged_error(&what, &image, &brute);
         assert!(e.rel_l1 < bound, "{name}: {e:?}");
     }
 }
@@ -205,18 +204,15 @@ fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
 #[test]
 fn rsm_sampling_converges_to_the_brute_force() {
     let gpu = gpu();
-    let scene = Scene::cornell();
     let mut errors = Vec::new();
     for samples in [16, 256, 4096] {
-        let mut r = Renderer::new(
+        let mut r = cornell(
             &gpu,
-            &scene,
             Settings {
                 samples,
                 ..settings(32)
             },
-        )
-        .unwrap();
+        );
         let brute = render(&mut r, Method::Reference);
         let image = render(&mut r, Method::Rsm);
         errors.push(compare(&image, &brute).rel_l1);
@@ -230,18 +226,15 @@ fn rsm_sampling_converges_to_the_brute_force() {
 #[test]
 fn subsampled_indirect_stays_close_to_full_resolution() {
     let gpu = gpu();
-    let scene = Scene::cornell();
-    let mut r = Renderer::new(&gpu, &scene, settings(32)).unwrap();
+    let mut r = cornell(&gpu, settings(32));
     let full = render(&mut r, Method::Quadtree);
-    let mut r = Renderer::new(
+    let mut r = cornell(
         &gpu,
-        &scene,
         Settings {
             subsample: 4,
             ..settings(32)
         },
-    )
-    .unwrap();
+    );
     let frame = r.render_frame(Method::Quadtree).unwrap();
     let e = compare(&frame.indirect, &full);
     println!(
@@ -290,9 +283,8 @@ fn absurd_settings_are_refused() {
 #[test]
 fn quadtree_nodes_match_a_cpu_rebuild() {
     let gpu = gpu();
-    let scene = Scene::cornell();
     let size = 32u32;
-    let mut r = Renderer::new(&gpu, &scene, settings(size)).unwrap();
+    let mut r = cornell(&gpu, settings(size));
     for validity in [Validity::Local, Validity::Recursive] {
         let cluster = ClusterSettings {
             validity,

@@ -2,9 +2,7 @@
 //! read back in f32 (the Rgba32Float path is the frame itself).
 
 use quadray_gpu::{Gpu, read_buffer, texture_2d};
-use quadray_indirect::{
-    ClusterSettings, Method, OutputPass, OutputTerm, Renderer, Scene, Settings,
-};
+use quadray_indirect::{Method, OutputPass, OutputTerm, Renderer, Scene, Settings};
 
 /// Writes the renderer's last frame into a fresh texture of `format` and reads it back as f32
 /// (`texel_bytes` per texel, decoded by `decode`).
@@ -68,13 +66,7 @@ type Case<'a> = (
 #[test]
 fn output_pass_writes_rgba16float_and_rgba8unorm_like_the_f32_frame() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
-    let settings = Settings {
-        width: 64,
-        height: 48,
-        rsm_size: 32,
-        cluster: ClusterSettings::defaults(32),
-        ..Settings::default()
-    };
+    let settings = Settings::sized(64, 48, 32);
     let mut renderer = Renderer::new(&gpu, &Scene::cornell(), settings).unwrap();
     let truth = renderer.render_frame(Method::Quadtree).unwrap().combined();
     let brightest = truth.iter().flatten().fold(0f32, |m, &v| m.max(v));

@@ -5,17 +5,11 @@
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::{brute_force, compare, ground_truth};
 use quadray_indirect::scene::scenes_dir;
-use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings};
+use quadray_indirect::{Method, Renderer, Scene, Settings};
 
 /// 48x48 pixels and a 32^2 RSM: the ground truth traces 2.4M rays.
 fn small() -> Settings {
-    Settings {
-        width: 48,
-        height: 48,
-        rsm_size: 32,
-        cluster: ClusterSettings::defaults(32),
-        ..Settings::default()
-    }
+    Settings::sized(48, 48, 32)
 }
 
 #[test]

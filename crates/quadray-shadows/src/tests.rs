@@ -394,11 +394,8 @@ fn transmission_updates_the_carried_state() {
     u.transmit(false);
     assert_eq!(u.sc, None);
     // An unknown condition is never sustained: the next point takes a shadow ray.
-    let (shadowed, sub) = u.hst_step(0, 10.0, false, true, || unreachable!(), || false);
-    assert_eq!(
-        (shadowed, sub),
-        (false, crate::shadow::Subscheme::Conventional)
-    );
+    let decided = u.hst_step(0, 10.0, false, true, || unreachable!(), || false);
+    assert_eq!(decided, (false, crate::shadow::Subscheme::Conventional));
 }
 
 #[test]
@@ -663,11 +660,8 @@ fn self_shadowed_points_carry_a_valid_count_on() {
     u.hst_step(30, 8.0, true, true, || unreachable!(), || unreachable!());
     assert!(!u.sdf);
     // Invalid count and shadowed: a shadow ray decides.
-    let (shadowed, sub) = u.hst_step(2, 8.0, false, true, || unreachable!(), || false);
-    assert_eq!(
-        (shadowed, sub),
-        (false, crate::shadow::Subscheme::Conventional)
-    );
+    let decided = u.hst_step(2, 8.0, false, true, || unreachable!(), || false);
+    assert_eq!(decided, (false, crate::shadow::Subscheme::Conventional));
 }
 
 /// The builder refuses what would break the tracer, says which face and why, and adds nothing.

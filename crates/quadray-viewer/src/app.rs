@@ -22,6 +22,23 @@ pub enum Technique {
     Indirect,
 }
 
+/// A combo box that sets `value` to one of `choices`, each shown by `name`.
+pub fn choice_box<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut T,
+    choices: &[T],
+    name: impl Fn(T) -> String,
+) {
+    egui::ComboBox::from_label(label)
+        .selected_text(name(*value))
+        .show_ui(ui, |ui| {
+            for &choice in choices {
+                ui.selectable_value(value, choice, name(choice));
+            }
+        });
+}
+
 pub fn run(args: Args, maps: Vec<MapChoice>, start: usize, settings: Settings) -> Result<()> {
     let event_loop =
         EventLoop::new().context("no window system (is DISPLAY or WAYLAND_DISPLAY set?)")?;

@@ -2,6 +2,7 @@
 //! moving light; the frame is drawn by `quadray_displace::Renderer::draw` into an offscreen
 //! texture that egui shows, so what a person sees is exactly what `quadray displace` renders.
 
+use crate::app::choice_box;
 use crate::{absolute, shell_word};
 use anyhow::Result;
 use quadray_core::image_out::Rgba8Image;
@@ -210,27 +211,16 @@ impl DisplaceView {
     /// The control panel.
     pub fn controls(&mut self, ui: &mut egui::Ui) {
         let s = &mut self.settings;
-        egui::ComboBox::from_label("map")
-            .selected_text(self.maps[self.map].name.clone())
-            .show_ui(ui, |ui| {
-                for (i, m) in self.maps.iter().enumerate() {
-                    ui.selectable_value(&mut self.map, i, m.name.clone());
-                }
-            });
-        egui::ComboBox::from_label("surface")
-            .selected_text(self.surface.name())
-            .show_ui(ui, |ui| {
-                for k in SurfaceKind::ALL {
-                    ui.selectable_value(&mut self.surface, k, k.name());
-                }
-            });
-        egui::ComboBox::from_label("method")
-            .selected_text(s.method.name())
-            .show_ui(ui, |ui| {
-                for m in Method::ALL {
-                    ui.selectable_value(&mut s.method, m, m.name());
-                }
-            });
+        let maps: Vec<usize> = (0..self.maps.len()).collect();
+        choice_box(ui, "map", &mut self.map, &maps, |i| {
+            self.maps[i].name.clone()
+        });
+        choice_box(ui, "surface", &mut self.surface, &SurfaceKind::ALL, |k| {
+            k.name().into()
+        });
+        choice_box(ui, "method", &mut s.method, &Method::ALL, |m| {
+            m.name().into()
+        });
         ui.add(egui::Slider::new(&mut s.view_angle_deg, 0.0..=89.0).text("view angle"));
         ui.add(egui::Slider::new(&mut s.azimuth_deg, -180.0..=180.0).text("azimuth"));
         ui.add(egui::Slider::new(&mut s.zoom, 0.2..=4.0).text("zoom"));

@@ -3,6 +3,7 @@
 //! and are tone-mapped by the same code as `quadray indirect`, so the screenshot's command line
 //! renders the same picture headless. A frame is rendered only when something changed.
 
+use crate::app::choice_box;
 use crate::{absolute, shell_word};
 use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
@@ -176,12 +177,6 @@ impl IndirectView {
             clusters: None,
             error: None,
         }
-    }
-
-    fn scene_name(&self, i: usize) -> String {
-        self.scenes[i]
-            .file_stem()
-            .map_or("scene".into(), |s| s.to_string_lossy().into_owned())
     }
 
     /// Renders when something changed and returns the picture's texture and size in pixels.
@@ -365,28 +360,14 @@ impl IndirectView {
     /// The control panel; marks what a change invalidates.
     pub fn controls(&mut self, ui: &mut egui::Ui) {
         let before = (self.scene, self.method, self.show, self.exposure);
-        egui::ComboBox::from_label("scene")
-            .selected_text(self.scene_name(self.scene))
-            .show_ui(ui, |ui| {
-                for i in 0..self.scenes.len() {
-                    let name = self.scene_name(i);
-                    ui.selectable_value(&mut self.scene, i, name);
-                }
-            });
-        egui::ComboBox::from_label("method")
-            .selected_text(self.method.name())
-            .show_ui(ui, |ui| {
-                for m in Method::ALL {
-                    ui.selectable_value(&mut self.method, m, m.name());
-                }
-            });
-        egui::ComboBox::from_label("show")
-            .selected_text(self.show.name())
-            .show_ui(ui, |ui| {
-                for v in Show::ALL {
-                    ui.selectable_value(&mut self.show, v, v.name());
-                }
-            });
+        let scenes: Vec<usize> = (0..self.scenes.len()).collect();
+        choice_box(ui, "scene", &mut self.scene, &scenes, |i| {
+            scene_name(&self.scenes[i])
+        });
+        choice_box(ui, "method", &mut self.method, &Method::ALL, |m| {
+            m.name().into()
+        });
+        choice_box(ui, "show", &mut self.show, &Show::ALL, |v| v.name().into());
         ui.add(
             egui::Slider::new(&mut self.exposure, 0.05..=20.0)
                 .logarithmic(true)
@@ -509,4 +490,10 @@ impl IndirectView {
             }
         });
     }
+}
+
+/// A scene file's name without its extension.
+fn scene_name(path: &Path) -> String {
+    path.file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned())
 }

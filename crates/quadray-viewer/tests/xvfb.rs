@@ -131,16 +131,11 @@ fn replay(txt: &Path) -> String {
         bin.parent().expect("target folder").display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    let out = Command::new("sh")
-        .args(["-c", &command])
-        .env("PATH", path)
-        .output()
-        .expect("run sh");
-    assert!(
-        out.status.success(),
-        "`{command}` failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut sh = Command::new("sh");
+    let out = sh.args(["-c", &command]).env("PATH", path).output();
+    let out = out.expect("run sh");
+    let errors = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "`{command}` failed:\n{errors}");
     command
 }
 
@@ -159,75 +154,58 @@ fn assert_matches(shot: &Path, headless: &Path) {
     );
 }
 
+/// Runs `program` with `args` (split at spaces) on the display until it saves its screenshot of
+/// `size` pixels to `shot`; checks the picture, replays the command line saved beside it and
+/// compares the two. Returns that command line.
+fn screenshot_matches_replay(
+    x: &Xvfb,
+    program: &Path,
+    args: &str,
+    shot: &Path,
+    size: (u32, u32),
+) -> String {
+    let _ = std::fs::remove_file(shot);
+    let view_size = format!("{}x{}", size.0, size.1);
+    let mut args: Vec<&str> = args.split_whitespace().collect();
+    args.extend([
+        "--view-size",
+        &view_size,
+        "--screenshot",
+        shot.to_str().unwrap(),
+    ]);
+    run_on(&x.display, program, &args, Duration::from_secs(300));
+    assert_screenshot(shot, size);
+    let command = replay(&shot.with_extension("txt"));
+    assert_matches(shot, &shot.with_extension("headless.png"));
+    command
+}
+
 #[test]
 fn viewer_screenshots_match_their_headless_command_lines() {
     let x = Xvfb::start();
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("xvfb");
     std::fs::create_dir_all(&dir).unwrap();
-    let viewer = Path::new(env!("CARGO_BIN_EXE_quadray-view"));
-    let limit = Duration::from_secs(300);
 
     // displacement: 3 frames turning 10 degrees each from azimuth 20
-    let shot = dir.join("displace.png");
-    let _ = std::fs::remove_file(&shot);
-    run_on(
-        &x.display,
-        viewer,
-        &[
-            "--technique",
-            "displace",
-            "--bundled",
-            "tiles",
-            "--method",
-            "pyramid",
-            "--view-angle",
-            "55",
-            "--azimuth",
-            "20",
-            "--spin",
-            "10",
-            "--shadows",
-            "--frames",
-            "3",
-            "--view-size",
-            "160x120",
-            "--screenshot",
-            shot.to_str().unwrap(),
-        ],
-        limit,
+    let command = screenshot_matches_replay(
+        &x,
+        Path::new(env!("CARGO_BIN_EXE_quadray-view")),
+        "--technique displace --bundled tiles --method pyramid --view-angle 55 --azimuth 20 \
+         --spin 10 --shadows --frames 3",
+        &dir.join("displace.png"),
+        (160, 120),
     );
-    assert_screenshot(&shot, (160, 120));
-    let command = replay(&shot.with_extension("txt"));
     assert!(
         command.contains("--azimuth 40 "),
         "scripted camera not applied: {command}"
     );
-    assert_matches(&shot, &shot.with_extension("headless.png"));
 
     // indirect light through `quadray view`: the camera turns 5 degrees a frame
-    let shot = dir.join("indirect.png");
-    let _ = std::fs::remove_file(&shot);
-    run_on(
-        &x.display,
+    screenshot_matches_replay(
+        &x,
         &quadray(),
-        &[
-            "view",
-            "--technique",
-            "indirect",
-            "--rsm-size",
-            "32",
-            "--spin",
-            "5",
-            "--frames",
-            "3",
-            "--view-size",
-            "96x72",
-            "--screenshot",
-            shot.to_str().unwrap(),
-        ],
-        limit,
+        "view --technique indirect --rsm-size 32 --spin 5 --frames 3",
+        &dir.join("indirect.png"),
+        (96, 72),
     );
-    assert_screenshot(&shot, (96, 72));
-    replay(&shot.with_extension("txt"));
-    assert_matches(&shot, &shot.with_extension("headless.png"));
 }

@@ -8,7 +8,7 @@ use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, tone_map};
 use quadray_indirect::reference::{compare, error_map, ground_truth};
 use quadray_indirect::scene::scenes_dir;
-use quadray_indirect::{ClusterSettings, IndirectError, Method, Renderer, Scene, Settings};
+use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
 use std::path::{Path, PathBuf};
 
 const EXPOSURE: f32 = 1.0;
@@ -18,12 +18,8 @@ fn settings(gpu: &Gpu, width: u32, height: u32, samples: u32) -> Settings {
     // the brute force beside every picture costs pixels x VPLs: small RSMs on a CPU rasterizer
     let rsm_size = if gpu.is_software() { 32 } else { 512 };
     Settings {
-        width,
-        height,
-        rsm_size,
-        cluster: ClusterSettings::defaults(rsm_size),
         samples,
-        ..Settings::default()
+        ..Settings::sized(width, height, rsm_size)
     }
 }
 
@@ -146,13 +142,7 @@ const SHADOW_STEPS: u32 = 8;
 fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join("leak.toml"))?;
     let rsm_size = 32;
-    let plain = Settings {
-        width: size,
-        height: size,
-        rsm_size,
-        cluster: ClusterSettings::defaults(rsm_size),
-        ..Settings::default()
-    };
+    let plain = Settings::sized(size, size, rsm_size);
     let mut r = Renderer::new(gpu, &scene, plain.clone())?;
     let leaky = r.render_frame(Method::Quadtree)?.indirect;
     let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);

@@ -227,13 +227,7 @@ pub fn run(
     for file in SCENES {
         let scene = Scene::load(&scenes_dir().join(file))?;
         for &rsm_size in &options.rsm_sizes {
-            let base = Settings {
-                width: options.size,
-                height: options.size,
-                rsm_size,
-                cluster: ClusterSettings::defaults(rsm_size),
-                ..Settings::default()
-            };
+            let base = Settings::sized(options.size, options.size, rsm_size);
             scenes.push(scene_result(
                 gpu,
                 &scene,

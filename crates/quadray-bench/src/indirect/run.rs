@@ -82,7 +82,7 @@ pub fn check_ground_truth_size(settings: &Settings) -> Result<(), IndirectError>
         * u64::from(settings.rsm_size).pow(2);
     if rays > reference::MAX_GROUND_TRUTH_RAYS {
         return Err(IndirectError::Settings(format!(
-            "the ground truth traces a ray per pixel and VPL: {}x{} pixels x {}^2 VPLs is {rays:.3e}              rays, over the limit of {:.3e}; use a smaller --size or --rsm-size",
+            "the ground truth traces a ray per pixel and VPL: {}x{} pixels x {}^2 VPLs is {rays:.3e} rays, over the limit of {:.3e}; use a smaller --size or --rsm-size",
             settings.width,
             settings.height,
             settings.rsm_size,

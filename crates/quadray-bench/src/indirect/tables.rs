@@ -256,13 +256,7 @@ pub fn run(
     let (default_size, frames) = if options.quick { (64, 3) } else { (512, 30) };
     let size = options.size.unwrap_or(default_size);
     let rsm_size = options.rsm_size.unwrap_or(default_size);
-    let base = Settings {
-        width: size,
-        height: size,
-        rsm_size,
-        cluster: ClusterSettings::defaults(rsm_size),
-        ..Settings::default()
-    };
+    let base = Settings::sized(size, size, rsm_size);
     let mut renderer = Renderer::new(gpu, &scene, base.clone())?;
     progress("brute force");
     let brute = renderer.render_frame(Method::Reference)?.indirect;

@@ -347,58 +347,59 @@ impl File<'_> {
         Ok((0..count).map(move |i| &bytes[start + i * stride..][..size]))
     }
 
-    fn check_type(
+    /// The elements of `accessor`, each decoded from its bytes and the accessor's component type,
+    /// after checking that they are `dimensions` of one of `data_types`.
+    fn read<T>(
         &self,
         accessor: &gltf::Accessor,
         what: &str,
         dimensions: Dimensions,
         data_types: &[DataType],
-    ) -> Result<(), MeshError> {
-        if accessor.dimensions() != dimensions || !data_types.contains(&accessor.data_type()) {
+        decode: impl Fn(DataType, &[u8]) -> T,
+    ) -> Result<Vec<T>, MeshError> {
+        let data_type = accessor.data_type();
+        if accessor.dimensions() != dimensions || !data_types.contains(&data_type) {
             return Err(self.error(format!(
-                "{what} accessor {} is {:?} {:?}, expected {dimensions:?} of {data_types:?}",
+                "{what} accessor {} is {:?} {data_type:?}, expected {dimensions:?} of {data_types:?}",
                 accessor.index(),
                 accessor.dimensions(),
-                accessor.data_type()
             )));
         }
-        Ok(())
+        Ok(self
+            .elements(accessor)?
+            .map(|e| decode(data_type, e))
+            .collect())
     }
 
     fn read_vec3(&self, accessor: &gltf::Accessor, what: &str) -> Result<Vec<Vec3>, MeshError> {
-        self.check_type(accessor, what, Dimensions::Vec3, &[DataType::F32])?;
-        Ok(self
-            .elements(accessor)?
-            .map(|e| Vec3::new(f32_at(e, 0), f32_at(e, 4), f32_at(e, 8)))
-            .collect())
+        self.read(
+            accessor,
+            what,
+            Dimensions::Vec3,
+            &[DataType::F32],
+            |_, e| Vec3::new(f32_at(e, 0), f32_at(e, 4), f32_at(e, 8)),
+        )
     }
 
+    /// Texture coordinates: floats, or normalized unsigned bytes or shorts.
     fn read_uvs(&self, accessor: &gltf::Accessor) -> Result<Vec<Vec2>, MeshError> {
         use DataType::{F32, U8, U16};
-        self.check_type(accessor, "TEXCOORD_0", Dimensions::Vec2, &[F32, U8, U16])?;
-        let data_type = accessor.data_type();
-        Ok(self
-            .elements(accessor)?
-            .map(|e| match data_type {
-                U8 => Vec2::new(e[0] as f32, e[1] as f32) / 255.0,
-                U16 => Vec2::new(u16_at(e, 0) as f32, u16_at(e, 2) as f32) / 65535.0,
-                _ => Vec2::new(f32_at(e, 0), f32_at(e, 4)),
-            })
-            .collect())
+        let types = [F32, U8, U16];
+        self.read(accessor, "TEXCOORD_0", Dimensions::Vec2, &types, |t, e| {
+            if t == F32 {
+                return Vec2::new(f32_at(e, 0), f32_at(e, 4));
+            }
+            let max = if t == U8 { 255.0 } else { 65535.0 };
+            Vec2::new(uint_at(t, e, 0) as f32, uint_at(t, e, 1) as f32) / max
+        })
     }
 
     fn read_indices(&self, accessor: &gltf::Accessor) -> Result<Vec<u32>, MeshError> {
         use DataType::{U8, U16, U32};
-        self.check_type(accessor, "index", Dimensions::Scalar, &[U8, U16, U32])?;
-        let data_type = accessor.data_type();
-        Ok(self
-            .elements(accessor)?
-            .map(|e| match data_type {
-                U8 => e[0] as u32,
-                U16 => u16_at(e, 0) as u32,
-                _ => u32::from_le_bytes([e[0], e[1], e[2], e[3]]),
-            })
-            .collect())
+        let types = [U8, U16, U32];
+        self.read(accessor, "index", Dimensions::Scalar, &types, |t, e| {
+            uint_at(t, e, 0)
+        })
     }
 
     /// The primitive's vertices in its mesh's space, or `None` for points and lines.
@@ -490,6 +491,16 @@ fn f32_at(bytes: &[u8], offset: usize) -> f32 {
     ])
 }
 
-fn u16_at(bytes: &[u8], offset: usize) -> u16 {
-    u16::from_le_bytes([bytes[offset], bytes[offset + 1]])
+/// Component `i` of an element of unsigned bytes, shorts or ints (`data_type`).
+fn uint_at(data_type: DataType, bytes: &[u8], i: usize) -> u32 {
+    match data_type {
+        DataType::U8 => u32::from(bytes[i]),
+        DataType::U16 => u32::from(u16::from_le_bytes([bytes[2 * i], bytes[2 * i + 1]])),
+        _ => u32::from_le_bytes([
+            bytes[4 * i],
+            bytes[4 * i + 1],
+            bytes[4 * i + 2],
+            bytes[4 * i + 3],
+        ]),
+    }
 }

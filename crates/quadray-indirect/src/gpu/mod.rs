@@ -192,11 +192,19 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
+        Self::sized(512, 512, 512)
+    }
+}
+
+impl Settings {
+    /// The defaults for a `width` x `height` picture lit through an `rsm_size`^2 RSM (the cut's
+    /// limits follow the RSM's size).
+    pub fn sized(width: u32, height: u32, rsm_size: u32) -> Self {
         Self {
-            width: 512,
-            height: 512,
-            rsm_size: 512,
-            cluster: ClusterSettings::defaults(512),
+            width,
+            height,
+            rsm_size,
+            cluster: ClusterSettings::defaults(rsm_size),
             samples: 256,
             rsm_radius: 1.0,
             subsample: 1,
@@ -204,9 +212,7 @@ impl Default for Settings {
             shadow_thickness: 0.1,
         }
     }
-}
 
-impl Settings {
     /// Refuses sizes and parameters that would make no picture or an absurd amount of work.
     pub fn validate(&self) -> Result<(), String> {
         let s = self;

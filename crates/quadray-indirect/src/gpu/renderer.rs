@@ -232,7 +232,7 @@ impl<'g> Renderer<'g> {
             self.gpu,
             self.gather.counts(),
         )?);
-        let rgb = |v: &[[f32; 4]]| v.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let rgb = |v: Vec<[f32; 4]>| v.into_iter().map(xyz).collect();
         let s = self.settings();
         Ok(Frame {
             counts: WorkCounts {
@@ -243,8 +243,8 @@ impl<'g> Renderer<'g> {
             width: s.width,
             height: s.height,
             recomputed: indirect.iter().filter(|p| p[3] > 0.5).count() as u32,
-            indirect: rgb(&indirect),
-            direct: rgb(&direct),
+            indirect: rgb(indirect),
+            direct: rgb(direct),
         })
     }
 
@@ -269,7 +269,7 @@ impl<'g> Renderer<'g> {
     /// The RSM's flux per texel, row-major (what the cut clusters).
     pub fn read_rsm_flux(&self) -> Result<Vec<[f32; 3]>, IndirectError> {
         let flux = self.read_texture(&self.rsm.textures()[0])?;
-        Ok(flux.iter().map(|p| [p[0], p[1], p[2]]).collect())
+        Ok(flux.into_iter().map(xyz).collect())
     }
 
     /// The quadtree as built: per node (flux rgb + texel count, position + depth, normal +
@@ -279,21 +279,34 @@ impl<'g> Renderer<'g> {
         Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
     }
 
+    /// The xyz of three same-sized textures per texel, `None` where the w of `textures[coverage]`
+    /// marks the texel empty.
+    fn read_covered(
+        &self,
+        textures: [&wgpu::Texture; 3],
+        coverage: usize,
+    ) -> Result<Vec<Option<[[f32; 3]; 3]>>, IndirectError> {
+        let texels = [
+            self.read_texture(textures[0])?,
+            self.read_texture(textures[1])?,
+            self.read_texture(textures[2])?,
+        ];
+        Ok((0..texels[0].len())
+            .map(|i| (texels[coverage][i][3] > 0.5).then(|| texels.each_ref().map(|t| xyz(t[i]))))
+            .collect())
+    }
+
     /// The RSM's VPLs (texels that see geometry), for the CPU reference.
     pub fn read_vpls(&self) -> Result<Vec<Vpl>, IndirectError> {
         let [flux, pos, normal] = self.rsm.textures();
-        let (flux, pos, normal) = (
-            self.read_texture(flux)?,
-            self.read_texture(pos)?,
-            self.read_texture(normal)?,
-        );
-        let v3 = |p: &[f32; 4]| [p[0], p[1], p[2]];
-        Ok((0..flux.len())
-            .filter(|&i| normal[i][3] > 0.5)
-            .map(|i| Vpl {
-                flux: v3(&flux[i]),
-                position: v3(&pos[i]),
-                normal: v3(&normal[i]),
+        let texels = self.read_covered([flux, pos, normal], 2)?;
+        Ok(texels
+            .into_iter()
+            .flatten()
+            .map(|[flux, position, normal]| Vpl {
+                flux,
+                position,
+                normal,
             })
             .collect())
     }
@@ -301,20 +314,20 @@ impl<'g> Renderer<'g> {
     /// The G-buffer, for the CPU reference.
     pub fn read_receivers(&self) -> Result<Vec<Option<Receiver>>, IndirectError> {
         let [pos, normal, albedo] = &self.gbuffer.targets.colors;
-        let (pos, normal, albedo) = (
-            self.read_texture(pos)?,
-            self.read_texture(normal)?,
-            self.read_texture(albedo)?,
-        );
-        let v3 = |p: &[f32; 4]| [p[0], p[1], p[2]];
-        Ok((0..pos.len())
-            .map(|i| {
-                (pos[i][3] > 0.5).then(|| Receiver {
-                    position: v3(&pos[i]),
-                    normal: v3(&normal[i]),
-                    albedo: v3(&albedo[i]),
+        let texels = self.read_covered([pos, normal, albedo], 0)?;
+        Ok(texels
+            .into_iter()
+            .map(|texel| {
+                texel.map(|[position, normal, albedo]| Receiver {
+                    position,
+                    normal,
+                    albedo,
                 })
             })
             .collect())
     }
+}
+
+fn xyz(p: [f32; 4]) -> [f32; 3] {
+    [p[0], p[1], p[2]]
 }
