@@ -215,11 +215,39 @@ impl Grid {
         if poly.is_empty() || poly.iter().any(|p| !p.is_finite()) {
             return;
         }
-        let b = Aabb::of_points(poly.iter().copied());
-        // Columns run along the polygon's most normal-like axis (the one with the least spread).
-        let c_axis = b.extent().min_position();
-        let (a_axis, b_axis) = ((c_axis + 1) % 3, (c_axis + 2) % 3);
         let pad = self.cell_size * 1e-4;
+        let (mut tmp, mut strip, mut piece) = (Vec::new(), Vec::new(), Vec::new());
+        // A polygon reaching out of the grid (a shadow polygon, extruded far beyond it) is cut to
+        // the grid first, so that its columns are chosen by the part that lies in cells.
+        let mut inside = Vec::new();
+        let mut b = Aabb::of_points(poly.iter().copied());
+        let poly = if b.union(self.bounds) == self.bounds {
+            poly
+        } else {
+            inside.extend_from_slice(poly);
+            for axis in 0..3 {
+                let (lo, hi) = (self.bounds.min[axis], self.bounds.max[axis]);
+                clip_slab(
+                    &inside,
+                    axis,
+                    lo - pad[axis],
+                    hi + pad[axis],
+                    &mut tmp,
+                    &mut piece,
+                );
+                std::mem::swap(&mut inside, &mut piece);
+            }
+            b = Aabb::of_points(inside.iter().copied());
+            &inside
+        };
+        if poly.is_empty() {
+            return;
+        }
+        // Columns run along the polygon's longest axis: each column's cells come from one clip
+        // of the polygon, so the fewer columns the cheaper (a long shadow polygon, or a wall,
+        // is cut into a few long columns rather than many short ones).
+        let c_axis = b.extent().max_position();
+        let (a_axis, b_axis) = ((c_axis + 1) % 3, (c_axis + 2) % 3);
         // Keeps the part of `src` in the slab of cells `i` along `axis`; false when none is left.
         let clip_to_cells =
             |src: &[Vec3], axis: usize, i: u32, tmp: &mut _, out: &mut Vec<Vec3>| {
@@ -228,7 +256,6 @@ impl Grid {
                 clip_slab(src, axis, lo, hi, tmp, out);
                 !out.is_empty()
             };
-        let (mut tmp, mut strip, mut piece) = (Vec::new(), Vec::new(), Vec::new());
         let range = |axis: usize, bx: &Aabb| {
             (
                 self.coord(axis, bx.min[axis] - pad[axis]),
