@@ -646,6 +646,20 @@ fn the_bunny_in_the_cornell_box_decides_like_the_conventional_test() {
     }
 }
 
+/// The Happy Buddha's 100,000 triangles on the floor of the box, HST with the shadow volumes
+/// built in parallel from the silhouette edges alone.
+#[test]
+fn the_buddha_in_the_cornell_box_decides_like_the_conventional_test() {
+    let scene = asset_scene("scenes/shadows-buddha.toml");
+    assert!(scene.faces.len() > 100_000, "{} faces", scene.faces.len());
+    let opts = RunOptions {
+        width: 160,
+        height: 120,
+        ..options(SchemeChoice::Hst, Nth::Fixed(16.0))
+    };
+    assert_agrees(&scene, &opts, 10_000, "buddha");
+}
+
 #[test]
 fn the_cornell_box_loads_with_its_colours_and_its_lights_inside_the_grid() {
     let scene = asset_scene("scenes/shadows-cornell.toml");
