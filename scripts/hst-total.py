@@ -6,7 +6,10 @@ alternating which goes first, and the medians of the per-round ratios are printe
 preprocessing split out (CPU seconds of all threads, from `--stats`), and HST's disagreements
 with the conventional test (`--check`, one extra render each).
 
-    python3 scripts/hst-total.py [ROUNDS] [WxH]    (defaults 5, 384x360; a release build)
+    python3 scripts/hst-total.py [ROUNDS] [WxH] [--embree]    (defaults 5, 384x360)
+
+With --embree (a build with `--features embree`), each round also renders `--shadows embree`,
+and HST's shadow time over Embree's is added (median of the per-round ratios).
 """
 import json
 import statistics
@@ -33,21 +36,24 @@ def render(scene_args, scheme, size, out, extra=()):
 
 
 def main():
-    rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 5
-    size = sys.argv[2] if len(sys.argv) > 2 else "384x360"
+    embree = "--embree" in sys.argv
+    args = [a for a in sys.argv[1:] if a != "--embree"]
+    rounds = int(args[0]) if args else 5
+    size = args[1] if len(args) > 1 else "384x360"
+    schemes = ["conventional", "hst"] + (["embree"] if embree else [])
     print(f"{rounds} paired rounds, {size}, 1 sample per pixel")
     print("| scene | polygons | conv total s (pre) | hst total s (pre, of it shadow volumes) "
-          "| hst/conv total | hst/conv without preprocessing | disagreements |")
-    print("|---|---|---|---|---|---|---|")
+          "| hst/conv total | hst/conv without preprocessing | disagreements |"
+          + (" hst/Embree shadow |" if embree else ""))
+    print("|---|---|---|---|---|---|---|" + ("---|" if embree else ""))
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp)
         for name, args in SCENES:
-            conv, hst = [], []
+            runs = {s: [] for s in schemes}
             for r in range(rounds):
-                order = ["conventional", "hst"] if r % 2 == 0 else ["hst", "conventional"]
-                for scheme in order:
-                    t = render(args, scheme, size, out)
-                    (conv if scheme == "conventional" else hst).append(t)
+                for scheme in schemes if r % 2 == 0 else schemes[::-1]:
+                    runs[scheme].append(render(args, scheme, size, out))
+            conv, hst = runs["conventional"], runs["hst"]
             med = lambda xs: statistics.median(xs)
             ratio = med([h["times_s"]["total"] / c["times_s"]["total"]
                          for c, h in zip(conv, hst)])
@@ -64,7 +70,12 @@ def main():
             d, n = checked["disagreements"], checked["shading_points"]
             print(f"| {name} | {conv[0]['polygons']:,} | {c_tot:.3f} ({c_pre:.3f}) "
                   f"| {h_tot:.3f} ({h_pre:.3f}, {h_vol:.3f}) | {ratio:.2f} | {render_ratio:.2f} "
-                  f"| {d} of {n:,} ({d / n:.1e}) |", flush=True)
+                  f"| {d} of {n:,} ({d / n:.1e}) |", end="")
+            if embree:
+                shadow = med([h["times_s"]["shadow"] / e["times_s"]["shadow"]
+                              for h, e in zip(hst, runs["embree"])])
+                print(f" {shadow:.2f} |", end="")
+            print(flush=True)
 
 
 if __name__ == "__main__":
