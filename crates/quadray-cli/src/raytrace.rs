@@ -253,12 +253,13 @@ fn render(
     bar.finish_and_clear();
     let t = &report.times_s;
     println!(
-        "{} {} {}x{}: preprocess {:.3}s shadow {:.3}s other {:.3}s total {:.3}s, N_th predicted {:.2}{}",
+        "{} {} {}x{}: preprocess {:.3}s (shadow volumes {:.3}s) shadow {:.3}s other {:.3}s total {:.3}s, N_th predicted {:.2}{}",
         report.scene,
         report.scheme,
         opts.width,
         opts.height,
         t.preprocess,
+        t.shadow_volumes,
         t.shadow,
         t.other,
         t.total,

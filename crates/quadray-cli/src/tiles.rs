@@ -276,23 +276,35 @@ pub fn read_header(path: &Path) -> anyhow::Result<TileHeader> {
 
 /// The radiance of a tile whose header [`read_header`] checked.
 pub fn read_pixels(path: &Path, header: &TileHeader) -> anyhow::Result<Radiance> {
-    let width = header.region.width as usize;
+    let name = path.display();
+    // Indexed by the size the decoder reports, so a file whose pixels are not the size its
+    // header claimed is refused below instead of indexing out of bounds.
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
         .rgb_channels(
-            |size, _| vec![[0f32; 3]; size.area()],
-            move |pixels: &mut Vec<[f32; 3]>, p, (r, g, b): (f32, f32, f32)| {
-                pixels[p.y() * width + p.x()] = [r, g, b]
+            |size, _| (size.width(), vec![[0f32; 3]; size.area()]),
+            |(width, pixels): &mut (usize, Vec<[f32; 3]>), p, (r, g, b): (f32, f32, f32)| {
+                pixels[p.y() * *width + p.x()] = [r, g, b]
             },
         )
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .with_context(|| format!("{}: cannot read the tile's pixels", path.display()))?;
+        .with_context(|| format!("{name}: cannot read the tile's pixels"))?;
+    let layer = image.layer_data;
+    let r = header.region;
+    ensure!(
+        layer.size.x() == r.width as usize && layer.size.y() == r.height as usize,
+        "{name}: the tile claims {}x{} pixels but holds {}x{}",
+        r.width,
+        r.height,
+        layer.size.x(),
+        layer.size.y()
+    );
     Ok(Radiance {
-        region: header.region,
-        pixels: image.layer_data.channel_data.pixels,
+        region: r,
+        pixels: layer.channel_data.pixels.1,
     })
 }
 
@@ -335,6 +347,43 @@ mod tests {
         assert!(items.index_from(Some(6)).is_err());
         assert_eq!(parse_frames("2..5"), Ok(2..5));
         assert!(parse_frames("5..5").is_err() && parse_frames("x").is_err());
+    }
+
+    /// A tile whose pixels are not the size its header gave (the file replaced after its
+    /// header was read) is refused by name, not indexed out of bounds.
+    #[test]
+    fn pixels_of_another_size_than_the_header_claims_are_refused() {
+        let dir = std::env::temp_dir().join(format!("quadray-tile-size-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let header = |tile: u32| TileHeader {
+            image: (6, 9),
+            region: band(6, 9, tile, 2),
+            tile,
+            items: WorkItems {
+                tiles: 2,
+                frames: 0..1,
+            },
+            frame: 0,
+            settings: "s".into(),
+            fingerprint: "f".into(),
+        };
+        let path = dir.join("t.exr");
+        for tile in [0, 1] {
+            let region = band(6, 9, tile, 2);
+            let radiance = Radiance {
+                region,
+                pixels: vec![[0.5; 3]; (region.width * region.height) as usize],
+            };
+            write_exr(&path, &radiance, (6, 9), Some(&header(tile))).unwrap();
+        }
+        assert_eq!(read_header(&path).unwrap().region, band(6, 9, 1, 2));
+        assert_eq!(read_pixels(&path, &header(1)).unwrap().pixels.len(), 30);
+        let e = read_pixels(&path, &header(0)).unwrap_err().to_string();
+        assert!(
+            e.contains("t.exr") && e.contains("claims 6x4 pixels but holds 6x5"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! Every mesh and scene loader on mutations of the bundled real files (bit flips, truncation,
+//! Every mesh, scene and height-map loader on mutations of the bundled real files (bit flips, truncation,
 //! huge counts, NaN and infinite numbers, out-of-range indices): each case must end in a clear
 //! error or a valid model or scene; never a panic (the mesh loader's safety net catching one
 //! counts as a panic), a hang, or an allocation the file's size does not justify.
@@ -224,6 +224,61 @@ fn shadows_scene_loader(path: &Path) -> Result<bool, String> {
     }
 }
 
+/// Height maps: the 8-bit interlaced PNG bundled (348x348, resampled), and, cut from the
+/// bundled 16-bit Puget Sound map to keep cases fast, a 16-bit PNG and a float EXR (none is
+/// bundled).
+fn height_map_seeds() -> Vec<(String, Vec<u8>)> {
+    let full = image::load_from_memory(&read("heightmaps/puget_sound/ps_height_1k.png")).unwrap();
+    let crop = full.crop_imm(300, 400, 64, 64);
+    let encode = |image: image::DynamicImage, format| {
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        image.write_to(&mut bytes, format).unwrap();
+        bytes.into_inner()
+    };
+    vec![
+        (
+            "cube_depth.png".into(),
+            read("heightmaps/bevy_parallax/cube_depth.png"),
+        ),
+        (
+            "height16.png".into(),
+            encode(crop.to_luma16().into(), image::ImageFormat::Png),
+        ),
+        (
+            "height.exr".into(),
+            encode(crop.to_rgb32f().into(), image::ImageFormat::OpenExr),
+        ),
+    ]
+}
+
+/// The height-map loader as `quadray displace` calls it, in two of its conventions: a white-is-
+/// high map resampled to a power of two, and a depth photo refused when it is not one.
+fn height_map_loader(path: &Path) -> Result<bool, String> {
+    use quadray_displace::heightmap::{Convention, Fit, HeightMap};
+    let mut valid = false;
+    for (convention, fit) in [
+        (Convention::Height, Fit::Resample),
+        (Convention::DepthPhoto, Fit::Refuse),
+    ] {
+        match HeightMap::load(path, convention, fit) {
+            Ok(map) => {
+                let n = map.size() as usize;
+                if !n.is_power_of_two()
+                    || map.depth.len() != n * n
+                    || map.depth.iter().any(|d| !(0.0..=1.0).contains(d))
+                {
+                    return Err(format!("invalid map accepted: {n}x{n}"));
+                }
+                valid = true;
+            }
+            Err(e) => {
+                clear(&e.to_string(), path)?;
+            }
+        }
+    }
+    Ok(valid)
+}
+
 /// An error is clear when it names the file and did not come from a caught panic.
 fn clear(message: &str, path: &Path) -> Result<bool, String> {
     let name = path.file_name().unwrap().to_string_lossy();
@@ -288,6 +343,12 @@ fn loaders() -> Vec<Loader> {
             .map(|s| scene(&format!("scenes/{s}")))
             .to_vec(),
             load: shadows_scene_loader,
+        },
+        // Last, so that the loaders before keep their seeds and cases.
+        Loader {
+            name: "height map (PNG 8/16-bit, EXR)",
+            seeds: height_map_seeds(),
+            load: height_map_loader,
         },
     ]
 }

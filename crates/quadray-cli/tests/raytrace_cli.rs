@@ -49,7 +49,7 @@ fn raytrace_writes_the_picture_and_the_stats() {
     ] {
         assert!(json.get(key).is_some(), "stats lack {key}");
     }
-    for key in ["preprocess", "shadow", "other", "total"] {
+    for key in ["preprocess", "shadow_volumes", "shadow", "other", "total"] {
         assert!(json["times_s"][key].as_f64().unwrap() >= 0.0);
     }
     for key in ["sustain", "self_shadow", "shadow_volume", "conventional"] {

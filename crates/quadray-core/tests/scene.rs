@@ -29,6 +29,7 @@ fn every_bundled_scene_file_loads() {
         ("cornell_spot.gltf", 1, 1, 1, 0),
         ("example-hst.toml", 2, 0, 5, 4),
         ("leak.toml", 1, 1, 9, 2),
+        ("shadows-buddha.toml", 3, 0, 2, 1),
         ("shadows-bunny.toml", 3, 0, 2, 1),
         ("shadows-cornell.toml", 3, 0, 1, 0),
         ("shadows-demo.toml", 2, 0, 4, 3),

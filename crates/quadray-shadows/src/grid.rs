@@ -42,22 +42,6 @@ impl CellLists {
     pub fn registrations(&self) -> usize {
         self.items.len()
     }
-
-    /// Several lists over the same cells merged cell-major: row `c * k + i` is list `i`'s cell
-    /// `c` (`k` lists), so the rows of one cell share cache lines.
-    pub fn interleave(lists: &[CellLists], cells: usize) -> CellLists {
-        let k = lists.len();
-        let mut offsets = Vec::with_capacity(cells * k + 1);
-        let mut items = Vec::with_capacity(lists.iter().map(|l| l.items.len()).sum());
-        offsets.push(0);
-        for c in 0..cells as u32 {
-            for list in lists {
-                items.extend_from_slice(list.cell(c));
-                offsets.push(items.len() as u32);
-            }
-        }
-        CellLists { offsets, items }
-    }
 }
 
 /// A set of cells, one bit each: small enough to stay in cache while a ray walks.
@@ -231,11 +215,39 @@ impl Grid {
         if poly.is_empty() || poly.iter().any(|p| !p.is_finite()) {
             return;
         }
-        let b = Aabb::of_points(poly.iter().copied());
-        // Columns run along the polygon's most normal-like axis (the one with the least spread).
-        let c_axis = b.extent().min_position();
-        let (a_axis, b_axis) = ((c_axis + 1) % 3, (c_axis + 2) % 3);
         let pad = self.cell_size * 1e-4;
+        let (mut tmp, mut strip, mut piece) = (Vec::new(), Vec::new(), Vec::new());
+        // A polygon reaching out of the grid (a shadow polygon, extruded far beyond it) is cut to
+        // the grid first, so that its columns are chosen by the part that lies in cells.
+        let mut inside = Vec::new();
+        let mut b = Aabb::of_points(poly.iter().copied());
+        let poly = if b.union(self.bounds) == self.bounds {
+            poly
+        } else {
+            inside.extend_from_slice(poly);
+            for axis in 0..3 {
+                let (lo, hi) = (self.bounds.min[axis], self.bounds.max[axis]);
+                clip_slab(
+                    &inside,
+                    axis,
+                    lo - pad[axis],
+                    hi + pad[axis],
+                    &mut tmp,
+                    &mut piece,
+                );
+                std::mem::swap(&mut inside, &mut piece);
+            }
+            b = Aabb::of_points(inside.iter().copied());
+            &inside
+        };
+        if poly.is_empty() {
+            return;
+        }
+        // Columns run along the polygon's longest axis: each column's cells come from one clip
+        // of the polygon, so the fewer columns the cheaper (a long shadow polygon, or a wall,
+        // is cut into a few long columns rather than many short ones).
+        let c_axis = b.extent().max_position();
+        let (a_axis, b_axis) = ((c_axis + 1) % 3, (c_axis + 2) % 3);
         // Keeps the part of `src` in the slab of cells `i` along `axis`; false when none is left.
         let clip_to_cells =
             |src: &[Vec3], axis: usize, i: u32, tmp: &mut _, out: &mut Vec<Vec3>| {
@@ -244,7 +256,6 @@ impl Grid {
                 clip_slab(src, axis, lo, hi, tmp, out);
                 !out.is_empty()
             };
-        let (mut tmp, mut strip, mut piece) = (Vec::new(), Vec::new(), Vec::new());
         let range = |axis: usize, bx: &Aabb| {
             (
                 self.coord(axis, bx.min[axis] - pad[axis]),
@@ -276,30 +287,46 @@ impl Grid {
         &self,
         polygons: impl IndexedParallelIterator<Item = &'a [Vec3]>,
     ) -> CellLists {
-        let per_polygon: Vec<Vec<u32>> = polygons
-            .map(|poly| {
-                let mut cells = Vec::new();
-                self.cells_touched(poly, |c| cells.push(c));
-                cells
+        self.register_rows(1, polygons.enumerate().map(|(id, p)| (id as u32, 0, p)))
+    }
+
+    /// Registers polygons in `slots` rows per cell: polygon `(id, slot, outline)` goes, as `id`,
+    /// into row `cell * slots + slot` of every cell it touches. Several lists over the same
+    /// cells (each light's shadow polygons) are built at once this way, cell-major, so that the
+    /// rows of one cell share cache lines. Within a row, ids come in the order of `polygons`.
+    pub fn register_rows<'a>(
+        &self,
+        slots: u32,
+        polygons: impl IndexedParallelIterator<Item = (u32, u32, &'a [Vec3])>,
+    ) -> CellLists {
+        let per_polygon: Vec<(u32, Vec<u32>)> = polygons
+            .map(|(id, slot, poly)| {
+                let mut rows = Vec::new();
+                self.cells_touched(poly, |c| rows.push(c * slots + slot));
+                (id, rows)
             })
             .collect();
-        let mut offsets = vec![0u32; self.cell_count() + 1];
-        for cells in &per_polygon {
-            for &c in cells {
-                offsets[c as usize + 1] += 1;
+        // Counts into `offsets[row + 1]`, then starts; each row's start is moved along as it is
+        // filled, which leaves it at the next row's start, so the offsets are shifted back.
+        let mut offsets = vec![0u32; self.cell_count() * slots as usize + 1];
+        for (_, rows) in &per_polygon {
+            for &r in rows {
+                offsets[r as usize + 1] += 1;
             }
         }
         for i in 1..offsets.len() {
             offsets[i] += offsets[i - 1];
         }
-        let mut fill = offsets.clone();
         let mut items = vec![0u32; *offsets.last().unwrap() as usize];
-        for (id, cells) in per_polygon.iter().enumerate() {
-            for &c in cells {
-                items[fill[c as usize] as usize] = id as u32;
-                fill[c as usize] += 1;
+        for (id, rows) in &per_polygon {
+            for &r in rows {
+                items[offsets[r as usize] as usize] = *id;
+                offsets[r as usize] += 1;
             }
         }
+        let rows = offsets.len() - 1;
+        offsets.copy_within(..rows, 1);
+        offsets[0] = 0;
         CellLists { offsets, items }
     }
 

@@ -177,6 +177,9 @@ pub struct RunOptions {
 pub struct Times {
     /// Building the grid and the shadow polygons or BVH.
     pub preprocess: f64,
+    /// The part of `preprocess` spent finding and registering the shadow polygons (volume and
+    /// HST; 0 for the other schemes).
+    pub shadow_volumes: f64,
     /// Deciding shadows at the shading points.
     pub shadow: f64,
     /// Everything else of the render (eye and secondary rays, shading).
@@ -373,6 +376,7 @@ fn report(
         grid: prep.grid.res,
         times_s: Times {
             preprocess: prep.preprocess_s,
+            shadow_volumes: prep.shadow_volumes_s,
             shadow,
             other: r.render_cpu_s - shadow,
             total: prep.preprocess_s + r.render_cpu_s,

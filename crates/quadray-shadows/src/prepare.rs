@@ -62,6 +62,8 @@ pub struct Prepared {
     /// CPU seconds spent building the grid (always) and the shadow polygons or BVH the scheme
     /// needs.
     pub preprocess_s: f64,
+    /// The part of `preprocess_s` spent on the shadow polygons.
+    pub shadow_volumes_s: f64,
     /// Smallest ray parameter counted as a hit of a ray leaving a surface (scaled to the scene).
     pub eps: f32,
     /// The same for shadow rays: much smaller, so a polygon that a shadow ray crosses right next to
@@ -87,8 +89,10 @@ impl Prepared {
             .grow(scene.camera.eye);
         let grid = Grid::for_polygons(bounds, polygons.len());
         let cells = grid.register(polygons.par_iter().map(|p| p.vertices.as_slice()));
+        let volumes_start = crate::process_cpu_s();
         let volumes = matches!(scheme, Scheme::Volume | Scheme::Hst { .. })
             .then(|| ShadowVolumes::build(&scene, &polygons, &grid));
+        let shadow_volumes_s = crate::process_cpu_s() - volumes_start;
         let bvh = (scheme == Scheme::Bvh).then(|| Bvh::build(&polygons));
         let eps = bounds.extent().length() * 1e-5;
         #[cfg(feature = "embree")]
@@ -106,6 +110,7 @@ impl Prepared {
             #[cfg(feature = "embree")]
             embree,
             preprocess_s: crate::process_cpu_s() - start,
+            shadow_volumes_s,
             stats: OnceLock::new(),
             follow_up: OnceLock::new(),
         }

@@ -25,7 +25,6 @@ use crate::scene::{Face, MAX_LIGHTS, Scene};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use serde::Serialize;
-use std::collections::HashMap;
 
 /// A shadow polygon (a silhouette edge `a b` extruded away from the light) prepared for crossing
 /// tests: its plane, its edge `a b` and its two sides, the lines from the light through `a` and
@@ -108,35 +107,48 @@ pub struct ShadowVolumes {
 
 impl ShadowVolumes {
     /// Finds the silhouette edges of every light, extrudes them to beyond the grid's box,
-    /// registers them in the grid and counts the eye's depth.
+    /// registers them in the grid and counts the eye's depth. Every step runs in parallel, and
+    /// only silhouette edges (a few percent of a fine mesh's edges) get past the weight.
     pub fn build(scene: &Scene, polygons: &[ConvexPolygon], grid: &Grid) -> Self {
         let eye = scene.camera.eye;
-        let edges = edge_map(polygons, &scene.faces);
-        let (lights, per_light): (Vec<LightVolumes>, Vec<CellLists>) = scene
+        let edges = edge_faces(polygons, &scene.faces);
+        let edges: Vec<&[EdgeFace]> = edges.chunk_by(|x, y| x.0 == y.0).collect();
+        let (lights, outlines): (Vec<LightVolumes>, Vec<Vec<Outline>>) = scene
             .lights
-            .iter()
+            .par_iter()
             .map(|l| {
                 let light = l.position;
                 let (outlines, polys) =
                     silhouette_polygons(polygons, scene, &edges, light, &grid.bounds);
-                let cells = grid.register(outlines.par_iter().map(|p| p.as_slice()));
                 let volumes = LightVolumes {
                     light,
                     eye_depth: depth_at(polygons, light, eye),
                     polygons: polys,
                 };
-                (volumes, cells)
+                (volumes, outlines)
             })
             .unzip();
+        let n = lights.len() as u32;
+        let all: Vec<(u32, u32, &[Vec3])> = outlines
+            .iter()
+            .enumerate()
+            .flat_map(|(light, o)| {
+                o.iter()
+                    .enumerate()
+                    .map(move |(id, p)| (id as u32, light as u32, p.as_slice()))
+            })
+            .collect();
+        let cells = grid.register_rows(n, all.into_par_iter());
         let mut occupied = CellSet::new(grid.cell_count());
         for c in 0..grid.cell_count() as u32 {
-            if per_light.iter().any(|cells| cells.count(c) > 0) {
+            let rows = cells.row_bounds(c * n, n);
+            if rows[n as usize] > rows[0] {
                 occupied.insert(c);
             }
         }
         Self {
             lights,
-            cells: CellLists::interleave(&per_light, grid.cell_count()),
+            cells,
             occupied,
         }
     }
@@ -205,36 +217,40 @@ impl ShadowVolumes {
     }
 }
 
-type EdgeMap = HashMap<(u32, u32), Vec<u32>>;
+/// An edge (its vertex indices, the lower first) and a face on it.
+type EdgeFace = ((u32, u32), u32);
 
-/// Faces around each edge (by shared vertex indices), degenerate faces left out.
-fn edge_map(polygons: &[ConvexPolygon], faces: &[Face]) -> EdgeMap {
-    let mut edges: EdgeMap = HashMap::new();
-    for (f, face) in faces.iter().enumerate() {
-        if polygons[f].is_degenerate() {
-            continue;
-        }
-        let v = &face.vertices;
-        for i in 0..v.len() {
-            let (a, b) = (v[i], v[(i + 1) % v.len()]);
-            edges
-                .entry((a.min(b), a.max(b)))
-                .or_default()
-                .push(f as u32);
-        }
-    }
+/// Every (edge, face) pair of the non-degenerate faces, sorted: the faces of one edge are
+/// neighbours, in face order.
+fn edge_faces(polygons: &[ConvexPolygon], faces: &[Face]) -> Vec<EdgeFace> {
+    let mut edges: Vec<EdgeFace> = faces
+        .par_iter()
+        .enumerate()
+        .filter(|(f, _)| !polygons[*f].is_degenerate())
+        .flat_map_iter(|(f, face)| {
+            let v = &face.vertices;
+            (0..v.len()).map(move |i| {
+                let (a, b) = (v[i], v[(i + 1) % v.len()]);
+                ((a.min(b), a.max(b)), f as u32)
+            })
+        })
+        .collect();
+    edges.par_sort_unstable();
     edges
 }
+
+/// A shadow polygon's outline: the edge and its far points, for registration in the cells.
+type Outline = Vec<Vec3>;
 
 /// Shadow polygons of one light: each silhouette edge extruded away from the light to beyond
 /// `bounds`, as outlines (for registration in the cells) and prepared for crossing tests.
 fn silhouette_polygons(
     polygons: &[ConvexPolygon],
     scene: &Scene,
-    edges: &EdgeMap,
+    edges: &[&[EdgeFace]],
     light: Vec3,
     bounds: &Aabb,
-) -> (Vec<Vec<Vec3>>, Vec<ShadowPolygon>) {
+) -> (Vec<Outline>, Vec<ShadowPolygon>) {
     let corners = (0..8).map(|i| {
         Vec3::new(
             if i & 1 == 0 {
@@ -262,7 +278,7 @@ fn silhouette_polygons(
     // How each polygon faces the light: +1 towards, -1 away, 0 edge-on (an empty shadow volume;
     // rounding must not give it a side).
     let facing: Vec<i8> = polygons
-        .iter()
+        .par_iter()
         .map(|poly| {
             let to_light = light - poly.centroid();
             let f = poly.normal.dot(to_light);
@@ -275,66 +291,68 @@ fn silhouette_polygons(
             }
         })
         .collect();
-    let mut keys: Vec<&(u32, u32)> = edges.keys().collect();
-    keys.sort_unstable();
-    let mut out = (Vec::new(), Vec::new());
-    for key in keys {
-        let faces = &edges[key];
-        let (a, b) = (vertices[key.0 as usize], vertices[key.1 as usize]);
-        if (a - light).length() < 1e-6 || (b - light).length() < 1e-6 {
-            continue;
-        }
-        let (fa, fb) = (far(a), far(b));
-        let fm = far((a + b) * 0.5);
-        // The plane through the light and the edge, from them alone: the far points, thousands
-        // of edge lengths away on a fine mesh, would tilt it by their rounding, and an edge
-        // pointing nearly at the light (a sliver of a shadow polygon, but one rays do cross)
-        // would read as degenerate and leave a hole in the volume's boundary.
-        let Some(n) = (b - light).cross(a - light).try_normalize() else {
-            continue;
-        };
-        // Each polygon on the edge adds +1 when it lies on the positive side of the extruded plane,
-        // -1 on the negative side. Which side is decided by how the polygon faces the light and
-        // which way it runs along the edge, not by where its centroid falls: for a polygon seen
-        // nearly edge-on the two tests round differently, and the bunny's millions of such
-        // near-misses left holes in its volumes.
-        let weight: i32 = faces
-            .iter()
-            .map(|&f| {
-                let v = &scene.faces[f as usize].vertices;
-                let at = v
-                    .iter()
-                    .position(|&i| i == key.0)
-                    .expect("edge of the face");
-                let forward = v[(at + 1) % v.len()] == key.1;
-                let facing = facing[f as usize] as i32;
-                if forward { facing } else { -facing }
-            })
-            .sum();
-        // Each line (direction u, moment relative to the light m) oriented so that the ray
-        // through a point inside along the normal passes on its positive side.
-        let inside = (a + b + fa + fb) * 0.25 - light;
-        let ray_moment = inside.cross(n);
-        let oriented = |u: Vec3, m: Vec3| {
-            let c = u.dot(ray_moment) + n.dot(m);
-            (c != 0.0).then_some(if c > 0.0 { [u, m] } else { [-u, -m] })
-        };
-        let parts = (
-            oriented(b - a, (a - light).cross(b - a)),
-            oriented(a - light, Vec3::ZERO),
-            oriented(b - light, Vec3::ZERO),
-        );
-        if let (true, (Some(edge), Some([side_a, _]), Some([side_b, _]))) = (weight != 0, parts) {
-            out.1.push(ShadowPolygon {
+    edges
+        .par_iter()
+        .filter_map(|faces| {
+            let key = faces[0].0;
+            // Each polygon on the edge adds +1 when it lies on the positive side of the extruded
+            // plane, -1 on the negative side. Which side is decided by how the polygon faces the
+            // light and which way it runs along the edge, not by where its centroid falls: for a
+            // polygon seen nearly edge-on the two tests round differently, and the bunny's
+            // millions of such near-misses left holes in its volumes. Most edges of a fine mesh
+            // weigh 0 (not on a silhouette) and end here.
+            let weight: i32 = faces
+                .iter()
+                .map(|&(_, f)| {
+                    let v = &scene.faces[f as usize].vertices;
+                    let at = v
+                        .iter()
+                        .position(|&i| i == key.0)
+                        .expect("edge of the face");
+                    let forward = v[(at + 1) % v.len()] == key.1;
+                    let facing = facing[f as usize] as i32;
+                    if forward { facing } else { -facing }
+                })
+                .sum();
+            if weight == 0 {
+                return None;
+            }
+            let (a, b) = (vertices[key.0 as usize], vertices[key.1 as usize]);
+            if (a - light).length() < 1e-6 || (b - light).length() < 1e-6 {
+                return None;
+            }
+            let (fa, fb) = (far(a), far(b));
+            let fm = far((a + b) * 0.5);
+            // The plane through the light and the edge, from them alone: the far points, thousands
+            // of edge lengths away on a fine mesh, would tilt it by their rounding, and an edge
+            // pointing nearly at the light (a sliver of a shadow polygon, but one rays do cross)
+            // would read as degenerate and leave a hole in the volume's boundary.
+            let n = (b - light).cross(a - light).try_normalize()?;
+            // Each line (direction u, moment relative to the light m) oriented so that the ray
+            // through a point inside along the normal passes on its positive side.
+            let inside = (a + b + fa + fb) * 0.25 - light;
+            let ray_moment = inside.cross(n);
+            let oriented = |u: Vec3, m: Vec3| {
+                let c = u.dot(ray_moment) + n.dot(m);
+                (c != 0.0).then_some(if c > 0.0 { [u, m] } else { [-u, -m] })
+            };
+            let parts = (
+                oriented(b - a, (a - light).cross(b - a)),
+                oriented(a - light, Vec3::ZERO),
+                oriented(b - light, Vec3::ZERO),
+            );
+            let (Some(edge), Some([side_a, _]), Some([side_b, _])) = parts else {
+                return None;
+            };
+            let polygon = ShadowPolygon {
                 plane: n.extend(-n.dot(a)),
                 edge,
                 sides: [side_a, side_b],
                 weight,
-            });
-            out.0.push(vec![a, b, fb, fm, fa]);
-        }
-    }
-    out
+            };
+            Some((vec![a, b, fb, fm, fa], polygon))
+        })
+        .unzip()
 }
 
 /// D at `p` for `light`: the polygons the open segment (light, p) crosses.

@@ -117,6 +117,63 @@ fn grid_closest_hit_equals_brute_force() {
     }
 }
 
+/// Registration against brute force: a polygon is in exactly the cells whose box (padded by
+/// 1e-4 of a cell, as registration pads) it meets, found by clipping it to every cell. Random
+/// triangles, many reaching far out of the grid as shadow polygons do, in two slots per cell
+/// (how every light's shadow polygons are registered at once).
+#[test]
+fn registration_equals_clipping_to_every_cell() {
+    use crate::geom::{Aabb, clip_slab};
+    use crate::grid::Grid;
+    use rayon::prelude::*;
+    let bounds = Aabb {
+        min: Vec3::new(-1.0, -2.0, 0.5),
+        max: Vec3::new(3.0, 1.0, 2.5),
+    };
+    let grid = Grid::with_resolution(bounds, [7, 5, 4]);
+    let mut rng = SplitMix(17);
+    let mut point = |reach: f32| {
+        let u = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * (2.0 * reach + 1.0) - reach;
+        bounds.min + u * bounds.extent()
+    };
+    let triangles: Vec<Vec<Vec3>> = (0..300)
+        .map(|i| {
+            let reach = if i % 3 == 0 { 4.0 } else { 0.0 };
+            vec![point(0.0), point(reach), point(reach)]
+        })
+        .collect();
+    let lists = grid.register_rows(
+        2,
+        triangles
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| (i as u32 / 2, i as u32 % 2, t.as_slice())),
+    );
+    let pad = grid.cell_size * 1e-4;
+    let (mut tmp, mut a, mut b) = (Vec::new(), Vec::new(), Vec::new());
+    let mut registrations = 0;
+    for (i, t) in triangles.iter().enumerate() {
+        let (id, slot) = (i as u32 / 2, i as u32 % 2);
+        for c in 0..grid.cell_count() as u32 {
+            let cell = [c % 7, c / 7 % 5, c / 35];
+            let mut meets = true;
+            a.clone_from(t);
+            for axis in 0..3 {
+                let lo = bounds.min[axis] + cell[axis] as f32 * grid.cell_size[axis];
+                let hi = lo + grid.cell_size[axis];
+                clip_slab(&a, axis, lo - pad[axis], hi + pad[axis], &mut tmp, &mut b);
+                std::mem::swap(&mut a, &mut b);
+                meets &= !a.is_empty();
+            }
+            let registered = lists.cell(c * 2 + slot).contains(&id);
+            assert_eq!(registered, meets, "triangle {i} {t:?}, cell {cell:?}");
+            registrations += meets as usize;
+        }
+    }
+    assert_eq!(lists.registrations(), registrations);
+    assert!(registrations > 1000, "{registrations}");
+}
+
 #[test]
 fn the_walk_notes_the_cells_of_the_set_it_crosses_even_on_the_longest_walks() {
     // Eye rays, rays along cell boundaries, and the grid's four diagonals from corner to corner
@@ -584,6 +641,20 @@ fn the_bunny_in_the_cornell_box_decides_like_the_conventional_test() {
         };
         assert_agrees(&scene, &opts, 10_000, "bunny");
     }
+}
+
+/// The Happy Buddha's 100,000 triangles on the floor of the box, HST with the shadow volumes
+/// built in parallel from the silhouette edges alone.
+#[test]
+fn the_buddha_in_the_cornell_box_decides_like_the_conventional_test() {
+    let scene = asset_scene("scenes/shadows-buddha.toml");
+    assert!(scene.faces.len() > 100_000, "{} faces", scene.faces.len());
+    let opts = RunOptions {
+        width: 160,
+        height: 120,
+        ..options(SchemeChoice::Hst, Nth::Fixed(16.0))
+    };
+    assert_agrees(&scene, &opts, 10_000, "buddha");
 }
 
 #[test]
