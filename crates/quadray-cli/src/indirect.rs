@@ -57,6 +57,11 @@ pub struct IndirectArgs {
     /// extent), with --indirect-shadows.
     #[arg(long, default_value_t = Settings::default().shadow_thickness)]
     shadow_thickness: f32,
+    /// Weight of each frame's indirect light in a running average over frames (1: off), every
+    /// method but the brute force: damps the cut's popping under a moving light. Not
+    /// reprojected: it restarts when the camera moves.
+    #[arg(long, default_value_t = Settings::default().temporal_weight)]
+    temporal_weight: f32,
     /// Image size WxH.
     #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
     size: (u32, u32),
@@ -143,6 +148,7 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             0
         },
         shadow_thickness: args.shadow_thickness,
+        temporal_weight: args.temporal_weight,
         ..Settings::default()
     };
     if let Some(degrees) = args.light_orbit {

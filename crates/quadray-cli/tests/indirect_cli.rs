@@ -171,7 +171,25 @@ fn a_turning_light_gives_the_temporal_figures() {
     let ratio = t["flicker_ratio"].as_f64().unwrap();
     assert!(ratio > 0.2 && ratio < 5.0, "{ratio}");
     assert!(t["reference_flicker"].as_f64().unwrap() > 0.0);
+    let error = t["mean_rel_l1"].as_f64().unwrap();
+    assert!(error > 0.0 && error <= t["max_rel_l1"].as_f64().unwrap());
+    // over two frame pairs a running average of weight w changes at most w(2 - w) as much
+    // (0.55 for w = 0.33): the flag reaches the renderer
+    let filtered = [&args[..], &["--temporal-weight", "0.33"]].concat();
+    quadray_writes(&filtered, &out, &stats);
+    let damped = &read_json(&stats)["temporal"];
+    let (flicker, damped_flicker) = (
+        t["flicker"].as_f64().unwrap(),
+        damped["flicker"].as_f64().unwrap(),
+    );
+    assert!(
+        damped_flicker < 0.7 * flicker,
+        "{damped_flicker} vs {flicker}"
+    );
+    assert_eq!(damped["reference_flicker"], t["reference_flicker"]);
     let out = out.to_str().unwrap();
+    let zero_weight = ["indirect", "--out", out, "--temporal-weight", "0"];
+    quadray_refuses(&zero_weight, "temporal weight");
     let one_frame = [
         "indirect",
         "--out",

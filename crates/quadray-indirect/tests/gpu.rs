@@ -273,8 +273,76 @@ fn absurd_settings_are_refused() {
             width: 0,
             ..settings(32)
         },
+        Settings {
+            temporal_weight: 0.0,
+            ..settings(32)
+        },
+        Settings {
+            temporal_weight: f32::NAN,
+            ..settings(32)
+        },
     ] {
         assert!(Renderer::new(&gpu, &scene, bad).is_err());
+    }
+}
+
+/// The temporal filter against its CPU ground truth: the running average of the frames an
+/// unfiltered renderer makes under a turning light, at full resolution and sub-sampled; the brute
+/// force neither filtered nor disturbing the average, and a moving camera restarting it.
+#[test]
+fn temporal_filter_is_the_running_average_of_the_unfiltered_frames() {
+    let gpu = gpu();
+    let scene = Scene::cornell();
+    let weight = 0.25;
+    for subsample in [1, 2] {
+        let plain_settings = Settings {
+            subsample,
+            ..settings(32)
+        };
+        let filtered_settings = Settings {
+            temporal_weight: weight,
+            ..plain_settings.clone()
+        };
+        let mut plain = Renderer::new(&gpu, &scene, plain_settings).unwrap();
+        let mut filtered = Renderer::new(&gpu, &scene, filtered_settings).unwrap();
+        let mut average: Option<Vec<[f32; 3]>> = None;
+        for frame in 0..4 {
+            let turned = scene.light_turned(5.0 * frame as f32);
+            plain.set_view(&turned);
+            filtered.set_view(&turned);
+            let now = render(&mut plain, Method::Quadtree);
+            let brute_force = render(&mut filtered, Method::Reference);
+            assert!(compare(&brute_force, &render(&mut plain, Method::Reference)).rel_l1 < 1e-6);
+            let shown = render(&mut filtered, Method::Quadtree);
+            let expected: Vec<[f32; 3]> = match &average {
+                None => now.clone(),
+                Some(last) => last
+                    .iter()
+                    .zip(&now)
+                    .map(|(a, n)| std::array::from_fn(|c| a[c] + weight * (n[c] - a[c])))
+                    .collect(),
+            };
+            let e = compare(&shown, &expected);
+            println!("subsample {subsample}, frame {frame}: filtered vs CPU average {e:?}");
+            assert!(e.rel_l1 < 1e-5, "frame {frame}: {e:?}");
+            if frame > 0 {
+                // the light moved: the average is not this frame's light
+                assert!(compare(&shown, &now).rel_l1 > 1e-3, "frame {frame}");
+            }
+            average = Some(expected);
+        }
+        let mut moved = scene.light_turned(20.0);
+        moved.camera.position[0] += 0.1;
+        plain.set_view(&moved);
+        filtered.set_view(&moved);
+        let e = compare(
+            &render(&mut filtered, Method::Quadtree),
+            &render(&mut plain, Method::Quadtree),
+        );
+        assert!(
+            e.rel_l1 < 1e-6,
+            "a moved camera restarts the average: {e:?}"
+        );
     }
 }
 

@@ -266,7 +266,7 @@ impl IndirectView {
         let cut = if self.method == Method::Quadtree || self.show == Show::Cut {
             // the other methods do not store the cut (the per-level passes select the same set)
             if self.method != Method::Quadtree {
-                renderer.render(Method::Quadtree, true, false)?;
+                renderer.build_cut()?;
             }
             let cut = renderer.read_cut()?;
             self.clusters = Some(cut.len() as u32);
@@ -327,6 +327,9 @@ impl IndirectView {
                 " --indirect-shadows --shadow-steps {} --shadow-thickness {}",
                 s.shadow_steps, s.shadow_thickness
             );
+        }
+        if s.temporal_weight < 1.0 {
+            cmd += &format!(" --temporal-weight {}", s.temporal_weight);
         }
         Some(cmd + &format!(" --out {}", shell_word(out)))
     }
@@ -418,6 +421,13 @@ impl IndirectView {
         let mut shadows = s.shadow_steps > 0;
         ui.checkbox(&mut shadows, "indirect shadows (quadtree)");
         s.shadow_steps = if shadows { 8 } else { 0 };
+        let mut temporal = s.temporal_weight < 1.0;
+        ui.checkbox(&mut temporal, "temporal filter (moving light)");
+        s.temporal_weight = if temporal {
+            Settings::MOVING_LIGHT_TEMPORAL_WEIGHT
+        } else {
+            1.0
+        };
         ui.checkbox(&mut self.animate_light, "animate light (L)");
         if self.method == Method::Reference {
             let work = f64::from(s.width) * f64::from(s.height) * f64::from(s.rsm_size).powi(2);

@@ -105,6 +105,9 @@ pub(crate) struct ShadeUniform {
     pub plane_agreement: f32,
     pub shadow_steps: u32,
     pub shadow_thickness: f32,
+    pub temporal_weight: f32,
+    /// Up to the camera's 16-byte alignment.
+    pub _pad: [u32; 3],
     /// Written by `Gather::set_camera`, the fields before by `Gather::set_light`.
     pub camera: [[f32; 4]; 4],
     pub eye: [f32; 4],
@@ -407,6 +410,7 @@ mod tests {
                     plane_agreement,
                     shadow_steps,
                     shadow_thickness,
+                    temporal_weight,
                     camera,
                     eye
                 ]

@@ -16,6 +16,7 @@ use super::rsm::{LIGHT_WGSL, RsmViews};
 use super::{Method, Settings};
 use crate::{IndirectError, baselines};
 use quadray_gpu::GpuTimer;
+use std::cell::Cell;
 use wgpu::util::DeviceExt;
 
 /// The gather's shader, in order.
@@ -60,6 +61,8 @@ struct Outputs {
     samples: wgpu::Buffer,
     /// Per pixel: VPL evaluations and texel fetches of the last indirect passes (two `u32`).
     counts: wgpu::Buffer,
+    /// The temporal filter's running average of the indirect light (one texel without it).
+    history: wgpu::Buffer,
 }
 
 impl Outputs {
@@ -83,6 +86,7 @@ impl Outputs {
                 whole(&self.low),
                 whole(&self.samples),
                 whole(&self.counts),
+                whole(&self.history),
             ],
         )
     }
@@ -98,6 +102,7 @@ pub struct Gather {
     direct_light: wgpu::ComputePipeline,
     brute_force: wgpu::ComputePipeline,
     rsm_sampling: wgpu::ComputePipeline,
+    temporal_blend: wgpu::ComputePipeline,
     light_layout: wgpu::BindGroupLayout,
     frame_layout: wgpu::BindGroupLayout,
     light: wgpu::Buffer,
@@ -109,6 +114,11 @@ pub struct Gather {
     frame_group: wgpu::BindGroup,
     /// Per dispatch: a level and a slice.
     dispatch_group: wgpu::BindGroup,
+    /// The method whose frames the temporal filter's history averages; `None` when it holds
+    /// nothing to continue from.
+    history_of: Cell<Option<Method>>,
+    /// The camera last set, to restart the (not reprojected) average when it moves.
+    camera: Cell<Option<(glam::Mat4, glam::Vec3)>>,
 }
 
 impl Gather {
@@ -151,6 +161,7 @@ impl Gather {
                 storage_entry::<[f32; 4]>(6, false),
                 storage_entry::<[f32; 4]>(7, true),
                 storage_entry::<[u32; 2]>(8, false),
+                storage_entry::<[f32; 4]>(9, false),
             ],
         );
         let dispatch_layout = layout(
@@ -183,6 +194,15 @@ impl Gather {
                 usage: wgpu::BufferUsages::STORAGE,
             }),
             counts: storage_buffer(device, "work counts", pixels * 8),
+            history: storage_buffer(
+                device,
+                "indirect history",
+                if s.temporal_weight < 1.0 {
+                    pixels * 16
+                } else {
+                    0
+                },
+            ),
         };
         let slots = Slots::new(device, "gather slots", MAX_SLICES);
         Ok(Self {
@@ -194,6 +214,7 @@ impl Gather {
             direct_light: pipeline("direct_light"),
             brute_force: pipeline("brute_force"),
             rsm_sampling: pipeline("rsm_sampling"),
+            temporal_blend: pipeline("temporal_blend"),
             light_group: Self::light_group(device, &light_layout, &light, quadtree, rsm),
             frame_group: outputs.frame_group(device, &frame_layout, gbuffer),
             dispatch_group: bind_group(
@@ -207,6 +228,8 @@ impl Gather {
             light,
             outputs,
             slots,
+            history_of: Cell::new(None),
+            camera: Cell::new(None),
         })
     }
 
@@ -236,12 +259,14 @@ impl Gather {
 
     /// Reads another quadtree or RSM from now on (when the caller's RSM textures change).
     pub fn bind_rsm(&mut self, device: &wgpu::Device, quadtree: &LightQuadtree, rsm: RsmViews) {
+        self.reset_history();
         self.light_group =
             Self::light_group(device, &self.light_layout, &self.light, quadtree, rsm);
     }
 
     /// Shades another G-buffer of the same size from now on (when the caller's targets change).
     pub fn bind_gbuffer(&mut self, device: &wgpu::Device, gbuffer: GBufferViews) {
+        self.reset_history();
         self.frame_group = self
             .outputs
             .frame_group(device, &self.frame_layout, gbuffer);
@@ -271,6 +296,8 @@ impl Gather {
                 plane_agreement: 0.02 * spot.extent,
                 shadow_steps: s.shadow_steps,
                 shadow_thickness: s.shadow_thickness * spot.extent,
+                temporal_weight: s.temporal_weight,
+                _pad: [0; 3],
                 camera: [[0.0; 4]; 4],
                 eye: [0.0; 4],
             })[..CAMERA_OFFSET],
@@ -278,8 +305,12 @@ impl Gather {
     }
 
     /// Sets the camera the G-buffer is rendered from (`view_proj`: world -> clip, `eye`: its
-    /// position): indirect shadows read the G-buffer as a depth map.
+    /// position): indirect shadows read the G-buffer as a depth map. A camera that moves
+    /// restarts the temporal filter's average.
     pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
+        if self.camera.replace(Some((view_proj, eye))) != Some((view_proj, eye)) {
+            self.reset_history();
+        }
         let camera = (view_proj.to_cols_array_2d(), eye.extend(1.0).to_array());
         queue.write_buffer(
             &self.outputs.shade,
@@ -301,8 +332,16 @@ impl Gather {
         );
     }
 
+    /// Forgets the temporal filter's average: the next frame starts it anew (when what the
+    /// frames show changes other than by the light moving, e.g. new cluster settings).
+    pub fn reset_history(&self) {
+        self.history_of.set(None);
+    }
+
     /// Records the indirect light of `method` (after `quadtree`'s build, and its cut for
-    /// [`Method::Quadtree`]) into `timer`'s `indirect` and `upsample` slots.
+    /// [`Method::Quadtree`]) into `timer`'s `indirect` and `upsample` slots; with a temporal
+    /// weight below 1 (not for the brute force) the frame is then averaged with the last ones,
+    /// in the last of those slots.
     pub fn record_indirect(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -316,6 +355,8 @@ impl Gather {
         let rsm_texels = u64::from(s.rsm_size).pow(2);
         // a cut partitions the RSM into nodes no finer than the limit level
         let cut_slices = slices(u64::from(s.rsm_size >> c.limit_level).pow(2), SLICE);
+        let filtered = s.temporal_weight < 1.0 && method != Method::Reference;
+        let blend = filtered && self.history_of.get() == Some(method);
         if method == Method::QuadtreePasses {
             encoder.clear_buffer(&self.outputs.indirect, 0, None);
         }
@@ -359,6 +400,9 @@ impl Gather {
                     sliced(&mut pass, 0, slices(rsm_texels, SLICE), w, h);
                 }
             }
+            if blend && !subsampled {
+                self.record_blend(&mut pass);
+            }
         }
         if subsampled {
             // where the upsampler recomputes a pixel it sums the cut, in the same slices
@@ -371,7 +415,28 @@ impl Gather {
                 self.bind(&mut pass, 0, slice);
                 dispatch_2d(&mut pass, s.width, s.height);
             }
+            if blend {
+                self.record_blend(&mut pass);
+            }
         }
+        if filtered && !blend {
+            // the average starts from this frame
+            let size = self.outputs.indirect.size();
+            encoder.copy_buffer_to_buffer(
+                &self.outputs.indirect,
+                0,
+                &self.outputs.history,
+                0,
+                size,
+            );
+            self.history_of.set(Some(method));
+        }
+    }
+
+    /// The temporal filter, in a pass that has the groups bound.
+    fn record_blend(&self, pass: &mut wgpu::ComputePass) {
+        pass.set_pipeline(&self.temporal_blend);
+        dispatch_2d(pass, self.settings.width, self.settings.height);
     }
 
     /// Records the direct light of the spot, shadowed by the RSM depth, into `timer`'s `slot`.

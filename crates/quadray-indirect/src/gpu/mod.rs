@@ -188,6 +188,11 @@ pub struct Settings {
     /// How far behind a surface a depth map sees a marched point counts as inside an occluder,
     /// as a fraction of the scene's extent.
     pub shadow_thickness: f32,
+    /// Weight of this frame's indirect light in a running average over frames (1: no filter),
+    /// for every method but the brute force. Damps the popping of the cut under a moving light
+    /// (see BENCHMARKS.md); the average is not reprojected, so it restarts whenever the camera,
+    /// the method or the cluster settings change.
+    pub temporal_weight: f32,
 }
 
 impl Default for Settings {
@@ -210,8 +215,15 @@ impl Settings {
             subsample: 1,
             shadow_steps: 0,
             shadow_thickness: 0.1,
+            temporal_weight: 1.0,
         }
     }
+
+    /// A [`Settings::temporal_weight`] for a light that moves under a still camera: on the
+    /// Cornell box and the atrium at 1 degree a frame it brings the image's frame-to-frame
+    /// change down to the brute force's, for a few percent more error against each frame's
+    /// brute force (BENCHMARKS.md, "A moving light").
+    pub const MOVING_LIGHT_TEMPORAL_WEIGHT: f32 = 0.33;
 
     /// Refuses sizes and parameters that would make no picture or an absurd amount of work.
     pub fn validate(&self) -> Result<(), String> {
@@ -265,6 +277,12 @@ impl Settings {
             return Err(format!(
                 "shadow thickness {} is outside (0, 1]",
                 s.shadow_thickness
+            ));
+        }
+        if !(s.temporal_weight.is_finite() && s.temporal_weight > 0.0 && s.temporal_weight <= 1.0) {
+            return Err(format!(
+                "temporal weight {} is outside (0, 1]",
+                s.temporal_weight
             ));
         }
         Ok(())

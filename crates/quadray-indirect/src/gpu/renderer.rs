@@ -90,6 +90,7 @@ impl<'g> Renderer<'g> {
         };
         settings.validate().map_err(IndirectError::Settings)?;
         self.quadtree.set_cluster(&self.gpu.queue, cluster);
+        self.gather.reset_history();
         self.settings = settings;
         Ok(())
     }
@@ -110,18 +111,7 @@ impl<'g> Renderer<'g> {
             let timer = timed.then_some(&self.timer);
             let slot = |pass: Pass| timer.map(|t| (t, pass as u32));
             let slots = |a: Pass, b: Pass| timer.map(|t| (t, a as u32, b as u32));
-            if run.contains(&Pass::Rsm) {
-                let vertices = self.vertices.slice(..);
-                self.rsm
-                    .record(&mut encoder, vertices, self.vertex_count, slot(Pass::Rsm));
-            }
-            if run.contains(&Pass::Pyramid) {
-                self.quadtree
-                    .record_build(&mut encoder, slots(Pass::Pyramid, Pass::Validity));
-            }
-            if run.contains(&Pass::Cut) {
-                self.quadtree.record_cut(&mut encoder, slot(Pass::Cut));
-            }
+            self.record_light(&mut encoder, &run, timer);
             self.gbuffer.record(
                 &mut encoder,
                 self.vertices.slice(..),
@@ -143,6 +133,42 @@ impl<'g> Renderer<'g> {
         if timed {
             self.timer.collect(gpu)?;
         }
+        Ok(())
+    }
+
+    /// Records the light-dependent passes of `run` (RSM, pyramid and validity, cut).
+    fn record_light(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        run: &[Pass],
+        timer: Option<&GpuTimer>,
+    ) {
+        let slot = |pass: Pass| timer.map(|t| (t, pass as u32));
+        if run.contains(&Pass::Rsm) {
+            let vertices = self.vertices.slice(..);
+            self.rsm
+                .record(encoder, vertices, self.vertex_count, slot(Pass::Rsm));
+        }
+        if run.contains(&Pass::Pyramid) {
+            let slots = timer.map(|t| (t, Pass::Pyramid as u32, Pass::Validity as u32));
+            self.quadtree.record_build(encoder, slots);
+        }
+        if run.contains(&Pass::Cut) {
+            self.quadtree.record_cut(encoder, slot(Pass::Cut));
+        }
+    }
+
+    /// Rebuilds the RSM, the quadtree and the compacted cut without shading anything: the cut
+    /// to read ([`Self::read_cut`]) beside a frame of a method that keeps none, leaving that
+    /// frame and the temporal filter's average as they are.
+    pub fn build_cut(&mut self) -> Result<(), IndirectError> {
+        let gpu = self.gpu;
+        let run = self.passes_run(Method::Quadtree, true);
+        gpu.checked(|| {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.record_light(&mut encoder, &run, None);
+            gpu.queue.submit([encoder.finish()]);
+        })?;
         Ok(())
     }
 

@@ -18,6 +18,8 @@ struct Shade {
     // behind a depth map's surface a point counts as inside the occluder (world units)
     shadow_steps: u32,
     shadow_thickness: f32,
+    // weight of this frame in the running average of the indirect light (1: no filter)
+    temporal_weight: f32,
     // the camera the G-buffer was rendered from (set with the camera, not with the light)
     camera: mat4x4<f32>,
     eye: vec4<f32>,
@@ -45,6 +47,8 @@ struct Shade {
 @group(1) @binding(7) var<storage, read> samples: array<vec4<f32>>;
 // per pixel: VPL evaluations and fetches of the indirect passes (cleared before them)
 @group(1) @binding(8) var<storage, read_write> counts: array<vec2<u32>>;
+// the running average of the indirect light over the last frames (rgb)
+@group(1) @binding(9) var<storage, read_write> history: array<vec4<f32>>;
 // Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
