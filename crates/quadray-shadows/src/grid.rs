@@ -1,7 +1,7 @@
 //! The uniform grid (Fujimoto's SEADS): resolution by a density rule, exact registration of convex
 //! polygons in the cells they touch, 3DDDA traversal (Amanatides & Woo) and per-ray mailboxes.
 
-use crate::geom::{Aabb, ConvexPolygon, Ray, clip_slab};
+use crate::geom::{Aabb, Ray, clip_slab};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -99,7 +99,7 @@ impl CellRecord {
     }
 
     #[inline]
-    fn note(&mut self, set: &CellSet, c: u32) {
+    pub(crate) fn note(&mut self, set: &CellSet, c: u32) {
         self.cells[self.len] = c;
         self.len += set.contains(c) as usize;
     }
@@ -378,63 +378,6 @@ impl Grid {
             t_enter = t_next[axis];
             t_next[axis] += t_delta[axis];
         }
-    }
-
-    /// Closest polygon hit on the ray, never `skip` (the polygon the ray starts on). With
-    /// `record`, the walked cells that are in its set are noted in it (the cells of the ray
-    /// segment that hold shadow polygons, for N_s: a bit test per cell, in the walk that visits
-    /// them anyway).
-    pub fn closest_hit(
-        &self,
-        lists: &CellLists,
-        polygons: &[ConvexPolygon],
-        ray: &Ray,
-        skip: Option<u32>,
-        mailbox: &mut Mailbox,
-        mut record: Option<(&CellSet, &mut CellRecord)>,
-    ) -> Option<Hit> {
-        let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
-        mailbox.start_ray(skip);
-        let mut best: Option<Hit> = None;
-        self.walk(ray, |c, _, t_exit| {
-            if let Some((set, cells)) = &mut record {
-                cells.note(set, c);
-            }
-            for &id in lists.cell(c) {
-                if mailbox.first_visit(id) {
-                    let limit = best.map_or(t_max, |h| h.t);
-                    if let Some(t) = polygons[id as usize].intersect(o, d, t_min, limit) {
-                        best = Some(Hit { t, polygon: id });
-                    }
-                }
-            }
-            best.is_some_and(|h| h.t <= t_exit)
-        });
-        best
-    }
-
-    /// Occlusion query: is any polygon but `skip` hit on the ray? Stops at the first.
-    pub fn occluded(
-        &self,
-        lists: &CellLists,
-        polygons: &[ConvexPolygon],
-        ray: &Ray,
-        skip: Option<u32>,
-        mailbox: &mut Mailbox,
-    ) -> bool {
-        let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
-        mailbox.start_ray(skip);
-        let mut blocked = false;
-        self.walk(ray, |c, _, _| {
-            blocked = lists.cell(c).iter().any(|&id| {
-                mailbox.first_visit(id)
-                    && polygons[id as usize]
-                        .intersect(o, d, t_min, t_max)
-                        .is_some()
-            });
-            blocked
-        });
-        blocked
     }
 }
 

@@ -176,9 +176,7 @@ fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
         for x in 0..64 {
             let d = pinhole.dir(x as f32 + 0.5, y as f32 + 0.5);
             occupied.clear();
-            let hit = prep.grid.closest_hit(
-                &prep.cells,
-                &prep.polygons,
+            let hit = prep.grid_occluder().closest_hit(
                 &Ray::new(eye, d, prep.eps, f32::INFINITY),
                 None,
                 &mut objects,

@@ -5,6 +5,7 @@
 use crate::cost::{self, MachineCosts};
 use crate::geom::{ConvexPolygon, Ray};
 use crate::grid::{CellRecord, CellSet, Mailbox};
+use crate::occlusion::{GridOccluder, Occluder};
 use crate::prepare::{Prepared, Scheme};
 use crate::scene::{BUILTINS, Face, Scene};
 use crate::shadow::{LightState, ShadowVolumes, depth_at};
@@ -96,9 +97,7 @@ fn grid_closest_hit_equals_brute_force() {
         let prep = Prepared::new(scene_with_degenerates(name), Scheme::Conventional);
         let mut mailbox = Mailbox::new(prep.polygons.len());
         for (o, d) in test_rays(&prep, 4000) {
-            let grid = prep.grid.closest_hit(
-                &prep.cells,
-                &prep.polygons,
+            let grid = prep.grid_occluder().closest_hit(
                 &Ray::new(o, d, 0.0, f32::INFINITY),
                 None,
                 &mut mailbox,
@@ -200,9 +199,12 @@ fn the_walk_notes_the_cells_of_the_set_it_crosses_even_on_the_longest_walks() {
         let mut longest_noted = 0;
         for &(o, d) in &rays {
             record.clear();
-            let hit = grid.closest_hit(
-                &no_polygons,
-                &[],
+            let empty = GridOccluder {
+                grid,
+                cells: &no_polygons,
+                polygons: &[],
+            };
+            let hit = empty.closest_hit(
                 &Ray::new(o, d, 0.0, f32::INFINITY),
                 None,
                 &mut mailbox,
@@ -245,13 +247,8 @@ fn bvh_and_grid_occlusion_equal_brute_force() {
             "bvh {o} {d}"
         );
         assert_eq!(
-            prep.grid.occluded(
-                &prep.cells,
-                &prep.polygons,
-                &Ray::new(o, d, 0.0, t_max),
-                None,
-                &mut mailbox
-            ),
+            prep.grid_occluder()
+                .occluded(&Ray::new(o, d, 0.0, t_max), None, &mut mailbox),
             brute,
             "grid {o} {d}"
         );
@@ -296,10 +293,8 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
         for (o, d) in test_rays(&prep, 1500) {
             occupied.clear();
             let t1 = prep
-                .grid
+                .grid_occluder()
                 .closest_hit(
-                    &prep.cells,
-                    &prep.polygons,
                     &Ray::new(o, d, 0.0, 2.0),
                     None,
                     &mut objects,

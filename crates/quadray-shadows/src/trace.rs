@@ -313,9 +313,7 @@ impl<S: ShadowTest> Tracer<'_, S> {
     ) -> Vec3 {
         let prep = self.prep;
         sc.occupied.clear();
-        let Some(hit) = prep.grid.closest_hit(
-            &prep.cells,
-            &prep.polygons,
+        let Some(hit) = prep.grid_occluder().closest_hit(
             &Ray::new(o, d, prep.eps, f32::INFINITY),
             skip,
             &mut sc.objects,
