@@ -168,7 +168,8 @@ impl ShadowVolumes {
     }
 
     /// The cells holding shadow polygons of any light: what a ray walk records
-    /// ([`Grid::closest_hit`]) for [`Self::counts`] and [`Self::crossings`].
+    /// ([`GridOccluder::closest_hit`](crate::occlusion::GridOccluder::closest_hit)) for
+    /// [`Self::counts`] and [`Self::crossings`].
     pub fn occupied_cells(&self) -> &CellSet {
         &self.occupied
     }
