@@ -43,11 +43,12 @@ fn tangent(world: vec3f) -> vec3f { return vec3f(world.x, world.z, world.y); }
     let l = normalize(u.light.xyz - world);
     let lit = pyramid_lit(heights, u.pyramid, uv, hit.z, tangent(l), DEPTH_SCALE, 0);
     // Shade the hit: a stone colour darker with depth, the normal from the depth's slope.
-    let dx = 1.0 / f32(1 << u32(u.pyramid.levels));
+    let dx = vec2f(1.0 / f32(u.pyramid.size.x), 0.0);
+    let dy = vec2f(0.0, 1.0 / f32(u.pyramid.size.y));
     let slope = vec2f(
-        depth_bilinear(heights, u.pyramid, uv + vec2f(dx, 0.0)) - depth_bilinear(heights, u.pyramid, uv - vec2f(dx, 0.0)),
-        depth_bilinear(heights, u.pyramid, uv + vec2f(0.0, dx)) - depth_bilinear(heights, u.pyramid, uv - vec2f(0.0, dx)),
-    ) / (2.0 * dx);
+        depth_bilinear(heights, u.pyramid, uv + dx) - depth_bilinear(heights, u.pyramid, uv - dx),
+        depth_bilinear(heights, u.pyramid, uv + dy) - depth_bilinear(heights, u.pyramid, uv - dy),
+    ) / (2.0 * vec2f(dx.x, dy.y));
     let n = normalize(vec3f(slope.x * DEPTH_SCALE, 1.0, slope.y * DEPTH_SCALE));
     let depth = depth_bilinear(heights, u.pyramid, uv);
     let srgb = floor(vec3f(220.0, 190.0, 150.0) * (1.0 - 0.55 * depth)) / 255.0;
@@ -74,7 +75,7 @@ struct Uniforms {
 pub fn tile_map() -> HeightMap {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let file = root.join("assets/heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
-    HeightMap::load(&file, Convention::Height, Fit::Refuse).expect("the bundled tile map")
+    HeightMap::load(&file, Convention::Height, Fit::Exact).expect("the bundled tile map")
 }
 
 /// Draws the displaced quad on `device` and reads the picture back.

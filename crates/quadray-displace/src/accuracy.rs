@@ -51,7 +51,7 @@ impl Accuracy {
             })
             .collect();
         let truth_hits = intersect_all(map, addressing, truth, &rays);
-        let texel = 1.0 / f64::from(map.size());
+        let texels_per_uv = map.texels_per_uv();
         let error_texels: Vec<f32> = rays
             .iter()
             .zip(&frame.hits)
@@ -62,7 +62,7 @@ impl Accuracy {
                 }
                 let gpu_hit = (gpu[2] >= 0.0).then(|| DVec2::new(gpu[0].into(), gpu[1].into()));
                 match (gpu_hit, truth) {
-                    (Some(g), Some(t)) => (g.distance(t.uv) / texel) as f32,
+                    (Some(g), Some(t)) => ((g - t.uv) * texels_per_uv).length() as f32,
                     (None, None) => 0.0,
                     _ => STATUS_MISMATCH_TEXELS,
                 }

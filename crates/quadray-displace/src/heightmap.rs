@@ -1,5 +1,5 @@
 //! Height maps in the spec's convention: depth in `[0, 1]` (0 = the polygon's plane, 1 = deepest),
-//! 2^n x 2^n texels, row-major with row 0 at v = 0.
+//! any width x height, row-major with row 0 at v = 0.
 
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -45,8 +45,8 @@ impl std::str::FromStr for Convention {
 /// What to do with a map that is not 2^n x 2^n.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fit {
-    /// Refuse it with an error suggesting `--resample`.
-    Refuse,
+    /// Keep it as stored: the pyramid pads it and traces it exactly.
+    Exact,
     /// Bilinear resampling to the nearest power of two (1025 -> 1024, 348 -> 256, 640x480 -> 512).
     Resample,
 }
@@ -59,17 +59,13 @@ pub enum HeightMapError {
     Unreadable { path: PathBuf, reason: String },
     #[error("{path}: the image is empty (0 texels)")]
     Empty { path: PathBuf },
-    #[error(
-        "{path}: {width}x{height} is not 2^n x 2^n; resample it to {suggested}x{suggested} (`--resample` on the command line)"
-    )]
-    NotPowerOfTwo {
+    #[error("{path}: {width}x{height} is outside the supported 1x1 .. {max}x{max}")]
+    Size {
         path: PathBuf,
         width: u32,
         height: u32,
-        suggested: u32,
+        max: u32,
     },
-    #[error("{path}: {size}x{size} is outside the supported 2x2 .. {max}x{max}")]
-    Size { path: PathBuf, size: u32, max: u32 },
     #[error("{path}: texel ({x}, {y}) is {value}, not a finite number")]
     NotFinite {
         path: PathBuf,
@@ -85,10 +81,13 @@ pub enum HeightMapError {
 pub const MAX_SIZE: u32 = 8192;
 
 #[derive(Clone, Debug, PartialEq)]
-/// A square 2^n x 2^n height field in depth convention.
+/// A `width` x `height` height field in depth convention; uv [0, 1)^2 spans it once, texel
+/// (i, j) covering [i / width, (i + 1) / width) x [j / height, (j + 1) / height).
 pub struct HeightMap {
-    /// log2 of the side: the pyramid has `levels + 1` levels, the root being 1x1.
-    pub levels: u32,
+    /// Texels per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
     /// Depths in [0, 1], row-major, row 0 at v = 0.
     pub depth: Vec<f32>,
 }
@@ -107,40 +106,57 @@ fn all_finite(path: &Path, values: &[f32], width: u32) -> Result<(), HeightMapEr
 }
 
 impl HeightMap {
-    /// Texels per side (2^levels).
-    pub fn size(&self) -> u32 {
-        1 << self.levels
+    /// The pyramid's storage: width and height rounded up to powers of two.
+    pub fn padded_size(&self) -> (u32, u32) {
+        (self.width.next_power_of_two(), self.height.next_power_of_two())
+    }
+
+    /// Pyramid levels above the map's: the root (level `levels()`) is 1x1 over the padded size.
+    pub fn levels(&self) -> u32 {
+        let (w, h) = self.padded_size();
+        w.max(h).ilog2()
+    }
+
+    /// Texels per unit of uv on each axis: (width, height).
+    pub fn texels_per_uv(&self) -> glam::DVec2 {
+        glam::DVec2::new(self.width.into(), self.height.into())
     }
 
     /// The depth of texel (x, y).
     pub fn at(&self, x: u32, y: u32) -> f32 {
-        self.depth[(y * self.size() + x) as usize]
+        self.depth[y as usize * self.width as usize + x as usize]
     }
 
-    /// Builds a map from depths in `[0, 1]`; `name` is used in errors.
-    pub fn from_depths(name: &Path, size: u32, depth: Vec<f32>) -> Result<Self, HeightMapError> {
-        if size == 0 || depth.is_empty() {
+    /// Builds a `width` x `height` map from depths in `[0, 1]`; `name` is used in errors.
+    ///
+    /// # Panics
+    /// If `depth` does not hold `width * height` entries.
+    pub fn from_depths(
+        name: &Path,
+        width: u32,
+        height: u32,
+        depth: Vec<f32>,
+    ) -> Result<Self, HeightMapError> {
+        if width == 0 || height == 0 || depth.is_empty() {
             return Err(HeightMapError::Empty { path: name.into() });
         }
-        if !size.is_power_of_two() {
-            return Err(HeightMapError::NotPowerOfTwo {
-                path: name.into(),
-                width: size,
-                height: size,
-                suggested: nearest_power_of_two(size),
-            });
-        }
-        if !(2..=MAX_SIZE).contains(&size) {
+        if width > MAX_SIZE || height > MAX_SIZE {
             return Err(HeightMapError::Size {
                 path: name.into(),
-                size,
+                width,
+                height,
                 max: MAX_SIZE,
             });
         }
-        assert_eq!(depth.len(), (size * size) as usize, "depth buffer size");
-        all_finite(name, &depth, size)?;
+        assert_eq!(
+            depth.len(),
+            width as usize * height as usize,
+            "depth buffer size"
+        );
+        all_finite(name, &depth, width)?;
         Ok(Self {
-            levels: size.trailing_zeros(),
+            width,
+            height,
             depth: depth.into_iter().map(|d| d.clamp(0.0, 1.0)).collect(),
         })
     }
@@ -193,24 +209,15 @@ impl HeightMap {
         assert_eq!(values.len(), (w as usize) * (h as usize), "value grid size");
         all_finite(path, values, w)?;
         let depth = to_depth(path, values, convention)?;
-        let (size, depth) = if w == h && w.is_power_of_two() {
-            (w, depth)
-        } else if fit == Fit::Resample {
-            let size = nearest_power_of_two(w.max(h));
-            tracing::warn!(
-                "{}: resampled {w}x{h} to {size}x{size} (not a power of two)",
-                path.display()
-            );
-            (size, resample(&depth, w, h, size))
-        } else {
-            return Err(HeightMapError::NotPowerOfTwo {
-                path: path.into(),
-                width: w,
-                height: h,
-                suggested: nearest_power_of_two(w.max(h)),
-            });
-        };
-        Self::from_depths(path, size, depth)
+        if fit == Fit::Exact || (w == h && w.is_power_of_two()) {
+            return Self::from_depths(path, w, h, depth);
+        }
+        let size = nearest_power_of_two(w.max(h));
+        tracing::warn!(
+            "{}: resampled {w}x{h} to {size}x{size} (--resample): the surface changes",
+            path.display()
+        );
+        Self::from_depths(path, size, size, resample(&depth, w, h, size))
     }
 }
 
@@ -276,16 +283,38 @@ mod tests {
     }
 
     #[test]
-    fn nan_and_odd_sizes_are_refused_with_the_file_name() {
+    fn nan_empty_and_oversized_maps_are_refused_with_the_file_name() {
         let p = Path::new("m.exr");
-        let err = HeightMap::from_depths(p, 2, vec![0.0, f32::NAN, 0.0, 0.0]).unwrap_err();
+        let err = HeightMap::from_depths(p, 3, 1, vec![0.0, f32::NAN, 0.0]).unwrap_err();
         assert!(err.to_string().contains("m.exr") && err.to_string().contains("(1, 0)"));
-        let err = HeightMap::from_depths(p, 3, vec![0.0; 9]).unwrap_err();
-        assert!(matches!(err, HeightMapError::NotPowerOfTwo { .. }));
         assert!(matches!(
-            HeightMap::from_depths(p, 0, vec![]).unwrap_err(),
+            HeightMap::from_depths(p, 0, 0, vec![]).unwrap_err(),
             HeightMapError::Empty { .. }
         ));
+        let err = HeightMap::from_values(
+            p,
+            MAX_SIZE + 1,
+            1,
+            &vec![0.0; MAX_SIZE as usize + 1],
+            Convention::Depth,
+            Fit::Exact,
+        )
+        .unwrap_err();
+        assert!(matches!(err, HeightMapError::Size { .. }), "{err}");
+    }
+
+    #[test]
+    fn odd_sizes_pad_each_side_to_its_own_power_of_two() {
+        let p = Path::new("m");
+        let size = |w, h| {
+            let map = HeightMap::from_depths(p, w, h, vec![0.5; (w * h) as usize]).unwrap();
+            (map.padded_size(), map.levels())
+        };
+        assert_eq!(size(1, 1), ((1, 1), 0));
+        assert_eq!(size(3, 5), ((4, 8), 3));
+        assert_eq!(size(4096, 16), ((4096, 16), 12));
+        assert_eq!(size(348, 348), ((512, 512), 9));
+        assert_eq!(size(1000, 777), ((1024, 1024), 10));
     }
 
     #[test]

@@ -74,13 +74,9 @@ pub fn assets_dir() -> PathBuf {
 }
 
 impl BundledMap {
-    /// Loads the map (resampled to a power of two when it is not one).
+    /// Loads the map as stored (any size).
     pub fn load(&self) -> Result<HeightMap, HeightMapError> {
-        HeightMap::load(
-            &assets_dir().join(self.file),
-            self.convention,
-            Fit::Resample,
-        )
+        HeightMap::load(&assets_dir().join(self.file), self.convention, Fit::Exact)
     }
 
     /// Loads its albedo image, if it has one.
@@ -108,13 +104,15 @@ pub fn load_color(path: &Path) -> Result<Rgba8Image, HeightMapError> {
 
 /// Resamples a map to `size` x `size` (figure 21's map-size sweep).
 pub fn resized(map: &HeightMap, size: u32) -> HeightMap {
-    let src = map.size();
     let depth = (0..size * size)
         .map(|k| {
             let (i, j) = (k % size, k / size);
             // Nearest texel: keeps the map's sharpness at every size.
-            map.at(i * src / size, j * src / size)
+            map.at(
+                (u64::from(i) * u64::from(map.width) / u64::from(size)) as u32,
+                (u64::from(j) * u64::from(map.height) / u64::from(size)) as u32,
+            )
         })
         .collect();
-    HeightMap::from_depths(Path::new("resized"), size, depth).expect("power-of-two size")
+    HeightMap::from_depths(Path::new("resized"), size, size, depth).expect("a supported size")
 }

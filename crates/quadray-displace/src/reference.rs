@@ -15,7 +15,7 @@ use rayon::prelude::*;
 pub enum Surface {
     /// Each texel a flat-topped column (what point sampling sees).
     Point,
-    /// Bilinear interpolation between texel centres at (i + 0.5) / 2^n.
+    /// Bilinear interpolation between texel centres at ((i + 0.5) / width, (j + 0.5) / height).
     Bilinear,
 }
 
@@ -69,18 +69,18 @@ pub fn intersect_all(
         .collect()
 }
 
-/// Walks the cells of a unit grid (cells of side 1/n, offset by `offset` texels) that the ray's
-/// footprint crosses, calling `visit(ix, iy, z_in, z_out)` until it returns `Some`. Ends when the
-/// ray gets deeper than 1 (every surface point lies above) .
+/// Walks the cells of the texel grid (`n` cells per unit of uv on each axis, offset by `offset`
+/// texels) that the ray's footprint crosses, calling `visit(ix, iy, z_in, z_out)` until it returns
+/// `Some`. Ends when the ray gets deeper than 1 (every surface point lies above).
 fn walk_cells<T>(
     ray: Ray,
-    n: f64,
+    n: DVec2,
     offset: f64,
     mut visit: impl FnMut(i64, i64, f64, f64) -> Option<T>,
 ) -> Option<T> {
     let q = ray.p0 * n - offset;
     let (mut ix, mut iy) = (q.x.floor() as i64, q.y.floor() as i64);
-    let axis = |q: f64, i: i64, e: f64| -> (f64, f64) {
+    let axis = |q: f64, i: i64, e: f64, n: f64| -> (f64, f64) {
         if e > 0.0 {
             ((i as f64 + 1.0 - q) / (e * n), 1.0 / (e * n))
         } else if e < 0.0 {
@@ -89,8 +89,8 @@ fn walk_cells<T>(
             (f64::INFINITY, f64::INFINITY)
         }
     };
-    let (mut next_x, dx) = axis(q.x, ix, ray.e.x);
-    let (mut next_y, dy) = axis(q.y, iy, ray.e.y);
+    let (mut next_x, dx) = axis(q.x, ix, ray.e.x, n.x);
+    let (mut next_y, dy) = axis(q.y, iy, ray.e.y, n.y);
     let (sx, sy) = (ray.e.x.signum() as i64, ray.e.y.signum() as i64);
     let mut z_in = 0.0;
     loop {
@@ -132,18 +132,20 @@ fn leave_depth(ray: Ray, addressing: Addressing) -> f64 {
 }
 
 fn intersect_point(map: &HeightMap, addressing: Addressing, ray: Ray) -> Option<Hit> {
-    let n = map.size();
     let leave = leave_depth(ray, addressing);
     if addressing == Addressing::Clamp
         && (ray.p0.cmplt(DVec2::ZERO).any() || ray.p0.cmpge(DVec2::ONE).any())
     {
         return None;
     }
-    walk_cells(ray, n as f64, 0.0, |ix, iy, z_in, z_out| {
+    walk_cells(ray, map.texels_per_uv(), 0.0, |ix, iy, z_in, z_out| {
         if z_in >= leave {
             return Some(None);
         }
-        let d = f64::from(map.at(addressing.texel(ix, n), addressing.texel(iy, n)));
+        let d = f64::from(map.at(
+            addressing.texel(ix, map.width),
+            addressing.texel(iy, map.height),
+        ));
         let z = if z_in >= d {
             z_in // the column's wall
         } else if z_out >= d {
@@ -157,21 +159,25 @@ fn intersect_point(map: &HeightMap, addressing: Addressing, ray: Ray) -> Option<
 }
 
 fn intersect_bilinear(map: &HeightMap, addressing: Addressing, ray: Ray) -> Option<Hit> {
-    let n = map.size();
-    let nf = n as f64;
+    let n = map.texels_per_uv();
     let leave = leave_depth(ray, addressing);
     if leave <= 0.0 {
         return None;
     }
-    let d = |i: i64, j: i64| f64::from(map.at(addressing.texel(i, n), addressing.texel(j, n)));
-    walk_cells(ray, nf, 0.5, |cx, cy, z_in, z_out| {
+    let d = |i: i64, j: i64| {
+        f64::from(map.at(
+            addressing.texel(i, map.width),
+            addressing.texel(j, map.height),
+        ))
+    };
+    walk_cells(ray, n, 0.5, |cx, cy, z_in, z_out| {
         if z_in >= leave {
             return Some(None);
         }
         let (s00, s10, s01, s11) = (d(cx, cy), d(cx + 1, cy), d(cx, cy + 1), d(cx + 1, cy + 1));
         // Local cell coordinates f(z) = a + b z; surface s = s00 + A fx + B fy + C fx fy.
-        let (ax, bx) = (ray.p0.x * nf - 0.5 - cx as f64, ray.e.x * nf);
-        let (ay, by) = (ray.p0.y * nf - 0.5 - cy as f64, ray.e.y * nf);
+        let (ax, bx) = (ray.p0.x * n.x - 0.5 - cx as f64, ray.e.x * n.x);
+        let (ay, by) = (ray.p0.y * n.y - 0.5 - cy as f64, ray.e.y * n.y);
         let (a, b, c) = (s10 - s00, s01 - s00, s00 - s10 - s01 + s11);
         // g(z) = s(z) - z = c0 + c1 z + c2 z^2; the ray is above the surface while g > 0.
         let c0 = s00 + a * ax + b * ay + c * ax * ay;
@@ -220,9 +226,9 @@ mod tests {
     use super::*;
     use std::path::Path;
 
-    fn random_map(size: u32, seed: u64, sharp: bool) -> HeightMap {
+    fn random_map(width: u32, height: u32, seed: u64, sharp: bool) -> HeightMap {
         let mut s = seed;
-        let depth = (0..size * size)
+        let depth = (0..width * height)
             .map(|_| {
                 s = s
                     .wrapping_mul(6364136223846793005)
@@ -231,7 +237,7 @@ mod tests {
                 if sharp { (v * 4.0).floor() / 3.0 } else { v }.min(1.0)
             })
             .collect();
-        HeightMap::from_depths(Path::new("random"), size, depth).unwrap()
+        HeightMap::from_depths(Path::new("random"), width, height, depth).unwrap()
     }
 
     fn random_rays(count: usize, seed: u64) -> Vec<Ray> {
@@ -263,61 +269,86 @@ mod tests {
         z
     }
 
-    fn point_depth(map: &HeightMap, p: DVec2) -> f64 {
-        let n = map.size();
-        let t = |c: f64| Addressing::Wrap.texel((c * n as f64).floor() as i64, n);
-        f64::from(map.at(t(p.x), t(p.y)))
+    /// The depth of texel (i, j), wherever the ray is.
+    fn texel_depth(map: &HeightMap, addressing: Addressing, i: i64, j: i64) -> f64 {
+        f64::from(map.at(
+            addressing.texel(i, map.width),
+            addressing.texel(j, map.height),
+        ))
     }
 
-    fn bilinear_depth(map: &HeightMap, p: DVec2) -> f64 {
-        let n = map.size();
-        let q = p * n as f64 - 0.5;
+    fn point_depth(map: &HeightMap, addressing: Addressing, p: DVec2) -> f64 {
+        let q = p * map.texels_per_uv();
+        texel_depth(map, addressing, q.x.floor() as i64, q.y.floor() as i64)
+    }
+
+    fn bilinear_depth(map: &HeightMap, addressing: Addressing, p: DVec2) -> f64 {
+        let q = p * map.texels_per_uv() - 0.5;
         let (i, j) = (q.x.floor() as i64, q.y.floor() as i64);
         let (fx, fy) = (q.x - i as f64, q.y - j as f64);
-        let d = |a: i64, b: i64| {
-            f64::from(map.at(Addressing::Wrap.texel(a, n), Addressing::Wrap.texel(b, n)))
-        };
+        let d = |a: i64, b: i64| texel_depth(map, addressing, a, b);
         let top = d(i, j) * (1.0 - fx) + d(i + 1, j) * fx;
         let bottom = d(i, j + 1) * (1.0 - fx) + d(i + 1, j + 1) * fx;
         top * (1.0 - fy) + bottom * fy
     }
 
+    /// Square, odd, one-texel-wide and one-texel-high maps.
+    const SIZES: [(u32, u32); 5] = [(16, 16), (3, 5), (1, 9), (13, 1), (12, 7)];
+
     #[test]
     fn point_sampled_dda_matches_fine_marching() {
-        for sharp in [false, true] {
-            let map = random_map(16, 7, sharp);
-            matches_marching(&map, 11, Surface::Point, point_depth);
+        for (w, h) in SIZES {
+            for sharp in [false, true] {
+                let map = random_map(w, h, 7, sharp);
+                matches_marching(&map, 11, Surface::Point, point_depth);
+            }
         }
     }
 
-    /// `intersect` on `surface` against fine marching of `depth` along 400 random rays.
+    /// `intersect` on `surface` against fine marching of `depth` along 400 random rays, wrapped
+    /// and clamped (where a ray that leaves the map before the marched hit misses).
     fn matches_marching(
         map: &HeightMap,
         seed: u64,
         surface: Surface,
-        depth: impl Fn(&HeightMap, DVec2) -> f64,
+        depth: impl Fn(&HeightMap, Addressing, DVec2) -> f64,
     ) {
-        for ray in random_rays(400, seed) {
-            let dz = 2e-5;
-            let expected = march(ray, dz, |p| depth(map, p));
-            let hit = intersect(map, Addressing::Wrap, surface, ray).unwrap();
-            assert!(
-                (hit.z - expected).abs() <= dz * 1.01,
-                "ray {ray:?}: {surface:?} {} march {expected}",
-                hit.z
-            );
+        let size = format!("{}x{}", map.width, map.height);
+        for addressing in [Addressing::Wrap, Addressing::Clamp] {
+            for ray in random_rays(400, seed) {
+                let dz = 2e-5;
+                let expected = march(ray, dz, |p| depth(map, addressing, p));
+                let hit = intersect(map, addressing, surface, ray);
+                let leave = leave_depth(ray, addressing);
+                if (expected - leave).abs() <= dz * 1.01 {
+                    continue; // marching cannot tell which comes first
+                }
+                match hit {
+                    Some(hit) => assert!(
+                        expected < leave && (hit.z - expected).abs() <= dz * 1.01,
+                        "{size} {addressing:?} ray {ray:?}: {surface:?} {} march {expected}",
+                        hit.z
+                    ),
+                    None => assert!(
+                        expected > leave,
+                        "{size} {addressing:?} ray {ray:?}: {surface:?} missed, march {expected}"
+                    ),
+                }
+            }
         }
     }
 
     #[test]
     fn bilinear_roots_match_fine_marching() {
-        let map = random_map(16, 3, false);
-        matches_marching(&map, 5, Surface::Bilinear, bilinear_depth);
+        for (w, h) in SIZES {
+            let map = random_map(w, h, 3, false);
+            matches_marching(&map, 5, Surface::Bilinear, bilinear_depth);
+        }
     }
 
     #[test]
     fn clamped_rays_that_leave_the_map_miss() {
-        let map = HeightMap::from_depths(Path::new("deep"), 4, vec![1.0; 16]).unwrap();
+        let map = HeightMap::from_depths(Path::new("deep"), 4, 4, vec![1.0; 16]).unwrap();
         let leaving = Ray {
             p0: DVec2::new(0.9, 0.5),
             e: DVec2::new(2.0, 0.0),
@@ -331,7 +362,7 @@ mod tests {
 
     #[test]
     fn a_vertical_ray_stops_on_the_top_of_its_column() {
-        let map = random_map(8, 1, true);
+        let map = random_map(8, 8, 1, true);
         let ray = Ray {
             p0: DVec2::new(0.3, 0.6),
             e: DVec2::ZERO,

@@ -1,9 +1,12 @@
-//! Every GPU method against the CPU ground truth on the bundled maps, on lavapipe in CI: small
-//! frames, every view angle the spec names.
+//! Every GPU method against the CPU ground truth on the bundled maps as stored (powers of two and
+//! odd sizes) and on procedural maps of any size, on lavapipe in CI: small frames, every view
+//! angle the spec names. The tests print each case's wrong-hit fraction (`--nocapture`) as
+//! BENCHMARKS.md tabulates them.
 
 mod common;
 
 use quadray_displace::accuracy::{Accuracy, Cost};
+use quadray_displace::heightmap::HeightMap;
 use quadray_displace::pyramid::{Addressing, Pyramid};
 use quadray_displace::scene::SurfaceKind;
 use quadray_displace::{HeightPyramid, Lod, Method, PyramidKind, Renderer, Settings};
@@ -29,6 +32,33 @@ fn settings(method: Method, angle: f32) -> Settings {
     }
 }
 
+/// Renders `map` with `method` at `angle` and measures it against the ground truth, checking
+/// that the frame shows the surface and that no cap stopped a ray. Prints a BENCHMARKS.md row.
+fn wrong_hit_fraction(
+    gpu: &Gpu,
+    renderer: &mut Renderer,
+    (name, map): (&str, &HeightMap),
+    method: Method,
+    angle: f32,
+) -> f64 {
+    let surface = renderer.surface();
+    let frame = renderer.render(gpu, &settings(method, angle)).unwrap();
+    let acc = Accuracy::measure(&frame, map, addressing(surface), method.truth());
+    let cost = Cost::of(&frame);
+    let at = format!("{name} {surface:?} {method} {angle} deg");
+    assert!(
+        acc.covered > 200,
+        "{at}: only {} pixels show the surface",
+        acc.covered
+    );
+    assert_eq!(cost.iteration_cap_hits, 0, "{at}: iteration cap hit");
+    println!(
+        "| {name} | {}x{} | {surface:?} | {method} | {angle} | {:.4} | {} |",
+        map.width, map.height, acc.wrong_hit_fraction, acc.covered
+    );
+    acc.wrong_hit_fraction
+}
+
 /// Every level of a pyramid, read back, finest first.
 fn read_back(gpu: &Gpu, pyramid: &HeightPyramid) -> Vec<Vec<f32>> {
     (0..=pyramid.levels())
@@ -40,7 +70,9 @@ fn read_back(gpu: &Gpu, pyramid: &HeightPyramid) -> Vec<Vec<f32>> {
 fn gpu_and_uploaded_pyramids_are_bit_identical_to_the_cpu_ones() {
     let gpu = Gpu::new().expect("a GPU adapter");
     let (device, queue) = (&gpu.device, &gpu.queue);
-    for (name, map, _) in common::bundled_maps() {
+    let bundled = common::bundled_maps().into_iter().map(|(name, map, _)| (name, map));
+    let tiny = [(3, 5), (1, 37), (29, 1)].map(|(w, h)| ("scattered", common::scattered(w, h)));
+    for (name, map) in bundled.chain(tiny) {
         let cases = [
             (PyramidKind::Point, Pyramid::build(&map)),
             (
@@ -58,7 +90,7 @@ fn gpu_and_uploaded_pyramids_are_bit_identical_to_the_cpu_ones() {
                 ("cpu", HeightPyramid::build_cpu(device, queue, &map, kind)),
             ];
             for (how, pyramid) in built {
-                assert_eq!(pyramid.levels(), map.levels, "{name} {how}");
+                assert_eq!(pyramid.levels(), map.levels(), "{name} {how}");
                 let levels = read_back(&gpu, &pyramid);
                 assert_eq!(levels.len(), cpu.levels.len(), "{name} {how}");
                 for (k, (g, c)) in levels.iter().zip(&cpu.levels).enumerate() {
@@ -90,25 +122,44 @@ fn pyramid_methods_match_the_ground_truth_at_every_angle_on_every_map() {
                     0.001
                 };
                 for angle in ANGLES {
-                    let frame = renderer.render(&gpu, &settings(method, angle)).unwrap();
-                    let acc = Accuracy::measure(&frame, &map, addressing(surface), method.truth());
-                    let cost = Cost::of(&frame);
-                    let at = format!("{name} {surface:?} {method} {angle} deg");
+                    let wrong =
+                        wrong_hit_fraction(&gpu, &mut renderer, (name, &map), method, angle);
                     assert!(
-                        acc.covered > 200,
-                        "{at}: only {} pixels show the surface",
-                        acc.covered
+                        wrong <= limit,
+                        "{name} {surface:?} {method} {angle} deg: wrong_hit_fraction {wrong} > {limit}"
                     );
-                    assert!(
-                        acc.wrong_hit_fraction <= limit,
-                        "{at}: wrong_hit_fraction {} > {limit}",
-                        acc.wrong_hit_fraction
-                    );
-                    assert_eq!(cost.iteration_cap_hits, 0, "{at}: iteration cap hit");
                 }
             }
         }
     }
+}
+
+#[test]
+fn maps_of_any_size_are_traced_exactly_without_resampling() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    let maps = [
+        ("procedural", common::procedural(1000, 777)),
+        ("scattered", common::scattered(3, 5)),
+        ("scattered", common::scattered(1, 37)),
+        ("scattered", common::scattered(29, 1)),
+    ];
+    let mut failures = Vec::new();
+    for (name, map) in &maps {
+        for surface in [SurfaceKind::Wall, SurfaceKind::Terrain] {
+            let mut renderer = Renderer::new(&gpu, map, None, surface);
+            for method in [Method::Pyramid, Method::PyramidBilinear] {
+                for angle in [0.0, 30.0, 60.0, 80.0, 85.0] {
+                    let wrong =
+                        wrong_hit_fraction(&gpu, &mut renderer, (name, map), method, angle);
+                    if wrong > 0.001 {
+                        let size = format!("{}x{}", map.width, map.height);
+                        failures.push(format!("{size} {surface:?} {method} {angle}: {wrong}"));
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "wrong-hit fraction > 0.001: {failures:#?}");
 }
 
 #[test]
@@ -154,7 +205,7 @@ fn coarser_lod_levels_cost_fewer_iterations() {
         };
         Cost::of(&renderer.render(&gpu, &s).unwrap()).mean_iterations
     };
-    let per_level: Vec<f64> = (0..=map.levels)
+    let per_level: Vec<f64> = (0..=map.levels())
         .map(|l| cost(&mut renderer, Lod::Level(l)))
         .collect();
     for pair in per_level.windows(2) {
@@ -164,7 +215,7 @@ fn coarser_lod_levels_cost_fewer_iterations() {
         );
     }
     assert!(
-        per_level[map.levels as usize] < 0.5 * per_level[0],
+        per_level[map.levels() as usize] < 0.5 * per_level[0],
         "{per_level:?}"
     );
     let auto = cost(&mut renderer, Lod::Auto);
@@ -178,7 +229,7 @@ fn coarser_lod_levels_cost_fewer_iterations() {
 #[test]
 fn the_displaced_mesh_and_the_ray_cast_surface_agree_pixel_by_pixel() {
     let gpu = Gpu::new().expect("a GPU adapter");
-    let (_, map, _) = common::bundled_maps().remove(1); // bevy cube, 256^2
+    let (_, map, _) = common::bundled_maps().remove(1); // bevy cube, 348^2
     let mut renderer = Renderer::new(&gpu, &map, None, SurfaceKind::Terrain);
     for angle in [0.0, 45.0] {
         let mesh = renderer
@@ -187,13 +238,13 @@ fn the_displaced_mesh_and_the_ray_cast_surface_agree_pixel_by_pixel() {
         let cast = renderer
             .render(&gpu, &settings(Method::PyramidBilinear, angle))
             .unwrap();
-        let texel = 1.0 / map.size() as f32;
+        let (w, h) = (map.width as f32, map.height as f32);
         let (mut both, mut close) = (0, 0);
         for (m, c) in mesh.hits.iter().zip(&cast.hits) {
             if m[2] >= 0.0 && c[2] >= 0.0 {
                 both += 1;
-                let d = ((m[0] - c[0]).powi(2) + (m[1] - c[1]).powi(2)).sqrt();
-                close += usize::from(d <= 2.0 * texel);
+                let texels = (((m[0] - c[0]) * w).powi(2) + ((m[1] - c[1]) * h).powi(2)).sqrt();
+                close += usize::from(texels <= 2.0);
             }
         }
         assert!(both > 1000, "{angle}: only {both} pixels in both");
@@ -209,12 +260,8 @@ fn the_displaced_mesh_and_the_ray_cast_surface_agree_pixel_by_pixel() {
 fn self_shadows_darken_a_sharp_map_and_leave_a_flat_one_alone() {
     let gpu = Gpu::new().expect("a GPU adapter");
     let (_, map, _) = common::bundled_maps().remove(0);
-    let flat = quadray_displace::heightmap::HeightMap::from_depths(
-        std::path::Path::new("flat"),
-        64,
-        vec![0.3; 64 * 64],
-    )
-    .unwrap();
+    let flat =
+        HeightMap::from_depths(std::path::Path::new("flat"), 64, 64, vec![0.3; 64 * 64]).unwrap();
     let darker = |map| {
         let mut r = Renderer::new(&gpu, map, None, SurfaceKind::Wall);
         let lit = r.render(&gpu, &settings(Method::Pyramid, 50.0)).unwrap();

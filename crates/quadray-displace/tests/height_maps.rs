@@ -7,29 +7,24 @@ use quadray_displace::heightmap::{Convention, Fit, HeightMap, HeightMapError};
 use quadray_displace::{Method, Settings};
 
 #[test]
-fn odd_sizes_are_refused_or_resampled_on_request() {
+fn odd_sizes_load_as_stored_or_resampled_on_request() {
     let bevy = common::asset("heightmaps/bevy_parallax/cube_depth.png");
-    let err = HeightMap::load(&bevy, Convention::Depth, Fit::Refuse).unwrap_err();
-    let msg = err.to_string();
-    assert!(
-        msg.contains("cube_depth.png") && msg.contains("348x348") && msg.contains("256x256"),
-        "{msg}"
-    );
-    let map = HeightMap::load(&bevy, Convention::Depth, Fit::Resample).unwrap();
-    assert_eq!(map.size(), 256);
+    let map = HeightMap::load(&bevy, Convention::Depth, Fit::Exact).unwrap();
+    assert_eq!((map.width, map.height, map.padded_size()), (348, 348, (512, 512)));
+    let resampled = HeightMap::load(&bevy, Convention::Depth, Fit::Resample).unwrap();
+    assert_eq!((resampled.width, resampled.height), (256, 256));
     let puget = common::asset("heightmaps/puget_sound/ps_height_1k.png");
-    assert_eq!(
-        HeightMap::load(&puget, Convention::Height, Fit::Resample)
-            .unwrap()
-            .size(),
-        1024
-    );
+    let map = HeightMap::load(&puget, Convention::Height, Fit::Resample).unwrap();
+    assert_eq!((map.width, map.height), (1024, 1024));
+    let photo = common::asset("heightmaps/depth_tum_rgbd/TUM_depth.png");
+    let map = HeightMap::load(&photo, Convention::DepthPhoto, Fit::Exact).unwrap();
+    assert_eq!((map.padded_size(), map.levels()), ((1024, 512), 10));
 }
 
 #[test]
 fn sixteen_bit_maps_keep_their_precision() {
     let tiles = common::asset("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
-    let map = HeightMap::load(&tiles, Convention::Height, Fit::Refuse).unwrap();
+    let map = HeightMap::load(&tiles, Convention::Height, Fit::Exact).unwrap();
     let mut levels: Vec<u32> = map
         .depth
         .iter()
@@ -55,7 +50,7 @@ fn nan_empty_and_broken_files_are_refused_with_their_name() {
     let mut img = image::Rgb32FImage::new(4, 4);
     img.put_pixel(2, 1, image::Rgb([f32::NAN, 0.0, 0.0]));
     img.save(&nan).unwrap();
-    let err = HeightMap::load(&nan, Convention::Height, Fit::Refuse).unwrap_err();
+    let err = HeightMap::load(&nan, Convention::Height, Fit::Exact).unwrap_err();
     assert!(
         matches!(err, HeightMapError::NotFinite { x: 2, y: 1, .. }),
         "{err}"
@@ -69,7 +64,7 @@ fn nan_empty_and_broken_files_are_refused_with_their_name() {
     std::fs::write(&truncated, &bytes[..bytes.len() / 3]).unwrap();
     let text = common::asset("SOURCES.md");
     for path in [empty, truncated, text, dir.join("missing.png")] {
-        let err = HeightMap::load(&path, Convention::Height, Fit::Refuse).unwrap_err();
+        let err = HeightMap::load(&path, Convention::Height, Fit::Exact).unwrap_err();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         assert!(err.to_string().contains(&name), "{err}");
     }
@@ -130,8 +125,8 @@ fn float_exr_maps_load_as_stored() {
         image::Rgb([v, v, v])
     });
     img.save(&path).unwrap();
-    let map = HeightMap::load(&path, Convention::Depth, Fit::Refuse).unwrap();
-    assert_eq!(map.size(), 8);
+    let map = HeightMap::load(&path, Convention::Depth, Fit::Exact).unwrap();
+    assert_eq!((map.width, map.height), (8, 8));
     for (k, d) in map.depth.iter().enumerate() {
         assert!((d - k as f32 / 63.0).abs() < 1e-6, "texel {k}: {d}");
     }

@@ -25,7 +25,7 @@ pub enum PyramidKind {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct PyramidInfo {
-    /// n: mip 0 is 2^n x 2^n, the root (mip n) is 1x1.
+    /// n: the root (mip n) is 1x1; mip 0 is the map padded to powers of two.
     pub levels: i32,
     /// 1: rays that leave [0, 1)^2 miss (terrain); 0: the map tiles.
     pub clamp_to_map: u32,
@@ -33,28 +33,35 @@ pub struct PyramidInfo {
     pub iteration_cap: u32,
     /// Hard cap on `bilinear_trace`'s refinement rounds.
     pub refine_cap: u32,
+    /// The map's width and height in texels (what uv [0, 1) spans), without the padding.
+    pub size: [u32; 2],
+    /// Rounds the struct up to 16 bytes, as a uniform's nested struct must be.
+    pub _pad: [u32; 2],
 }
 
 impl PyramidInfo {
-    /// For a pyramid of `levels` levels above the map's, read with `addressing`, with the default
-    /// caps.
-    pub fn new(levels: u32, addressing: Addressing) -> Self {
+    /// For the pyramid of a `width` x `height` map, read with `addressing`, with the default caps.
+    pub fn new(width: u32, height: u32, addressing: Addressing) -> Self {
         Self {
-            levels: levels as i32,
+            levels: width.next_power_of_two().max(height.next_power_of_two()).ilog2() as i32,
             clamp_to_map: u32::from(addressing == Addressing::Clamp),
             iteration_cap: ITERATION_CAP,
             refine_cap: REFINE_CAP,
+            size: [width, height],
+            _pad: [0; 2],
         }
     }
 }
 
-/// A min-depth (max-height) pyramid in an R32Float texture with one mip per level, built on the
+/// A min-depth (max-height) pyramid in an R32Float texture with one mip per level (mip 0 the map
+/// padded to powers of two with depth 1, as [`Pyramid`] stores it), built on the
 /// caller's device from a [`HeightMap`]; bind [`HeightPyramid::view`] as a `texture_2d<f32>`
 /// (unfilterable float) and pass it to `trace.wgsl`'s functions.
 pub struct HeightPyramid {
     texture: wgpu::Texture,
     view: wgpu::TextureView,
     kind: PyramidKind,
+    map_size: (u32, u32),
 }
 
 impl HeightPyramid {
@@ -93,10 +100,9 @@ impl HeightPyramid {
         pyramid: &Pyramid,
         kind: PyramidKind,
     ) -> Self {
-        let size = 1u32 << (pyramid.levels.len() - 1);
-        let texture = Self::create_texture(device, size);
+        let texture = Self::create_texture(device, pyramid.level_size(0));
         for (level, depths) in pyramid.levels.iter().enumerate() {
-            let side = size >> level;
+            let (width, height) = pyramid.level_size(level as u32);
             queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     mip_level: level as u32,
@@ -105,30 +111,30 @@ impl HeightPyramid {
                 bytemuck::cast_slice(depths),
                 wgpu::TexelCopyBufferLayout {
                     offset: 0,
-                    bytes_per_row: Some(side * 4),
-                    rows_per_image: Some(side),
+                    bytes_per_row: Some(width * 4),
+                    rows_per_image: Some(height),
                 },
                 wgpu::Extent3d {
-                    width: side,
-                    height: side,
+                    width,
+                    height,
                     depth_or_array_layers: 1,
                 },
             );
         }
-        Self::from_texture(texture, kind)
+        Self::from_texture(texture, kind, (pyramid.width, pyramid.height))
     }
 
-    /// An empty pyramid texture for a `size` x `size` map (usable as a storage texture, so the
-    /// compute builder can write it).
-    pub(super) fn create_texture(device: &wgpu::Device, size: u32) -> wgpu::Texture {
+    /// An empty pyramid texture with a full mip chain over a power-of-two `width` x `height` level
+    /// 0 (usable as a storage texture, so the compute builder can write it).
+    pub(super) fn create_texture(device: &wgpu::Device, (width, height): (u32, u32)) -> wgpu::Texture {
         device.create_texture(&wgpu::TextureDescriptor {
             label: Some("min-depth pyramid"),
             size: wgpu::Extent3d {
-                width: size,
-                height: size,
+                width,
+                height,
                 depth_or_array_layers: 1,
             },
-            mip_level_count: size.ilog2() + 1,
+            mip_level_count: width.max(height).ilog2() + 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: Self::FORMAT,
@@ -140,11 +146,17 @@ impl HeightPyramid {
         })
     }
 
-    pub(super) fn from_texture(texture: wgpu::Texture, kind: PyramidKind) -> Self {
+    /// Wraps a built pyramid `texture` of a `map_size` map.
+    pub(super) fn from_texture(
+        texture: wgpu::Texture,
+        kind: PyramidKind,
+        map_size: (u32, u32),
+    ) -> Self {
         Self {
             view: texture.create_view(&Default::default()),
             texture,
             kind,
+            map_size,
         }
     }
 
@@ -158,9 +170,14 @@ impl HeightPyramid {
         &self.view
     }
 
-    /// n: the map is 2^n x 2^n and the root is mip n.
+    /// n: the root is mip n (1x1).
     pub fn levels(&self) -> u32 {
         self.texture.mip_level_count() - 1
+    }
+
+    /// The map's width and height in texels (mip 0 pads them to powers of two).
+    pub fn map_size(&self) -> (u32, u32) {
+        self.map_size
     }
 
     /// Which pyramid this is.
@@ -171,6 +188,6 @@ impl HeightPyramid {
     /// The `PyramidInfo` for tracing this pyramid with `addressing` (for a conservative pyramid,
     /// the addressing it was built for).
     pub fn info(&self, addressing: Addressing) -> PyramidInfo {
-        PyramidInfo::new(self.levels(), addressing)
+        PyramidInfo::new(self.map_size.0, self.map_size.1, addressing)
     }
 }

@@ -1,14 +1,15 @@
-//! The pyramid build pass (`pyramid_build.wgsl`): one compute dispatch per level, and the
-//! conservative level 0 for the bilinear surface.
+//! The pyramid build pass (`pyramid_build.wgsl`): level 0 padded to powers of two (the map, or
+//! the conservative level 0 for the bilinear surface), then one compute dispatch per level.
 
 use super::height_pyramid::{HeightPyramid, PyramidKind};
 use crate::heightmap::HeightMap;
-use crate::pyramid::Addressing;
+use crate::pyramid::{Addressing, level_size};
 use wgpu::util::DeviceExt;
 
 /// Builds min-depth pyramids on the GPU; keeps its pipelines for any number of maps.
 pub struct PyramidBuilder {
     reduce: wgpu::ComputePipeline,
+    pad: wgpu::ComputePipeline,
     dilate_wrap: wgpu::ComputePipeline,
     dilate_clamp: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -50,23 +51,24 @@ impl PyramidBuilder {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = |entry: &str, wrap: f64| {
+        let pipeline = |entry: &str, wrap: f64, radius: f64| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&pipeline_layout),
                 module: &module,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &[("WRAP", wrap)],
+                    constants: &[("WRAP", wrap), ("RADIUS", radius)],
                     ..Default::default()
                 },
                 cache: None,
             })
         };
         Self {
-            reduce: pipeline("reduce", 1.0),
-            dilate_wrap: pipeline("dilate", 1.0),
-            dilate_clamp: pipeline("dilate", 0.0),
+            reduce: pipeline("reduce", 1.0, 0.0),
+            pad: pipeline("level0", 1.0, 0.0),
+            dilate_wrap: pipeline("level0", 1.0, 1.0),
+            dilate_clamp: pipeline("level0", 0.0, 1.0),
             layout,
         }
     }
@@ -97,8 +99,8 @@ impl PyramidBuilder {
         kind: PyramidKind,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) -> HeightPyramid {
-        let size = map.size();
-        let texture = HeightPyramid::create_texture(device, size);
+        let padded = map.padded_size();
+        let texture = HeightPyramid::create_texture(device, padded);
         let level_view = |t: &wgpu::Texture, level: u32| {
             t.create_view(&wgpu::TextureViewDescriptor {
                 base_mip_level: level,
@@ -122,51 +124,38 @@ impl PyramidBuilder {
                 ],
             })
         };
-        let extent = wgpu::Extent3d {
-            width: size,
-            height: size,
-            depth_or_array_layers: 1,
-        };
-        let depths = bytemuck::cast_slice(&map.depth);
-        match kind {
-            PyramidKind::Point => queue.write_texture(
-                texture.as_image_copy(),
-                depths,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(size * 4),
-                    rows_per_image: Some(size),
+        let source = device.create_texture_with_data(
+            queue,
+            &wgpu::TextureDescriptor {
+                label: Some("depth map"),
+                size: wgpu::Extent3d {
+                    width: map.width,
+                    height: map.height,
+                    depth_or_array_layers: 1,
                 },
-                extent,
-            ),
-            PyramidKind::Conservative(addressing) => {
-                let source = device.create_texture_with_data(
-                    queue,
-                    &wgpu::TextureDescriptor {
-                        label: Some("depth map"),
-                        size: extent,
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: HeightPyramid::FORMAT,
-                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                        view_formats: &[],
-                    },
-                    wgpu::util::TextureDataOrder::LayerMajor,
-                    depths,
-                );
-                let pipeline = match addressing {
-                    Addressing::Wrap => &self.dilate_wrap,
-                    Addressing::Clamp => &self.dilate_clamp,
-                };
-                let group = bind(&level_view(&source, 0), &level_view(&texture, 0));
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &group, &[]);
-                pass.dispatch_workgroups(size.div_ceil(8), size.div_ceil(8), 1);
-            }
-        }
-        let groups: Vec<_> = (1..=map.levels)
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: HeightPyramid::FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(&map.depth),
+        );
+        let level0 = match kind {
+            PyramidKind::Point => &self.pad,
+            PyramidKind::Conservative(Addressing::Wrap) => &self.dilate_wrap,
+            PyramidKind::Conservative(Addressing::Clamp) => &self.dilate_clamp,
+        };
+        let level0_group = bind(&level_view(&source, 0), &level_view(&texture, 0));
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(level0);
+        pass.set_bind_group(0, &level0_group, &[]);
+        pass.dispatch_workgroups(padded.0.div_ceil(8), padded.1.div_ceil(8), 1);
+        drop(pass);
+        let levels = map.levels();
+        let groups: Vec<_> = (1..=levels)
             .map(|k| bind(&level_view(&texture, k - 1), &level_view(&texture, k)))
             .collect();
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -174,12 +163,12 @@ impl PyramidBuilder {
             timestamp_writes,
         });
         pass.set_pipeline(&self.reduce);
-        for (k, group) in (1..=map.levels).zip(&groups) {
-            let side = size >> k;
+        for (k, group) in (1..=levels).zip(&groups) {
+            let (width, height) = level_size(map.width, map.height, k);
             pass.set_bind_group(0, group, &[]);
-            pass.dispatch_workgroups(side.div_ceil(8), side.div_ceil(8), 1);
+            pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
         }
         drop(pass);
-        HeightPyramid::from_texture(texture, kind)
+        HeightPyramid::from_texture(texture, kind, (map.width, map.height))
     }
 }

@@ -32,7 +32,8 @@ pub struct Frame {
 pub struct Renderer {
     pass: SurfacePass,
     map_levels: u32,
-    map_size: u32,
+    /// The map's width and height in texels.
+    map_size: (u32, u32),
     surface: SurfaceKind,
     point_group: wgpu::BindGroup,
     conservative_group: wgpu::BindGroup,
@@ -96,7 +97,7 @@ impl Renderer {
                 plane_v: v4(plane.v),
                 pyramid: point.info(addressing),
                 tile_world: surface.tile_world(),
-                mesh_grid: map.size(),
+                mesh_grid: mesh_grid(map.width, map.height),
                 tiles: surface.tiles(),
                 _pad: 0,
             },
@@ -120,8 +121,8 @@ impl Renderer {
         });
         Self {
             pass,
-            map_levels: map.levels,
-            map_size: map.size(),
+            map_levels: map.levels(),
+            map_size: (map.width, map.height),
             surface,
             point_group,
             conservative_group,
@@ -137,15 +138,17 @@ impl Renderer {
 
     /// Memory the method needs beyond the albedo, in bytes.
     pub fn memory_bytes(&self, method: Method) -> u64 {
-        let texels = u64::from(self.map_size).pow(2);
+        let (width, height) = self.map_size;
+        let texels = u64::from(width) * u64::from(height);
+        let padded = u64::from(width.next_power_of_two()) * u64::from(height.next_power_of_two());
         match method {
-            // Pyramid levels above 0 add a third; normal map RGBA16F.
+            // Pyramid levels above 0 add a third of the padded level 0; normal map RGBA16F.
             Method::Pyramid | Method::PyramidAscend | Method::PyramidBilinear => {
-                texels * 4 * 4 / 3 + texels * 8
+                padded * 4 * 4 / 3 + texels * 8
             }
             Method::Mesh => {
                 // The paper's figure 20 counts a vertex buffer (position + normal) per grid point.
-                let vertices = (u64::from(self.map_size) + 1).pow(2);
+                let vertices = (u64::from(mesh_grid(width, height)) + 1).pow(2);
                 vertices * 24 + texels * 4 + texels * 8
             }
             _ => texels * 4 + texels * 8,
@@ -202,7 +205,7 @@ impl Renderer {
         };
         let geometry = if method == Method::Mesh {
             Geometry::MeshGrid {
-                grid: self.map_size,
+                grid: mesh_grid(self.map_size.0, self.map_size.1),
                 tiles: self.surface.tiles(),
             }
         } else {
@@ -330,16 +333,21 @@ impl Renderer {
     }
 }
 
+/// The displaced-mesh baseline's quads per side per tile: one per texel of the map's longer side.
+fn mesh_grid(width: u32, height: u32) -> u32 {
+    width.max(height)
+}
+
 /// Depth gradients per unit of uv at texel centres (central differences), filtered by the sampler
 /// and turned into normals in the shader with the frame's depth scale: n ~ (grad * s, 1).
 fn upload_gradients(gpu: &Gpu, map: &HeightMap) -> wgpu::Texture {
-    let n = map.size() as i64;
-    let d = |i: i64, j: i64| map.at(i.rem_euclid(n) as u32, j.rem_euclid(n) as u32);
-    let mut texels: Vec<half::f16> = Vec::with_capacity((n * n * 4) as usize);
-    for j in 0..n {
-        for i in 0..n {
-            let du = (d(i + 1, j) - d(i - 1, j)) * 0.5 * n as f32;
-            let dv = (d(i, j + 1) - d(i, j - 1)) * 0.5 * n as f32;
+    let (w, h) = (i64::from(map.width), i64::from(map.height));
+    let d = |i: i64, j: i64| map.at(i.rem_euclid(w) as u32, j.rem_euclid(h) as u32);
+    let mut texels: Vec<half::f16> = Vec::with_capacity((w * h * 4) as usize);
+    for j in 0..h {
+        for i in 0..w {
+            let du = (d(i + 1, j) - d(i - 1, j)) * 0.5 * w as f32;
+            let dv = (d(i, j + 1) - d(i, j - 1)) * 0.5 * h as f32;
             texels.extend([du, dv, 0.0, 0.0].map(half::f16::from_f32));
         }
     }
@@ -348,8 +356,8 @@ fn upload_gradients(gpu: &Gpu, map: &HeightMap) -> wgpu::Texture {
         &wgpu::TextureDescriptor {
             label: Some("depth gradients"),
             size: wgpu::Extent3d {
-                width: n as u32,
-                height: n as u32,
+                width: map.width,
+                height: map.height,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -366,7 +374,7 @@ fn upload_gradients(gpu: &Gpu, map: &HeightMap) -> wgpu::Texture {
 
 /// An albedo for maps without a colour image: warm stone, darker with depth.
 fn tint_by_depth(map: &HeightMap) -> Rgba8Image {
-    let mut img = Rgba8Image::new(map.size(), map.size(), [0, 0, 0, 255]);
+    let mut img = Rgba8Image::new(map.width, map.height, [0, 0, 0, 255]);
     for (px, d) in img.pixels.iter_mut().zip(&map.depth) {
         let k = 1.0 - 0.55 * d;
         *px = [(220.0 * k) as u8, (190.0 * k) as u8, (150.0 * k) as u8, 255];

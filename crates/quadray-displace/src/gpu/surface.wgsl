@@ -185,7 +185,7 @@ fn finest_level(uv: vec2f) -> i32 {
     if frame.lod >= 0 {
         return min(frame.lod, levels);
     }
-    return pyramid_lod(dpdx(uv), dpdy(uv), levels);
+    return pyramid_lod(surface.pyramid, dpdx(uv), dpdy(uv));
 }
 
 fn shade(uv: vec2f, world: vec3f, tangent: vec3f, bitangent: vec3f, normal: vec3f, lit: bool) -> vec3f {

@@ -5,14 +5,18 @@
 // pyramid_*, depth_bilinear, bilinear_*, ray_slope, shadow_lit, outside_map.
 //
 // What a caller provides
-// - Texture space: uv in [0, 1)^2 per copy of the map; texel (i, j) of a 2^n x 2^n level covers
-//   [i, i + 1) / 2^n x [j, j + 1) / 2^n, row j = 0 at v = 0.
+// - Texture space: uv in [0, 1)^2 per copy of a W x H map (any size); texel (i, j) covers
+//   [i, i + 1) / W x [j, j + 1) / H, row j = 0 at v = 0. The functions work in texel units,
+//   x = uv * (W, H).
 // - Depth, not height: 0 is the polygon's plane, 1 the deepest point of the map.
-// - The pyramid: a texture_2d<f32> (wgpu R32Float, unfilterable) of 2^n x 2^n texels with n + 1
-//   mips; mip k holds at each texel the minimum depth of the 2^k x 2^k texels of mip 0 below it,
-//   mip n is 1x1. `quadray_displace::HeightPyramid` builds it: the point variant (mip 0 is the map
-//   itself) or the conservative one for the bilinear surface (mip 0 the minimum over each texel's
-//   3x3 neighbourhood). The bilinear functions also read the map: mip 0 of the point pyramid.
+// - The pyramid: a texture_2d<f32> (wgpu R32Float, unfilterable) whose mip 0 is the map padded to
+//   Pw x Ph, the next powers of two of W and H, with depth 1 (the deepest), and a full mip chain
+//   of n + 1 mips (mip k is max(Pw >> k, 1) x max(Ph >> k, 1), mip n is 1x1); mip k holds at each
+//   texel the minimum depth of the 2^k x 2^k texels of mip 0 below it.
+//   `quadray_displace::HeightPyramid` builds it: the point variant (mip 0 is the map itself) or
+//   the conservative one for the bilinear surface (mip 0 the minimum over each texel's 3x3
+//   neighbourhood). The bilinear functions also read the map: mip 0 of the point pyramid. Nodes
+//   are clipped to the map: tracing never visits padding.
 // - The ray: P(z) = p0 + e * z, its parameter z the depth in [0, 1]. p0 is the uv where the view
 //   ray meets the polygon (wrapped into [0, 1) on a tiling map); e = ray_slope(V, depth_scale)
 //   = -V.xy / V.z * depth_scale, with V the unit tangent-space direction towards the eye (x along
@@ -23,10 +27,12 @@
 // caller's derivatives for pyramid_lod need a fragment shader.
 
 struct PyramidInfo {
-    levels: i32,        // n: mip 0 is 2^n x 2^n, the root (mip n) is 1x1
+    levels: i32,        // n: the root (mip n) is 1x1
     clamp_to_map: u32,  // 1: rays that leave [0, 1)^2 miss (terrain); 0: the map tiles
     iteration_cap: u32, // hard cap on the steps of any one trace (the per-ray bound is far lower)
     refine_cap: u32,    // hard cap on bilinear_trace's refinement rounds
+    size: vec2u,        // W, H: the map's texels, which uv [0, 1) spans (without the padding)
+    _pad: vec2u,
 }
 
 // What a trace found: the depth z where it stopped, the steps it took, whether the ray left a
@@ -43,16 +49,18 @@ fn ray_slope(towards: vec3f, depth_scale: f32) -> vec2f {
     return -towards.xy / towards.z * depth_scale;
 }
 
-fn pyramid_address(info: PyramidInfo, t: vec2i, size: i32) -> vec2i {
+// Texel t of the map, wrapped or clamped to the map's own W x H (never into the padding).
+fn pyramid_address(info: PyramidInfo, t: vec2i) -> vec2i {
+    let size = vec2i(info.size);
     if info.clamp_to_map == 1u {
-        return clamp(t, vec2i(0), vec2i(size - 1));
+        return clamp(t, vec2i(0), size - 1);
     }
     return ((t % size) + size) % size;
 }
 
-fn pyramid_load(pyramid: texture_2d<f32>, info: PyramidInfo, level: i32, node: vec2f) -> f32 {
-    let size = 1 << u32(info.levels - level);
-    return textureLoad(pyramid, pyramid_address(info, vec2i(node), size), level).r;
+// The map's size in texels, as floats: uv * pyramid_texels(info) is in level-0 texel units.
+fn pyramid_texels(info: PyramidInfo) -> vec2f {
+    return vec2f(info.size);
 }
 
 // True when p is off a clamped map (a ray there has missed).
@@ -60,17 +68,17 @@ fn outside_map(info: PyramidInfo, p: vec2f) -> bool {
     return info.clamp_to_map == 1u && (any(p < vec2f(0.0)) || any(p >= vec2f(1.0)));
 }
 
-// The bilinear surface's depth at p, between texel centres at (i + 0.5) / 2^n, by hand: hardware
-// filtering has only a few bits of sub-texel precision and differs between GPUs.
+// The bilinear surface's depth at p, between texel centres at (i + 0.5) / (W, H), by hand:
+// hardware filtering has only a few bits of sub-texel precision and differs between GPUs (and
+// would blend in the padding).
 fn depth_bilinear(depth_map: texture_2d<f32>, info: PyramidInfo, p: vec2f) -> f32 {
-    let size = i32(textureDimensions(depth_map).x);
-    let x = p * f32(size) - 0.5;
+    let x = p * pyramid_texels(info) - 0.5;
     let i = vec2i(floor(x));
     let f = x - floor(x);
-    let d00 = textureLoad(depth_map, pyramid_address(info, i, size), 0).r;
-    let d10 = textureLoad(depth_map, pyramid_address(info, i + vec2i(1, 0), size), 0).r;
-    let d01 = textureLoad(depth_map, pyramid_address(info, i + vec2i(0, 1), size), 0).r;
-    let d11 = textureLoad(depth_map, pyramid_address(info, i + vec2i(1, 1), size), 0).r;
+    let d00 = textureLoad(depth_map, pyramid_address(info, i), 0).r;
+    let d10 = textureLoad(depth_map, pyramid_address(info, i + vec2i(1, 0)), 0).r;
+    let d01 = textureLoad(depth_map, pyramid_address(info, i + vec2i(0, 1)), 0).r;
+    let d11 = textureLoad(depth_map, pyramid_address(info, i + vec2i(1, 1)), 0).r;
     return mix(mix(d00, d10, f.x), mix(d01, d11, f.x), f.y);
 }
 
@@ -80,18 +88,22 @@ fn depth_bilinear(depth_map: texture_2d<f32>, info: PyramidInfo, p: vec2f) -> f3
 // leaves (0, or pyramid_lod's choice). `ascend`: after a node crossing go one level up (maximum
 // mipmaps / QDM) instead of staying on the level (the paper).
 fn pyramid_trace(pyramid: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2f, z_start: f32, start_level: i32, finest: i32, ascend: bool) -> TraceHit {
-    let res0 = f32(1 << u32(info.levels));
-    // Node crossing steps 0.1% of a finest texel past the boundary. The step can clip the corner
-    // of a texel the ray only grazes (the paper's 1% missed such corners visibly on real maps);
-    // 0.1% is still above float spacing for coordinates in [0, 1) up to 4096^2 maps, and the
-    // next-float guard below keeps the ray moving where it is not.
-    let delta = 0.001 / res0;
+    // Level-0 texel units of the map: x(z) = x0 + ex * z.
+    let size = pyramid_texels(info);
+    let x0 = p0 * size;
+    let ex = e * size;
+    let footprint = length(ex);
+    // Node crossing steps 0.1% of a texel past the boundary. The step can clip the corner of a
+    // texel the ray only grazes (the paper's 1% missed such corners visibly on real maps); 0.1%
+    // is still above float spacing for coordinates up to 4096 texels, and the next-float guard
+    // below keeps the ray moving where it is not.
+    let delta = 0.001;
     var t: TraceHit;
     t.z = z_start;
     var level = start_level;
     // A bound on any ray: at most two steps per node its footprint crosses on each level, plus
     // the descents; the global cap keeps even absurd inputs finite.
-    let cap = min(info.iteration_cap, u32(8.0 * (length(e) * res0 + 2.0)) + 16u * u32(info.levels + 1));
+    let cap = min(info.iteration_cap, u32(8.0 * (footprint + 2.0)) + 16u * u32(info.levels + 1));
     loop {
         if level < finest {
             break;
@@ -101,29 +113,39 @@ fn pyramid_trace(pyramid: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2
             break;
         }
         t.iterations += 1u;
-        let res = f32(1 << u32(info.levels - level));
-        let p = p0 + e * t.z;
-        if outside_map(info, p) {
+        if outside_map(info, p0 + e * t.z) {
             t.missed = true;
             break;
         }
-        let node = floor(p * res);
-        let d = pyramid_load(pyramid, info, level, node);
+        let x = x0 + ex * t.z;
+        // The copy of the map x lies in (x / size can round up to the next one; a clamped map
+        // has only copy 0), and the node of this level within it.
+        var copy = floor(x / size);
+        copy -= select(vec2f(0.0), vec2f(1.0), x < copy * size);
+        copy *= f32(1u - info.clamp_to_map);
+        let origin = copy * size;
+        let scale = f32(1 << u32(level)); // level-0 texels per node side
+        let node = clamp(floor((x - origin) / scale), vec2f(0.0), ceil(size / scale) - 1.0);
+        let d = textureLoad(pyramid, vec2i(node), level).r;
+        // The node's extent, clipped to the map: a ray leaving the last (partial) node goes on in
+        // the next copy's first node (wrap) or off the map (clamp), never into the padding.
+        let lo = origin + node * scale;
+        let hi = origin + min(node * scale + scale, size);
         if t.z < d {
-            let advanced = p0 + e * d;
-            if all(floor(advanced * res) == node) {
+            let advanced = x0 + ex * d;
+            if all((advanced >= lo) & (advanced < hi)) {
                 t.z = d;
                 level -= 1;
             } else {
                 // Node crossing: move to the nearer boundary along the ray, just past it.
-                let boundary = (node + select(vec2f(0.0), vec2f(1.0), e > vec2f(0.0))) / res;
-                let to_boundary = select(vec2f(1.0e30), (boundary - p0) / e, e != vec2f(0.0));
+                let boundary = select(lo, hi, ex > vec2f(0.0));
+                let to_boundary = select(vec2f(1.0e30), (boundary - x0) / ex, ex != vec2f(0.0));
                 let x_first = to_boundary.x < to_boundary.y;
                 let crossing = select(to_boundary.y, to_boundary.x, x_first);
                 // Step `delta` along the footprint, not along the crossing axis: when that axis
                 // is nearly parallel to the ray, a step of delta along it could skip texels on the
                 // other. If rounding keeps the ray in its node, the next crossing steps on again.
-                t.z = max(max(t.z, crossing) + delta / length(e), bitcast<f32>(bitcast<u32>(t.z) + 1u));
+                t.z = max(max(t.z, crossing) + delta / footprint, bitcast<f32>(bitcast<u32>(t.z) + 1u));
                 if ascend {
                     level = min(level + 1, info.levels);
                 }
@@ -139,27 +161,26 @@ fn pyramid_trace(pyramid: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2
 // from depth z_start, at most `max_cells` of them. x: the hit depth, or -1 when none; y: the depth
 // where the walk stopped; z: cells visited.
 fn bilinear_cells(depth_map: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2f, z_start: f32, max_cells: u32) -> vec3f {
-    let res0 = f32(1 << u32(info.levels));
-    let size = i32(res0);
-    let q = (p0 + e * z_start) * res0 - 0.5;
+    let size = pyramid_texels(info);
+    let q = (p0 + e * z_start) * size - 0.5;
     var cell = floor(q);
     let dir = select(vec2f(-1.0), vec2f(1.0), e >= vec2f(0.0));
     let boundary = cell + select(vec2f(0.0), vec2f(1.0), e > vec2f(0.0));
     // Depth at which the ray crosses the next cell boundary on each axis, and per cell after.
-    var next = select(vec2f(1.0e30), z_start + (boundary - q) / (e * res0), e != vec2f(0.0));
-    let step = select(vec2f(1.0e30), abs(1.0 / (e * res0)), e != vec2f(0.0));
+    var next = select(vec2f(1.0e30), z_start + (boundary - q) / (e * size), e != vec2f(0.0));
+    let step = select(vec2f(1.0e30), abs(1.0 / (e * size)), e != vec2f(0.0));
     var z_in = z_start;
     for (var k = 0u; k < max_cells; k++) {
         let z_out = min(min(next.x, next.y), 1.0);
         let c = vec2i(cell);
-        let s00 = textureLoad(depth_map, pyramid_address(info, c, size), 0).r;
-        let s10 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 0), size), 0).r;
-        let s01 = textureLoad(depth_map, pyramid_address(info, c + vec2i(0, 1), size), 0).r;
-        let s11 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 1), size), 0).r;
+        let s00 = textureLoad(depth_map, pyramid_address(info, c), 0).r;
+        let s10 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 0)), 0).r;
+        let s01 = textureLoad(depth_map, pyramid_address(info, c + vec2i(0, 1)), 0).r;
+        let s11 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 1)), 0).r;
         // Cell coordinates f(z) = a + b z; surface s = s00 + A fx + B fy + C fx fy; the ray is
         // above the surface while g(z) = s - z > 0, a quadratic in z.
-        let a = p0 * res0 - 0.5 - cell;
-        let b = e * res0;
+        let a = p0 * size - 0.5 - cell;
+        let b = e * size;
         let ca = s10 - s00;
         let cb = s01 - s00;
         let cc = s00 - s10 - s01 + s11;
@@ -215,10 +236,9 @@ fn bilinear_cells(depth_map: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: v
 // few cells, then resumes the conservative search (climbing from level 0, as maximum mipmaps do)
 // when the ray passed them untouched.
 fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2f, finest: i32) -> TraceHit {
-    let res0 = f32(1 << u32(info.levels));
     var t = pyramid_trace(pyramid, info, p0, e, 0.0, info.levels, finest, false);
     // Refinement rounds can at most walk the ray's whole footprint.
-    let round_cap = min(info.refine_cap, u32(length(e) * res0 + 4.0));
+    let round_cap = min(info.refine_cap, u32(length(e * pyramid_texels(info)) + 4.0));
     var round = 0u;
     loop {
         if t.missed || t.capped {
@@ -247,11 +267,11 @@ fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: Py
 
 // Section 3.4: the finest level worth reaching for a pixel whose uv changes by uv_dx, uv_dy to
 // its neighbours (in a fragment shader: dpdx(uv), dpdy(uv), taken in uniform control flow), as
-// mip selection does.
-fn pyramid_lod(uv_dx: vec2f, uv_dy: vec2f, levels: i32) -> i32 {
-    let res0 = f32(1 << u32(levels));
-    let footprint = max(length(uv_dx), length(uv_dy)) * res0;
-    return clamp(i32(floor(log2(max(footprint, 1.0)))), 0, levels);
+// mip selection does: the pixel's footprint in texels of the map.
+fn pyramid_lod(info: PyramidInfo, uv_dx: vec2f, uv_dy: vec2f) -> i32 {
+    let size = pyramid_texels(info);
+    let footprint = max(length(uv_dx * size), length(uv_dy * size));
+    return clamp(i32(floor(log2(max(footprint, 1.0)))), 0, info.levels);
 }
 
 // Self-shadowing (section 4). The light's ray through a hit at uv `hit` and depth z enters the
@@ -265,8 +285,7 @@ fn shadow_lit(info: PyramidInfo, z: f32, from_light: TraceHit, el: vec2f) -> boo
         return true;
     }
     let short_by = z - from_light.z;
-    let res0 = f32(1 << u32(info.levels));
-    return short_by * length(el) <= 1.5 / res0 || short_by <= 2.0e-3;
+    return short_by * length(el * pyramid_texels(info)) <= 1.5 || short_by <= 2.0e-3;
 }
 
 // shadow_lit with the point-sampled trace: is the hit (uv, depth z) lit by a light in unit

@@ -50,7 +50,7 @@ fn assert_layout(module: &naga::Module, name: &str, rust: (usize, Vec<(&str, usi
 }
 
 fn pyramid_info() -> (usize, Vec<(&'static str, usize)>) {
-    rust_layout!(PyramidInfo: levels, clamp_to_map, iteration_cap, refine_cap)
+    rust_layout!(PyramidInfo: levels, clamp_to_map, iteration_cap, refine_cap, size, _pad)
 }
 
 #[test]
