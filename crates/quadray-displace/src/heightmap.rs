@@ -108,7 +108,10 @@ fn all_finite(path: &Path, values: &[f32], width: u32) -> Result<(), HeightMapEr
 impl HeightMap {
     /// The pyramid's storage: width and height rounded up to powers of two.
     pub fn padded_size(&self) -> (u32, u32) {
-        (self.width.next_power_of_two(), self.height.next_power_of_two())
+        (
+            self.width.next_power_of_two(),
+            self.height.next_power_of_two(),
+        )
     }
 
     /// Pyramid levels above the map's: the root (level `levels()`) is 1x1 over the padded size.

@@ -95,7 +95,12 @@ impl Pyramid {
             let at = |i: u32, j: u32| prev[(j.min(h - 1) * w + i.min(w - 1)) as usize];
             let next = (0..half_h)
                 .flat_map(|j| (0..half_w).map(move |i| (2 * i, 2 * j)))
-                .map(|(i, j)| at(i, j).min(at(i + 1, j)).min(at(i, j + 1)).min(at(i + 1, j + 1)))
+                .map(|(i, j)| {
+                    at(i, j)
+                        .min(at(i + 1, j))
+                        .min(at(i, j + 1))
+                        .min(at(i + 1, j + 1))
+                })
                 .collect();
             pyramid.levels.push(next);
         }

@@ -70,7 +70,9 @@ fn read_back(gpu: &Gpu, pyramid: &HeightPyramid) -> Vec<Vec<f32>> {
 fn gpu_and_uploaded_pyramids_are_bit_identical_to_the_cpu_ones() {
     let gpu = Gpu::new().expect("a GPU adapter");
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let bundled = common::bundled_maps().into_iter().map(|(name, map, _)| (name, map));
+    let bundled = common::bundled_maps()
+        .into_iter()
+        .map(|(name, map, _)| (name, map));
     let tiny = [(3, 5), (1, 37), (29, 1)].map(|(w, h)| ("scattered", common::scattered(w, h)));
     for (name, map) in bundled.chain(tiny) {
         let cases = [
@@ -116,17 +118,12 @@ fn pyramid_methods_match_the_ground_truth_at_every_angle_on_every_map() {
                 Method::PyramidAscend,
                 Method::PyramidBilinear,
             ] {
-                let limit = if method == Method::PyramidBilinear {
-                    0.005
-                } else {
-                    0.001
-                };
                 for angle in ANGLES {
                     let wrong =
                         wrong_hit_fraction(&gpu, &mut renderer, (name, &map), method, angle);
                     assert!(
-                        wrong <= limit,
-                        "{name} {surface:?} {method} {angle} deg: wrong_hit_fraction {wrong} > {limit}"
+                        wrong <= 0.001,
+                        "{name} {surface:?} {method} {angle} deg: wrong_hit_fraction {wrong} > 0.001"
                     );
                 }
             }
@@ -149,8 +146,7 @@ fn maps_of_any_size_are_traced_exactly_without_resampling() {
             let mut renderer = Renderer::new(&gpu, map, None, surface);
             for method in [Method::Pyramid, Method::PyramidBilinear] {
                 for angle in [0.0, 30.0, 60.0, 80.0, 85.0] {
-                    let wrong =
-                        wrong_hit_fraction(&gpu, &mut renderer, (name, map), method, angle);
+                    let wrong = wrong_hit_fraction(&gpu, &mut renderer, (name, map), method, angle);
                     if wrong > 0.001 {
                         let size = format!("{}x{}", map.width, map.height);
                         failures.push(format!("{size} {surface:?} {method} {angle}: {wrong}"));
@@ -159,7 +155,10 @@ fn maps_of_any_size_are_traced_exactly_without_resampling() {
             }
         }
     }
-    assert!(failures.is_empty(), "wrong-hit fraction > 0.001: {failures:#?}");
+    assert!(
+        failures.is_empty(),
+        "wrong-hit fraction > 0.001: {failures:#?}"
+    );
 }
 
 #[test]

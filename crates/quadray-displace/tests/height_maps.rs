@@ -10,7 +10,10 @@ use quadray_displace::{Method, Settings};
 fn odd_sizes_load_as_stored_or_resampled_on_request() {
     let bevy = common::asset("heightmaps/bevy_parallax/cube_depth.png");
     let map = HeightMap::load(&bevy, Convention::Depth, Fit::Exact).unwrap();
-    assert_eq!((map.width, map.height, map.padded_size()), (348, 348, (512, 512)));
+    assert_eq!(
+        (map.width, map.height, map.padded_size()),
+        (348, 348, (512, 512))
+    );
     let resampled = HeightMap::load(&bevy, Convention::Depth, Fit::Resample).unwrap();
     assert_eq!((resampled.width, resampled.height), (256, 256));
     let puget = common::asset("heightmaps/puget_sound/ps_height_1k.png");

@@ -43,7 +43,10 @@ impl PyramidInfo {
     /// For the pyramid of a `width` x `height` map, read with `addressing`, with the default caps.
     pub fn new(width: u32, height: u32, addressing: Addressing) -> Self {
         Self {
-            levels: width.next_power_of_two().max(height.next_power_of_two()).ilog2() as i32,
+            levels: width
+                .next_power_of_two()
+                .max(height.next_power_of_two())
+                .ilog2() as i32,
             clamp_to_map: u32::from(addressing == Addressing::Clamp),
             iteration_cap: ITERATION_CAP,
             refine_cap: REFINE_CAP,
@@ -126,7 +129,10 @@ impl HeightPyramid {
 
     /// An empty pyramid texture with a full mip chain over a power-of-two `width` x `height` level
     /// 0 (usable as a storage texture, so the compute builder can write it).
-    pub(super) fn create_texture(device: &wgpu::Device, (width, height): (u32, u32)) -> wgpu::Texture {
+    pub(super) fn create_texture(
+        device: &wgpu::Device,
+        (width, height): (u32, u32),
+    ) -> wgpu::Texture {
         device.create_texture(&wgpu::TextureDescriptor {
             label: Some("min-depth pyramid"),
             size: wgpu::Extent3d {

@@ -177,20 +177,22 @@ fn bilinear_cells(depth_map: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: v
         let s10 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 0)), 0).r;
         let s01 = textureLoad(depth_map, pyramid_address(info, c + vec2i(0, 1)), 0).r;
         let s11 = textureLoad(depth_map, pyramid_address(info, c + vec2i(1, 1)), 0).r;
-        // Cell coordinates f(z) = a + b z; surface s = s00 + A fx + B fy + C fx fy; the ray is
-        // above the surface while g(z) = s - z > 0, a quadratic in z.
-        let a = p0 * size - 0.5 - cell;
+        // Cell coordinates f(t) = a + b t, t = z - z_in the depth past the cell's entry; surface
+        // s = s00 + A fx + B fy + C fx fy; the ray is above the surface while g(t) = s - z > 0, a
+        // quadratic in t. Centred on the cell, its coefficients stay of cell size: centred on
+        // p0, a far cell's cancel to a few bits, which loses grazing hits.
         let b = e * size;
+        let a = (p0 * size - 0.5 - cell) + b * z_in;
         let ca = s10 - s00;
         let cb = s01 - s00;
         let cc = s00 - s10 - s01 + s11;
-        let c0 = s00 + ca * a.x + cb * a.y + cc * a.x * a.y;
+        let c0 = s00 + ca * a.x + cb * a.y + cc * a.x * a.y - z_in;
         let c1 = ca * b.x + cb * b.y + cc * (a.x * b.y + a.y * b.x) - 1.0;
         let c2 = cc * b.x * b.y;
-        let g_in = c0 + c1 * z_in + c2 * z_in * z_in;
-        if g_in <= 0.0 {
+        if c0 <= 0.0 {
             return vec3f(z_in, z_in, f32(k + 1u));
         }
+        let span = z_out - z_in;
         var root = 2.0;
         if abs(c2) < 1.0e-7 * max(abs(c1), 1.0) {
             root = -c0 / c1;
@@ -200,13 +202,13 @@ fn bilinear_cells(depth_map: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: v
                 let h = -0.5 * (c1 + select(-1.0, 1.0, c1 >= 0.0) * sqrt(disc));
                 let r1 = h / c2;
                 let r2 = c0 / h;
-                if r1 >= z_in && r1 <= z_out { root = r1; }
-                if r2 >= z_in && r2 <= z_out { root = min(root, r2); }
+                if r1 >= 0.0 && r1 <= span { root = r1; }
+                if r2 >= 0.0 && r2 <= span { root = min(root, r2); }
             }
         }
-        let g_out = c0 + c1 * z_out + c2 * z_out * z_out;
-        if root >= z_in && root <= z_out {
-            return vec3f(root, root, f32(k + 1u));
+        let g_out = c0 + c1 * span + c2 * span * span;
+        if root >= 0.0 && root <= span {
+            return vec3f(z_in + root, z_in + root, f32(k + 1u));
         }
         // The sign changed but rounding put the root just outside the cell; or the ray reached
         // depth 1, at or below every surface point (rounding can leave g a hair above 0 there).
