@@ -111,8 +111,9 @@ pub struct PyramidExtension {
     /// The pyramid built from `depth_map` (set by [`PyramidDisplacementPlugin`]).
     #[texture(101, sample_type = "float", filterable = false)]
     pub pyramid: Option<Handle<Image>>,
-    /// Levels of `pyramid` above its finest (set with it).
-    pub levels: u32,
+    /// The depth map's width and height in texels, which `pyramid` pads to powers of two (set with
+    /// it).
+    pub map_size: UVec2,
     /// Debug output: per pixel the ray and the hit, for `debug_width`-wide targets.
     #[storage(102, visibility(fragment))]
     pub debug_hits: Handle<ShaderBuffer>,
@@ -132,7 +133,7 @@ impl PyramidExtension {
             shadow_strength: 0.0,
             light: Vec4::new(0.0, 1.0, 0.0, 0.0),
             pyramid: None,
-            levels: 0,
+            map_size: UVec2::ONE,
             debug_hits: NO_HITS,
             debug_width: 0,
         }
@@ -165,6 +166,7 @@ pub struct PyramidUniform {
     clamp_to_map: u32,
     iteration_cap: u32,
     refine_cap: u32,
+    map_size: UVec2,
     depth_scale: f32,
     flags: u32,
     debug_width: u32,
@@ -174,13 +176,14 @@ pub struct PyramidUniform {
 
 impl From<&PyramidExtension> for PyramidUniform {
     fn from(m: &PyramidExtension) -> Self {
-        let info = PyramidInfo::new(m.levels, m.addressing());
+        let info = PyramidInfo::new(m.map_size.x, m.map_size.y, m.addressing());
         let ready = u32::from(m.pyramid.is_some());
         Self {
             levels: info.levels,
             clamp_to_map: info.clamp_to_map,
             iteration_cap: info.iteration_cap,
             refine_cap: info.refine_cap,
+            map_size: UVec2::from(info.size),
             depth_scale: m.depth_scale,
             flags: ready | (u32::from(m.lod) << 1),
             debug_width: m.debug_width,
@@ -190,11 +193,12 @@ impl From<&PyramidExtension> for PyramidUniform {
     }
 }
 
-/// Each depth map's pyramid image and level count, or `None` once the map proved unusable.
+/// Each depth map's pyramid image and size, or `None` once the map proved unusable.
 #[derive(Resource, Default)]
 struct Pyramids(HashMap<AssetId<Image>, Option<BuiltPyramid>>);
 
-type BuiltPyramid = (Handle<Image>, u32);
+/// The pyramid image and the depth map's width and height in texels.
+type BuiltPyramid = (Handle<Image>, UVec2);
 
 /// Builds the pyramid of every depth map a material uses once the image is loaded (and again when
 /// it changes), and points the materials at it. An unusable map is logged once, naming the asset.
@@ -218,9 +222,9 @@ fn build_pyramids(
                 .extension
                 .pyramid
                 .as_ref()
-                .map(|p| (p.id(), m.extension.levels));
+                .map(|p| (p.id(), m.extension.map_size));
             match wanted {
-                Some(Some((handle, levels))) => current != Some((handle.id(), *levels)),
+                Some(Some((handle, size))) => current != Some((handle.id(), *size)),
                 Some(None) => false,
                 None => images.contains(&m.extension.depth_map),
             }
@@ -238,10 +242,10 @@ fn build_pyramids(
                 .map_or_else(|| format!("{source:?}"), |p| p.to_string());
             let map = images.get(source).map(|image| depth_map(&name, image));
             match map {
-                Some(Ok(map)) => {
-                    let (pyramid, levels) = pyramid_image(&map);
-                    Some((images.add(pyramid), levels))
-                }
+                Some(Ok(map)) => Some((
+                    images.add(pyramid_image(&map)),
+                    UVec2::new(map.width, map.height),
+                )),
                 Some(Err(e)) => {
                     error!("quadray-bevy: {e}");
                     None
@@ -249,9 +253,9 @@ fn build_pyramids(
                 None => None,
             }
         });
-        if let Some((handle, levels)) = built {
+        if let Some((handle, size)) = built {
             material.extension.pyramid = Some(handle.clone());
-            material.extension.levels = *levels;
+            material.extension.map_size = *size;
         }
     }
 }

@@ -47,8 +47,8 @@ pub enum PyramidImageError {
 }
 
 /// The height field the material traces for a depth-map image: its first channel as a shader
-/// sampling it reads it, 0 at the surface and 1 deepest. `name` names the asset in errors. Maps
-/// that are not 2^n x 2^n are resampled to one.
+/// sampling it reads it, 0 at the surface and 1 deepest, at the image's own size (any size is
+/// traced exactly, no resampling). `name` names the asset in errors.
 pub fn depth_map(name: &str, image: &Image) -> Result<HeightMap, PyramidImageError> {
     let values = first_channel(name, image)?;
     Ok(HeightMap::from_values(
@@ -57,35 +57,34 @@ pub fn depth_map(name: &str, image: &Image) -> Result<HeightMap, PyramidImageErr
         image.height(),
         &values,
         Convention::Depth,
-        Fit::Resample,
+        Fit::Exact,
     )?)
 }
 
-/// The pyramid image of a height field and its level count (mips beyond the finest): the point
-/// pyramid of `quadray_displace` (mip 0 the map, each mip above the minimum depth of the four
-/// below), in an R32Float texture that the material reads with `textureLoad`.
-pub fn pyramid_image(map: &HeightMap) -> (Image, u32) {
+/// The pyramid image of a height field: the point pyramid of `quadray_displace` (mip 0 the map
+/// padded to powers of two with depth 1, each mip above the minimum depth of the four below, down
+/// to 1x1), in an R32Float texture that the material reads with `textureLoad`.
+pub fn pyramid_image(map: &HeightMap) -> Image {
     let pyramid = Pyramid::build(map);
-    let levels = pyramid.levels.len() as u32 - 1;
     let bytes: Vec<u8> = pyramid
         .levels
         .iter()
         .flat_map(|level| level.iter().flat_map(|d| d.to_le_bytes()))
         .collect();
-    let size = map.size();
+    let (width, height) = pyramid.level_size(0);
     let mut out = Image::new_uninit(
         Extent3d {
-            width: size,
-            height: size,
+            width,
+            height,
             depth_or_array_layers: 1,
         },
         TextureDimension::D2,
         TextureFormat::R32Float,
         RenderAssetUsages::RENDER_WORLD,
     );
-    out.texture_descriptor.mip_level_count = levels + 1;
+    out.texture_descriptor.mip_level_count = pyramid.levels.len() as u32;
     out.data = Some(bytes);
-    (out, levels)
+    out
 }
 
 /// The first channel of every texel, row-major, as a shader sampling the image would read it
@@ -200,13 +199,27 @@ mod tests {
             ),
         )
         .unwrap();
-        let (pyramid, levels) = pyramid_image(&map);
-        assert_eq!(levels, 2);
+        let pyramid = pyramid_image(&map);
         assert_eq!(pyramid.texture_descriptor.mip_level_count, 3);
         let texels: Vec<f32> = bytemuck::pod_collect_to_vec(pyramid.data.as_ref().unwrap());
         assert_eq!(texels.len(), 16 + 4 + 1);
         // The root is the smallest depth (the highest point) of the map.
         assert_eq!(texels[20], 105.0 / 255.0);
+    }
+
+    #[test]
+    fn an_odd_sized_map_keeps_its_size_and_pads_its_pyramid() {
+        let map = depth_map("odd", &image(3, 5, TextureFormat::R8Unorm, vec![0; 15])).unwrap();
+        assert_eq!((map.width, map.height), (3, 5));
+        let pyramid = pyramid_image(&map);
+        let size = pyramid.texture_descriptor.size;
+        assert_eq!((size.width, size.height), (4, 8));
+        assert_eq!(pyramid.texture_descriptor.mip_level_count, 4);
+        let texels: Vec<f32> = bytemuck::pod_collect_to_vec(pyramid.data.as_ref().unwrap());
+        // Levels 4x8, 2x4, 1x2, 1x1; padding is deepest, the map's texels at depth 0.
+        assert_eq!(texels.len(), 32 + 8 + 2 + 1);
+        assert_eq!((texels[0], texels[3], texels[4 * 5]), (0.0, 1.0, 1.0));
+        assert_eq!(texels[42], 0.0);
     }
 
     #[test]

@@ -17,6 +17,8 @@ struct PyramidParams {
     clamp_to_map: u32,
     iteration_cap: u32,
     refine_cap: u32,
+    // The depth map's width and height in texels (the pyramid pads them to powers of two).
+    map_size: vec2<u32>,
     depth_scale: f32,
     flags: u32,
     debug_width: u32,
@@ -57,10 +59,10 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> PyramidO
     // Bevy's bitangent points along -v; quadray's tangent space has y along +v.
     let towards = vec3(dot(V, tbn[0]), -dot(V, tbn[1]), dot(V, tbn[2]));
     if (params.flags & FLAG_READY) != 0u && towards.z > 1.0e-4 {
-        let info = PyramidInfo(params.levels, params.clamp_to_map, params.iteration_cap, params.refine_cap);
+        let info = PyramidInfo(params.levels, params.clamp_to_map, params.iteration_cap, params.refine_cap, params.map_size, vec2(0u));
         var finest = 0;
         if (params.flags & FLAG_LOD) != 0u {
-            finest = pyramid_lod(uv_dx, uv_dy, info.levels);
+            finest = pyramid_lod(info, uv_dx, uv_dy);
         }
         let e = ray_slope(towards, params.depth_scale);
         var p0 = in.uv;

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct DisplaceArgs {
-    /// Height map: 8/16-bit PNG or float EXR, 2^n x 2^n (see --fit).
+    /// Height map: 8/16-bit PNG or float EXR, any size up to 8192x8192.
     #[arg(long)]
     map: PathBuf,
     /// pyramid, pyramid-ascend, pyramid-bilinear, bump, parallax, pom, relief or mesh.
@@ -63,7 +63,8 @@ pub struct DisplaceArgs {
     /// (a Kinect/TUM depth image: 0 = no measurement).
     #[arg(long, default_value = "height")]
     convention: Convention,
-    /// Resample maps that are not 2^n x 2^n to the nearest power of two instead of refusing them.
+    /// Resample maps that are not 2^n x 2^n to the nearest square power of two (this changes the
+    /// surface; without it, maps of any size are traced exactly as stored).
     #[arg(long)]
     resample: bool,
     /// Albedo image (default: tinted by depth).
@@ -88,7 +89,8 @@ struct Stats<'a> {
     width: u32,
     height: u32,
     map: &'a Path,
-    map_size: u32,
+    /// The map's width and height in texels.
+    map_size: [u32; 2],
     surface: SurfaceKind,
     view_angle_deg: f32,
     depth_scale: f32,
@@ -138,7 +140,7 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
     let fit = if args.resample {
         Fit::Resample
     } else {
-        Fit::Refuse
+        Fit::Exact
     };
     let map = HeightMap::load(&args.map, args.convention, fit)?;
     let color = args.color.as_deref().map(load_color).transpose()?;
@@ -169,7 +171,7 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
         width: settings.width,
         height: settings.height,
         map: &args.map,
-        map_size: map.size(),
+        map_size: [map.width, map.height],
         surface: args.surface,
         view_angle_deg: settings.view_angle_deg,
         depth_scale: settings.depth_scale,

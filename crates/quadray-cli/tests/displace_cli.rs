@@ -61,14 +61,46 @@ fn displace_writes_the_picture_the_stats_and_the_error_map() {
 }
 
 #[test]
+fn odd_sized_maps_are_traced_as_stored_without_resample() {
+    let dir = scratch("displace-odd");
+    let map = assets().join("heightmaps/bevy_parallax/cube_depth.png");
+    let (out, stats) = (dir.join("bevy.png"), dir.join("bevy.json"));
+    quadray_writes(
+        &[
+            "displace",
+            "--map",
+            map.to_str().unwrap(),
+            "--convention",
+            "depth",
+            "--view-angle",
+            "60",
+            "--size",
+            "64x64",
+            "--frames",
+            "1",
+            "--reference",
+        ],
+        &out,
+        &stats,
+    );
+    let json = read_json(&stats);
+    assert_eq!(json["map_size"], serde_json::json!([348, 348]), "{json}");
+    assert!(
+        json["wrong_hit_fraction"].as_f64().unwrap() <= 0.001,
+        "{json}"
+    );
+}
+
+#[test]
 fn bad_input_gets_a_clear_error_and_no_panic() {
     let dir = scratch("displace-bad");
     let out = dir.join("x.png");
     let tiles = assets().join("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
-    let bevy = assets().join("heightmaps/bevy_parallax/cube_depth.png");
+    let too_wide = dir.join("too_wide.png");
+    image::GrayImage::new(8193, 1).save(&too_wide).unwrap();
     let text = assets().join("SOURCES.md");
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec!["--map", bevy.to_str().unwrap()], "348x348"),
+        (vec!["--map", too_wide.to_str().unwrap()], "8193x1"),
         (vec!["--map", text.to_str().unwrap()], "SOURCES.md"),
         (vec!["--map", "/nonexistent/map.png"], "map.png"),
         (

@@ -224,7 +224,7 @@ fn shadows_scene_loader(path: &Path) -> Result<bool, String> {
     }
 }
 
-/// Height maps: the 8-bit interlaced PNG bundled (348x348, resampled), and, cut from the
+/// Height maps: the 8-bit interlaced PNG bundled (348x348, traced as stored), and, cut from the
 /// bundled 16-bit Puget Sound map to keep cases fast, a 16-bit PNG and a float EXR (none is
 /// bundled).
 fn height_map_seeds() -> Vec<(String, Vec<u8>)> {
@@ -252,22 +252,25 @@ fn height_map_seeds() -> Vec<(String, Vec<u8>)> {
 }
 
 /// The height-map loader as `quadray displace` calls it, in two of its conventions: a white-is-
-/// high map resampled to a power of two, and a depth photo refused when it is not one.
+/// high map resampled to a square power of two (`--resample`), and a depth photo as stored.
 fn height_map_loader(path: &Path) -> Result<bool, String> {
-    use quadray_displace::heightmap::{Convention, Fit, HeightMap};
+    use quadray_displace::heightmap::{Convention, Fit, HeightMap, MAX_SIZE};
     let mut valid = false;
     for (convention, fit) in [
         (Convention::Height, Fit::Resample),
-        (Convention::DepthPhoto, Fit::Refuse),
+        (Convention::DepthPhoto, Fit::Exact),
     ] {
         match HeightMap::load(path, convention, fit) {
             Ok(map) => {
-                let n = map.size() as usize;
-                if !n.is_power_of_two()
-                    || map.depth.len() != n * n
+                let (w, h) = (map.width, map.height);
+                let resampled_square = fit == Fit::Exact || (w == h && w.is_power_of_two());
+                if !resampled_square
+                    || !(1..=MAX_SIZE).contains(&w)
+                    || !(1..=MAX_SIZE).contains(&h)
+                    || map.depth.len() != w as usize * h as usize
                     || map.depth.iter().any(|d| !(0.0..=1.0).contains(d))
                 {
-                    return Err(format!("invalid map accepted: {n}x{n}"));
+                    return Err(format!("invalid map accepted: {w}x{h}"));
                 }
                 valid = true;
             }

@@ -84,7 +84,7 @@ impl DisplaceView {
         let stale = !matches!(loaded, Some((m, s, _)) if *m == map && *s == surface);
         if stale {
             let choice = &maps[map];
-            let height = HeightMap::load(&choice.path, choice.convention, Fit::Resample)?;
+            let height = HeightMap::load(&choice.path, choice.convention, Fit::Exact)?;
             let color = choice.color.as_deref().map(load_color).transpose()?;
             *loaded = Some((
                 map,
@@ -184,7 +184,7 @@ impl DisplaceView {
     pub fn command_line(&self, out: &Path) -> String {
         let choice = &self.maps[self.map];
         let mut cmd = format!(
-            "quadray displace --map {} --convention {} --resample --surface {} {}",
+            "quadray displace --map {} --convention {} --surface {} {}",
             shell_word(&choice.path),
             choice.convention.name(),
             self.surface.name(),

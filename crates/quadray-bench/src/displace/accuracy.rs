@@ -49,9 +49,10 @@ pub fn by_view_angle(
         columns.extend(angles.iter().map(|a| format!("{a:.0} deg")));
         let mut table = Table {
             title: format!(
-                "Wrong-hit fraction by view angle: {} ({}^2, {acc_size}x{acc_size})",
+                "Wrong-hit fraction by view angle: {} ({}x{} map, {acc_size}x{acc_size})",
                 b.name,
-                map.size()
+                map.width,
+                map.height
             ),
             columns,
             rows: vec![],

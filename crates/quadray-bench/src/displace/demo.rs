@@ -159,7 +159,7 @@ pub fn render_demo(
         montage(&tiles, 4).save_png(&path)?;
         written.push(path);
         // Figure 18: the finest level the traversal may reach, coarser and coarser.
-        let top = map.levels;
+        let top = map.levels();
         let lods: Vec<(String, Rgba8Image)> = [
             Lod::Auto,
             Lod::Level(0),

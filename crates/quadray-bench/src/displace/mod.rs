@@ -29,7 +29,8 @@ pub struct BenchOptions {
 pub struct TimingRow {
     pub experiment: String,
     pub map: String,
-    pub map_size: u32,
+    /// The map's width and height in texels.
+    pub map_size: [u32; 2],
     pub method: String,
     pub width: u32,
     pub height: u32,
@@ -120,7 +121,7 @@ impl Bench<'_> {
         self.timings.push(TimingRow {
             experiment: experiment.into(),
             map: name.into(),
-            map_size: map.size(),
+            map_size: [map.width, map.height],
             method: label,
             width: s.width,
             height: s.height,
