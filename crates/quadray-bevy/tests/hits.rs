@@ -187,11 +187,7 @@ fn bevy_hits_agree_with_the_cpu_ground_truth() {
         let map = depth_map(path, image).unwrap();
         // The material traces exactly what quadray's own loader reads from the file, at the
         // file's own size (Bevy's map is 348x348: no resampling).
-        let file = HeightMap::load(
-            &Path::new(ASSETS).join(path),
-            Convention::Depth,
-            Fit::Exact,
-        );
+        let file = HeightMap::load(&Path::new(ASSETS).join(path), Convention::Depth, Fit::Exact);
         assert_eq!(
             Some(&map),
             file.as_ref().ok(),

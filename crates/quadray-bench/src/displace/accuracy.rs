@@ -50,9 +50,7 @@ pub fn by_view_angle(
         let mut table = Table {
             title: format!(
                 "Wrong-hit fraction by view angle: {} ({}x{} map, {acc_size}x{acc_size})",
-                b.name,
-                map.width,
-                map.height
+                b.name, map.width, map.height
             ),
             columns,
             rows: vec![],
