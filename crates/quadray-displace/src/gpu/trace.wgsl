@@ -29,11 +29,13 @@ struct PyramidInfo {
     refine_cap: u32,    // hard cap on bilinear_trace's refinement rounds
 }
 
-// What a trace found: the depth z where it stopped, the steps it took, whether the ray left a
-// clamped map (missed) and whether a cap stopped it (capped: a bound was too low).
+// What a trace found: the depth z where it stopped, the steps it took, the texels it read
+// (fetches: every textureLoad), whether the ray left a clamped map (missed) and whether a cap
+// stopped it (capped: a bound was too low).
 struct TraceHit {
     z: f32,
     iterations: u32,
+    fetches: u32,
     missed: bool,
     capped: bool,
 }
@@ -109,6 +111,7 @@ fn pyramid_trace(pyramid: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2
         }
         let node = floor(p * res);
         let d = pyramid_load(pyramid, info, level, node);
+        t.fetches += 1u;
         if t.z < d {
             let advanced = p0 + e * d;
             if all(floor(advanced * res) == node) {
@@ -231,6 +234,7 @@ fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: Py
         round += 1u;
         let cells = bilinear_cells(depth_map, info, p0, e, t.z, 4u);
         t.iterations += u32(cells.z);
+        t.fetches += 4u * u32(cells.z);
         if cells.x >= 0.0 {
             t.z = cells.x;
             t.missed = outside_map(info, p0 + e * t.z);
@@ -241,6 +245,7 @@ fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: Py
         t.missed = resumed.missed;
         t.capped = resumed.capped;
         t.iterations += resumed.iterations;
+        t.fetches += resumed.fetches;
     }
     return t;
 }
