@@ -244,10 +244,10 @@ fn best_ratio(
         }
         for (cx, cy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
             let child = (2 * nx + cx, 2 * ny + cy);
-            if let Some(b) = bound(level - 1, child, copy) {
-                if f32::from_bits(b) < best {
-                    heap.push(Reverse((b, level - 1, child.0, child.1, copy)));
-                }
+            if let Some(b) = bound(level - 1, child, copy)
+                && f32::from_bits(b) < best
+            {
+                heap.push(Reverse((b, level - 1, child.0, child.1, copy)));
             }
         }
     }
