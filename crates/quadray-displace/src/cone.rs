@@ -215,8 +215,8 @@ fn best_ratio(
     // point over its shallowest exit. Positive floats order as their bits.
     let bound = |level: usize, (nx, ny): (i64, i64), (ox, oy): (i64, i64)| -> Option<u32> {
         let side = 1i64 << (level as u32);
-        let levels_side = (field.width >> level).max(1);
-        let shallowest = pyramid.levels[level][(ny * levels_side + nx) as usize];
+        let level_side = pyramid.levels[level].len().isqrt() as i64;
+        let shallowest = pyramid.levels[level][(ny * level_side + nx) as usize];
         if shallowest >= ds {
             return None;
         }
@@ -236,8 +236,12 @@ fn best_ratio(
             break;
         }
         if level == 0 {
-            let a = (nx + copy.0, ny + copy.1);
-            if let Some(r) = field.texel_ratio((sx, sy), ds, a) {
+            // Leaves beyond the map (of a pyramid padded to a power of two) are no texel.
+            let in_map = nx < field.width && ny < field.height;
+            if let Some(r) = in_map
+                .then(|| field.texel_ratio((sx, sy), ds, (nx + copy.0, ny + copy.1)))
+                .flatten()
+            {
                 best = best.min(r);
             }
             continue;
