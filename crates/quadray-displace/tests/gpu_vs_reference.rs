@@ -177,6 +177,41 @@ fn cone_stepping_converges_to_the_ground_truth_and_its_budget_error_is_bounded()
     );
 }
 
+/// The shader's texel-fetch counter against what each search reads by construction: one texel
+/// per pyramid node or cone step; four per hand-bilinear depth sample, of which POM and relief
+/// take one more than their steps (the sample at the polygon) and parallax one; none for bump.
+#[test]
+fn texel_fetch_counts_follow_each_search() {
+    let gpu = Gpu::new().expect("a GPU adapter");
+    let (_, map, _) = common::bundled_maps().remove(0);
+    let mut renderer = Renderer::new(&gpu, &map, None, SurfaceKind::Wall);
+    let expected = |method, iterations: f32| match method {
+        Method::Pyramid | Method::PyramidAscend | Method::Cone => iterations,
+        Method::Pom | Method::Relief => 4.0 * (iterations + 1.0),
+        Method::Parallax => 4.0,
+        _ => 0.0,
+    };
+    for method in [
+        Method::Pyramid,
+        Method::PyramidAscend,
+        Method::Cone,
+        Method::Pom,
+        Method::Relief,
+        Method::Parallax,
+        Method::Bump,
+    ] {
+        let frame = renderer.render(&gpu, &settings(method, 60.0)).unwrap();
+        let mut traced = 0;
+        for (hit, &fetches) in frame.hits.iter().zip(&frame.fetches) {
+            if hit[2] != -2.0 {
+                traced += 1;
+                assert_eq!(fetches, expected(method, hit[3]), "{method}: hit {hit:?}");
+            }
+        }
+        assert!(traced > 200, "{method}: only {traced} pixels traced");
+    }
+}
+
 #[test]
 fn pom_and_relief_at_engine_defaults_miss_where_the_pyramid_does_not() {
     let gpu = Gpu::new().expect("a GPU adapter");
