@@ -116,8 +116,9 @@ fn pyramid_methods_match_the_ground_truth_at_every_angle_on_every_map() {
 /// built for. With steps to spare (256) it must be nearly exact: a step from above a texel centre
 /// ends before the next exit, so a converged ray brackets the first intersection. Measured worst
 /// case 0.014 (puget-sound, wall, 85 deg); it stays at 0.011 with 1024 and 4096 steps on a
-/// 256x256 frame, so it is not the budget; most likely rays off a texel's centre crossing an
-/// exit near it (the cones are the chapter's, apex at the centre): bound 0.02. Cone ratios that were
+/// 256x256 frame, so it is not the budget but rays off a texel's centre crossing an exit near it
+/// (the cones are the chapter's, apex at the centre; a step shortened by that offset brings it to
+/// 0, BENCHMARKS.md): bound 0.02. Cone ratios that were
 /// too wide would tunnel through walls far more often than that; too narrow ones would stall
 /// rays above the surface. At the fixed budget of 15 cone steps some rays are still above the
 /// surface: measured worst 0.37 (puget-sound, wall, 85 deg), bound 0.45.
