@@ -235,6 +235,8 @@ fn bevy_hits_agree_with_the_cpu_ground_truth() {
             color: Rgba8Image::new(SIZE, SIZE, [0; 4]),
             hits,
             rays,
+            // Only the accuracy is measured here, not the cost.
+            fetches: Vec::new(),
         };
         let accuracy = Accuracy::measure(&frame, &maps[view.map], Addressing::Wrap, Surface::Point);
         let what = format!("{} at {} degrees", MAPS[view.map], view.angle_deg);

@@ -17,7 +17,8 @@ pub struct DisplaceArgs {
     /// Height map: 8/16-bit PNG or float EXR, any size up to 8192x8192.
     #[arg(long)]
     map: PathBuf,
-    /// pyramid, pyramid-ascend, pyramid-bilinear, bump, parallax, pom, relief or mesh.
+    /// pyramid, pyramid-ascend, pyramid-bilinear, bump, parallax, pom, relief, cone (relaxed cone
+    /// stepping; builds its cone map first) or mesh.
     #[arg(long, default_value = "pyramid")]
     method: Method,
     /// Angle between the view direction at the surface centre and the normal (0..89).
@@ -30,9 +31,10 @@ pub struct DisplaceArgs {
     #[arg(long, default_value_t = 0.1)]
     depth_scale: f32,
     /// POM / relief layers MIN,MAX (head-on .. grazing). Bevy: 1,16; Godot: 8,32; three.js: 20,25.
+    /// Cone stepping takes MAX as its number of cone steps.
     #[arg(long, default_value = "8,32", value_parser = parse_layers)]
     layers: (u32, u32),
-    /// Relief mapping's binary search steps (three.js: 5).
+    /// Relief mapping's and cone stepping's binary search steps (three.js: 5).
     #[arg(long, default_value_t = 5)]
     binary_steps: u32,
     /// Finest pyramid level: `auto` (from screen-space derivatives) or a level number.
@@ -99,7 +101,11 @@ struct Stats<'a> {
     frames: usize,
     iteration_cap_hits: usize,
     mean_iterations: f64,
+    texel_fetches_per_pixel: f64,
     max_iterations: u32,
+    /// CPU seconds building the method's data before the first frame (the cone map).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    preprocess_seconds: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     wrong_hit_fraction: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -180,7 +186,9 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
         frames: args.frames,
         iteration_cap_hits: cost.iteration_cap_hits,
         mean_iterations: cost.mean_iterations,
+        texel_fetches_per_pixel: cost.texel_fetches_per_pixel,
         max_iterations: cost.max_iterations,
+        preprocess_seconds: renderer.cone_build_seconds(),
         wrong_hit_fraction: accuracy.as_ref().map(|a| a.wrong_hit_fraction),
         accuracy,
         error_map,

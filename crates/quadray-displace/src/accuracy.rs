@@ -89,11 +89,13 @@ impl Accuracy {
     }
 }
 
-/// Iterations per pixel and how many pixels the iteration cap stopped.
+/// Iterations and texel reads per pixel, and how many pixels the iteration cap stopped.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Cost {
     /// Mean iterations over covered pixels.
     pub mean_iterations: f64,
+    /// Mean texels the search read (every textureLoad of the trace) over covered pixels.
+    pub texel_fetches_per_pixel: f64,
     /// Most iterations any pixel took.
     pub max_iterations: u32,
     /// Pixels a cap stopped (must be 0).
@@ -103,17 +105,23 @@ pub struct Cost {
 impl Cost {
     /// The cost of `frame`'s searches.
     pub fn of(frame: &Frame) -> Self {
-        let covered = frame.hits.iter().filter(|h| h[2] != -2.0);
-        let (mut sum, mut max, mut caps, mut n) = (0.0, 0u32, 0, 0usize);
-        for h in covered {
+        let covered = frame
+            .hits
+            .iter()
+            .zip(&frame.fetches)
+            .filter(|(h, _)| h[2] != -2.0);
+        let (mut sum, mut fetches, mut max, mut caps, mut n) = (0.0, 0.0, 0u32, 0, 0usize);
+        for (h, f) in covered {
             let it = h[3].abs();
             sum += f64::from(it);
+            fetches += f64::from(*f);
             max = max.max(it as u32);
             caps += usize::from(h[3] < 0.0);
             n += 1;
         }
         Self {
             mean_iterations: sum / n.max(1) as f64,
+            texel_fetches_per_pixel: fetches / n.max(1) as f64,
             max_iterations: max,
             iteration_cap_hits: caps,
         }

@@ -14,6 +14,7 @@
 #![warn(missing_docs)]
 
 pub mod accuracy;
+pub mod cone;
 pub mod gpu;
 pub mod heightmap;
 pub mod maps;

@@ -22,13 +22,16 @@ pub enum Method {
     Pom,
     /// Relief mapping: linear search, then binary search.
     Relief,
+    /// Relaxed cone step mapping (Policarpo & Oliveira, GPU Gems 3 ch. 18): cone steps on a
+    /// precomputed cone map, then binary search.
+    Cone,
     /// A real grid mesh displaced by the map (figure 20).
     Mesh,
 }
 
 impl Method {
     /// Every method, in shader-id order.
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 9] = [
         Method::Pyramid,
         Method::PyramidAscend,
         Method::PyramidBilinear,
@@ -36,6 +39,7 @@ impl Method {
         Method::Parallax,
         Method::Pom,
         Method::Relief,
+        Method::Cone,
         Method::Mesh,
     ];
 
@@ -49,6 +53,7 @@ impl Method {
             Method::Parallax => "parallax",
             Method::Pom => "pom",
             Method::Relief => "relief",
+            Method::Cone => "cone",
             Method::Mesh => "mesh",
         }
     }
@@ -71,10 +76,11 @@ impl Method {
     }
 
     /// The surface whose exact intersection is this method's ground truth: the pyramid methods
-    /// trace point-sampled columns; the baselines sample bilinearly, as engines do.
+    /// trace point-sampled columns, and the cone map is built for them; the other baselines
+    /// sample bilinearly, as engines do.
     pub fn truth(self) -> Surface {
         match self {
-            Method::Pyramid | Method::PyramidAscend => Surface::Point,
+            Method::Pyramid | Method::PyramidAscend | Method::Cone => Surface::Point,
             _ => Surface::Bilinear,
         }
     }

@@ -50,9 +50,10 @@ pub struct Settings {
     pub height: u32,
     /// Texture units per unit of depth (Bevy's default 0.1).
     pub depth_scale: f32,
-    /// POM / relief layer counts, from head-on (min) to grazing (max).
+    /// POM / relief layer counts, from head-on (min) to grazing (max); cone stepping takes the
+    /// max as its number of cone steps.
     pub layers: (u32, u32),
-    /// Relief mapping's binary search steps.
+    /// Relief mapping's and cone stepping's binary search steps.
     pub binary_steps: u32,
     /// Finest pyramid level the traversal reaches.
     pub lod: Lod,
@@ -105,6 +106,17 @@ impl Settings {
             method: Method::Relief,
             layers: (20, 25),
             binary_steps: 5,
+            ..Default::default()
+        }
+    }
+
+    /// Relaxed cone step mapping with 15 cone steps and 8 binary steps: a fixed budget in the
+    /// range the chapter's shaders use.
+    pub fn relaxed_cone() -> Self {
+        Self {
+            method: Method::Cone,
+            layers: (15, 15),
+            binary_steps: 8,
             ..Default::default()
         }
     }

@@ -10,8 +10,8 @@ use quadray_displace::pyramid::Addressing;
 use quadray_displace::{DisplaceError, Method, Renderer, Settings};
 use std::path::Path;
 
-/// Wrong-hit fraction by view angle, every method, every bundled map: one table and one plot
-/// (accuracy_MAP.svg in `out`) per map, and every measurement as a row.
+/// Wrong-hit fraction and texel fetches per pixel by view angle, every method, every bundled map:
+/// two tables and one plot (accuracy_MAP.svg in `out`) per map, and every measurement as a row.
 pub fn by_view_angle(
     bench: &Bench,
     out: &Path,
@@ -34,11 +34,13 @@ pub fn by_view_angle(
         default_with(Method::PyramidBilinear),
         Settings::bevy_pom(),
         Settings::threejs_relief(),
+        Settings::relaxed_cone(),
         default_with(Method::Parallax),
         default_with(Method::Bump),
     ];
     let label = |s: &Settings| match s.method {
         Method::Pom | Method::Relief => format!("{} {}-{}", s.method, s.layers.0, s.layers.1),
+        Method::Cone => format!("cone {}+{}", s.layers.1, s.binary_steps),
         m => m.to_string(),
     };
     let mut accuracy = Vec::new();
@@ -52,12 +54,21 @@ pub fn by_view_angle(
                 "Wrong-hit fraction by view angle: {} ({}x{} map, {acc_size}x{acc_size})",
                 b.name, map.width, map.height
             ),
+            columns: columns.clone(),
+            rows: vec![],
+        };
+        let mut fetch_table = Table {
+            title: format!(
+                "Texel fetches per pixel by view angle: {} ({}x{} map, {acc_size}x{acc_size})",
+                b.name, map.width, map.height
+            ),
             columns,
             rows: vec![],
         };
         let mut series = Vec::new();
         for c in &candidates {
             let mut row = vec![label(c)];
+            let mut fetch_row = vec![label(c)];
             let mut points = Vec::new();
             for &angle in angles {
                 let s = Settings {
@@ -70,6 +81,7 @@ pub fn by_view_angle(
                 let acc = Accuracy::measure(&frame, &map, addressing(b), c.method.truth());
                 let cost = Cost::of(&frame);
                 row.push(format!("{:.4}", acc.wrong_hit_fraction));
+                fetch_row.push(format!("{:.1}", cost.texel_fetches_per_pixel));
                 points.push((f64::from(angle), acc.wrong_hit_fraction));
                 accuracy.push(AccuracyRow {
                     map: b.name.into(),
@@ -79,16 +91,19 @@ pub fn by_view_angle(
                     mean_error_texels: acc.mean_error_texels,
                     covered: acc.covered,
                     mean_iterations: cost.mean_iterations,
+                    texel_fetches_per_pixel: cost.texel_fetches_per_pixel,
                     iteration_cap_hits: cost.iteration_cap_hits,
                 });
             }
             table.row(row);
+            fetch_table.row(fetch_row);
             series.push(Series {
                 name: label(c),
                 points,
             });
         }
         tables.push(table);
+        tables.push(fetch_table);
         line_plot(
             &out.join(format!("accuracy_{}.svg", b.name)),
             &PlotSpec {

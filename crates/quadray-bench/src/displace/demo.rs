@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 fn caption(s: &Settings) -> String {
     match s.method {
         Method::Pom | Method::Relief => format!("{} {}-{}", s.method, s.layers.0, s.layers.1),
+        Method::Cone => format!("cone {}+{}", s.layers.1, s.binary_steps),
         m => m.to_string(),
     }
 }
@@ -70,6 +71,12 @@ pub fn render_demo(
                     width: size,
                     height: size,
                     ..Settings::threejs_relief()
+                },
+                Settings {
+                    view_angle_deg: angle,
+                    width: size,
+                    height: size,
+                    ..Settings::relaxed_cone()
                 },
                 Settings {
                     method: Method::Parallax,

@@ -52,6 +52,7 @@ pub struct AccuracyRow {
     pub mean_error_texels: f64,
     pub covered: usize,
     pub mean_iterations: f64,
+    pub texel_fetches_per_pixel: f64,
     pub iteration_cap_hits: usize,
 }
 
@@ -113,6 +114,7 @@ impl Bench<'_> {
         let summary = renderer.time(self.gpu, s, self.frames)?;
         let mut label = match s.method {
             Method::Pom | Method::Relief => format!("{}-{}", s.method, s.layers.1),
+            Method::Cone => format!("cone-{}+{}", s.layers.1, s.binary_steps),
             m => m.to_string(),
         };
         if s.lod == Lod::Auto {
@@ -199,8 +201,10 @@ pub fn run(
     tables.push(timing::figure_21(&mut bench, &tiles, out, &mut ratios)?);
     progress("pyramid build");
     tables.push(timing::pyramid_build(&bench, &tiles)?);
+    progress("cone map build");
+    tables.push(timing::cone_build(&bench, &tiles)?);
     progress("1920x1080");
-    tables.push(timing::todays_frame(&mut bench, &tiles, &mut ratios)?);
+    tables.extend(timing::todays_frame(&mut bench, &tiles, &mut ratios)?);
     progress("accuracy by view angle");
     let (accuracy_tables, accuracy) = accuracy::by_view_angle(&bench, out)?;
     tables.extend(accuracy_tables);

@@ -1,9 +1,11 @@
-//! The paper's timing tables and figures (tables 1 and 2, figures 20 and 21, the pyramid build)
-//! and today's frame size, each as the rows it measured.
+//! The paper's timing tables and figures (tables 1 and 2, figures 20 and 21, the pyramid build),
+//! the cone map build and today's frame size, each as the rows it measured.
 
-use super::{Bench, Ratios, fixed_layers, ms, ratio, ratio_text};
+use super::{Bench, Ratios, addressing, fixed_layers, ms, ratio, ratio_text};
 use crate::report::{PlotSpec, Series, Table, line_plot};
-use quadray_core::stats::time_cpu;
+use quadray_core::stats::{Summary, time_cpu};
+use quadray_displace::accuracy::Cost;
+use quadray_displace::cone::ConeMap;
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::maps::{BUNDLED, resized};
 use quadray_displace::pyramid::Pyramid;
@@ -220,12 +222,46 @@ pub fn pyramid_build(bench: &Bench, tiles: &HeightMap) -> Result<Table, Displace
     Ok(build)
 }
 
-/// Today's frame: 1920x1080 with a 1024^2 map (480x270 when quick).
+/// Relaxed cone stepping's preprocessing at the sizes the issue names: the cone map built on the
+/// CPU (all cores), median seconds of a few builds (each takes seconds: no warm-up build).
+pub fn cone_build(bench: &Bench, tiles: &HeightMap) -> Result<Table, DisplaceError> {
+    let runs = if bench.quick { 3 } else { 5 };
+    let mut build = Table::new(
+        format!(
+            "Cone map build (relaxed cones, tiles, wrapped): CPU seconds, median of {runs}, {} threads",
+            rayon::current_num_threads()
+        ),
+        &["map size", "seconds", "p10", "p90"],
+    );
+    let addressing = addressing(&BUNDLED[0]);
+    for size in [1024, 2048, 4096] {
+        let map = resized(tiles, size);
+        let mut seconds: Vec<f64> = (0..runs)
+            .map(|_| {
+                let start = std::time::Instant::now();
+                ConeMap::build(&map, addressing);
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        // Summary names its fields in ms; here they hold the samples' unit, seconds.
+        let s = Summary::from_samples(&mut seconds).expect("at least one run");
+        build.row(vec![
+            format!("{size}^2"),
+            format!("{:.2}", s.median_ms),
+            format!("{:.2}", s.p10_ms),
+            format!("{:.2}", s.p90_ms),
+        ]);
+    }
+    Ok(build)
+}
+
+/// Today's frame: 1920x1080 with a 1024^2 map (480x270 when quick): GPU time at 60 degrees, and
+/// the hardware-independent cost (iterations, texel fetches per pixel) by view angle.
 pub fn todays_frame(
     bench: &mut Bench,
     tiles: &HeightMap,
     ratios: &mut Ratios,
-) -> Result<Table, DisplaceError> {
+) -> Result<Vec<Table>, DisplaceError> {
     let gpu = bench.gpu;
     let (w, h) = if bench.quick {
         (480, 270)
@@ -254,6 +290,8 @@ pub fn todays_frame(
                 ..fixed_layers(Method::Pyramid, 16)
             },
         ),
+        ("relief-16+5", fixed_layers(Method::Relief, 16)),
+        ("cone-15+8", Settings::relaxed_cone()),
     ];
     let mut times = Vec::new();
     for (_, s) in &columns {
@@ -272,5 +310,30 @@ pub fn todays_frame(
         row.push(ratio_text(ratio(times[k], times[0])));
     }
     t.row(row);
-    Ok(t)
+    let angles = [0.0, 45.0, 60.0, 70.0, 85.0];
+    let mut angle_columns = vec!["method".to_string()];
+    angle_columns.extend(angles.map(|a| format!("{a:.0} deg")));
+    let mut cost = Table {
+        title: format!(
+            "Today's frame: mean iterations / texel fetches per pixel by view angle ({w}x{h}, tiles 1024^2)"
+        ),
+        columns: angle_columns,
+        rows: vec![],
+    };
+    for (name, s) in &columns {
+        let mut row = vec![name.to_string()];
+        for angle in angles {
+            let s = Settings {
+                view_angle_deg: angle,
+                ..today(s.clone())
+            };
+            let c = Cost::of(&r.render(gpu, &s)?);
+            row.push(format!(
+                "{:.1} / {:.1}",
+                c.mean_iterations, c.texel_fetches_per_pixel
+            ));
+        }
+        cost.row(row);
+    }
+    Ok(vec![t, cost])
 }

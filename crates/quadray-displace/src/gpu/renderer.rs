@@ -4,9 +4,10 @@
 use super::height_pyramid::{HeightPyramid, PyramidKind};
 use super::pyramid_build::PyramidBuilder;
 use super::surface_pass::{
-    COLOR_FORMAT, DEPTH_FORMAT, FrameParams, Geometry, HIT_FORMAT, MapParams, MapTextures,
-    SurfacePass, Targets,
+    COLOR_FORMAT, DEPTH_FORMAT, DebugTargets, FETCHES_FORMAT, FrameParams, Geometry, HIT_FORMAT,
+    MapParams, MapTextures, SurfacePass, Targets,
 };
+use crate::cone::ConeMap;
 use crate::heightmap::HeightMap;
 use crate::method::Method;
 use crate::pyramid::Addressing;
@@ -26,17 +27,25 @@ pub struct Frame {
     pub hits: Vec<[f32; 4]>,
     /// Per pixel: the ray's p0 and e.
     pub rays: Vec<[f32; 4]>,
+    /// Per pixel: the texels the search read (every textureLoad of the trace).
+    pub fetches: Vec<f32>,
 }
 
 /// One map on one surface, ready to render with any method.
 pub struct Renderer {
     pass: SurfacePass,
-    map_levels: u32,
-    /// The map's width and height in texels.
-    map_size: (u32, u32),
+    map: HeightMap,
+    addressing: Addressing,
     surface: SurfaceKind,
+    params: wgpu::Buffer,
+    point: HeightPyramid,
+    gradients: wgpu::TextureView,
+    albedo: wgpu::TextureView,
     point_group: wgpu::BindGroup,
     conservative_group: wgpu::BindGroup,
+    /// Built the first time the cone method draws: the group binding the cone map, and the CPU
+    /// build's seconds.
+    cone: Option<(wgpu::BindGroup, f64)>,
     triangles: wgpu::Buffer,
     vertex_count: u32,
 }
@@ -104,13 +113,15 @@ impl Renderer {
         );
         let pass = SurfacePass::new(device);
         let group = |pyramid: &HeightPyramid| {
-            let textures = MapTextures {
-                pyramid: pyramid.view(),
-                depth_map: point.view(),
-                normal_map: &gradients,
-                color_map: &albedo,
-            };
-            pass.map_group(device, &params, textures)
+            map_group(
+                &pass,
+                device,
+                &params,
+                pyramid.view(),
+                &point,
+                &gradients,
+                &albedo,
+            )
         };
         let (point_group, conservative_group) = (group(&point), group(&conservative));
         let vertices = surface.vertices();
@@ -121,11 +132,16 @@ impl Renderer {
         });
         Self {
             pass,
-            map_levels: map.levels(),
-            map_size: (map.width, map.height),
+            map: map.clone(),
+            addressing,
             surface,
+            params,
+            point,
+            gradients,
+            albedo,
             point_group,
             conservative_group,
+            cone: None,
             triangles,
             vertex_count: vertices.len() as u32,
         }
@@ -136,9 +152,36 @@ impl Renderer {
         self.surface
     }
 
+    /// Seconds the CPU took to build the cone map (the cone method's preprocessing), once a cone
+    /// frame was drawn.
+    pub fn cone_build_seconds(&self) -> Option<f64> {
+        self.cone.as_ref().map(|(_, seconds)| *seconds)
+    }
+
+    /// Builds the cone map the first time the cone method draws.
+    fn prepare(&mut self, gpu: &Gpu, method: Method) {
+        if method != Method::Cone || self.cone.is_some() {
+            return;
+        }
+        let start = std::time::Instant::now();
+        let cones = ConeMap::build(&self.map, self.addressing);
+        let seconds = start.elapsed().as_secs_f64();
+        let texture = cones.upload(&gpu.device, &gpu.queue);
+        let group = map_group(
+            &self.pass,
+            &gpu.device,
+            &self.params,
+            &texture.create_view(&Default::default()),
+            &self.point,
+            &self.gradients,
+            &self.albedo,
+        );
+        self.cone = Some((group, seconds));
+    }
+
     /// Memory the method needs beyond the albedo, in bytes.
     pub fn memory_bytes(&self, method: Method) -> u64 {
-        let (width, height) = self.map_size;
+        let (width, height) = (self.map.width, self.map.height);
         let texels = u64::from(width) * u64::from(height);
         let padded = u64::from(width.next_power_of_two()) * u64::from(height.next_power_of_two());
         match method {
@@ -146,6 +189,8 @@ impl Renderer {
             Method::Pyramid | Method::PyramidAscend | Method::PyramidBilinear => {
                 padded * 4 * 4 / 3 + texels * 8
             }
+            // The cone map: depth and ratio as two floats.
+            Method::Cone => texels * 8 + texels * 8,
             Method::Mesh => {
                 // The paper's figure 20 counts a vertex buffer (position + normal) per grid point.
                 let vertices = (u64::from(mesh_grid(width, height)) + 1).pow(2);
@@ -164,7 +209,7 @@ impl Renderer {
             depth_scale: s.depth_scale,
             lod: match s.lod {
                 Lod::Auto => -1,
-                Lod::Level(l) => l.min(self.map_levels) as i32,
+                Lod::Level(l) => l.min(self.map.levels()) as i32,
             },
             layers_min: s.layers.0 as f32,
             layers_max: s.layers.1 as f32,
@@ -185,6 +230,7 @@ impl Renderer {
         if debug_outputs {
             t.push(make(HIT_FORMAT, "hits"));
             t.push(make(HIT_FORMAT, "rays"));
+            t.push(make(FETCHES_FORMAT, "fetches"));
         }
         t
     }
@@ -195,17 +241,18 @@ impl Renderer {
         encoder: &mut wgpu::CommandEncoder,
         method: Method,
         targets: Targets,
-        debug: Option<(&wgpu::TextureView, &wgpu::TextureView)>,
+        debug: Option<DebugTargets>,
         timer: Option<&GpuTimer>,
     ) {
-        let map_group = if method.uses_conservative_pyramid() {
-            &self.conservative_group
-        } else {
-            &self.point_group
+        self.prepare(gpu, method);
+        let map_group = match (&self.cone, method) {
+            (Some((cone_group, _)), Method::Cone) => cone_group,
+            _ if method.uses_conservative_pyramid() => &self.conservative_group,
+            _ => &self.point_group,
         };
         let geometry = if method == Method::Mesh {
             Geometry::MeshGrid {
-                grid: mesh_grid(self.map_size.0, self.map_size.1),
+                grid: mesh_grid(self.map.width, self.map.height),
                 tiles: self.surface.tiles(),
             }
         } else {
@@ -270,7 +317,11 @@ impl Renderer {
                     color: &views[0],
                     depth: &views[1],
                 },
-                Some((&views[2], &views[3])),
+                Some(DebugTargets {
+                    hits: &views[2],
+                    rays: &views[3],
+                    fetches: &views[4],
+                }),
                 None,
             )
         })?;
@@ -288,6 +339,7 @@ impl Renderer {
             ),
             hits: pixels(read_texture_f32(gpu, &targets[2], 0, 4)?),
             rays: pixels(read_texture_f32(gpu, &targets[3], 0, 4)?),
+            fetches: read_texture_f32(gpu, &targets[4], 0, 1)?,
         })
     }
 
@@ -336,6 +388,25 @@ impl Renderer {
 /// The displaced-mesh baseline's quads per side per tile: one per texel of the map's longer side.
 fn mesh_grid(width: u32, height: u32) -> u32 {
     width.max(height)
+}
+
+/// The per-map bind group with `traced` (a pyramid or the cone map) in the pyramid's slot.
+fn map_group(
+    pass: &SurfacePass,
+    device: &wgpu::Device,
+    params: &wgpu::Buffer,
+    traced: &wgpu::TextureView,
+    point: &HeightPyramid,
+    gradients: &wgpu::TextureView,
+    albedo: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    let textures = MapTextures {
+        pyramid: traced,
+        depth_map: point.view(),
+        normal_map: gradients,
+        color_map: albedo,
+    };
+    pass.map_group(device, params, textures)
 }
 
 /// Depth gradients per unit of uv at texel centres (central differences), filtered by the sampler

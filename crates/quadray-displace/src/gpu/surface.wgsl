@@ -36,7 +36,8 @@ struct FrameParams {
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
 @group(1) @binding(0) var<uniform> surface: MapParams;
-@group(1) @binding(1) var pyramid: texture_2d<f32>;   // min depths, one mip per level
+// Min depths, one mip per level; for METHOD_CONE the cone map (cone.wgsl) instead.
+@group(1) @binding(1) var pyramid: texture_2d<f32>;
 @group(1) @binding(2) var depth_map: texture_2d<f32>; // the map itself (bilinear reads)
 @group(1) @binding(3) var normal_map: texture_2d<f32>;
 @group(1) @binding(4) var color_map: texture_2d<f32>;
@@ -65,6 +66,8 @@ struct FragmentOut {
     @location(1) hit: vec4f,
     // The ray itself, so the CPU ground truth traces exactly the same one.
     @location(2) ray: vec4f,
+    // Texels the search read (TraceHit.fetches).
+    @location(3) fetches: f32,
 }
 
 @vertex
@@ -113,13 +116,18 @@ struct Bracket {
     gap_above: f32,   // surface depth - ray depth at z_above (> 0)
     gap_below: f32,   // ray depth - surface depth at z_below (>= 0)
     steps: u32,
+    fetches: u32,
 }
+
+// The textureLoads of one depth_bilinear.
+const BILINEAR_FETCHES: u32 = 4u;
 
 fn linear_search(p0: vec2f, e: vec2f, view_z: f32) -> Bracket {
     let layers = max(round(mix(frame.layers_max, frame.layers_min, abs(view_z))), 1.0);
     let dz = 1.0 / layers;
     var b: Bracket;
     var d = depth_bilinear(depth_map, surface.pyramid, p0);
+    b.fetches = BILINEAR_FETCHES;
     b.gap_above = d;
     // The ray is at or below every surface point by z = 1, so this ends after `layers` steps.
     while b.z_below < d && f32(b.steps) < layers + 2.0 {
@@ -128,6 +136,7 @@ fn linear_search(p0: vec2f, e: vec2f, view_z: f32) -> Bracket {
         b.z_below += dz;
         d = depth_bilinear(depth_map, surface.pyramid, p0 + e * b.z_below);
         b.steps += 1u;
+        b.fetches += BILINEAR_FETCHES;
     }
     b.gap_below = b.z_below - d;
     return b;
@@ -150,19 +159,23 @@ fn trace(p0: vec2f, e: vec2f, view_z: f32, finest: i32) -> TraceHit {
             // Offset limiting: the offset is not divided by V.z, so it never runs away.
             t.z = depth_bilinear(depth_map, info, p0);
             t.iterations = 1u;
+            t.fetches = BILINEAR_FETCHES;
         }
         case METHOD_POM: {
             let b = linear_search(p0, e, view_z);
             let w = select(0.0, b.gap_above / (b.gap_above + b.gap_below), b.steps > 0u);
             t.z = mix(b.z_above, b.z_below, w);
             t.iterations = b.steps;
+            t.fetches = b.fetches;
         }
         case METHOD_RELIEF: {
             let b = linear_search(p0, e, view_z);
             var lo = b.z_above;
             var hi = b.z_below;
+            t.fetches = b.fetches;
             for (var i = 0u; i < frame.binary_steps; i++) {
                 let mid = 0.5 * (lo + hi);
+                t.fetches += BILINEAR_FETCHES;
                 if mid < depth_bilinear(depth_map, info, p0 + e * mid) {
                     lo = mid;
                 } else {
@@ -171,6 +184,11 @@ fn trace(p0: vec2f, e: vec2f, view_z: f32, finest: i32) -> TraceHit {
             }
             t.z = 0.5 * (lo + hi);
             t.iterations = b.steps + frame.binary_steps;
+        }
+        case METHOD_CONE: {
+            // The cone map is bound in the pyramid's place; the largest layer count is the
+            // number of cone steps.
+            t = cone_trace(pyramid, info, p0, e, u32(frame.layers_max), frame.binary_steps);
         }
         default: {
             // METHOD_BUMP: no search, the surface stays flat.
@@ -236,6 +254,7 @@ fn fs_surface(in: VertexOut) -> FragmentOut {
     t.missed = t.missed || outside_map(info, hit_uv);
     // Iterations, negated when the cap stopped the search.
     out.hit = vec4f(hit_uv, select(t.z, -1.0, t.missed), select(f32(t.iterations), -f32(t.iterations), t.capped));
+    out.fetches = f32(t.fetches);
     if t.missed {
         out.color = SKY;
         return out;

@@ -1,6 +1,6 @@
 //! The surface render pass: quadray's wall, terrain, photo and torus (and the displaced-mesh
 //! baseline) drawn with any method by `surface.wgsl`, which is composed after the generated method
-//! constants and `trace.wgsl`. Bindings by how often they change: group 0 per frame (the camera
+//! constants, `trace.wgsl` and `cone.wgsl`. Bindings by how often they change: group 0 per frame (the camera
 //! and the settings), group 1 per map (its pyramid, textures and surface).
 
 use super::height_pyramid::PyramidInfo;
@@ -12,6 +12,7 @@ use wgpu::util::DeviceExt;
 pub(super) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub(super) const HIT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+pub(super) const FETCHES_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// `surface.wgsl`'s `MapParams` (group 1).
 #[repr(C)]
@@ -44,11 +45,13 @@ pub(super) struct FrameParams {
     pub _pad: u32,
 }
 
-/// The surface shader's whole source: the method ids, the tracing module, the passes' code.
+/// The surface shader's whole source: the method ids, the tracing module, the cone trace, the
+/// passes' code.
 pub(super) fn shader_source() -> String {
     [
         Method::wgsl_constants().as_str(),
         super::TRACE_WGSL,
+        include_str!("cone.wgsl"),
         include_str!("surface.wgsl"),
     ]
     .join("\n")
@@ -76,9 +79,17 @@ pub struct Targets<'a> {
     pub depth: &'a wgpu::TextureView,
 }
 
+/// The per-pixel outputs beside the colour that tests and benchmarks read back: the hit
+/// (Rgba32Float), the ray (Rgba32Float) and the texels read (R32Float).
+pub(super) struct DebugTargets<'a> {
+    pub hits: &'a wgpu::TextureView,
+    pub rays: &'a wgpu::TextureView,
+    pub fetches: &'a wgpu::TextureView,
+}
+
 /// The textures of one map, for [`SurfacePass::map_group`].
 pub(super) struct MapTextures<'a> {
-    /// The pyramid the method traces (point or conservative).
+    /// The pyramid the method traces (point or conservative), or the cone map.
     pub pyramid: &'a wgpu::TextureView,
     /// The map itself at mip 0 (the point pyramid).
     pub depth_map: &'a wgpu::TextureView,
@@ -222,11 +233,14 @@ impl SurfacePass {
             .entry((method, debug_outputs))
             .or_insert_with(|| {
                 let mesh = method == Method::Mesh;
-                let hit_target = debug_outputs.then_some(wgpu::ColorTargetState {
-                    format: HIT_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                });
+                let debug_target = |format| {
+                    debug_outputs.then_some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })
+                };
+                let hit_target = debug_target(HIT_FORMAT);
                 let constants = [("METHOD", f64::from(method.shader_id()))];
                 let options = wgpu::PipelineCompilationOptions {
                     constants: &constants,
@@ -256,7 +270,12 @@ impl SurfacePass {
                         module,
                         entry_point: Some(if mesh { "fs_mesh" } else { "fs_surface" }),
                         compilation_options: options,
-                        targets: &[Some(COLOR_FORMAT.into()), hit_target.clone(), hit_target],
+                        targets: &[
+                            Some(COLOR_FORMAT.into()),
+                            hit_target.clone(),
+                            hit_target,
+                            debug_target(FETCHES_FORMAT),
+                        ],
                     }),
                     multiview_mask: None,
                     cache: None,
@@ -264,8 +283,7 @@ impl SurfacePass {
             })
     }
 
-    /// Records the pass into `targets`, and into the hit and ray targets (Rgba32Float) when
-    /// given. The frame parameters must have been written for this frame.
+    /// Records the pass into `targets`, and into the debug targets when given. The frame parameters must have been written for this frame.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
@@ -275,7 +293,7 @@ impl SurfacePass {
         map_group: &wgpu::BindGroup,
         geometry: Geometry,
         targets: Targets,
-        debug: Option<(&wgpu::TextureView, &wgpu::TextureView)>,
+        debug: Option<DebugTargets>,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let Targets { color, depth } = targets;
@@ -291,15 +309,17 @@ impl SurfacePass {
             b: -2.0,
             a: 0.0,
         };
+        let debug_outputs = debug.is_some();
         let color_attachments = match debug {
-            Some((hits, rays)) => [
+            Some(d) => [
                 cleared_attachment(color, sky),
-                cleared_attachment(hits, no_surface),
-                cleared_attachment(rays, no_surface),
+                cleared_attachment(d.hits, no_surface),
+                cleared_attachment(d.rays, no_surface),
+                cleared_attachment(d.fetches, wgpu::Color::TRANSPARENT),
             ],
-            None => [cleared_attachment(color, sky), None, None],
+            None => [cleared_attachment(color, sky), None, None, None],
         };
-        let pipeline = self.pipeline(device, method, debug.is_some()).clone();
+        let pipeline = self.pipeline(device, method, debug_outputs).clone();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("displace"),
             color_attachments: &color_attachments,

@@ -35,11 +35,13 @@ struct PyramidInfo {
     _pad: vec2u,
 }
 
-// What a trace found: the depth z where it stopped, the steps it took, whether the ray left a
-// clamped map (missed) and whether a cap stopped it (capped: a bound was too low).
+// What a trace found: the depth z where it stopped, the steps it took, the texels it read
+// (fetches: every textureLoad), whether the ray left a clamped map (missed) and whether a cap
+// stopped it (capped: a bound was too low).
 struct TraceHit {
     z: f32,
     iterations: u32,
+    fetches: u32,
     missed: bool,
     capped: bool,
 }
@@ -127,6 +129,7 @@ fn pyramid_trace(pyramid: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2
         let scale = f32(1 << u32(level)); // level-0 texels per node side
         let node = clamp(floor((x - origin) / scale), vec2f(0.0), ceil(size / scale) - 1.0);
         let d = textureLoad(pyramid, vec2i(node), level).r;
+        t.fetches += 1u;
         // The node's extent, clipped to the map: a ray leaving the last (partial) node goes on in
         // the next copy's first node (wrap) or off the map (clamp), never into the padding.
         let lo = origin + node * scale;
@@ -253,6 +256,7 @@ fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: Py
         round += 1u;
         let cells = bilinear_cells(depth_map, info, p0, e, t.z, 4u);
         t.iterations += u32(cells.z);
+        t.fetches += 4u * u32(cells.z);
         if cells.x >= 0.0 {
             t.z = cells.x;
             t.missed = outside_map(info, p0 + e * t.z);
@@ -263,6 +267,7 @@ fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: Py
         t.missed = resumed.missed;
         t.capped = resumed.capped;
         t.iterations += resumed.iterations;
+        t.fetches += resumed.fetches;
     }
     return t;
 }
