@@ -181,24 +181,12 @@ impl ConeMap {
 
     /// The cone map as the texture `cone.wgsl` reads: Rg32Float, one mip, (depth, ratio).
     pub fn upload(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::Texture {
-        use wgpu::util::DeviceExt;
-        device.create_texture_with_data(
+        quadray_gpu::texture_2d_with_data(
+            device,
             queue,
-            &wgpu::TextureDescriptor {
-                label: Some("cone map"),
-                size: wgpu::Extent3d {
-                    width: self.width,
-                    height: self.height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rg32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
+            "cone map",
+            (self.width, self.height),
+            wgpu::TextureFormat::Rg32Float,
             bytemuck::cast_slice(&self.texels),
         )
     }
@@ -269,6 +257,7 @@ fn best_ratio(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::heightmap::random_map;
 
     /// Every exit wall of every texel in every copy, without pruning.
     fn brute_force(map: &HeightMap, addressing: Addressing) -> ConeMap {
@@ -303,26 +292,6 @@ mod tests {
         }
     }
 
-    fn random_map((width, height): (u32, u32), seed: u64, levels: u32) -> HeightMap {
-        let mut s = seed;
-        let depth = (0..width * height)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let v = (s >> 40) as f32 / (1u64 << 24) as f32;
-                // `levels` distinct depths make flat plateaus (texels without exits); 0: smooth.
-                if levels > 0 {
-                    (v * levels as f32).floor() / (levels - 1).max(1) as f32
-                } else {
-                    v
-                }
-                .min(1.0)
-            })
-            .collect();
-        HeightMap::from_depths(Path::new("random"), width, height, depth).unwrap()
-    }
-
     /// Pruning only skips nodes that cannot lower a ratio, and the bounds use the same float
     /// operations as the texels they bound: the ratios are bit-identical.
     #[test]
@@ -340,7 +309,7 @@ mod tests {
             ((1, 9), 8, 2),
         ];
         for (size, seed, levels) in cases {
-            let map = random_map(size, seed, levels);
+            let map = random_map(size.0, size.1, seed, levels);
             for addressing in [Addressing::Wrap, Addressing::Clamp] {
                 let fast = ConeMap::build(&map, addressing);
                 assert_eq!(

@@ -273,6 +273,28 @@ fn resample(src: &[f32], w: u32, h: u32, size: u32) -> Vec<f32> {
     out
 }
 
+/// Seeded pseudo-random maps for the crate's unit tests.
+#[cfg(test)]
+pub(crate) fn random_map(width: u32, height: u32, seed: u64, levels: u32) -> HeightMap {
+    let mut s = seed;
+    let depth = (0..width * height)
+        .map(|_| {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let v = (s >> 40) as f32 / (1u64 << 24) as f32;
+            // `levels` distinct depths make flat plateaus and sharp walls; 0: every depth.
+            if levels > 0 {
+                (v * levels as f32).floor() / (levels - 1).max(1) as f32
+            } else {
+                v
+            }
+            .min(1.0)
+        })
+        .collect();
+    HeightMap::from_depths(Path::new("random"), width, height, depth).unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

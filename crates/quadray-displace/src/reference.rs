@@ -224,21 +224,8 @@ fn first_root(c0: f64, c1: f64, c2: f64, lo: f64, hi: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::heightmap::random_map;
     use std::path::Path;
-
-    fn random_map(width: u32, height: u32, seed: u64, sharp: bool) -> HeightMap {
-        let mut s = seed;
-        let depth = (0..width * height)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let v = (s >> 40) as f32 / (1u64 << 24) as f32;
-                if sharp { (v * 4.0).floor() / 3.0 } else { v }.min(1.0)
-            })
-            .collect();
-        HeightMap::from_depths(Path::new("random"), width, height, depth).unwrap()
-    }
 
     fn random_rays(count: usize, seed: u64) -> Vec<Ray> {
         let mut s = seed;
@@ -299,7 +286,7 @@ mod tests {
     fn point_sampled_dda_matches_fine_marching() {
         for (w, h) in SIZES {
             for sharp in [false, true] {
-                let map = random_map(w, h, 7, sharp);
+                let map = random_map(w, h, 7, if sharp { 4 } else { 0 });
                 matches_marching(&map, 11, Surface::Point, point_depth);
             }
         }
@@ -341,7 +328,7 @@ mod tests {
     #[test]
     fn bilinear_roots_match_fine_marching() {
         for (w, h) in SIZES {
-            let map = random_map(w, h, 3, false);
+            let map = random_map(w, h, 3, 0);
             matches_marching(&map, 5, Surface::Bilinear, bilinear_depth);
         }
     }
@@ -362,7 +349,7 @@ mod tests {
 
     #[test]
     fn a_vertical_ray_stops_on_the_top_of_its_column() {
-        let map = random_map(8, 8, 1, true);
+        let map = random_map(8, 8, 1, 4);
         let ray = Ray {
             p0: DVec2::new(0.3, 0.6),
             e: DVec2::ZERO,

@@ -10,7 +10,7 @@ mod target;
 mod timer;
 
 pub use readback::{read_buffer, read_texture_f32, read_texture_rgba8};
-pub use target::{cleared_attachment, nearest_depth, texture_2d};
+pub use target::{cleared_attachment, nearest_depth, texture_2d, texture_2d_with_data};
 pub use timer::{GpuTimer, TimingSummary};
 
 use thiserror::Error;

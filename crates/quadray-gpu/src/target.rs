@@ -5,11 +5,40 @@
 pub fn texture_2d(
     device: &wgpu::Device,
     label: &str,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
+    device.create_texture(&single_mip(label, size, format, usage))
+}
+
+/// A sampled single-mip 2-D texture of `size` (width, height) holding `data` (rows of texels,
+/// tightly packed), as map data (depths, colours, derived maps) is uploaded.
+pub fn texture_2d_with_data(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    data: &[u8],
+) -> wgpu::Texture {
+    use wgpu::util::DeviceExt;
+    let descriptor = single_mip(label, size, format, wgpu::TextureUsages::TEXTURE_BINDING);
+    device.create_texture_with_data(
+        queue,
+        &descriptor,
+        wgpu::util::TextureDataOrder::LayerMajor,
+        data,
+    )
+}
+
+fn single_mip(
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::TextureDescriptor<'_> {
+    wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d {
             width,
@@ -22,7 +51,7 @@ pub fn texture_2d(
         format,
         usage,
         view_formats: &[],
-    })
+    }
 }
 
 /// The usual depth test: the nearest fragment wins and writes its depth.

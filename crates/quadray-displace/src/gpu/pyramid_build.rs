@@ -4,7 +4,6 @@
 use super::height_pyramid::{HeightPyramid, PyramidKind};
 use crate::heightmap::HeightMap;
 use crate::pyramid::{Addressing, level_size};
-use wgpu::util::DeviceExt;
 
 /// Builds min-depth pyramids on the GPU; keeps its pipelines for any number of maps.
 pub struct PyramidBuilder {
@@ -124,23 +123,12 @@ impl PyramidBuilder {
                 ],
             })
         };
-        let source = device.create_texture_with_data(
+        let source = quadray_gpu::texture_2d_with_data(
+            device,
             queue,
-            &wgpu::TextureDescriptor {
-                label: Some("depth map"),
-                size: wgpu::Extent3d {
-                    width: map.width,
-                    height: map.height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: HeightPyramid::FORMAT,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
+            "depth map",
+            (map.width, map.height),
+            HeightPyramid::FORMAT,
             bytemuck::cast_slice(&map.depth),
         );
         let level0 = match kind {

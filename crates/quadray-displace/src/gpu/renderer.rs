@@ -75,23 +75,12 @@ impl Renderer {
                 &tinted
             }
         };
-        let albedo = device.create_texture_with_data(
+        let albedo = quadray_gpu::texture_2d_with_data(
+            device,
             queue,
-            &wgpu::TextureDescriptor {
-                label: Some("albedo"),
-                size: wgpu::Extent3d {
-                    width: color.width,
-                    height: color.height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8UnormSrgb,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
+            "albedo",
+            (color.width, color.height),
+            wgpu::TextureFormat::Rgba8UnormSrgb,
             color.pixels.as_flattened(),
         );
         let albedo = albedo.create_view(&Default::default());
@@ -422,23 +411,12 @@ fn upload_gradients(gpu: &Gpu, map: &HeightMap) -> wgpu::Texture {
             texels.extend([du, dv, 0.0, 0.0].map(half::f16::from_f32));
         }
     }
-    gpu.device.create_texture_with_data(
+    quadray_gpu::texture_2d_with_data(
+        &gpu.device,
         &gpu.queue,
-        &wgpu::TextureDescriptor {
-            label: Some("depth gradients"),
-            size: wgpu::Extent3d {
-                width: map.width,
-                height: map.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
+        "depth gradients",
+        (map.width, map.height),
+        wgpu::TextureFormat::Rgba16Float,
         bytemuck::cast_slice(&texels),
     )
 }
