@@ -26,7 +26,7 @@ const SCENES: [&str; 5] = [
     "leak.toml",
 ];
 /// The quadtree's sub-samplings (1: full resolution), each also RSM sampling's.
-const SUBSAMPLES: [u32; 3] = [1, 2, 4];
+const SUBSAMPLES: [u32; 4] = [1, 2, 4, 8];
 /// RSM sample counts swept, up to where sampling reaches the quadtree's error.
 const SAMPLES: [u32; 10] = [16, 64, 216, 512, 1024, 2040, 4096, 8192, 16384, 32768];
 
