@@ -189,10 +189,16 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     let frame = sub.render_frame(Method::Rsm).unwrap();
     let low: u64 = low_receivers.iter().map(|r| sampled(r).0).sum();
     let per_pixel: Vec<u64> = receivers.iter().flatten().map(|r| sampled(r).0).collect();
-    let (fewest, most) = (per_pixel.iter().min().unwrap(), per_pixel.iter().max().unwrap());
+    let (fewest, most) = (
+        per_pixel.iter().min().unwrap(),
+        per_pixel.iter().max().unwrap(),
+    );
     let recomputed = u64::from(frame.recomputed);
     let rest = frame.counts.vpl_evaluations as i64 - low as i64;
-    println!("RSM sub-sampled: {:?}, {recomputed} recomputed", frame.counts);
+    println!(
+        "RSM sub-sampled: {:?}, {recomputed} recomputed",
+        frame.counts
+    );
     assert!(recomputed > 0 && *fewest > 0, "{recomputed} {fewest}");
     // 0.1% slack for samples on texel borders, as above
     let slack = (1e-3 * frame.counts.vpl_evaluations as f64) as i64;
