@@ -43,7 +43,8 @@ pub struct IndirectArgs {
     /// RSM-sampling samples per pixel.
     #[arg(long, default_value_t = Settings::default().samples)]
     samples: u32,
-    /// Indirect at one sample per KxK pixels, upsampled where the geometry agrees (quadtree).
+    /// Indirect at one sample per KxK pixels, upsampled where the geometry agrees (quadtree,
+    /// rsm).
     #[arg(long, default_value_t = Settings::default().subsample)]
     subsample: u32,
     /// Indirect shadows (quadtree methods): march between each receiver and cluster against the

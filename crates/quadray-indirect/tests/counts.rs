@@ -6,6 +6,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use quadray_gpu::Gpu;
 use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
+use quadray_indirect::gpu::Receiver;
 use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings, Validity, WorkCounts};
 
 const RSM: u32 = 32;
@@ -112,8 +113,9 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     );
     let view_proj = scene.light_view_proj();
     let side = RSM as f32;
-    let (mut evaluations, mut fetches) = (0, 3 * pixels);
-    for receiver in receivers.iter().flatten() {
+    // one receiver's (evaluations, fetches) past its G-buffer reads
+    let sampled = |receiver: &Receiver| {
+        let (mut evaluations, mut fetches) = (0, 0);
         let clip = view_proj * Vec3::from(receiver.position).extend(1.0);
         let ndc = Vec2::new(clip.x, clip.y) / clip.w.max(1e-6);
         let projected = Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * side;
@@ -136,6 +138,12 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
                 }
             }
         }
+        (evaluations, fetches)
+    };
+    let (mut evaluations, mut fetches) = (0, 3 * pixels);
+    for (e, f) in receivers.iter().flatten().map(sampled) {
+        evaluations += e;
+        fetches += f;
     }
     let rsm = counted(&mut r, Method::Rsm);
     // a sample on a texel border may floor differently than on the GPU: 0.1% slack
@@ -158,13 +166,14 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     )
     .unwrap();
     let frame = sub.render_frame(Method::Quadtree).unwrap();
-    let low_shaded = (0..s.height.div_ceil(k))
+    let low_receivers: Vec<&Receiver> = (0..s.height.div_ceil(k))
         .flat_map(|y| (0..s.width.div_ceil(k)).map(move |x| (x, y)))
-        .filter(|&(x, y)| {
+        .filter_map(|(x, y)| {
             let p = |v: u32, n: u32| (v * k + k / 2).min(n - 1);
-            receivers[(p(y, s.height) * s.width + p(x, s.width)) as usize].is_some()
+            receivers[(p(y, s.height) * s.width + p(x, s.width)) as usize].as_ref()
         })
-        .count() as u64;
+        .collect();
+    let low_shaded = low_receivers.len() as u64;
     let recomputed = u64::from(frame.recomputed);
     assert!(recomputed > 0 && recomputed < shaded / 2, "{recomputed}");
     println!("sub-sampled: {:?}", frame.counts);
@@ -173,4 +182,29 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
         (low_shaded + recomputed) * cut
     );
     assert_eq!(frame.counts.shaded_pixels as u64, shaded);
+
+    // RSM sampling sub-sampled: each low-resolution sample's evaluations, and each recomputed
+    // pixel's (which pixels is the upsampler's choice: their sum lies between the fewest and
+    // the most any pixel makes)
+    let frame = sub.render_frame(Method::Rsm).unwrap();
+    let low: u64 = low_receivers.iter().map(|r| sampled(r).0).sum();
+    let per_pixel: Vec<u64> = receivers.iter().flatten().map(|r| sampled(r).0).collect();
+    let (fewest, most) = (
+        per_pixel.iter().min().unwrap(),
+        per_pixel.iter().max().unwrap(),
+    );
+    let recomputed = u64::from(frame.recomputed);
+    let rest = frame.counts.vpl_evaluations as i64 - low as i64;
+    println!(
+        "RSM sub-sampled: {:?}, {recomputed} recomputed",
+        frame.counts
+    );
+    assert!(recomputed > 0 && *fewest > 0, "{recomputed} {fewest}");
+    // 0.1% slack for samples on texel borders, as above
+    let slack = (1e-3 * frame.counts.vpl_evaluations as f64) as i64;
+    assert!(
+        rest + slack >= (recomputed * fewest) as i64 && rest - slack <= (recomputed * most) as i64,
+        "{rest} evaluations past the low-resolution samples' {low} for {recomputed} pixels \
+         making {fewest}..{most} each"
+    );
 }

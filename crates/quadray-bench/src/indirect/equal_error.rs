@@ -1,8 +1,11 @@
 //! `quadray bench indirect --equal-error`: the light quadtree against RSM sampling at the same
 //! error, in the work counts the shaders report (VPL evaluations and texel fetches per shaded
 //! pixel, the same on any hardware) and in GPU time, on every bundled scene of the technique at
-//! several RSM sizes. RSM sampling is swept over sample counts; its cost at the quadtree's error
-//! is interpolated log-log between the two counts whose errors bracket it.
+//! several RSM sizes. The quadtree runs at full resolution and sub-sampled (one gather per
+//! `k`^2 pixels, geometry-aware upsampling, recomputed pixels counted). RSM sampling is swept
+//! over sample counts at full resolution (the paper's baseline) and, as the fair extra row, at
+//! each sub-sampling the quadtree uses; its cost at the quadtree's error is interpolated log-log
+//! between the two counts whose errors bracket it.
 
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_core::{write_json, write_text};
@@ -13,13 +16,17 @@ use quadray_indirect::{ClusterSettings, IndirectError, Method, Renderer, Scene, 
 use serde::Serialize;
 use std::path::Path;
 
-/// The scenes compared: the Cornell box, the bunny and the Buddha in it, the atrium.
-const SCENES: [&str; 4] = [
+/// The scenes compared: the Cornell box, the bunny and the Buddha in it, the atrium, the leak
+/// scene.
+const SCENES: [&str; 5] = [
     "cornell.toml",
     "cornell_bunny.toml",
     "cornell_buddha.toml",
     "atrium.toml",
+    "leak.toml",
 ];
+/// The quadtree's sub-samplings (1: full resolution), each also RSM sampling's.
+const SUBSAMPLES: [u32; 4] = [1, 2, 4, 8];
 /// RSM sample counts swept, up to where sampling reaches the quadtree's error.
 const SAMPLES: [u32; 10] = [16, 64, 216, 512, 1024, 2040, 4096, 8192, 16384, 32768];
 
@@ -54,6 +61,8 @@ impl EqualErrorOptions {
 pub struct Point {
     /// The method's setting ("default", "paper", "N samples").
     pub label: String,
+    /// One gather per `subsample`^2 pixels (1: full resolution).
+    pub subsample: u32,
     /// Relative L1 error of the indirect term against the brute force.
     pub rel_l1: f64,
     /// VPL kernels evaluated per shaded pixel, counted in the shaders.
@@ -69,6 +78,15 @@ pub struct Point {
 pub struct Comparison {
     /// The quadtree's point.
     pub quadtree: Point,
+    /// Against RSM sampling at full resolution (the paper's baseline).
+    pub full_resolution: AtError,
+    /// Against RSM sampling sub-sampled as the quadtree is (`None` at full resolution).
+    pub same_subsample: Option<AtError>,
+}
+
+/// RSM sampling's cost at a quadtree's error, over the quadtree's.
+#[derive(Clone, Debug, Serialize)]
+pub struct AtError {
     /// RSM samples per pixel that reach the quadtree's error; `None` when no swept count does.
     pub rsm_samples: Option<f64>,
     /// RSM sampling's evaluations per pixel there over the quadtree's.
@@ -88,7 +106,7 @@ pub struct SceneResult {
     pub rsm_size: u32,
     /// The quadtree settings, each against RSM sampling.
     pub comparisons: Vec<Comparison>,
-    /// RSM sampling at every swept sample count.
+    /// RSM sampling at every swept sample count and sub-sampling.
     pub rsm: Vec<Point>,
 }
 
@@ -129,6 +147,7 @@ fn measure(
     let timing = r.time(method, false, frames)?;
     Ok(Point {
         label,
+        subsample: r.settings().subsample,
         rel_l1: compare(&frame.indirect, brute).rel_l1,
         vpl_evaluations_per_pixel: frame.counts.vpl_evaluations_per_pixel(),
         texel_fetches_per_pixel: frame.counts.texel_fetches_per_pixel(),
@@ -136,25 +155,35 @@ fn measure(
     })
 }
 
-fn compare_at_error(quadtree: Point, rsm: &[Point]) -> Comparison {
+/// RSM sampling's points at `subsample` (`rsm` holds every sweep) at `quadtree`'s error.
+fn at_quadtree_error(quadtree: &Point, rsm: &[Point], subsample: u32) -> AtError {
     let curve = |value: &dyn Fn(&Point) -> Option<f64>| -> Vec<(f64, f64)> {
         rsm.iter()
+            .filter(|p| p.subsample == subsample)
             .filter_map(|p| value(p).map(|v| (p.rel_l1, v)))
             .collect()
     };
     let at = |value: &dyn Fn(&Point) -> Option<f64>| at_error(&curve(value), quadtree.rel_l1);
     let ratio = |value: &dyn Fn(&Point) -> Option<f64>| {
         at(value)
-            .zip(value(&quadtree))
+            .zip(value(quadtree))
             .filter(|(_, q)| *q > 0.0)
             .map(|(r, q)| r / q)
     };
     let samples = |p: &Point| p.label.trim_end_matches(" samples").parse::<f64>().ok();
-    Comparison {
+    AtError {
         rsm_samples: at(&samples),
         evaluation_ratio: ratio(&|p| Some(p.vpl_evaluations_per_pixel)),
         fetch_ratio: ratio(&|p| Some(p.texel_fetches_per_pixel)),
         time_ratio: ratio(&|p| p.static_ms),
+    }
+}
+
+fn compare_at_error(quadtree: Point, rsm: &[Point]) -> Comparison {
+    Comparison {
+        full_resolution: at_quadtree_error(&quadtree, rsm, 1),
+        same_subsample: (quadtree.subsample > 1)
+            .then(|| at_quadtree_error(&quadtree, rsm, quadtree.subsample)),
         quadtree,
     }
 }
@@ -167,42 +196,66 @@ fn scene_result(
     progress: &mut dyn FnMut(&str),
 ) -> Result<SceneResult, IndirectError> {
     let name = format!("{} {}^2", scene.name, base.rsm_size);
-    let mut r = Renderer::new(gpu, scene, base.clone())?;
     progress(&format!("{name}: brute force"));
-    let brute = r.render_frame(Method::Reference)?.indirect;
+    let brute = Renderer::new(gpu, scene, base.clone())?
+        .render_frame(Method::Reference)?
+        .indirect;
     let mut quadtree = Vec::new();
-    for (label, cluster) in [
-        ("default", ClusterSettings::defaults(base.rsm_size)),
-        ("paper", ClusterSettings::with_limit_side(base.rsm_size, 32)),
-    ] {
-        progress(&format!("{name}: quadtree {label}"));
-        r.set_cluster(cluster)?;
-        quadtree.push(measure(
-            &mut r,
-            Method::Quadtree,
-            label.into(),
-            &brute,
-            frames,
-        )?);
-    }
-    let mut rsm: Vec<Point> = Vec::new();
-    for samples in SAMPLES {
-        // past the best quadtree's error there is nothing more to interpolate
-        let best = quadtree.iter().map(|p| p.rel_l1).fold(f64::MAX, f64::min);
-        if rsm.last().is_some_and(|p| p.rel_l1 <= best) {
-            break;
-        }
-        progress(&format!("{name}: RSM {samples} samples"));
-        let mut rs = Renderer::new(
+    for subsample in SUBSAMPLES {
+        let mut r = Renderer::new(
             gpu,
             scene,
             Settings {
-                samples,
+                subsample,
                 ..base.clone()
             },
         )?;
-        let label = format!("{samples} samples");
-        rsm.push(measure(&mut rs, Method::Rsm, label, &brute, frames)?);
+        for (label, cluster) in [
+            ("default", ClusterSettings::defaults(base.rsm_size)),
+            ("paper", ClusterSettings::with_limit_side(base.rsm_size, 32)),
+        ] {
+            progress(&format!("{name}: quadtree {label}, subsample {subsample}"));
+            r.set_cluster(cluster)?;
+            quadtree.push(measure(
+                &mut r,
+                Method::Quadtree,
+                label.into(),
+                &brute,
+                frames,
+            )?);
+        }
+    }
+    let mut rsm: Vec<Point> = Vec::new();
+    for subsample in SUBSAMPLES {
+        // past the best error of the quadtree settings compared with this sweep there is
+        // nothing more to interpolate (full resolution is compared with every setting)
+        let best = quadtree
+            .iter()
+            .filter(|p| subsample == 1 || p.subsample == subsample)
+            .map(|p| p.rel_l1)
+            .fold(f64::MAX, f64::min);
+        let mut last = f64::MAX;
+        for samples in SAMPLES {
+            if last <= best {
+                break;
+            }
+            progress(&format!(
+                "{name}: RSM {samples} samples, subsample {subsample}"
+            ));
+            let mut rs = Renderer::new(
+                gpu,
+                scene,
+                Settings {
+                    samples,
+                    subsample,
+                    ..base.clone()
+                },
+            )?;
+            let label = format!("{samples} samples");
+            let point = measure(&mut rs, Method::Rsm, label, &brute, frames)?;
+            last = point.rel_l1;
+            rsm.push(point);
+        }
     }
     Ok(SceneResult {
         scene: scene.name.clone(),
@@ -261,6 +314,7 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             "scene",
             "RSM",
             "quadtree",
+            "subsample",
             "rel L1",
             "evals/px",
             "fetches/px",
@@ -269,23 +323,33 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             "evals ratio",
             "fetches ratio",
             "time ratio",
+            "same-subsample RSM samples",
+            "evals ratio",
+            "time ratio",
         ],
     );
     for s in &results.scenes {
         for c in &s.comparisons {
-            let q = &c.quadtree;
+            let (q, full, same) = (&c.quadtree, &c.full_resolution, &c.same_subsample);
+            let same = |value: &dyn Fn(&AtError) -> Option<f64>, digits| {
+                fixed(same.as_ref().and_then(value), digits)
+            };
             table.row(vec![
                 s.scene.clone(),
                 format!("{}^2", s.rsm_size),
                 q.label.clone(),
+                q.subsample.to_string(),
                 format!("{:.4}", q.rel_l1),
-                format!("{:.0}", q.vpl_evaluations_per_pixel),
+                format!("{:.1}", q.vpl_evaluations_per_pixel),
                 format!("{:.0}", q.texel_fetches_per_pixel),
                 fixed(q.static_ms, 2),
-                fixed(c.rsm_samples, 0),
-                fixed(c.evaluation_ratio, 2),
-                fixed(c.fetch_ratio, 2),
-                fixed(c.time_ratio, 2),
+                fixed(full.rsm_samples, 0),
+                fixed(full.evaluation_ratio, 2),
+                fixed(full.fetch_ratio, 2),
+                fixed(full.time_ratio, 2),
+                same(&|a| a.rsm_samples, 0),
+                same(&|a| a.evaluation_ratio, 2),
+                same(&|a| a.time_ratio, 2),
             ]);
         }
     }
@@ -294,6 +358,7 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
         &[
             "scene",
             "RSM",
+            "subsample",
             "samples",
             "rel L1",
             "evals/px",
@@ -306,6 +371,7 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             sweep.row(vec![
                 s.scene.clone(),
                 format!("{}^2", s.rsm_size),
+                p.subsample.to_string(),
                 p.label.trim_end_matches(" samples").into(),
                 format!("{:.4}", p.rel_l1),
                 format!("{:.0}", p.vpl_evaluations_per_pixel),
@@ -323,14 +389,17 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             ps.map(|p| (p.vpl_evaluations_per_pixel, p.rel_l1))
                 .collect()
         };
-        series.push(Series {
-            name: format!("{} {}^2 RSM sampling", s.scene, s.rsm_size),
-            points: points(&mut s.rsm.iter()),
-        });
-        series.push(Series {
-            name: format!("{} {}^2 quadtree", s.scene, s.rsm_size),
-            points: points(&mut s.comparisons.iter().map(|c| &c.quadtree)),
-        });
+        for k in SUBSAMPLES {
+            let at = |p: &&Point| p.subsample == k;
+            series.push(Series {
+                name: format!("{} {}^2 RSM sampling, subsample {k}", s.scene, s.rsm_size),
+                points: points(&mut s.rsm.iter().filter(at)),
+            });
+            series.push(Series {
+                name: format!("{} {}^2 quadtree, subsample {k}", s.scene, s.rsm_size),
+                points: points(&mut s.comparisons.iter().map(|c| &c.quadtree).filter(at)),
+            });
+        }
     }
     line_plot(
         &out.join("equal_error.svg"),

@@ -99,6 +99,8 @@ pub struct Gather {
     indirect_level: wgpu::ComputePipeline,
     indirect_low: wgpu::ComputePipeline,
     upsample: wgpu::ComputePipeline,
+    sampled_low: wgpu::ComputePipeline,
+    sampled_upsample: wgpu::ComputePipeline,
     direct_light: wgpu::ComputePipeline,
     brute_force: wgpu::ComputePipeline,
     rsm_sampling: wgpu::ComputePipeline,
@@ -211,6 +213,8 @@ impl Gather {
             indirect_level: pipeline("indirect_level"),
             indirect_low: pipeline("indirect_low"),
             upsample: pipeline("upsample"),
+            sampled_low: pipeline("sampled_low"),
+            sampled_upsample: pipeline("sampled_upsample"),
             direct_light: pipeline("direct_light"),
             brute_force: pipeline("brute_force"),
             rsm_sampling: pipeline("rsm_sampling"),
@@ -351,10 +355,17 @@ impl Gather {
     ) {
         let s = &self.settings;
         let c = quadtree.cluster();
-        let subsampled = method == Method::Quadtree && s.subsample > 1;
+        let subsampled = method.subsamples() && s.subsample > 1;
         let rsm_texels = u64::from(s.rsm_size).pow(2);
         // a cut partitions the RSM into nodes no finer than the limit level
         let cut_slices = slices(u64::from(s.rsm_size >> c.limit_level).pow(2), SLICE);
+        let sample_slices = slices(u64::from(s.samples), SLICE);
+        // the sub-sampled passes: their low-resolution and upsampling pipelines, and slices
+        let (low, upsample, low_slices) = if method == Method::Rsm {
+            (&self.sampled_low, &self.sampled_upsample, sample_slices)
+        } else {
+            (&self.indirect_low, &self.upsample, cut_slices)
+        };
         let filtered = s.temporal_weight < 1.0 && method != Method::Reference;
         let blend = filtered && self.history_of.get() == Some(method);
         if method == Method::QuadtreePasses {
@@ -375,10 +386,10 @@ impl Gather {
             };
             let (w, h) = (s.width, s.height);
             match method {
-                Method::Quadtree if subsampled => {
-                    pass.set_pipeline(&self.indirect_low);
+                _ if subsampled => {
+                    pass.set_pipeline(low);
                     let (lw, lh) = low_size(s);
-                    sliced(&mut pass, 0, cut_slices, lw, lh);
+                    sliced(&mut pass, 0, low_slices, lw, lh);
                 }
                 Method::Quadtree => {
                     pass.set_pipeline(&self.indirect_cut);
@@ -393,7 +404,7 @@ impl Gather {
                 }
                 Method::Rsm => {
                     pass.set_pipeline(&self.rsm_sampling);
-                    sliced(&mut pass, 0, slices(u64::from(s.samples), SLICE), w, h);
+                    sliced(&mut pass, 0, sample_slices, w, h);
                 }
                 Method::Reference => {
                     pass.set_pipeline(&self.brute_force);
@@ -405,13 +416,14 @@ impl Gather {
             }
         }
         if subsampled {
-            // where the upsampler recomputes a pixel it sums the cut, in the same slices
+            // where the upsampler recomputes a pixel it sums the same as the low-resolution
+            // samples, in the same slices
             let stamps = timer.and_then(|(t, _, slot)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "upsample", stamps);
             pass.set_bind_group(0, &self.light_group, &[]);
             pass.set_bind_group(1, &self.frame_group, &[]);
-            pass.set_pipeline(&self.upsample);
-            for slice in 0..cut_slices {
+            pass.set_pipeline(upsample);
+            for slice in 0..low_slices {
                 self.bind(&mut pass, 0, slice);
                 dispatch_2d(&mut pass, s.width, s.height);
             }

@@ -73,6 +73,12 @@ impl Method {
         }
     }
 
+    /// Whether [`Settings::subsample`] applies: the method can gather at low resolution and
+    /// upsample (the compacted cut, and RSM sampling as the fair comparison).
+    pub fn subsamples(self) -> bool {
+        matches!(self, Method::Quadtree | Method::Rsm)
+    }
+
     /// Whether the method builds the light quadtree and a cut (so a cluster count means
     /// something for it).
     pub fn uses_quadtree(self) -> bool {
@@ -180,7 +186,9 @@ pub struct Settings {
     pub samples: u32,
     /// Sampling radius as a fraction of the RSM's diagonal.
     pub rsm_radius: f32,
-    /// Indirect at one sample per `subsample`^2 pixels (1: full resolution).
+    /// Indirect at one sample per `subsample`^2 pixels (1: full resolution), for the methods
+    /// that [`Method::subsamples`]: the low-resolution samples are upsampled where the
+    /// geometry agrees and the other pixels recomputed at full resolution.
     pub subsample: u32,
     /// Indirect shadows for the quadtree methods: points marched between each receiver and
     /// cluster, tested against the camera's and the light's depth (0: none, as in the paper).

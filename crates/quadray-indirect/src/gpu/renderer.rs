@@ -185,7 +185,7 @@ impl<'g> Renderer<'g> {
             }
         }
         passes.extend([Pass::GBuffer, Pass::Indirect, Pass::Direct]);
-        if method == Method::Quadtree && self.settings().subsample > 1 {
+        if method.subsamples() && self.settings().subsample > 1 {
             passes.push(Pass::Upsample);
         }
         passes

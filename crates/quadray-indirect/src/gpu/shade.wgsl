@@ -61,43 +61,61 @@ fn low_pixel(low_xy: vec2<u32>) -> vec2<u32> {
     return min(p, vec2<u32>(shade.width - 1u, shade.height - 1u));
 }
 
-@compute @workgroup_size(8, 8)
-fn indirect_low(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.low_width || id.y >= shade.low_height) {
+// This dispatch's slice of the sum a sub-sampled method gathers: the cut's clusters, or RSM
+// sampling's samples (`sampled`).
+fn gathered_irradiance(r: Receiver, sampled: bool) -> vec3<f32> {
+    if (sampled) {
+        return sampled_irradiance(r);
+    }
+    return cut_irradiance(r);
+}
+
+// One low-resolution sample's irradiance (w: 1 where it sees geometry).
+fn low_sample(low_xy: vec2<u32>, sampled: bool) {
+    if (low_xy.x >= shade.low_width || low_xy.y >= shade.low_height) {
         return;
     }
-    let r = receiver(low_pixel(id.xy));
+    let r = receiver(low_pixel(low_xy));
     var e = vec3<f32>(0.0);
     if (r.covered) {
-        e = cut_irradiance(r);
+        e = gathered_irradiance(r, sampled);
     }
-    let index = id.y * shade.low_width + id.x;
+    let index = low_xy.y * shade.low_width + low_xy.x;
     if (slice.level == 0u) {
         low[index] = vec4<f32>(e, select(0.0, 1.0, r.covered));
     } else {
         low[index] += vec4<f32>(e, 0.0);
     }
-    let full = low_pixel(id.xy);
+    let full = low_pixel(low_xy);
     store_counts(full.y * shade.width + full.x);
 }
 
-// Bilinear over the four nearest low-resolution samples that lie on the same surface (normals
-// and planes agree); where none does, the pixel is recomputed from the cut, one slice per
-// dispatch like the cut pass.
 @compute @workgroup_size(8, 8)
-fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.width || id.y >= shade.height) {
+fn indirect_low(@builtin(global_invocation_id) id: vec3<u32>) {
+    low_sample(id.xy, false);
+}
+
+@compute @workgroup_size(8, 8)
+fn sampled_low(@builtin(global_invocation_id) id: vec3<u32>) {
+    low_sample(id.xy, true);
+}
+
+// Bilinear over the four nearest low-resolution samples that lie on the same surface (normals
+// and planes agree); where none does, the pixel is recomputed at full resolution, one slice per
+// dispatch like the low-resolution pass.
+fn upsample_pixel(pixel: vec2<u32>, sampled: bool) {
+    if (pixel.x >= shade.width || pixel.y >= shade.height) {
         return;
     }
-    let r = receiver(id.xy);
-    let index = pixel_index(id.xy);
+    let r = receiver(pixel);
+    let index = pixel_index(pixel);
     if (!r.covered) {
         add_indirect(index, vec4<f32>(0.0));
         store_counts(index);
         return;
     }
     let k = f32(shade.subsample);
-    let f = (vec2<f32>(id.xy) + 0.5 - vec2<f32>(f32(shade.subsample / 2u) + 0.5)) / k;
+    let f = (vec2<f32>(pixel) + 0.5 - vec2<f32>(f32(shade.subsample / 2u) + 0.5)) / k;
     let base = vec2<i32>(floor(f));
     let t = f - vec2<f32>(base);
     var e = vec3<f32>(0.0);
@@ -120,9 +138,19 @@ fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
             indirect[index] = vec4<f32>(r.albedo / PI * e / weight, 0.0);
         }
     } else {
-        add_indirect(index, vec4<f32>(r.albedo / PI * cut_irradiance(r), 1.0));
+        add_indirect(index, vec4<f32>(r.albedo / PI * gathered_irradiance(r, sampled), 1.0));
     }
     store_counts(index);
+}
+
+@compute @workgroup_size(8, 8)
+fn upsample(@builtin(global_invocation_id) id: vec3<u32>) {
+    upsample_pixel(id.xy, false);
+}
+
+@compute @workgroup_size(8, 8)
+fn sampled_upsample(@builtin(global_invocation_id) id: vec3<u32>) {
+    upsample_pixel(id.xy, true);
 }
 
 // Direct light from the spot, shadowed by the RSM depth.
