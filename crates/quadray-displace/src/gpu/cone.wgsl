@@ -1,19 +1,13 @@
 // Relaxed cone step mapping (Policarpo & Oliveira, GPU Gems 3 ch. 18) on the point-sampled
-// height field, after trace.wgsl (PyramidInfo, TraceHit, outside_map) and in its conventions.
+// height field, after trace.wgsl (PyramidInfo, TraceHit, its addressing) and in its conventions.
 // The cone map (quadray_displace::cone::ConeMap): a texture_2d<f32> (Rg32Float, one mip) of the
-// map's size, r the texel's depth, g its relaxed cone ratio (uv units per unit of depth), read by
-// textureLoad (point sampling) with the map's own width and height.
+// map's size (PyramidInfo.size), r the texel's depth, g its relaxed cone ratio (uv units per unit
+// of depth), read by textureLoad (point sampling) and addressed as the map is.
 
 // The cone map texel under uv p: (depth, cone ratio).
 fn cone_load(cone_map: texture_2d<f32>, info: PyramidInfo, p: vec2f) -> vec2f {
-    let size = vec2i(textureDimensions(cone_map));
-    var t = vec2i(floor(p * vec2f(size)));
-    if info.clamp_to_map == 1u {
-        t = clamp(t, vec2i(0), size - 1);
-    } else {
-        t = ((t % size) + size) % size;
-    }
-    return textureLoad(cone_map, t, 0).rg;
+    let texel = vec2i(floor(p * pyramid_texels(info)));
+    return textureLoad(cone_map, pyramid_address(info, texel), 0).rg;
 }
 
 // At most `cone_steps` steps, each to the edge of the cone of the texel under the ray, until the
