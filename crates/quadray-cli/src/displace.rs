@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::maps::load_color;
@@ -152,6 +153,13 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
     let color = args.color.as_deref().map(load_color).transpose()?;
     let gpu = Gpu::new()?;
     let mut renderer = Renderer::new(&gpu, &map, color.as_ref(), args.surface);
+    if settings.method == Method::Cone {
+        let bar = ProgressBar::new(u64::from(map.height)).with_style(ProgressStyle::with_template(
+            "cone map {bar:40} {pos}/{len} rows {elapsed}, {eta} left",
+        )?);
+        renderer.build_cone_map(&gpu, || bar.inc(1));
+        bar.finish_and_clear();
+    }
     let frame = renderer.render(&gpu, &settings)?;
     frame.color.save_png(&args.out)?;
     let timing = renderer.time(&gpu, &settings, args.frames)?;

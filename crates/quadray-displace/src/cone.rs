@@ -26,6 +26,8 @@ use rayon::prelude::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The ratio stored where no exit bounds the cone (a flat map): a step then reaches the texel's
 /// top, as an unbounded cone would, while every product in the shader stays finite.
@@ -138,6 +140,17 @@ impl Field<'_> {
 impl ConeMap {
     /// The relaxed cone map of `map` for rays that wrap or clamp as `addressing` says.
     pub fn build(map: &HeightMap, addressing: Addressing) -> Self {
+        Self::build_with_progress(map, addressing, || {})
+    }
+
+    /// As [`ConeMap::build`], calling `row_done` (from the build's threads) as each of the
+    /// map's rows is finished, so that a caller can show progress: the build takes seconds at
+    /// 1024^2 and minutes from 4096^2 on a few cores (BENCHMARKS.md).
+    pub fn build_with_progress(
+        map: &HeightMap,
+        addressing: Addressing,
+        row_done: impl Fn() + Sync,
+    ) -> Self {
         let field = Field {
             map,
             addressing,
@@ -166,10 +179,15 @@ impl ConeMap {
         let copies = field.copies();
         let texels = (0..field.height)
             .into_par_iter()
-            .flat_map_iter(|y| (0..field.width).map(move |x| (x, y)))
-            .map(|s| {
-                let ds = field.depth(s.0, s.1);
-                [ds, best_ratio(&field, &pyramid, &copies, s, ds)]
+            .flat_map_iter(|y| {
+                let row: Vec<[f32; 2]> = (0..field.width)
+                    .map(|x| {
+                        let ds = field.depth(x, y);
+                        [ds, best_ratio(&field, &pyramid, &copies, (x, y), ds)]
+                    })
+                    .collect();
+                row_done();
+                row
             })
             .collect();
         Self {
@@ -189,6 +207,52 @@ impl ConeMap {
             wgpu::TextureFormat::Rg32Float,
             bytemuck::cast_slice(&self.texels),
         )
+    }
+}
+
+/// A cone map built on a thread of its own, so that an interactive program keeps drawing while it
+/// builds (quadray's viewer shows its progress).
+pub struct ConeMapJob {
+    rows_done: Arc<AtomicU32>,
+    rows: u32,
+    thread: std::thread::JoinHandle<(ConeMap, f64)>,
+}
+
+impl ConeMapJob {
+    /// Starts building the cone map of `map` for rays addressed as `addressing` says.
+    pub fn spawn(map: HeightMap, addressing: Addressing) -> Self {
+        let rows_done = Arc::new(AtomicU32::new(0));
+        let counter = Arc::clone(&rows_done);
+        let rows = map.height;
+        let thread = std::thread::spawn(move || {
+            let start = std::time::Instant::now();
+            let cones = ConeMap::build_with_progress(&map, addressing, || {
+                counter.fetch_add(1, Ordering::Relaxed);
+            });
+            (cones, start.elapsed().as_secs_f64())
+        });
+        Self {
+            rows_done,
+            rows,
+            thread,
+        }
+    }
+
+    /// The fraction of the map's rows built so far, 0 to 1.
+    pub fn progress(&self) -> f32 {
+        self.rows_done.load(Ordering::Relaxed) as f32 / self.rows as f32
+    }
+
+    /// Whether the build has ended, so that [`ConeMapJob::finish`] returns at once.
+    pub fn is_finished(&self) -> bool {
+        self.thread.is_finished()
+    }
+
+    /// The cone map and the seconds its build took, waiting for the build if it is still on.
+    pub fn finish(self) -> (ConeMap, f64) {
+        self.thread
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     }
 }
 
@@ -334,6 +398,24 @@ mod tests {
         assert_eq!(cones.texels[2 * n], [1.0, 1.5 / 8.0]);
         // On the row itself nothing is above the apex.
         assert_eq!(cones.texels[3 * n], [0.0, UNBOUNDED_RATIO]);
+    }
+
+    #[test]
+    fn a_job_on_its_own_thread_builds_the_same_map_and_counts_every_row() {
+        let map = random_map(24, 9, 11, 3);
+        let job = ConeMapJob::spawn(map.clone(), Addressing::Clamp);
+        while !job.is_finished() {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        assert_eq!(job.progress(), 1.0);
+        let (cones, seconds) = job.finish();
+        assert_eq!(cones, ConeMap::build(&map, Addressing::Clamp));
+        assert!(seconds >= 0.0);
+        let rows = AtomicU32::new(0);
+        ConeMap::build_with_progress(&map, Addressing::Wrap, || {
+            rows.fetch_add(1, Ordering::Relaxed);
+        });
+        assert_eq!(rows.into_inner(), 9);
     }
 
     #[test]

@@ -222,6 +222,9 @@ impl State {
                         displace.gpu_ms.map_or("n/a".into(), |t| format!("{t:.3} ms")),
                         frame_ms
                     ));
+                    if let Some(p) = displace.cone_progress {
+                        ui.label(format!("building the cone map: {:.0}%", p * 100.0));
+                    }
                     if let Some(e) = &displace.error {
                         ui.colored_label(egui::Color32::LIGHT_RED, e);
                     }
@@ -256,7 +259,7 @@ impl State {
                         view.handle_keys(ui, dt);
                     }
                     None => {
-                        if let Some(id) = displace.draw(gpu, egui_renderer, pixels, dt) {
+                        if let Some(id) = displace.draw(gpu, egui_renderer, pixels, dt, scripted) {
                             let image = egui::Image::new(egui::load::SizedTexture::new(id, shown(pixels)));
                             let response = ui.add(image.sense(sense));
                             displace.handle_pointer(&response, ui);
@@ -272,6 +275,9 @@ impl State {
                 };
                 if animating || ui.input(|i| !i.keys_down.is_empty()) {
                     ui.ctx().request_repaint();
+                } else if displace.cone_progress.is_some() {
+                    // poll the cone map's build without redrawing the 3-D view meanwhile
+                    ui.ctx().request_repaint_after(std::time::Duration::from_millis(200));
                 }
             });
         });

@@ -6,6 +6,7 @@ use crate::app::choice_box;
 use crate::{absolute, shell_word};
 use anyhow::Result;
 use quadray_core::image_out::Rgba8Image;
+use quadray_displace::cone::ConeMapJob;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::maps::{BUNDLED, assets_dir, load_color};
 use quadray_displace::scene::{SurfaceKind, View};
@@ -54,6 +55,10 @@ pub struct DisplaceView {
     timer: GpuTimer,
     pub gpu_ms: Option<f64>,
     pub error: Option<String>,
+    /// The cone map being built for the loaded map and surface, off the UI thread.
+    cone_job: Option<(usize, SurfaceKind, ConeMapJob)>,
+    /// How far that build has come, while the cone method waits for it.
+    pub cone_progress: Option<f32>,
 }
 
 impl DisplaceView {
@@ -70,6 +75,8 @@ impl DisplaceView {
             timer: GpuTimer::new(gpu, 1),
             gpu_ms: None,
             error: None,
+            cone_job: None,
+            cone_progress: None,
         }
     }
 
@@ -96,12 +103,15 @@ impl DisplaceView {
     }
 
     /// Draws the frame at `size` pixels into the offscreen target and returns its egui texture.
+    /// A cone map is built on its own thread while the last frame stays up, unless `wait` (a
+    /// scripted run, whose frames must show what was asked).
     pub fn draw(
         &mut self,
         gpu: &Gpu,
         egui_renderer: &mut egui_wgpu::Renderer,
         size: [u32; 2],
         dt: f32,
+        wait: bool,
     ) -> Option<egui::TextureId> {
         let size = [size[0].clamp(16, 4096), size[1].clamp(16, 4096)];
         if self.animate_light {
@@ -155,6 +165,21 @@ impl DisplaceView {
         let result = (|| -> Result<()> {
             let renderer =
                 Self::renderer(&mut self.loaded, &self.maps, self.map, self.surface, gpu)?;
+            self.cone_progress = None;
+            if self.settings.method == Method::Cone && !renderer.has_cone_map() && !wait {
+                let key = (self.map, self.surface);
+                if !matches!(&self.cone_job, Some((m, s, _)) if (*m, *s) == key) {
+                    self.cone_job = Some((key.0, key.1, renderer.cone_map_job()));
+                }
+                let (.., job) = self.cone_job.as_ref().expect("set above");
+                if !job.is_finished() {
+                    self.cone_progress = Some(job.progress());
+                    return Ok(());
+                }
+                let (.., job) = self.cone_job.take().expect("set above");
+                let (cones, seconds) = job.finish();
+                renderer.set_cone_map(gpu, &cones, Some(seconds))?;
+            }
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let view = View::of(self.surface, &self.settings);
             let targets = Targets {

@@ -7,7 +7,7 @@ use super::surface_pass::{
     COLOR_FORMAT, DEPTH_FORMAT, DebugTargets, FETCHES_FORMAT, FrameParams, Geometry, HIT_FORMAT,
     MapParams, MapTextures, SurfacePass, Targets,
 };
-use crate::cone::ConeMap;
+use crate::cone::{ConeMap, ConeMapJob};
 use crate::heightmap::HeightMap;
 use crate::method::Method;
 use crate::pyramid::Addressing;
@@ -43,9 +43,9 @@ pub struct Renderer {
     albedo: wgpu::TextureView,
     point_group: wgpu::BindGroup,
     conservative_group: wgpu::BindGroup,
-    /// Built the first time the cone method draws: the group binding the cone map, and the CPU
-    /// build's seconds.
-    cone: Option<(wgpu::BindGroup, f64)>,
+    /// Built the first time the cone method draws (or handed in): the group binding the cone
+    /// map, and the CPU build's seconds where known.
+    cone: Option<(wgpu::BindGroup, Option<f64>)>,
     triangles: wgpu::Buffer,
     vertex_count: u32,
 }
@@ -144,17 +144,44 @@ impl Renderer {
     /// Seconds the CPU took to build the cone map (the cone method's preprocessing), once a cone
     /// frame was drawn.
     pub fn cone_build_seconds(&self) -> Option<f64> {
-        self.cone.as_ref().map(|(_, seconds)| *seconds)
+        self.cone.as_ref().and_then(|(_, seconds)| *seconds)
     }
 
-    /// Builds the cone map the first time the cone method draws.
-    fn prepare(&mut self, gpu: &Gpu, method: Method) {
-        if method != Method::Cone || self.cone.is_some() {
-            return;
-        }
+    /// Whether the cone method has its cone map (else its first frame builds it).
+    pub fn has_cone_map(&self) -> bool {
+        self.cone.is_some()
+    }
+
+    /// Builds the cone map now, calling `row_done` as each row of the map is finished (see
+    /// [`ConeMap::build_with_progress`]), instead of in the cone method's first frame.
+    pub fn build_cone_map(&mut self, gpu: &Gpu, row_done: impl Fn() + Sync) {
         let start = std::time::Instant::now();
-        let cones = ConeMap::build(&self.map, self.addressing);
+        let cones = ConeMap::build_with_progress(&self.map, self.addressing, row_done);
         let seconds = start.elapsed().as_secs_f64();
+        self.set_cone_map(gpu, &cones, Some(seconds))
+            .expect("built from the renderer's own map");
+    }
+
+    /// A build of this renderer's cone map on a thread of its own; hand its result to
+    /// [`Renderer::set_cone_map`].
+    pub fn cone_map_job(&self) -> ConeMapJob {
+        ConeMapJob::spawn(self.map.clone(), self.addressing)
+    }
+
+    /// Uses `cones` for the cone method from now on (built on another thread, or kept from an
+    /// earlier run); `build_seconds` is what [`Renderer::cone_build_seconds`] reports.
+    pub fn set_cone_map(
+        &mut self,
+        gpu: &Gpu,
+        cones: &ConeMap,
+        build_seconds: Option<f64>,
+    ) -> Result<(), DisplaceError> {
+        if (cones.width, cones.height) != (self.map.width, self.map.height) {
+            return Err(DisplaceError::Settings(format!(
+                "a {}x{} cone map for a {}x{} height map",
+                cones.width, cones.height, self.map.width, self.map.height
+            )));
+        }
         let texture = cones.upload(&gpu.device, &gpu.queue);
         let group = map_group(
             &self.pass,
@@ -165,7 +192,15 @@ impl Renderer {
             &self.gradients,
             &self.albedo,
         );
-        self.cone = Some((group, seconds));
+        self.cone = Some((group, build_seconds));
+        Ok(())
+    }
+
+    /// Builds the cone map the first time the cone method draws.
+    fn prepare(&mut self, gpu: &Gpu, method: Method) {
+        if method == Method::Cone && !self.has_cone_map() {
+            self.build_cone_map(gpu, || {});
+        }
     }
 
     /// Memory the method needs beyond the albedo, in bytes.
