@@ -14,6 +14,10 @@ fn settings(rsm_size: u32) -> Settings {
     }
 }
 
+/// rel_l1 of the per-tile cuts at the default error on the Cornell box (256^2 RSM, 64x64 image):
+/// measured 0.0333 (lavapipe), with a third of margin.
+const TILE_DEFAULT_BOUND: f64 = 0.045;
+
 fn gpu() -> Gpu {
     Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)")
 }
@@ -201,6 +205,92 @@ fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
     }
 }
 
+/// Each tile's cut against the RSM: every lit texel in exactly one of its clusters (also where
+/// a full list stopped the refinement); returns the mean clusters of a lit tile.
+fn check_tile_cuts(r: &Renderer) -> f64 {
+    let size = r.settings().rsm_size;
+    let flux = r.read_rsm_flux().unwrap();
+    let cuts = r.read_tile_cuts().unwrap();
+    let lit: Vec<&Vec<CutNode>> = cuts.iter().filter(|c| !c.is_empty()).collect();
+    assert!(
+        lit.len() > cuts.len() / 2,
+        "{} of {} tiles",
+        lit.len(),
+        cuts.len()
+    );
+    for cut in &lit {
+        let mut cover = vec![0u32; (size * size) as usize];
+        for &CutNode { level, x, y } in cut.iter() {
+            let side = 1 << level;
+            for ty in y * side..(y + 1) * side {
+                for tx in x * side..(x + 1) * side {
+                    cover[(ty * size + tx) as usize] += 1;
+                }
+            }
+        }
+        for (i, &n) in cover.iter().enumerate() {
+            let is_lit = flux[i].iter().any(|&v| v > 0.0);
+            assert!(
+                n <= 1 && (n == 1 || !is_lit),
+                "texel {i} is in {n} clusters"
+            );
+        }
+    }
+    lit.iter().map(|c| c.len()).sum::<usize>() as f64 / lit.len() as f64
+}
+
+#[test]
+fn per_tile_cuts_converge_to_the_brute_force_as_their_error_bound_shrinks() {
+    let gpu = gpu();
+    // 32^2 VPLs: every tile's cut can hold every VPL
+    let mut r = cornell(&gpu, settings(32));
+    let brute = render(&mut r, Method::Reference);
+    let mut errors = Vec::new();
+    for tile_error in [0.1, 0.02, 0.005, 0.0] {
+        let mut r = cornell(
+            &gpu,
+            Settings {
+                tile_error,
+                ..settings(32)
+            },
+        );
+        let frame = r.render_frame(Method::QuadtreeTiles).unwrap();
+        let clusters = check_tile_cuts(&r);
+        assert_eq!(frame.counts.refused_splits, 0, "the tiles' lists had room");
+        let what = format!(
+            "tile error {tile_error}: {clusters:.1} clusters a tile, {:.1} evaluations and {:.1} bounds a pixel",
+            frame.counts.vpl_evaluations_per_pixel(),
+            frame.counts.bound_evaluations_per_pixel()
+        );
+        errors.push(logged_error(&what, &frame.indirect, &brute).rel_l1);
+    }
+    assert!(
+        errors.windows(2).all(|w| w[1] < w[0]),
+        "error falls with the bound: {errors:?}"
+    );
+    // at 0 every node the bound does not rule out is split down to single VPLs: the sum is
+    // the brute force's (in another order)
+    assert!(errors[3] < 1e-5, "{errors:?}");
+}
+
+#[test]
+fn per_tile_cuts_at_the_default_error_stay_within_their_measured_error() {
+    let gpu = gpu();
+    let size = 256;
+    let mut r = cornell(&gpu, settings(size));
+    let brute = render(&mut r, Method::Reference);
+    let frame = r.render_frame(Method::QuadtreeTiles).unwrap();
+    let clusters = check_tile_cuts(&r);
+    let what = format!(
+        "tile error {}: {clusters:.1} clusters a tile, {:.1} evaluations a pixel, {} splits refused",
+        r.settings().tile_error,
+        frame.counts.vpl_evaluations_per_pixel(),
+        frame.counts.refused_splits
+    );
+    let e = logged_error(&what, &frame.indirect, &brute);
+    assert!(e.rel_l1 < TILE_DEFAULT_BOUND, "{e:?}");
+}
+
 #[test]
 fn rsm_sampling_converges_to_the_brute_force() {
     let gpu = gpu();
@@ -280,6 +370,18 @@ fn absurd_settings_are_refused() {
         Settings {
             temporal_weight: f32::NAN,
             ..settings(32)
+        },
+        Settings {
+            tile_error: -0.1,
+            ..settings(32)
+        },
+        Settings {
+            tile_capacity: 2048,
+            ..settings(32)
+        },
+        Settings {
+            tile_capacity: 1024,
+            ..Settings::sized(4096, 4096, 32)
         },
     ] {
         assert!(Renderer::new(&gpu, &scene, bad).is_err());

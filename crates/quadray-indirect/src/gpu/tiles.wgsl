@@ -1,0 +1,220 @@
+// Per-tile cuts (Lightcuts, Walter et al. 2005, with the light quadtree as the light tree and a
+// tile of 8x8 receivers in place of a pixel): one workgroup per tile refines the quadtree level
+// by level from its root, splitting a node while the bound of what it gives any receiver of the
+// tile (bound.wgsl) exceeds `tile_error` of the tile's estimated irradiance (the nodes of level
+// `tile_start` summed at a few of its pixels), down to single VPLs where needed, then every
+// pixel of the tile sums the tile's list.
+
+const TILE_PIXELS: u32 = 64u;
+
+// the tile's receivers: position (w: 1 where covered) and normal
+var<workgroup> tile_x: array<vec4<f32>, 64>;
+var<workgroup> tile_n: array<vec3<f32>, 64>;
+// reductions over the tile's pixels: the receivers' box, their normals (summed, then the least
+// cosine to the mean in w) and the coarse estimate at each quadrant's sample pixel
+var<workgroup> reduce_lo: array<vec3<f32>, 64>;
+var<workgroup> reduce_hi: array<vec3<f32>, 64>;
+var<workgroup> reduce_n: array<vec4<f32>, 64>;
+var<workgroup> reduce_e: array<vec4<f32>, 64>;
+// per 4x4 quadrant of the tile, its first covered pixel (TILE_PIXELS: none): the estimate's
+// sample pixels
+var<workgroup> quadrant_pixel: array<atomic<u32>, 4>;
+// the nodes of the level being refined and of the next (pyramid indices)
+var<workgroup> frontier: array<array<u32, TILE_FRONTIER>, 2>;
+var<workgroup> frontier_len: array<atomic<u32>, 2>;
+var<workgroup> list_len: atomic<u32>;
+// list slots promised: the list's nodes and the frontiers' (a split adds three), so that
+// every node of a frontier can still be listed when the tile's capacity stops refinement
+var<workgroup> reserved: atomic<u32>;
+var<workgroup> refused: atomic<u32>;
+// work of the threads whose pixel lies outside the picture, counted with the tile's first pixel
+var<workgroup> stray: array<atomic<u32>, 3>;
+
+// Stores every thread's counts: those outside the picture's with the tile's first pixel.
+fn store_tile_counts(pixel: vec2<u32>, inside: bool, local: u32) {
+    if (!inside) {
+        atomicAdd(&stray[0], evaluations);
+        atomicAdd(&stray[1], fetches);
+        atomicAdd(&stray[2], bound_evaluations);
+    }
+    workgroupBarrier();
+    if (local == 0u) {
+        evaluations += atomicLoad(&stray[0]);
+        fetches += atomicLoad(&stray[1]);
+        bound_evaluations += atomicLoad(&stray[2]);
+    }
+    if (inside) {
+        store_counts(pixel_index(pixel));
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn indirect_tiles(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(workgroup_id) tile_xy: vec3<u32>,
+) {
+    let inside = id.x < shade.width && id.y < shade.height;
+    var r: Receiver;
+    if (inside) {
+        r = receiver(id.xy);
+    }
+    tile_x[local] = vec4<f32>(r.x, select(0.0, 1.0, r.covered));
+    tile_n[local] = r.n;
+    reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, r.covered);
+    reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, r.covered);
+    reduce_n[local] = select(vec4<f32>(0.0), vec4<f32>(r.n, 1.0), r.covered);
+    if (local < 4u) {
+        atomicStore(&quadrant_pixel[local], TILE_PIXELS);
+    }
+    if (local < 3u) {
+        atomicStore(&stray[local], 0u);
+    }
+    if (local == 0u) {
+        atomicStore(&frontier_len[1], 0u);
+        atomicStore(&list_len, 0u);
+        atomicStore(&refused, 0u);
+    }
+    workgroupBarrier();
+    if (r.covered) {
+        atomicMin(&quadrant_pixel[(local % 8u) / 4u + 2u * (local / 32u)], local);
+    }
+    for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
+        if (local < stride) {
+            reduce_lo[local] = min(reduce_lo[local], reduce_lo[local + stride]);
+            reduce_hi[local] = max(reduce_hi[local], reduce_hi[local + stride]);
+            reduce_n[local] += reduce_n[local + stride];
+        }
+        workgroupBarrier();
+    }
+    let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
+    if (workgroupUniformLoad(&reduce_n[0]).w == 0.0) {
+        // nothing to light
+        if (local == 0u) {
+            tile_sizes[tile] = vec2<u32>(0u);
+        }
+        store_tile_counts(id.xy, inside, local);
+        return;
+    }
+    let box_lo = reduce_lo[0];
+    let box_hi = reduce_hi[0];
+    let sum_n = reduce_n[0].xyz;
+    let axis = select(vec3<f32>(0.0, 0.0, 1.0), normalize(sum_n), length(sum_n) > 0.0);
+    workgroupBarrier();
+    reduce_n[local].w = select(1.0, dot(r.n, axis), r.covered);
+
+    // the coarse estimate: the nodes of level `tile_start` at each quadrant's sample pixel
+    let start = shade.tile_start;
+    let start_side = level_size(params, start);
+    let start_nodes = start_side * start_side;
+    let first = level_offset(params, start);
+    var e = vec4<f32>(0.0);
+    for (var i = local; i < start_nodes; i += TILE_PIXELS) {
+        fetches++;
+        let node = nodes[first + i];
+        if (node.flux.w > 0.5) {
+            for (var q = 0u; q < 4u; q++) {
+                let p = atomicLoad(&quadrant_pixel[q]);
+                if (p < TILE_PIXELS) {
+                    let x = tile_x[p].xyz;
+                    e[q] += luminance(vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, tile_n[p], shade.r_min));
+                }
+            }
+        }
+    }
+    reduce_e[local] = e;
+    // refinement starts from the root, so that far tiles may keep clusters coarser than the
+    // estimate's
+    let root = params.levels - 1u;
+    if (local == 0u) {
+        frontier[0][0] = level_offset(params, root);
+        atomicStore(&frontier_len[0], 1u);
+        atomicStore(&reserved, 1u);
+    }
+    workgroupBarrier();
+    for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
+        if (local < stride) {
+            reduce_e[local] += reduce_e[local + stride];
+            reduce_n[local].w = min(reduce_n[local].w, reduce_n[local + stride].w);
+        }
+        workgroupBarrier();
+    }
+    // the mean of the sample pixels' estimates (their least refined more for as little error)
+    var total = 0.0;
+    var samples = 0.0;
+    for (var q = 0u; q < 4u; q++) {
+        if (atomicLoad(&quadrant_pixel[q]) < TILE_PIXELS) {
+            total += reduce_e[0][q];
+            samples += 1.0;
+        }
+    }
+    total /= samples;
+    let threshold = shade.tile_error * total;
+    let receiver_cos = cos(min(acos(clamp(reduce_n[0].w, -1.0, 1.0)) + CONE_SLACK, PI));
+
+    // refinement, one level a step
+    for (var step = 0u; step <= root; step++) {
+        let level = root - step;
+        let current = step & 1u;
+        let next = current ^ 1u;
+        let count = atomicLoad(&frontier_len[current]);
+        let size = level_size(params, level);
+        let offset = level_offset(params, level);
+        for (var i = local; i < count; i += TILE_PIXELS) {
+            let index = frontier[current][i];
+            fetches++;
+            let node = nodes[index];
+            if (node.flux.w < 0.5) {
+                atomicSub(&reserved, 1u);
+                continue;
+            }
+            var split = false;
+            if (level > 0u) {
+                fetches++;
+                let bound = node_bound(node.flux.rgb, bounds[index], node.normal.xyz, box_lo, box_hi, axis, receiver_cos, shade.r_min);
+                split = bound > threshold;
+            }
+            if (split && atomicAdd(&reserved, 3u) + 3u > shade.tile_capacity) {
+                atomicSub(&reserved, 3u);
+                atomicAdd(&refused, 1u);
+                split = false;
+            }
+            if (split) {
+                let at = index - offset;
+                let xy = vec2<u32>(at % size, at / size);
+                let slot = atomicAdd(&frontier_len[next], 4u);
+                for (var c = 0u; c < 4u; c++) {
+                    let child = xy * 2u + vec2<u32>(c & 1u, c >> 1u);
+                    frontier[next][slot + c] = node_index(params, level - 1u, child);
+                }
+            } else {
+                tile_cuts[tile * shade.tile_capacity + atomicAdd(&list_len, 1u)] = index;
+            }
+        }
+        workgroupBarrier();
+        if (local == 0u) {
+            atomicStore(&frontier_len[current], 0u);
+        }
+        workgroupBarrier();
+    }
+
+    // the gather: every pixel sums the tile's list
+    storageBarrier();
+    let listed = atomicLoad(&list_len);
+    var irradiance = vec3<f32>(0.0);
+    if (r.covered) {
+        let base = tile * shade.tile_capacity;
+        for (var i = 0u; i < listed; i++) {
+            fetches += 2u;
+            irradiance += node_irradiance(nodes[tile_cuts[base + i]], r);
+        }
+    }
+    if (inside) {
+        add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * irradiance, 0.0));
+    }
+    if (local == 0u) {
+        refused_splits = atomicLoad(&refused);
+        tile_sizes[tile] = vec2<u32>(listed, refused_splits);
+    }
+    store_tile_counts(id.xy, inside, local);
+}
