@@ -27,6 +27,16 @@ var<workgroup> list_len: atomic<u32>;
 // every node of a frontier can still be listed when the tile's capacity stops refinement
 var<workgroup> reserved: atomic<u32>;
 var<workgroup> refused: atomic<u32>;
+// a level's verdict on each node of its frontier, four bytes to a word: VERDICT_LIST,
+// VERDICT_EMPTY, or the node wants a split and its bound is over the threshold by a factor of
+// 2^(verdict - 1) or more; how many nodes want a split in each bin; the bin at or below which
+// splits are refused (the one at it split while room is left)
+const VERDICT_LIST: u32 = 0u;
+const VERDICT_EMPTY: u32 = 255u;
+const SPLIT_BINS: u32 = 16u;
+var<workgroup> verdicts: array<atomic<u32>, TILE_FRONTIER / 4u>;
+var<workgroup> split_bins: array<atomic<u32>, SPLIT_BINS>;
+var<workgroup> split_cutoff: u32;
 // work of the threads whose pixel lies outside the picture, counted with the tile's first pixel
 var<workgroup> stray: array<atomic<u32>, 3>;
 
@@ -69,6 +79,12 @@ fn indirect_tiles(
     }
     if (local < 3u) {
         atomicStore(&stray[local], 0u);
+    }
+    if (local < SPLIT_BINS) {
+        atomicStore(&split_bins[local], 0u);
+    }
+    for (var i = local; i < TILE_FRONTIER / 4u; i += TILE_PIXELS) {
+        atomicStore(&verdicts[i], 0u);
     }
     if (local == 0u) {
         atomicStore(&frontier_len[1], 0u);
@@ -152,32 +168,71 @@ fn indirect_tiles(
     let threshold = shade.tile_error * total;
     let receiver_cos = cos(min(acos(clamp(reduce_n[0].w, -1.0, 1.0)) + CONE_SLACK, PI));
 
-    // refinement, one level a step
+    // refinement, one level a step: first every node's verdict (empty, listed, or the bin of
+    // how far its bound exceeds the threshold), then as many splits as the list has room for,
+    // the nodes of the highest bins first (Lightcuts splits the largest bound first)
     for (var step = 0u; step <= root; step++) {
         let level = root - step;
         let current = step & 1u;
         let next = current ^ 1u;
         let count = atomicLoad(&frontier_len[current]);
-        let size = level_size(params, level);
-        let offset = level_offset(params, level);
         for (var i = local; i < count; i += TILE_PIXELS) {
             let index = frontier[current][i];
             fetches++;
             let node = nodes[index];
+            var verdict = VERDICT_LIST;
             if (node.flux.w < 0.5) {
+                verdict = VERDICT_EMPTY;
                 atomicSub(&reserved, 1u);
-                continue;
-            }
-            var split = false;
-            if (level > 0u) {
+            } else if (level > 0u) {
                 fetches++;
                 let bound = node_bound(node.flux.rgb, bounds[index], node.normal.xyz, box_lo, box_hi, axis, receiver_cos, shade.r_min);
-                split = bound > threshold;
+                if (bound > threshold) {
+                    // bins of powers of two of bound / threshold, 1..SPLIT_BINS
+                    let bin = 1u + u32(clamp(floor(log2(bound / threshold)), 0.0, f32(SPLIT_BINS - 1u)));
+                    atomicAdd(&split_bins[bin - 1u], 1u);
+                    verdict = bin;
+                }
             }
-            if (split && atomicAdd(&reserved, 3u) + 3u > shade.tile_capacity) {
-                atomicSub(&reserved, 3u);
+            atomicOr(&verdicts[i / 4u], verdict << (8u * (i % 4u)));
+        }
+        workgroupBarrier();
+        if (local == 0u) {
+            // the bins above the cutoff all fit and have their room reserved here; the cutoff
+            // bin's nodes split while room is left
+            var room = (shade.tile_capacity - atomicLoad(&reserved)) / 3u;
+            var granted = 0u;
+            split_cutoff = 0u;
+            for (var bin = SPLIT_BINS; bin > 0u; bin--) {
+                let wanted = atomicLoad(&split_bins[bin - 1u]);
+                if (wanted > room) {
+                    split_cutoff = bin;
+                    break;
+                }
+                room -= wanted;
+                granted += wanted;
+            }
+            atomicAdd(&reserved, 3u * granted);
+        }
+        workgroupBarrier();
+        let cutoff = split_cutoff;
+        let size = level_size(params, level);
+        let offset = level_offset(params, level);
+        for (var i = local; i < count; i += TILE_PIXELS) {
+            let verdict = (atomicLoad(&verdicts[i / 4u]) >> (8u * (i % 4u))) & 255u;
+            if (verdict == VERDICT_EMPTY) {
+                continue;
+            }
+            let index = frontier[current][i];
+            var split = verdict > cutoff;
+            if (verdict == cutoff && cutoff > 0u) {
+                split = atomicAdd(&reserved, 3u) + 3u <= shade.tile_capacity;
+                if (!split) {
+                    atomicSub(&reserved, 3u);
+                }
+            }
+            if (verdict != VERDICT_LIST && !split) {
                 atomicAdd(&refused, 1u);
-                split = false;
             }
             if (split) {
                 let at = index - offset;
@@ -194,6 +249,12 @@ fn indirect_tiles(
         workgroupBarrier();
         if (local == 0u) {
             atomicStore(&frontier_len[current], 0u);
+        }
+        if (local < SPLIT_BINS) {
+            atomicStore(&split_bins[local], 0u);
+        }
+        for (var i = local; i < TILE_FRONTIER / 4u; i += TILE_PIXELS) {
+            atomicStore(&verdicts[i], 0u);
         }
         workgroupBarrier();
     }
