@@ -33,6 +33,7 @@ pub(crate) fn prelude() -> String {
          const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;\n\
          const MAX_LEVELS: u32 = {MAX_LEVELS}u;\n\
          const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;\n\
+         const TILE: u32 = {TILE}u;\n\
          const PI: f32 = {:?};\n\
          const OUTPUT_INDIRECT: u32 = {}u;\n\
          const OUTPUT_DIRECT: u32 = {}u;\n\
@@ -479,6 +480,7 @@ mod tests {
             format!("const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;"),
             format!("const MAX_LEVELS: u32 = {MAX_LEVELS}u;"),
             format!("const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;"),
+            format!("const TILE: u32 = {TILE}u;"),
         ] {
             assert!(prelude.contains(&line), "{line}");
         }

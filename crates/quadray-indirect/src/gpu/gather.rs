@@ -441,7 +441,9 @@ impl Gather {
                 Method::QuadtreeTiles => {
                     // one workgroup a tile; a list of at most TILE_FRONTIER nodes fits a slice
                     pass.set_pipeline(&self.indirect_tiles);
-                    sliced(&mut pass, 0, 1, w, h);
+                    self.bind(&mut pass, 0, 0);
+                    let (tx, ty) = tiles(s);
+                    pass.dispatch_workgroups(tx, ty, 1);
                 }
                 Method::QuadtreePasses => {
                     pass.set_pipeline(&self.indirect_level);

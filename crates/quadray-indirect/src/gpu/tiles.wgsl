@@ -5,18 +5,19 @@
 // `tile_start` summed at a few of its pixels), down to single VPLs where needed, then every
 // pixel of the tile sums the tile's list.
 
-const TILE_PIXELS: u32 = 64u;
+// TILE (the tile's side) comes from the prelude
+const TILE_PIXELS: u32 = TILE * TILE;
 
 // the tile's receivers: position (w: 1 where covered) and normal
-var<workgroup> tile_x: array<vec4<f32>, 64>;
-var<workgroup> tile_n: array<vec3<f32>, 64>;
+var<workgroup> tile_x: array<vec4<f32>, TILE_PIXELS>;
+var<workgroup> tile_n: array<vec3<f32>, TILE_PIXELS>;
 // reductions over the tile's pixels: the receivers' box, their normals (summed, then the least
 // cosine to the mean in w) and the coarse estimate at each quadrant's sample pixel
-var<workgroup> reduce_lo: array<vec3<f32>, 64>;
-var<workgroup> reduce_hi: array<vec3<f32>, 64>;
-var<workgroup> reduce_n: array<vec4<f32>, 64>;
-var<workgroup> reduce_e: array<vec4<f32>, 64>;
-// per 4x4 quadrant of the tile, its first covered pixel (TILE_PIXELS: none): the estimate's
+var<workgroup> reduce_lo: array<vec3<f32>, TILE_PIXELS>;
+var<workgroup> reduce_hi: array<vec3<f32>, TILE_PIXELS>;
+var<workgroup> reduce_n: array<vec4<f32>, TILE_PIXELS>;
+var<workgroup> reduce_e: array<vec4<f32>, TILE_PIXELS>;
+// per quadrant of the tile, its first covered pixel (TILE_PIXELS: none): the estimate's
 // sample pixels
 var<workgroup> quadrant_pixel: array<atomic<u32>, 4>;
 // the nodes of the level being refined and of the next (pyramid indices)
@@ -58,7 +59,7 @@ fn store_tile_counts(pixel: vec2<u32>, inside: bool, local: u32) {
     }
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(TILE, TILE)
 fn indirect_tiles(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
@@ -93,7 +94,7 @@ fn indirect_tiles(
     }
     workgroupBarrier();
     if (r.covered) {
-        atomicMin(&quadrant_pixel[(local % 8u) / 4u + 2u * (local / 32u)], local);
+        atomicMin(&quadrant_pixel[(local % TILE) / (TILE / 2u) + 2u * (local / (TILE_PIXELS / 2u))], local);
     }
     for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
         if (local < stride) {
