@@ -112,9 +112,9 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
 
     // per-tile cuts, per tile that sees geometry: the coarse estimate (every node of the start
     // level read, the non-empty ones evaluated at each 4x4 quadrant's first covered pixel), the
-    // refinement from the root (every node visited read; a bound, read and evaluated, for the
-    // non-empty ones above level 0, which are listed or split, the split ones' four children
-    // visited) and the gather (each covered pixel reads and sums the tile's list)
+    // refinement from the root (every node visited read; a bound record read and evaluated
+    // against both groups of receivers for the non-empty ones above level 0, which are listed or
+    // split, the split ones' four children visited) and the gather (each covered pixel reads and sums the tile's list)
     let tiles = counted(&mut r, Method::QuadtreeTiles);
     let cuts = r.read_tile_cuts().unwrap();
     let start = c.start_level;
@@ -151,7 +151,8 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
         let split = split.len() as u64;
         let listed = cut.len() as u64;
         let listed_above_0 = cut.iter().filter(|n| n.level > 0).count() as u64;
-        bounds += listed_above_0 + split;
+        // a bound for each of the tile's two groups of receivers
+        bounds += 2 * (listed_above_0 + split);
         evaluations += lit_start * quadrants + pixels_lit * listed;
         fetches +=
             start_nodes + (1 + 4 * split) + (listed_above_0 + split) + 2 * pixels_lit * listed;

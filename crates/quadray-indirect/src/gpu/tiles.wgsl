@@ -113,12 +113,40 @@ fn indirect_tiles(
         store_tile_counts(id.xy, inside, local);
         return;
     }
-    let box_lo = reduce_lo[0];
-    let box_hi = reduce_hi[0];
-    let sum_n = reduce_n[0].xyz;
-    let axis = select(vec3<f32>(0.0, 0.0, 1.0), normalize(sum_n), length(sum_n) > 0.0);
+    // two groups of receivers, the tile's box halved across its longest side: a tile on a
+    // depth discontinuity (an edge in front of a far wall) gets two boxes without the gap
+    // between them, and a node's bound is the larger of the two groups'
+    let extent = reduce_hi[0] - reduce_lo[0];
+    let split_axis = select(select(2u, 1u, extent.y >= extent.z), 0u, extent.x >= max(extent.y, extent.z));
+    let middle = 0.5 * (reduce_lo[0][split_axis] + reduce_hi[0][split_axis]);
+    let group = select(0u, 1u, r.x[split_axis] >= middle);
+    var group_lo: array<vec3<f32>, 2>;
+    var group_hi: array<vec3<f32>, 2>;
+    var group_axis: array<vec3<f32>, 2>;
+    for (var g = 0u; g < 2u; g++) {
+        workgroupBarrier();
+        let member = r.covered && group == g;
+        reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, member);
+        reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, member);
+        reduce_n[local] = select(vec4<f32>(0.0), vec4<f32>(r.n, 1.0), member);
+        workgroupBarrier();
+        for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
+            if (local < stride) {
+                reduce_lo[local] = min(reduce_lo[local], reduce_lo[local + stride]);
+                reduce_hi[local] = max(reduce_hi[local], reduce_hi[local + stride]);
+                reduce_n[local] += reduce_n[local + stride];
+            }
+            workgroupBarrier();
+        }
+        group_lo[g] = reduce_lo[0];
+        group_hi[g] = reduce_hi[0];
+        let sum_n = reduce_n[0].xyz;
+        group_axis[g] = select(vec3<f32>(0.0, 0.0, 1.0), normalize(sum_n), length(sum_n) > 0.0);
+    }
     workgroupBarrier();
-    reduce_n[local].w = select(1.0, dot(r.n, axis), r.covered);
+    // each group's least cosine to its axis (x: group 0, y: group 1)
+    let cos_own = select(1.0, dot(r.n, group_axis[group]), r.covered);
+    reduce_n[local] = vec4<f32>(select(1.0, cos_own, group == 0u), select(1.0, cos_own, group == 1u), 0.0, 0.0);
 
     // the coarse estimate: the nodes of level `tile_start` at each quadrant's sample pixel
     let start = shade.tile_start;
@@ -152,7 +180,7 @@ fn indirect_tiles(
     for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
         if (local < stride) {
             reduce_e[local] += reduce_e[local + stride];
-            reduce_n[local].w = min(reduce_n[local].w, reduce_n[local + stride].w);
+            reduce_n[local] = min(reduce_n[local], reduce_n[local + stride]);
         }
         workgroupBarrier();
     }
@@ -167,7 +195,8 @@ fn indirect_tiles(
     }
     total /= samples;
     let threshold = shade.tile_error * total;
-    let receiver_cos = cos(min(acos(clamp(reduce_n[0].w, -1.0, 1.0)) + CONE_SLACK, PI));
+    let least_cos = reduce_n[0].xy;
+    let group_cos = cos(min(acos(clamp(least_cos, vec2<f32>(-1.0), vec2<f32>(1.0))) + CONE_SLACK, vec2<f32>(PI)));
 
     // refinement, one level a step: first every node's verdict (empty, listed, or the bin of
     // how far its bound exceeds the threshold), then as many splits as the list has room for,
@@ -187,7 +216,11 @@ fn indirect_tiles(
                 atomicSub(&reserved, 1u);
             } else if (level > 0u) {
                 fetches++;
-                let bound = node_bound(node.flux.rgb, bounds[index], node.normal.xyz, box_lo, box_hi, axis, receiver_cos, shade.r_min);
+                let b = bounds[index];
+                let bound = max(
+                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[0], group_hi[0], group_axis[0], group_cos.x, shade.r_min),
+                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[1], group_hi[1], group_axis[1], group_cos.y, shade.r_min),
+                );
                 if (bound > threshold) {
                     // bins of powers of two of bound / threshold, 1..SPLIT_BINS
                     let bin = 1u + u32(clamp(floor(log2(bound / threshold)), 0.0, f32(SPLIT_BINS - 1u)));
