@@ -1,18 +1,19 @@
 // Per-tile cuts (Lightcuts, Walter et al. 2005, with the light quadtree as the light tree and a
 // tile of 8x8 receivers in place of a pixel): one workgroup per tile refines the quadtree level
 // by level from its root, splitting a node while the bound of what it gives any receiver of the
-// tile (bound.wgsl) exceeds `tile_error` of the tile's estimated irradiance (the nodes of level
-// `tile_start` summed at a few of its pixels), down to single VPLs where needed, then every
-// pixel of the tile sums the tile's list.
+// tile (bound.wgsl, against each half of the tile's receivers) exceeds `tile_error` of the tile's
+// estimated irradiance (the nodes of level `tile_start` summed at a few of its pixels), down to
+// single VPLs where needed, then every pixel of the tile sums the tile's list.
 
 // TILE (the tile's side) comes from the prelude
 const TILE_PIXELS: u32 = TILE * TILE;
 
-// the tile's receivers: position (w: 1 where covered) and normal
-var<workgroup> tile_x: array<vec4<f32>, TILE_PIXELS>;
+// the tile's receivers: position and normal
+var<workgroup> tile_x: array<vec3<f32>, TILE_PIXELS>;
 var<workgroup> tile_n: array<vec3<f32>, TILE_PIXELS>;
-// reductions over the tile's pixels: the receivers' box, their normals (summed, then the least
-// cosine to the mean in w) and the coarse estimate at each quadrant's sample pixel
+// reductions over the tile's pixels: the receivers' box and normals (summed; w: how many), of
+// the tile then of each half, each half's least cosine to its mean normal (x, y of reduce_n),
+// and the coarse estimate at each quadrant's sample pixel
 var<workgroup> reduce_lo: array<vec3<f32>, TILE_PIXELS>;
 var<workgroup> reduce_hi: array<vec3<f32>, TILE_PIXELS>;
 var<workgroup> reduce_n: array<vec4<f32>, TILE_PIXELS>;
@@ -70,7 +71,7 @@ fn indirect_tiles(
     if (inside) {
         r = receiver(id.xy);
     }
-    tile_x[local] = vec4<f32>(r.x, select(0.0, 1.0, r.covered));
+    tile_x[local] = r.x;
     tile_n[local] = r.n;
     reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, r.covered);
     reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, r.covered);
@@ -161,8 +162,7 @@ fn indirect_tiles(
             for (var q = 0u; q < 4u; q++) {
                 let p = atomicLoad(&quadrant_pixel[q]);
                 if (p < TILE_PIXELS) {
-                    let x = tile_x[p].xyz;
-                    e[q] += luminance(vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, tile_n[p], shade.r_min));
+                    e[q] += luminance(vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], shade.r_min));
                 }
             }
         }
