@@ -539,6 +539,52 @@ fn quadtree_nodes_match_a_cpu_rebuild() {
     }
 }
 
+#[test]
+fn node_bounds_hold_exactly_the_vpls_of_their_nodes() {
+    let gpu = gpu();
+    let size = 32u32;
+    let mut r = cornell(&gpu, settings(size));
+    r.render(Method::QuadtreeTiles, true, false).unwrap();
+    let nodes = r.read_nodes().unwrap();
+    let bounds = r.read_node_bounds().unwrap();
+    let (mut offset, mut narrow) = (0usize, 0);
+    for level in 0..=size.ilog2() {
+        let side = size >> level;
+        for i in 0..side * side {
+            let (x, y) = (i % side, i / side);
+            let node = nodes[offset + i as usize];
+            let [lo, hi] = bounds[offset + i as usize];
+            // the node's VPLs: the level-0 texels under it that see geometry
+            let mut box_lo = [f32::MAX; 3];
+            let mut box_hi = [f32::MIN; 3];
+            let mut least_cos = 1.0f32;
+            for ty in y << level..(y + 1) << level {
+                for tx in x << level..(x + 1) << level {
+                    let vpl = nodes[(ty * size + tx) as usize];
+                    if vpl[0][3] < 0.5 {
+                        continue;
+                    }
+                    for c in 0..3 {
+                        box_lo[c] = box_lo[c].min(vpl[1][c]);
+                        box_hi[c] = box_hi[c].max(vpl[1][c]);
+                    }
+                    least_cos = least_cos.min((0..3).map(|c| vpl[2][c] * node[2][c]).sum());
+                }
+            }
+            if node[0][3] < 0.5 {
+                assert!((0..3).all(|c| lo[c] > hi[c]), "empty node {level} {x},{y}");
+                continue;
+            }
+            assert_eq!((&lo[..3], &hi[..3]), (&box_lo[..], &box_hi[..]));
+            // the cone holds every VPL normal (less f32's rounding), and is not the sphere
+            assert!(lo[3] <= least_cos + 1e-5, "{} > {least_cos}", lo[3]);
+            narrow += usize::from(level > 0 && lo[3] > 0.9);
+        }
+        offset += (side * side) as usize;
+    }
+    assert!(narrow > 100, "{narrow} narrow cones above level 0");
+}
+
 /// The RSM's VPLs carry the flux the spot sends into its cone: with every ray of the cone landing
 /// on the floor, sum(flux / albedo) = integral of I(w) over the sphere (texel solid angles
 /// shrink as cos^3 off the axis).

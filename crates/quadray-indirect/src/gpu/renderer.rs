@@ -328,6 +328,14 @@ impl<'g> Renderer<'g> {
         Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
     }
 
+    /// What bounds each node's contribution, as built: the box of its VPLs' positions (lo,
+    /// hi; empty nodes hold lo > hi) with the cosine of its normal cone's half-angle in lo's w
+    /// (the cone's axis is the node's mean normal), finest level first.
+    pub fn read_node_bounds(&self) -> Result<Vec<[[f32; 4]; 2]>, IndirectError> {
+        let flat = self.read_vec4(self.quadtree.bounds())?;
+        Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+    }
+
     /// The xyz of three same-sized textures per texel, `None` where the w of `textures[coverage]`
     /// marks the texel empty.
     fn read_covered(
