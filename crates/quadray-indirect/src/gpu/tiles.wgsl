@@ -293,15 +293,21 @@ fn indirect_tiles(
         workgroupBarrier();
     }
 
-    // the gather: every pixel sums the tile's list
+    // the gather: the list copied once into workgroup memory (the frontier's, free now), then
+    // every pixel sums its nodes
     storageBarrier();
     let listed = atomicLoad(&list_len);
+    let base = tile * shade.tile_capacity;
+    for (var i = local; i < listed; i += TILE_PIXELS) {
+        fetches++;
+        frontier[0][i] = tile_cuts[base + i];
+    }
+    workgroupBarrier();
     var irradiance = vec3<f32>(0.0);
     if (r.covered) {
-        let base = tile * shade.tile_capacity;
         for (var i = 0u; i < listed; i++) {
-            fetches += 2u;
-            irradiance += node_irradiance(nodes[tile_cuts[base + i]], r);
+            fetches++;
+            irradiance += node_irradiance(nodes[frontier[0][i]], r);
         }
     }
     if (inside) {
