@@ -70,7 +70,7 @@ pub struct IndirectArgs {
     tile_error: f32,
     /// quadtree-tiles: the most clusters a tile's cut holds (1..1024; past it refinement
     /// stops, counted as refused_splits); default: 1024, less where the picture's lists would
-    /// take over 128 MiB.
+    /// take over 32 MiB (256 at 1920x1080).
     #[arg(long)]
     tile_capacity: Option<u32>,
     /// Image size WxH.

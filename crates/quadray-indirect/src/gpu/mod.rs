@@ -219,7 +219,9 @@ pub struct Settings {
     pub tile_error: f32,
     /// Per-tile cuts: the most nodes a tile's cut may hold (1..=1024); past it refinement stops
     /// (counted in [`WorkCounts::refused_splits`]). The lists take 4 bytes a node and tile of
-    /// GPU memory, at most 128 MiB.
+    /// GPU memory, allocated by every [`Gather`] whatever the method, at most
+    /// [`Self::MAX_TILE_LIST_BYTES`] ([`Self::tile_capacity_for`] keeps the default within
+    /// [`Self::DEFAULT_TILE_LIST_BYTES`]); set 1 where the per-tile cuts are never drawn.
     pub tile_capacity: u32,
 }
 
@@ -258,13 +260,24 @@ impl Settings {
     /// Bytes the per-tile cuts' lists may take, a storage buffer every adapter binds.
     pub const MAX_TILE_LIST_BYTES: u64 = 128 << 20;
 
+    /// Bytes the per-tile cuts' lists take by default at most: every [`Gather`] allocates them,
+    /// whatever the method. A large picture's tiles cover less of the scene and need fewer
+    /// clusters (BENCHMARKS.md, "Per-tile cuts").
+    pub const DEFAULT_TILE_LIST_BYTES: u64 = 32 << 20;
+
     /// The default [`Settings::tile_capacity`] of a `width` x `height` picture: the largest
     /// power of two up to [`Self::MAX_TILE_CAPACITY`] whose lists fit
-    /// [`Self::MAX_TILE_LIST_BYTES`].
+    /// [`Self::DEFAULT_TILE_LIST_BYTES`] (1,024 up to 512x512, 256 at 1920x1080).
     pub fn tile_capacity_for(width: u32, height: u32) -> u32 {
+        Self::tile_capacity_within(width, height, Self::DEFAULT_TILE_LIST_BYTES)
+    }
+
+    /// The largest power of two up to [`Self::MAX_TILE_CAPACITY`] whose lists for a `width` x
+    /// `height` picture fit `bytes` (at least 1).
+    fn tile_capacity_within(width: u32, height: u32, bytes: u64) -> u32 {
         let tiles =
             u64::from(width.div_ceil(contract::TILE)) * u64::from(height.div_ceil(contract::TILE));
-        let fits = Self::MAX_TILE_LIST_BYTES / 4 / tiles.max(1);
+        let fits = bytes / 4 / tiles.max(1);
         let capacity = u64::from(Self::MAX_TILE_CAPACITY).min(fits).max(1);
         1 << capacity.ilog2()
     }
@@ -354,7 +367,7 @@ impl Settings {
                 s.height,
                 bytes >> 20,
                 Self::MAX_TILE_LIST_BYTES >> 20,
-                Self::tile_capacity_for(s.width, s.height),
+                Self::tile_capacity_within(s.width, s.height, Self::MAX_TILE_LIST_BYTES),
             ));
         }
         Ok(())
