@@ -14,8 +14,9 @@ pub struct IndirectArgs {
     /// Scene file: TOML, or glTF 2.0 (.gltf, .glb); default: the bundled Cornell box.
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// quadtree (compacted cut), quadtree-passes (the paper's per-level passes), rsm (RSM
-    /// sampling) or reference (every VPL).
+    /// quadtree (compacted cut), quadtree-passes (the paper's per-level passes), quadtree-tiles
+    /// (a cut per 8x8 tile, refined where a cluster's bound exceeds --tile-error of the
+    /// tile's light), rsm (RSM sampling) or reference (every VPL).
     #[arg(long, default_value = "quadtree")]
     method: Method,
     /// Side of the reflective shadow map (power of two).
@@ -63,6 +64,15 @@ pub struct IndirectArgs {
     /// reprojected: it restarts when the camera moves.
     #[arg(long, default_value_t = Settings::default().temporal_weight)]
     temporal_weight: f32,
+    /// quadtree-tiles: split a cluster while a bound of its irradiance at any pixel of the tile
+    /// exceeds this fraction of the tile's estimated irradiance (0: every VPL).
+    #[arg(long, default_value_t = Settings::TILE_ERROR)]
+    tile_error: f32,
+    /// quadtree-tiles: the most clusters a tile's cut holds (1..1024; past it refinement
+    /// stops, counted as refused_splits); default: 1024, less where the picture's lists would
+    /// take over 32 MiB (256 at 1920x1080).
+    #[arg(long)]
+    tile_capacity: Option<u32>,
     /// Image size WxH.
     #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
     size: (u32, u32),
@@ -150,6 +160,10 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         },
         shadow_thickness: args.shadow_thickness,
         temporal_weight: args.temporal_weight,
+        tile_error: args.tile_error,
+        tile_capacity: args
+            .tile_capacity
+            .unwrap_or(Settings::tile_capacity_for(args.size.0, args.size.1)),
         ..Settings::default()
     };
     if let Some(degrees) = args.light_orbit {

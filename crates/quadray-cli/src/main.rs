@@ -89,6 +89,9 @@ enum Bench {
         /// fetches and time, on every bundled scene (image side 128, quick 64).
         #[arg(long)]
         equal_error: bool,
+        /// With --equal-error: only this bundled scene (file stem, e.g. cornell; repeatable).
+        #[arg(long = "scene")]
+        scenes: Vec<String>,
         #[arg(long, default_value = "out/bench/indirect")]
         out: PathBuf,
     },
@@ -178,12 +181,13 @@ fn main() -> Result<()> {
                     size,
                     rsm_size,
                     equal_error,
+                    scenes,
                     out,
                 },
         } => {
             if equal_error {
                 let options = quadray_bench::indirect::equal_error::EqualErrorOptions::new(
-                    quick, size, rsm_size,
+                    quick, size, rsm_size, scenes,
                 );
                 indirect::bench_equal_error(&options, &out)?
             } else {

@@ -70,12 +70,51 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
 }
 
 #[test]
+fn per_tile_cuts_report_their_bounds_and_clusters() {
+    let dir = scratch("indirect-tiles");
+    let out = dir.join("tiles.png");
+    let stats = dir.join("tiles.json");
+    quadray_writes(
+        &[
+            "indirect",
+            "--method",
+            "quadtree-tiles",
+            "--tile-error",
+            "0.1",
+            "--rsm-size",
+            "32",
+            "--size",
+            "40x24",
+            "--frames",
+            "1",
+            "--reference",
+        ],
+        &out,
+        &stats,
+    );
+    let json = read_json(&stats);
+    assert_eq!(json["method"], "quadtree-tiles");
+    assert_eq!(json["settings"]["tile_error"].as_f64(), Some(0.1));
+    let clusters = json["clusters_per_tile"].as_f64().unwrap();
+    let evaluations = json["vpl_evaluations_per_pixel"].as_f64().unwrap();
+    // every pixel sums its tile's list, plus its share of the tile's coarse estimate
+    assert!(
+        clusters > 4.0 && evaluations >= clusters,
+        "{clusters} {evaluations}"
+    );
+    assert!(json["bound_evaluations_per_pixel"].as_f64().unwrap() > 0.0);
+    assert_eq!(json["work"]["refused_splits"], 0);
+    let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
+    assert!(rel_l1 > 0.0 && rel_l1 < 0.05, "{rel_l1}");
+}
+
+#[test]
 fn bad_scenes_and_parameters_are_refused_with_a_reason() {
     let dir = scratch("indirect-bad");
     let out = dir.join("x.png");
     let scene = dir.join("bad.toml");
     std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();
-    let cases: [(Vec<&str>, &str); 7] = [
+    let cases: [(Vec<&str>, &str); 9] = [
         (vec!["--scene", scene.to_str().unwrap()], "bad.toml"),
         (vec!["--scene", "/nonexistent/scene.toml"], "scene.toml"),
         (vec!["--rsm-size", "100"], "power of two"),
@@ -86,6 +125,8 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
             vec!["--light-direction", "0,0,0"],
             "light direction is zero",
         ),
+        (vec!["--tile-capacity", "0"], "tile capacity 0"),
+        (vec!["--tile-error=-1"], "tile error -1"),
     ];
     for (extra, needle) in cases {
         let mut args = vec![

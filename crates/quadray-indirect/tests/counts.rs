@@ -25,13 +25,16 @@ fn settings() -> Settings {
     }
 }
 
+/// A node's index in the pyramid (finest level first).
+fn node_index(level: u32, x: u32, y: u32) -> usize {
+    let offset: u32 = (0..level).map(|l| (RSM >> l).pow(2)).sum();
+    (offset + y * (RSM >> level) + x) as usize
+}
+
 /// The top-down cut rule of `cut_rule.wgsl` over the nodes read back, with the node records it
 /// reads: (in the cut, reads).
 fn in_cut(nodes: &[[[f32; 4]; 3]], c: &ClusterSettings, level: u32, x: u32, y: u32) -> (bool, u64) {
-    let index = |level: u32, x: u32, y: u32| {
-        let offset: u32 = (0..level).map(|l| (RSM >> l).pow(2)).sum();
-        (offset + y * (RSM >> level) + x) as usize
-    };
+    let index = node_index;
     let mut reads = 1;
     let mut accepted = |level: u32, x: u32, y: u32| {
         if level == c.limit_level {
@@ -74,6 +77,8 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
         shaded_pixels: shaded as u32,
         vpl_evaluations: evaluations,
         texel_fetches: fetches,
+        bound_evaluations: 0,
+        refused_splits: 0,
     };
 
     // the cut: every shaded pixel sums every cluster, reading its record
@@ -103,6 +108,66 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     assert_eq!(
         reference,
         expect(shaded * vpls, 3 * pixels + shaded * (rsm_texels + 2 * vpls))
+    );
+
+    // per-tile cuts, per tile that sees geometry: the coarse estimate (every node of the start
+    // level read, the non-empty ones evaluated at each 4x4 quadrant's first covered pixel), the
+    // refinement from the root (every node visited read; a bound record read and evaluated
+    // against both groups of receivers for the non-empty ones above level 0, which are listed or
+    // split, the split ones' four children visited) and the gather (the list read once into
+    // workgroup memory, then each covered pixel reads and sums its nodes)
+    let tiles = counted(&mut r, Method::QuadtreeTiles);
+    let cuts = r.read_tile_cuts().unwrap();
+    let start = c.start_level;
+    let root = RSM.ilog2();
+    let start_nodes = u64::from((RSM >> start).pow(2));
+    let lit_start = (0..start_nodes as u32)
+        .filter(|&i| {
+            let side = RSM >> start;
+            nodes[node_index(start, i % side, i / side)][0][3] > 0.5
+        })
+        .count() as u64;
+    let (mut evaluations, mut fetches, mut bounds) = (0, 3 * pixels, 0);
+    let tiles_x = s.width.div_ceil(8);
+    for (tile, cut) in cuts.iter().enumerate() {
+        let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
+        let covered = |lx: u32, ly: u32| {
+            let (x, y) = (tx * 8 + lx, ty * 8 + ly);
+            x < s.width && y < s.height && receivers[(y * s.width + x) as usize].is_some()
+        };
+        let pixels_lit = (0..64).filter(|i| covered(i % 8, i / 8)).count() as u64;
+        if pixels_lit == 0 {
+            assert!(cut.is_empty());
+            continue;
+        }
+        let quadrants = (0..4)
+            .filter(|q| (0..16).any(|i| covered(q % 2 * 4 + i % 4, q / 2 * 4 + i / 4)))
+            .count() as u64;
+        let split: std::collections::BTreeSet<(u32, u32, u32)> = cut
+            .iter()
+            .flat_map(|n| {
+                (n.level + 1..=root).map(move |a| (a, n.x >> (a - n.level), n.y >> (a - n.level)))
+            })
+            .collect();
+        let split = split.len() as u64;
+        let listed = cut.len() as u64;
+        let listed_above_0 = cut.iter().filter(|n| n.level > 0).count() as u64;
+        // a bound for each of the tile's two groups of receivers
+        bounds += 2 * (listed_above_0 + split);
+        evaluations += lit_start * quadrants + pixels_lit * listed;
+        fetches +=
+            start_nodes + (1 + 4 * split) + (listed_above_0 + split) + listed + pixels_lit * listed;
+    }
+    println!("per-tile cuts: {tiles:?}");
+    assert_eq!(tiles.refused_splits, 0);
+    assert!(bounds > 0 && tiles.vpl_evaluations > 0);
+    assert_eq!(
+        (
+            tiles.vpl_evaluations,
+            tiles.texel_fetches,
+            tiles.bound_evaluations
+        ),
+        (evaluations, fetches, bounds)
     );
 
     // RSM sampling: the shader's disk around each receiver's projection, in f32 as there

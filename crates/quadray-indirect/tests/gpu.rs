@@ -14,6 +14,10 @@ fn settings(rsm_size: u32) -> Settings {
     }
 }
 
+/// rel_l1 of the per-tile cuts at the default error on the Cornell box (256^2 RSM, 64x64 image):
+/// measured 0.0304 (lavapipe), with 48% of margin.
+const TILE_DEFAULT_BOUND: f64 = 0.045;
+
 fn gpu() -> Gpu {
     Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)")
 }
@@ -201,6 +205,123 @@ fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
     }
 }
 
+/// Each tile's cut against the RSM: every lit texel in exactly one of its clusters (also where
+/// a full list stopped the refinement); returns the mean clusters of a lit tile.
+fn check_tile_cuts(r: &Renderer) -> f64 {
+    let size = r.settings().rsm_size;
+    let flux = r.read_rsm_flux().unwrap();
+    let cuts = r.read_tile_cuts().unwrap();
+    let lit: Vec<&Vec<CutNode>> = cuts.iter().filter(|c| !c.is_empty()).collect();
+    assert!(
+        lit.len() > cuts.len() / 2,
+        "{} of {} tiles",
+        lit.len(),
+        cuts.len()
+    );
+    for cut in &lit {
+        let mut cover = vec![0u32; (size * size) as usize];
+        for &CutNode { level, x, y } in cut.iter() {
+            let side = 1 << level;
+            for ty in y * side..(y + 1) * side {
+                for tx in x * side..(x + 1) * side {
+                    cover[(ty * size + tx) as usize] += 1;
+                }
+            }
+        }
+        for (i, &n) in cover.iter().enumerate() {
+            let is_lit = flux[i].iter().any(|&v| v > 0.0);
+            assert!(
+                n <= 1 && (n == 1 || !is_lit),
+                "texel {i} is in {n} clusters"
+            );
+        }
+    }
+    lit.iter().map(|c| c.len()).sum::<usize>() as f64 / lit.len() as f64
+}
+
+#[test]
+fn per_tile_cuts_converge_to_the_brute_force_as_their_error_bound_shrinks() {
+    let gpu = gpu();
+    // 32^2 VPLs: every tile's cut can hold every VPL
+    let mut r = cornell(&gpu, settings(32));
+    let brute = render(&mut r, Method::Reference);
+    let mut errors = Vec::new();
+    for tile_error in [0.1, 0.02, 0.005, 0.0] {
+        let mut r = cornell(
+            &gpu,
+            Settings {
+                tile_error,
+                ..settings(32)
+            },
+        );
+        let frame = r.render_frame(Method::QuadtreeTiles).unwrap();
+        let clusters = check_tile_cuts(&r);
+        assert_eq!(frame.counts.refused_splits, 0, "the tiles' lists had room");
+        let what = format!(
+            "tile error {tile_error}: {clusters:.1} clusters a tile, {:.1} evaluations and {:.1} bounds a pixel",
+            frame.counts.vpl_evaluations_per_pixel(),
+            frame.counts.bound_evaluations_per_pixel()
+        );
+        errors.push(logged_error(&what, &frame.indirect, &brute).rel_l1);
+    }
+    assert!(
+        errors.windows(2).all(|w| w[1] < w[0]),
+        "error falls with the bound: {errors:?}"
+    );
+    // at 0 every node the bound does not rule out is split down to single VPLs: the sum is
+    // the brute force's (in another order)
+    assert!(errors[3] < 1e-5, "{errors:?}");
+}
+
+#[test]
+fn a_full_tile_list_stops_refinement_and_keeps_every_vpl() {
+    let gpu = gpu();
+    let capacity = 16;
+    let mut r = cornell(
+        &gpu,
+        Settings {
+            tile_error: 0.0,
+            tile_capacity: capacity,
+            ..settings(32)
+        },
+    );
+    let frame = r.render_frame(Method::QuadtreeTiles).unwrap();
+    let clusters = check_tile_cuts(&r);
+    let most = r
+        .read_tile_cuts()
+        .unwrap()
+        .iter()
+        .map(Vec::len)
+        .max()
+        .unwrap();
+    println!(
+        "capacity {capacity}: {clusters:.1} clusters a tile, {} splits refused",
+        frame.counts.refused_splits
+    );
+    // a split takes three more slots: a full list has fewer than three left
+    let capacity = capacity as usize;
+    assert!(most <= capacity && most + 3 > capacity, "{most}");
+    assert!(frame.counts.refused_splits > 0);
+}
+
+#[test]
+fn per_tile_cuts_at_the_default_error_stay_within_their_measured_error() {
+    let gpu = gpu();
+    let size = 256;
+    let mut r = cornell(&gpu, settings(size));
+    let brute = render(&mut r, Method::Reference);
+    let frame = r.render_frame(Method::QuadtreeTiles).unwrap();
+    let clusters = check_tile_cuts(&r);
+    let what = format!(
+        "tile error {}: {clusters:.1} clusters a tile, {:.1} evaluations a pixel, {} splits refused",
+        r.settings().tile_error,
+        frame.counts.vpl_evaluations_per_pixel(),
+        frame.counts.refused_splits
+    );
+    let e = logged_error(&what, &frame.indirect, &brute);
+    assert!(e.rel_l1 < TILE_DEFAULT_BOUND, "{e:?}");
+}
+
 #[test]
 fn rsm_sampling_converges_to_the_brute_force() {
     let gpu = gpu();
@@ -280,6 +401,18 @@ fn absurd_settings_are_refused() {
         Settings {
             temporal_weight: f32::NAN,
             ..settings(32)
+        },
+        Settings {
+            tile_error: -0.1,
+            ..settings(32)
+        },
+        Settings {
+            tile_capacity: 2048,
+            ..settings(32)
+        },
+        Settings {
+            tile_capacity: 1024,
+            ..Settings::sized(4096, 4096, 32)
         },
     ] {
         assert!(Renderer::new(&gpu, &scene, bad).is_err());
@@ -404,6 +537,52 @@ fn quadtree_nodes_match_a_cpu_rebuild() {
         }
         assert!(valid_above_zero > 10, "some clusters are valid");
     }
+}
+
+#[test]
+fn node_bounds_hold_exactly_the_vpls_of_their_nodes() {
+    let gpu = gpu();
+    let size = 32u32;
+    let mut r = cornell(&gpu, settings(size));
+    r.render(Method::QuadtreeTiles, true, false).unwrap();
+    let nodes = r.read_nodes().unwrap();
+    let bounds = r.read_node_bounds().unwrap();
+    let (mut offset, mut narrow) = (0usize, 0);
+    for level in 0..=size.ilog2() {
+        let side = size >> level;
+        for i in 0..side * side {
+            let (x, y) = (i % side, i / side);
+            let node = nodes[offset + i as usize];
+            let [lo, hi] = bounds[offset + i as usize];
+            // the node's VPLs: the level-0 texels under it that see geometry
+            let mut box_lo = [f32::MAX; 3];
+            let mut box_hi = [f32::MIN; 3];
+            let mut least_cos = 1.0f32;
+            for ty in y << level..(y + 1) << level {
+                for tx in x << level..(x + 1) << level {
+                    let vpl = nodes[(ty * size + tx) as usize];
+                    if vpl[0][3] < 0.5 {
+                        continue;
+                    }
+                    for c in 0..3 {
+                        box_lo[c] = box_lo[c].min(vpl[1][c]);
+                        box_hi[c] = box_hi[c].max(vpl[1][c]);
+                    }
+                    least_cos = least_cos.min((0..3).map(|c| vpl[2][c] * node[2][c]).sum());
+                }
+            }
+            if node[0][3] < 0.5 {
+                assert!((0..3).all(|c| lo[c] > hi[c]), "empty node {level} {x},{y}");
+                continue;
+            }
+            assert_eq!((&lo[..3], &hi[..3]), (&box_lo[..], &box_hi[..]));
+            // the cone holds every VPL normal (less f32's rounding), and is not the sphere
+            assert!(lo[3] <= least_cos + 1e-5, "{} > {least_cos}", lo[3]);
+            narrow += usize::from(level > 0 && lo[3] > 0.9);
+        }
+        offset += (side * side) as usize;
+    }
+    assert!(narrow > 100, "{narrow} narrow cones above level 0");
 }
 
 /// The RSM's VPLs carry the flux the spot sends into its cone: with every ray of the cone landing

@@ -188,6 +188,9 @@ impl IndirectView {
     ) -> Option<(egui::TextureId, [u32; 2])> {
         self.settings.width = size[0].clamp(16, 4096);
         self.settings.height = size[1].clamp(16, 4096);
+        // the per-tile cuts' lists grow with the picture: keep them within their buffer
+        self.settings.tile_capacity =
+            Settings::tile_capacity_for(self.settings.width, self.settings.height);
         if self.animate_light
             && let Some((_, _, pose)) = &mut self.loaded
         {
@@ -416,6 +419,11 @@ impl IndirectView {
                 .text("RSM samples"),
         );
         ui.add(egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling"));
+        ui.add(
+            egui::Slider::new(&mut s.tile_error, 0.005..=1.0)
+                .logarithmic(true)
+                .text("tile error (quadtree-tiles)"),
+        );
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
         let mut shadows = s.shadow_steps > 0;

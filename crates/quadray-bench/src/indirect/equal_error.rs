@@ -2,7 +2,8 @@
 //! error, in the work counts the shaders report (VPL evaluations and texel fetches per shaded
 //! pixel, the same on any hardware) and in GPU time, on every bundled scene of the technique at
 //! several RSM sizes. The quadtree runs at full resolution and sub-sampled (one gather per
-//! `k`^2 pixels, geometry-aware upsampling, recomputed pixels counted). RSM sampling is swept
+//! `k`^2 pixels, geometry-aware upsampling, recomputed pixels counted), and with a cut per tile
+//! (at full resolution, at several error fractions). RSM sampling is swept
 //! over sample counts at full resolution (the paper's baseline) and, as the fair extra row, at
 //! each sub-sampling the quadtree uses; its cost at the quadtree's error is interpolated log-log
 //! between the two counts whose errors bracket it.
@@ -27,6 +28,8 @@ const SCENES: [&str; 5] = [
 ];
 /// The quadtree's sub-samplings (1: full resolution), each also RSM sampling's.
 const SUBSAMPLES: [u32; 4] = [1, 2, 4, 8];
+/// Error fractions of the per-tile cuts compared (full resolution).
+const TILE_ERRORS: [f32; 5] = [1.0, 0.5, 0.2, 0.05, 0.02];
 /// RSM sample counts swept, up to where sampling reaches the quadtree's error.
 const SAMPLES: [u32; 10] = [16, 64, 216, 512, 1024, 2040, 4096, 8192, 16384, 32768];
 
@@ -38,11 +41,13 @@ pub struct EqualErrorOptions {
     pub rsm_sizes: Vec<u32>,
     /// Timed frames per median (0: counts and errors only).
     pub frames: u32,
+    /// The scenes' file stems to run (empty: every bundled scene).
+    pub scenes: Vec<String>,
 }
 
 impl EqualErrorOptions {
     /// The setting: 128x128 images, 256^2 and 512^2 RSMs; quick: 64x64 and 64^2.
-    pub fn new(quick: bool, size: Option<u32>, rsm_size: Option<u32>) -> Self {
+    pub fn new(quick: bool, size: Option<u32>, rsm_size: Option<u32>, scenes: Vec<String>) -> Self {
         let rsm_sizes = match (rsm_size, quick) {
             (Some(s), _) => vec![s],
             (None, true) => vec![64],
@@ -52,6 +57,7 @@ impl EqualErrorOptions {
             size: size.unwrap_or(if quick { 64 } else { 128 }),
             rsm_sizes,
             frames: if quick { 2 } else { 5 },
+            scenes,
         }
     }
 }
@@ -59,7 +65,7 @@ impl EqualErrorOptions {
 /// One method at one setting: its error and its cost.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
-    /// The method's setting ("default", "paper", "N samples").
+    /// The method's setting ("default", "paper", "tiles E", "N samples").
     pub label: String,
     /// One gather per `subsample`^2 pixels (1: full resolution).
     pub subsample: u32,
@@ -69,6 +75,8 @@ pub struct Point {
     pub vpl_evaluations_per_pixel: f64,
     /// Texels and node records read per shaded pixel.
     pub texel_fetches_per_pixel: f64,
+    /// Bounds of a cluster's contribution to a tile evaluated per shaded pixel (per-tile cuts).
+    pub bound_evaluations_per_pixel: f64,
     /// Median GPU time of a frame with a static light (ms), when timestamps exist.
     pub static_ms: Option<f64>,
 }
@@ -151,6 +159,7 @@ fn measure(
         rel_l1: compare(&frame.indirect, brute).rel_l1,
         vpl_evaluations_per_pixel: frame.counts.vpl_evaluations_per_pixel(),
         texel_fetches_per_pixel: frame.counts.texel_fetches_per_pixel(),
+        bound_evaluations_per_pixel: frame.counts.bound_evaluations_per_pixel(),
         static_ms: timing.map(|t| t.total_ms),
     })
 }
@@ -225,6 +234,25 @@ fn scene_result(
             )?);
         }
     }
+    for tile_error in TILE_ERRORS {
+        progress(&format!("{name}: per-tile cuts, error {tile_error}"));
+        let mut r = Renderer::new(
+            gpu,
+            scene,
+            Settings {
+                tile_error,
+                ..base.clone()
+            },
+        )?;
+        let label = format!("tiles {tile_error}");
+        quadtree.push(measure(
+            &mut r,
+            Method::QuadtreeTiles,
+            label,
+            &brute,
+            frames,
+        )?);
+    }
     let mut rsm: Vec<Point> = Vec::new();
     for subsample in SUBSAMPLES {
         // past the best error of the quadtree settings compared with this sweep there is
@@ -277,7 +305,20 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<EqualErrorResults, IndirectError> {
     let mut scenes = Vec::new();
-    for file in SCENES {
+    let chosen = |file: &str| {
+        let stem = file.trim_end_matches(".toml");
+        options.scenes.is_empty() || options.scenes.iter().any(|s| s == stem)
+    };
+    if let Some(unknown) = options.scenes.iter().find(|s| {
+        !SCENES
+            .iter()
+            .any(|f| f.trim_end_matches(".toml") == s.as_str())
+    }) {
+        return Err(IndirectError::Settings(format!(
+            "no bundled scene `{unknown}` (cornell, cornell_bunny, cornell_buddha, atrium, leak)"
+        )));
+    }
+    for file in SCENES.into_iter().filter(|f| chosen(f)) {
         let scene = Scene::load(&scenes_dir().join(file))?;
         for &rsm_size in &options.rsm_sizes {
             let base = Settings::sized(options.size, options.size, rsm_size);
@@ -317,6 +358,7 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             "subsample",
             "rel L1",
             "evals/px",
+            "bounds/px",
             "fetches/px",
             "ms",
             "RSM samples at that error",
@@ -341,6 +383,7 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
                 q.subsample.to_string(),
                 format!("{:.4}", q.rel_l1),
                 format!("{:.1}", q.vpl_evaluations_per_pixel),
+                format!("{:.1}", q.bound_evaluations_per_pixel),
                 format!("{:.0}", q.texel_fetches_per_pixel),
                 fixed(q.static_ms, 2),
                 fixed(full.rsm_samples, 0),

@@ -47,6 +47,10 @@ pub struct Stats {
     pub vpl_evaluations_per_pixel: f64,
     /// G-buffer and RSM texels, node records and low-resolution samples read per shaded pixel.
     pub texel_fetches_per_pixel: f64,
+    /// Bounds of a cluster's contribution to a tile evaluated per shaded pixel (quadtree-tiles).
+    pub bound_evaluations_per_pixel: f64,
+    /// Mean clusters of a tile's cut over the tiles that see geometry (quadtree-tiles).
+    pub clusters_per_tile: Option<f64>,
     /// The totals the two means come from.
     pub work: WorkCounts,
     /// The light moves: RSM, pyramid, validity and cut rebuilt every frame.
@@ -145,6 +149,13 @@ pub fn run(
     let moving = renderer.time(method, true, options.frames)?;
     let still = renderer.time(method, false, options.frames)?;
     let frame = renderer.render_frame(method)?;
+    let clusters_per_tile = if method == Method::QuadtreeTiles {
+        let cuts = renderer.read_tile_cuts()?;
+        let lit: Vec<usize> = cuts.iter().map(Vec::len).filter(|&n| n > 0).collect();
+        Some(lit.iter().sum::<usize>() as f64 / lit.len().max(1) as f64)
+    } else {
+        None
+    };
     let s = renderer.settings().clone();
     let (w, h) = (s.width, s.height);
     let combined = frame.combined();
@@ -194,6 +205,8 @@ pub fn run(
             recomputed_pixels: frame.recomputed,
             vpl_evaluations_per_pixel: frame.counts.vpl_evaluations_per_pixel(),
             texel_fetches_per_pixel: frame.counts.texel_fetches_per_pixel(),
+            bound_evaluations_per_pixel: frame.counts.bound_evaluations_per_pixel(),
+            clusters_per_tile,
             work: frame.counts,
             gpu_time_ms_moving: moving,
             gpu_time_ms_static: still,

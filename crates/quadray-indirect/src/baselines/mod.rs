@@ -9,10 +9,11 @@ pub const WGSL: &str = include_str!("baselines.wgsl");
 pub const SAMPLE_SEED: u64 = 0x5eed;
 
 /// A small deterministic generator (SplitMix64), so every run samples the same pattern.
-struct SplitMix(u64);
+pub(crate) struct SplitMix(pub(crate) u64);
 
 impl SplitMix {
-    fn next_f32(&mut self) -> f32 {
+    /// Uniform in [0, 1).
+    pub(crate) fn next_f32(&mut self) -> f32 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);

@@ -11,6 +11,8 @@
 // holds the node's index (bit pattern) instead of its validity
 @group(0) @binding(5) var<storage, read_write> cut: array<Node>;
 @group(0) @binding(6) var<storage, read_write> cut_count: atomic<u32>;
+// per node, what bounds its contribution (reduced with the means, read by the per-tile cuts)
+@group(0) @binding(7) var<storage, read_write> bounds: array<NodeBounds>;
 // Group 1, per dispatch: the level (a dynamic offset into slots 0, 1, 2, ...).
 @group(1) @binding(0) var<uniform> current: Level;
 
@@ -25,16 +27,18 @@ fn pack(@builtin(global_invocation_id) id: vec3<u32>) {
     node.flux = vec4<f32>(textureLoad(rsm_flux, t, 0).rgb, n.w);
     node.pos = textureLoad(rsm_pos, t, 0);
     node.normal = vec4<f32>(n.xyz, 1.0);
-    nodes[node_index(params, 0u, id.xy)] = node;
+    let index = node_index(params, 0u, id.xy);
+    nodes[index] = node;
+    // a VPL: a box and a cone of zero size; an empty texel: an empty box
+    let empty = n.w < 0.5;
+    let lo = select(node.pos.xyz, vec3<f32>(EMPTY_BOX), empty);
+    let hi = select(node.pos.xyz, vec3<f32>(-EMPTY_BOX), empty);
+    bounds[index] = NodeBounds(vec4<f32>(lo, 1.0), vec4<f32>(hi, 0.0));
 }
 
 // Index of child `c` (x in bit 0, y in bit 1) of node `xy` of `level`.
 fn child_index(level: u32, xy: vec2<u32>, c: u32) -> u32 {
     return node_index(params, level - 1u, xy * 2u + vec2<u32>(c & 1u, c >> 1u));
-}
-
-fn luminance(c: vec3<f32>) -> f32 {
-    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
 
 // One level from the one below: sums of flux and texel counts, weighted means of position, depth
@@ -73,7 +77,27 @@ fn reduce(@builtin(global_invocation_id) id: vec3<u32>) {
     node.pos = select(vec4<f32>(0.0), pos / weight, weight > 0.0);
     let len = length(normal);
     node.normal = vec4<f32>(select(vec3<f32>(0.0), normal / len, len > 0.0), 0.0);
-    nodes[node_index(params, level, id.xy)] = node;
+    let index = node_index(params, level, id.xy);
+    nodes[index] = node;
+    // the children's boxes joined; the cone around the mean normal that holds the children's
+    // cones: its half-angle is the widest child's angle from the axis plus the child's own
+    var lo = vec3<f32>(EMPTY_BOX);
+    var hi = vec3<f32>(-EMPTY_BOX);
+    var angle = 0.0;
+    for (var c = 0u; c < 4u; c++) {
+        let at = child_index(level, id.xy, c);
+        if (nodes[at].flux.w > 0.5) {
+            let child = bounds[at];
+            lo = min(lo, child.lo.xyz);
+            hi = max(hi, child.hi.xyz);
+            let axis = nodes[at].normal.xyz;
+            let apart = acos(clamp(dot(axis, node.normal.xyz), -1.0, 1.0));
+            angle = max(angle, apart + acos(clamp(child.lo.w, -1.0, 1.0)));
+        }
+    }
+    // (no mean direction: the cone is the whole sphere)
+    let cone = select(cos(min(angle + CONE_SLACK, PI)), -1.0, len <= 0.0);
+    bounds[index] = NodeBounds(vec4<f32>(lo, cone), vec4<f32>(hi, 0.0));
 }
 
 // Valid when every non-empty child is close to the mean in depth and direction (the paper's local

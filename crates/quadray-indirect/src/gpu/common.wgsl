@@ -10,12 +10,28 @@
 // samples). The shading passes store them per pixel; elsewhere they are dropped.
 var<private> evaluations: u32;
 var<private> fetches: u32;
+// Upper bounds of a node's contribution evaluated (per-tile cuts).
+var<private> bound_evaluations: u32;
 
 struct Node {
     flux: vec4<f32>,
     pos: vec4<f32>,
     normal: vec4<f32>,
 }
+
+// What bounds a node's contribution (per-tile cuts): the box of its VPLs' positions and a cone
+// holding their normals (axis: the node's mean normal). Empty nodes hold an empty box (lo > hi).
+//   lo.xyz, hi.xyz: the box's corners; lo.w: cosine of the normal cone's half-angle
+struct NodeBounds {
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+}
+
+// An empty box's lo (its hi is the negative): any box joined with it is that box.
+const EMPTY_BOX: f32 = 1e30;
+// Widens a normal cone's half-angle (radians) past f32's rounding in acos near 1, so that the
+// cone still holds every VPL normal.
+const CONE_SLACK: f32 = 1e-3;
 
 struct ClusterParams {
     rsm_size: u32,
@@ -50,6 +66,10 @@ fn level_offset(p: ClusterParams, level: u32) -> u32 {
 
 fn node_index(p: ClusterParams, level: u32, xy: vec2<u32>) -> u32 {
     return level_offset(p, level) + xy.y * level_size(p, level) + xy.x;
+}
+
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
 
 // Irradiance at x (normal n) from a VPL or cluster of flux `flux` at xp (normal np), with the

@@ -17,6 +17,11 @@ pub(crate) const SLICE: u32 = 32768;
 pub(crate) const LEVEL_SLICE: u32 = 2048;
 /// Bound on the pyramid's levels (a 1024^2 RSM has 11).
 pub(crate) const MAX_LEVELS: u32 = 16;
+/// Nodes a tile's frontier holds in workgroup memory (per-tile cuts, two levels of it): the
+/// most a tile's list may hold ([`super::Settings::tile_capacity`]).
+pub(crate) const TILE_FRONTIER: u32 = 1024;
+/// Side of a tile of receivers that shares one per-tile cut (the gather's workgroup).
+pub(crate) const TILE: u32 = 8;
 /// Slice uniform slots: enough for level 0 of a 1024^2 RSM in level slices, the longest sum.
 pub(crate) const MAX_SLICES: u32 = 1024 * 1024 / LEVEL_SLICE;
 
@@ -27,6 +32,8 @@ pub(crate) fn prelude() -> String {
          const SLICE: u32 = {SLICE}u;\n\
          const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;\n\
          const MAX_LEVELS: u32 = {MAX_LEVELS}u;\n\
+         const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;\n\
+         const TILE: u32 = {TILE}u;\n\
          const PI: f32 = {:?};\n\
          const OUTPUT_INDIRECT: u32 = {}u;\n\
          const OUTPUT_DIRECT: u32 = {}u;\n\
@@ -106,6 +113,10 @@ pub(crate) struct ShadeUniform {
     pub shadow_steps: u32,
     pub shadow_thickness: f32,
     pub temporal_weight: f32,
+    pub tile_error: f32,
+    pub tile_capacity: u32,
+    pub tile_start: u32,
+    pub tiles_x: u32,
     /// Up to the camera's 16-byte alignment.
     pub _pad: [u32; 3],
     /// Written by `Gather::set_camera`, the fields before by `Gather::set_light`.
@@ -127,6 +138,14 @@ pub(crate) struct GpuNode {
     pub flux: [f32; 4],
     pub pos: [f32; 4],
     pub normal: [f32; 4],
+}
+
+/// WGSL `NodeBounds`: a node's box of VPL positions and normal cone (see common.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub(crate) struct GpuNodeBounds {
+    pub lo: [f32; 4],
+    pub hi: [f32; 4],
 }
 
 fn min_size<T>() -> Option<wgpu::BufferSize> {
@@ -411,12 +430,17 @@ mod tests {
                     shadow_steps,
                     shadow_thickness,
                     temporal_weight,
+                    tile_error,
+                    tile_capacity,
+                    tile_start,
+                    tiles_x,
                     camera,
                     eye
                 ]
             ),
             shared!("Level", LevelSlot, [level]),
             shared!("Node", GpuNode, [flux, pos, normal]),
+            shared!("NodeBounds", GpuNodeBounds, [lo, hi]),
         ];
         let mut seen = std::collections::BTreeSet::new();
         for (name, parts) in crate::gpu::shaders() {
@@ -455,6 +479,8 @@ mod tests {
             format!("const SLICE: u32 = {SLICE}u;"),
             format!("const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;"),
             format!("const MAX_LEVELS: u32 = {MAX_LEVELS}u;"),
+            format!("const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;"),
+            format!("const TILE: u32 = {TILE}u;"),
         ] {
             assert!(prelude.contains(&line), "{line}");
         }

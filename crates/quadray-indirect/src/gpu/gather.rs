@@ -5,13 +5,13 @@
 //! [`super::OutputPass`] copies into the caller's texture.
 
 use super::contract::{
-    ClusterUniform, GpuNode, LEVEL_SLICE, LevelSlot, LightUniform, MAX_SLICES, SLICE, ShadeUniform,
-    Slots, bind_group, compute_pass, compute_pipeline, dispatch_2d, layout, pipeline_layout,
-    shader_module, slices, storage_buffer, storage_entry, tex, texture_entry, uniform_buffer,
-    uniform_entry, whole,
+    ClusterUniform, GpuNode, GpuNodeBounds, LEVEL_SLICE, LevelSlot, LightUniform, MAX_SLICES,
+    SLICE, ShadeUniform, Slots, TILE, bind_group, compute_pass, compute_pipeline, dispatch_2d,
+    layout, pipeline_layout, shader_module, slices, storage_buffer, storage_entry, tex,
+    texture_entry, uniform_buffer, uniform_entry, whole,
 };
 use super::light::Spot;
-use super::quadtree::{COMMON_WGSL, CUT_RULE_WGSL, LightQuadtree};
+use super::quadtree::{BOUND_WGSL, COMMON_WGSL, CUT_RULE_WGSL, LightQuadtree};
 use super::rsm::{LIGHT_WGSL, RsmViews};
 use super::{Method, Settings};
 use crate::{IndirectError, baselines};
@@ -20,12 +20,14 @@ use std::cell::Cell;
 use wgpu::util::DeviceExt;
 
 /// The gather's shader, in order.
-pub(crate) const SOURCES: [&str; 6] = [
+pub(crate) const SOURCES: [&str; 8] = [
     COMMON_WGSL,
     LIGHT_WGSL,
     include_str!("shade_bindings.wgsl"),
     CUT_RULE_WGSL,
     include_str!("shade.wgsl"),
+    BOUND_WGSL,
+    include_str!("tiles.wgsl"),
     baselines::WGSL,
 ];
 
@@ -52,6 +54,26 @@ fn low_size(s: &Settings) -> (u32, u32) {
     )
 }
 
+/// Tiles of [`TILE`]^2 pixels across and down the picture (per-tile cuts).
+pub(crate) fn tiles(s: &Settings) -> (u32, u32) {
+    (s.width.div_ceil(TILE), s.height.div_ceil(TILE))
+}
+
+/// Bytes the per-tile cuts' lists take ([`Settings::tile_capacity`] node indices a tile).
+pub(crate) fn tile_list_bytes(s: &Settings) -> u64 {
+    let (tx, ty) = tiles(s);
+    u64::from(tx) * u64::from(ty) * u64::from(s.tile_capacity) * 4
+}
+
+/// The level whose nodes make a tile's coarse estimate of its irradiance (per-tile cuts): the
+/// quadtree's start level, or a coarser one where its nodes would outnumber a tile's list.
+pub(crate) fn tile_start_level(s: &Settings) -> u32 {
+    let top = s.rsm_size.ilog2();
+    (s.cluster.start_level..top)
+        .find(|&level| (s.rsm_size >> level).pow(2) <= s.tile_capacity)
+        .unwrap_or(top)
+}
+
 /// The per-frame buffers: sizes, radiance out, RSM samples, work counts.
 struct Outputs {
     shade: wgpu::Buffer,
@@ -59,10 +81,15 @@ struct Outputs {
     direct: wgpu::Buffer,
     low: wgpu::Buffer,
     samples: wgpu::Buffer,
-    /// Per pixel: VPL evaluations and texel fetches of the last indirect passes (two `u32`).
+    /// Per pixel: VPL evaluations, texel fetches, bound evaluations and refused splits of the
+    /// last indirect passes (four `u32`).
     counts: wgpu::Buffer,
     /// The temporal filter's running average of the indirect light (one texel without it).
     history: wgpu::Buffer,
+    /// Per tile, the per-tile cut's node indices (`tile_capacity` slots a tile).
+    tile_cuts: wgpu::Buffer,
+    /// Per tile, the nodes its list holds and the splits refused for want of room (two `u32`).
+    tile_sizes: wgpu::Buffer,
 }
 
 impl Outputs {
@@ -87,6 +114,8 @@ impl Outputs {
                 whole(&self.samples),
                 whole(&self.counts),
                 whole(&self.history),
+                whole(&self.tile_cuts),
+                whole(&self.tile_sizes),
             ],
         )
     }
@@ -96,6 +125,7 @@ impl Outputs {
 pub struct Gather {
     settings: Settings,
     indirect_cut: wgpu::ComputePipeline,
+    indirect_tiles: wgpu::ComputePipeline,
     indirect_level: wgpu::ComputePipeline,
     indirect_low: wgpu::ComputePipeline,
     upsample: wgpu::ComputePipeline,
@@ -148,6 +178,7 @@ impl Gather {
                 storage_entry::<GpuNode>(5, true),
                 storage_entry::<GpuNode>(6, true),
                 storage_entry::<u32>(7, true),
+                storage_entry::<GpuNodeBounds>(8, true),
             ],
         );
         let frame_layout = layout(
@@ -162,8 +193,10 @@ impl Gather {
                 storage_entry::<[f32; 4]>(5, false),
                 storage_entry::<[f32; 4]>(6, false),
                 storage_entry::<[f32; 4]>(7, true),
-                storage_entry::<[u32; 2]>(8, false),
+                storage_entry::<[u32; 4]>(8, false),
                 storage_entry::<[f32; 4]>(9, false),
+                storage_entry::<u32>(10, false),
+                storage_entry::<[u32; 2]>(11, false),
             ],
         );
         let dispatch_layout = layout(
@@ -179,6 +212,8 @@ impl Gather {
         let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry);
         let pixels = u64::from(s.width) * u64::from(s.height);
         let (lw, lh) = low_size(s);
+        let (tx, ty) = tiles(s);
+        let tile_count = u64::from(tx) * u64::from(ty);
         let samples = baselines::rsm_samples(
             s.samples,
             s.rsm_radius * s.rsm_size as f32 * std::f32::consts::SQRT_2,
@@ -195,7 +230,7 @@ impl Gather {
                 contents: bytemuck::cast_slice(&samples),
                 usage: wgpu::BufferUsages::STORAGE,
             }),
-            counts: storage_buffer(device, "work counts", pixels * 8),
+            counts: storage_buffer(device, "work counts", pixels * 16),
             history: storage_buffer(
                 device,
                 "indirect history",
@@ -205,11 +240,14 @@ impl Gather {
                     0
                 },
             ),
+            tile_cuts: storage_buffer(device, "per-tile cuts", tile_list_bytes(s)),
+            tile_sizes: storage_buffer(device, "per-tile cut sizes", tile_count * 8),
         };
         let slots = Slots::new(device, "gather slots", MAX_SLICES);
         Ok(Self {
             settings: s.clone(),
             indirect_cut: pipeline("indirect_cut"),
+            indirect_tiles: pipeline("indirect_tiles"),
             indirect_level: pipeline("indirect_level"),
             indirect_low: pipeline("indirect_low"),
             upsample: pipeline("upsample"),
@@ -257,6 +295,7 @@ impl Gather {
                 whole(quadtree.nodes()),
                 whole(quadtree.cut()),
                 whole(quadtree.cut_count()),
+                whole(quadtree.bounds()),
             ],
         )
     }
@@ -301,6 +340,10 @@ impl Gather {
                 shadow_steps: s.shadow_steps,
                 shadow_thickness: s.shadow_thickness * spot.extent,
                 temporal_weight: s.temporal_weight,
+                tile_error: s.tile_error,
+                tile_capacity: s.tile_capacity,
+                tile_start: tile_start_level(s),
+                tiles_x: tiles(s).0,
                 _pad: [0; 3],
                 camera: [[0.0; 4]; 4],
                 eye: [0.0; 4],
@@ -395,6 +438,13 @@ impl Gather {
                     pass.set_pipeline(&self.indirect_cut);
                     sliced(&mut pass, 0, cut_slices, w, h);
                 }
+                Method::QuadtreeTiles => {
+                    // one workgroup a tile; a list of at most TILE_FRONTIER nodes fits a slice
+                    pass.set_pipeline(&self.indirect_tiles);
+                    self.bind(&mut pass, 0, 0);
+                    let (tx, ty) = tiles(s);
+                    pass.dispatch_workgroups(tx, ty, 1);
+                }
                 Method::QuadtreePasses => {
                     pass.set_pipeline(&self.indirect_level);
                     for level in (c.limit_level..=c.start_level).rev() {
@@ -481,8 +531,19 @@ impl Gather {
         &self.outputs.direct
     }
 
-    /// Per pixel, the last indirect passes' VPL evaluations and texel fetches (`[u32; 2]`).
+    /// Per pixel, the last indirect passes' VPL evaluations, texel fetches, bound evaluations and
+    /// refused splits (`[u32; 4]`).
     pub(crate) fn counts(&self) -> &wgpu::Buffer {
         &self.outputs.counts
+    }
+
+    /// Per tile, the last per-tile cuts' node indices (`tile_capacity` `u32` slots a tile).
+    pub(crate) fn tile_cuts(&self) -> &wgpu::Buffer {
+        &self.outputs.tile_cuts
+    }
+
+    /// Per tile, its list's length and its refused splits (`[u32; 2]`).
+    pub(crate) fn tile_sizes(&self) -> &wgpu::Buffer {
+        &self.outputs.tile_sizes
     }
 }

@@ -48,6 +48,11 @@ pub enum Method {
     Quadtree,
     /// Light quadtree, the paper's one pass per level.
     QuadtreePasses,
+    /// Light quadtree, a cut per tile of 8x8 pixels refined where a bound of a cluster's
+    /// contribution to the tile exceeds [`Settings::tile_error`] of the tile's irradiance
+    /// (Lightcuts with the quadtree as light tree); the validity rule and limit level are not
+    /// used.
+    QuadtreeTiles,
     /// RSM sampling with N Poisson-disk samples (baseline).
     Rsm,
     /// Every VPL (brute force on the GPU).
@@ -56,9 +61,10 @@ pub enum Method {
 
 impl Method {
     /// Every method, in the order the CLI and the benchmark list them.
-    pub const ALL: [Method; 4] = [
+    pub const ALL: [Method; 5] = [
         Method::Quadtree,
         Method::QuadtreePasses,
+        Method::QuadtreeTiles,
         Method::Rsm,
         Method::Reference,
     ];
@@ -68,6 +74,7 @@ impl Method {
         match self {
             Method::Quadtree => "quadtree",
             Method::QuadtreePasses => "quadtree-passes",
+            Method::QuadtreeTiles => "quadtree-tiles",
             Method::Rsm => "rsm",
             Method::Reference => "reference",
         }
@@ -79,10 +86,15 @@ impl Method {
         matches!(self, Method::Quadtree | Method::Rsm)
     }
 
-    /// Whether the method builds the light quadtree and a cut (so a cluster count means
+    /// Whether the method uses the one cut of the light quadtree (so a cluster count means
     /// something for it).
     pub fn uses_quadtree(self) -> bool {
         matches!(self, Method::Quadtree | Method::QuadtreePasses)
+    }
+
+    /// Whether the method reads the light quadtree (one cut, or a cut per tile).
+    pub fn builds_quadtree(self) -> bool {
+        self.uses_quadtree() || self == Method::QuadtreeTiles
     }
 }
 
@@ -201,6 +213,16 @@ pub struct Settings {
     /// (see BENCHMARKS.md); the average is not reprojected, so it restarts whenever the camera,
     /// the method or the cluster settings change.
     pub temporal_weight: f32,
+    /// Per-tile cuts ([`Method::QuadtreeTiles`]): a node is split while an upper bound of its
+    /// irradiance at any pixel of the tile exceeds this fraction of the tile's estimated
+    /// irradiance (0: every VPL on its own).
+    pub tile_error: f32,
+    /// Per-tile cuts: the most nodes a tile's cut may hold (1..=1024); past it refinement stops
+    /// (counted in [`WorkCounts::refused_splits`]). The lists take 4 bytes a node and tile of
+    /// GPU memory, allocated by every [`Gather`] whatever the method, at most
+    /// [`Self::MAX_TILE_LIST_BYTES`] ([`Self::tile_capacity_for`] keeps the default within
+    /// [`Self::DEFAULT_TILE_LIST_BYTES`]); set 1 where the per-tile cuts are never drawn.
+    pub tile_capacity: u32,
 }
 
 impl Default for Settings {
@@ -224,7 +246,40 @@ impl Settings {
             shadow_steps: 0,
             shadow_thickness: 0.1,
             temporal_weight: 1.0,
+            tile_error: Self::TILE_ERROR,
+            tile_capacity: Self::tile_capacity_for(width, height),
         }
+    }
+
+    /// The default [`Settings::tile_error`] (see BENCHMARKS.md, "Per-tile cuts").
+    pub const TILE_ERROR: f32 = 0.05;
+
+    /// The largest [`Settings::tile_capacity`], what a tile's frontier holds in workgroup memory.
+    pub const MAX_TILE_CAPACITY: u32 = contract::TILE_FRONTIER;
+
+    /// Bytes the per-tile cuts' lists may take, a storage buffer every adapter binds.
+    pub const MAX_TILE_LIST_BYTES: u64 = 128 << 20;
+
+    /// Bytes the per-tile cuts' lists take by default at most: every [`Gather`] allocates them,
+    /// whatever the method. A large picture's tiles cover less of the scene and need fewer
+    /// clusters (BENCHMARKS.md, "Per-tile cuts").
+    pub const DEFAULT_TILE_LIST_BYTES: u64 = 32 << 20;
+
+    /// The default [`Settings::tile_capacity`] of a `width` x `height` picture: the largest
+    /// power of two up to [`Self::MAX_TILE_CAPACITY`] whose lists fit
+    /// [`Self::DEFAULT_TILE_LIST_BYTES`] (1,024 up to 512x512, 256 at 1920x1080).
+    pub fn tile_capacity_for(width: u32, height: u32) -> u32 {
+        Self::tile_capacity_within(width, height, Self::DEFAULT_TILE_LIST_BYTES)
+    }
+
+    /// The largest power of two up to [`Self::MAX_TILE_CAPACITY`] whose lists for a `width` x
+    /// `height` picture fit `bytes` (at least 1).
+    fn tile_capacity_within(width: u32, height: u32, bytes: u64) -> u32 {
+        let tiles =
+            u64::from(width.div_ceil(contract::TILE)) * u64::from(height.div_ceil(contract::TILE));
+        let fits = bytes / 4 / tiles.max(1);
+        let capacity = u64::from(Self::MAX_TILE_CAPACITY).min(fits).max(1);
+        1 << capacity.ilog2()
     }
 
     /// A [`Settings::temporal_weight`] for a light that moves under a still camera: on the
@@ -291,6 +346,28 @@ impl Settings {
             return Err(format!(
                 "temporal weight {} is outside (0, 1]",
                 s.temporal_weight
+            ));
+        }
+        if !(s.tile_error.is_finite() && s.tile_error >= 0.0) {
+            return Err(format!("tile error {} must be >= 0", s.tile_error));
+        }
+        if !(1..=Self::MAX_TILE_CAPACITY).contains(&s.tile_capacity) {
+            return Err(format!(
+                "tile capacity {} is outside 1..{}",
+                s.tile_capacity,
+                Self::MAX_TILE_CAPACITY
+            ));
+        }
+        let bytes = gather::tile_list_bytes(s);
+        if bytes > Self::MAX_TILE_LIST_BYTES {
+            return Err(format!(
+                "per-tile cuts of {} nodes for a {}x{} picture take {} MiB, over {} MiB: lower the tile capacity to {} or less",
+                s.tile_capacity,
+                s.width,
+                s.height,
+                bytes >> 20,
+                Self::MAX_TILE_LIST_BYTES >> 20,
+                Self::tile_capacity_within(s.width, s.height, Self::MAX_TILE_LIST_BYTES),
             ));
         }
         Ok(())
@@ -389,6 +466,11 @@ pub struct WorkCounts {
     /// Reads of G-buffer texels, RSM texels, quadtree node records and low-resolution samples,
     /// over all pixels.
     pub texel_fetches: u64,
+    /// Upper bounds of a node's contribution to a tile evaluated (per-tile cuts), over all
+    /// tiles.
+    pub bound_evaluations: u64,
+    /// Splits a per-tile cut refused because the tile's list was full, over all tiles.
+    pub refused_splits: u64,
 }
 
 impl WorkCounts {
@@ -400,6 +482,11 @@ impl WorkCounts {
     /// Mean texel fetches per shaded pixel.
     pub fn texel_fetches_per_pixel(&self) -> f64 {
         self.texel_fetches as f64 / f64::from(self.shaded_pixels.max(1))
+    }
+
+    /// Mean bound evaluations per shaded pixel.
+    pub fn bound_evaluations_per_pixel(&self) -> f64 {
+        self.bound_evaluations as f64 / f64::from(self.shaded_pixels.max(1))
     }
 }
 

@@ -177,7 +177,7 @@ impl<'g> Renderer<'g> {
         let mut passes = Vec::new();
         if rebuild {
             passes.push(Pass::Rsm);
-            if method.uses_quadtree() {
+            if method.builds_quadtree() {
                 passes.extend([Pass::Pyramid, Pass::Validity]);
             }
             if method == Method::Quadtree {
@@ -254,7 +254,7 @@ impl<'g> Renderer<'g> {
     pub fn read_frame(&self) -> Result<Frame, IndirectError> {
         let indirect = self.read_vec4(self.gather.indirect())?;
         let direct = self.read_vec4(self.gather.direct())?;
-        let counts: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&quadray_gpu::read_buffer(
+        let counts: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&quadray_gpu::read_buffer(
             self.gpu,
             self.gather.counts(),
         )?);
@@ -265,6 +265,8 @@ impl<'g> Renderer<'g> {
                 shaded_pixels: direct.iter().filter(|p| p[3] > 0.5).count() as u32,
                 vpl_evaluations: counts.iter().map(|c| u64::from(c[0])).sum(),
                 texel_fetches: counts.iter().map(|c| u64::from(c[1])).sum(),
+                bound_evaluations: counts.iter().map(|c| u64::from(c[2])).sum(),
+                refused_splits: counts.iter().map(|c| u64::from(c[3])).sum(),
             },
             width: s.width,
             height: s.height,
@@ -292,6 +294,27 @@ impl<'g> Renderer<'g> {
             .collect())
     }
 
+    /// The per-tile cuts of the last [`Method::QuadtreeTiles`] frame: each tile's clusters (tiles
+    /// of 8x8 pixels, row-major; empty where the tile sees no geometry), in no order.
+    pub fn read_tile_cuts(&self) -> Result<Vec<Vec<CutNode>>, IndirectError> {
+        let read = |buffer| -> Result<Vec<u32>, IndirectError> {
+            Ok(bytemuck::pod_collect_to_vec(&quadray_gpu::read_buffer(
+                self.gpu, buffer,
+            )?))
+        };
+        let sizes = read(self.gather.tile_sizes())?;
+        let lists = read(self.gather.tile_cuts())?;
+        let s = self.settings();
+        let capacity = s.tile_capacity as usize;
+        let (tx, ty) = super::gather::tiles(s);
+        Ok((0..(tx * ty) as usize)
+            .map(|tile| {
+                let list = &lists[tile * capacity..][..sizes[2 * tile] as usize];
+                list.iter().map(|&i| CutNode::at(s.rsm_size, i)).collect()
+            })
+            .collect())
+    }
+
     /// The RSM's flux per texel, row-major (what the cut clusters).
     pub fn read_rsm_flux(&self) -> Result<Vec<[f32; 3]>, IndirectError> {
         let flux = self.read_texture(&self.rsm.textures()[0])?;
@@ -303,6 +326,14 @@ impl<'g> Renderer<'g> {
     pub fn read_nodes(&self) -> Result<Vec<[[f32; 4]; 3]>, IndirectError> {
         let flat = self.read_vec4(self.quadtree.nodes())?;
         Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    }
+
+    /// What bounds each node's contribution, as built: the box of its VPLs' positions (lo,
+    /// hi; empty nodes hold lo > hi) with the cosine of its normal cone's half-angle in lo's w
+    /// (the cone's axis is the node's mean normal), finest level first.
+    pub fn read_node_bounds(&self) -> Result<Vec<[[f32; 4]; 2]>, IndirectError> {
+        let flat = self.read_vec4(self.quadtree.bounds())?;
+        Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
     }
 
     /// The xyz of three same-sized textures per texel, `None` where the w of `textures[coverage]`

@@ -20,6 +20,13 @@ struct Shade {
     shadow_thickness: f32,
     // weight of this frame in the running average of the indirect light (1: no filter)
     temporal_weight: f32,
+    // per-tile cuts: a node is split while its bound exceeds `tile_error` of the tile's
+    // irradiance estimated from the nodes of level `tile_start`; at most `tile_capacity` nodes
+    // a tile; tiles in a row of the picture
+    tile_error: f32,
+    tile_capacity: u32,
+    tile_start: u32,
+    tiles_x: u32,
     // the camera the G-buffer was rendered from (set with the camera, not with the light)
     camera: mat4x4<f32>,
     eye: vec4<f32>,
@@ -34,6 +41,7 @@ struct Shade {
 @group(0) @binding(5) var<storage, read> nodes: array<Node>;
 @group(0) @binding(6) var<storage, read> cut: array<Node>;
 @group(0) @binding(7) var<storage, read> cut_count: u32;
+@group(0) @binding(8) var<storage, read> bounds: array<NodeBounds>;
 // Group 1, per frame (its targets): the sizes, the G-buffer, the outputs and the RSM samples.
 @group(1) @binding(0) var<uniform> shade: Shade;
 @group(1) @binding(1) var g_pos: texture_2d<f32>;
@@ -45,10 +53,15 @@ struct Shade {
 @group(1) @binding(6) var<storage, read_write> low: array<vec4<f32>>;
 // xy: offset in RSM texels, z: weight, w: the pattern's radius
 @group(1) @binding(7) var<storage, read> samples: array<vec4<f32>>;
-// per pixel: VPL evaluations and fetches of the indirect passes (cleared before them)
-@group(1) @binding(8) var<storage, read_write> counts: array<vec2<u32>>;
+// per pixel: VPL evaluations, fetches, bound evaluations and refused splits of the indirect
+// passes (cleared before them)
+@group(1) @binding(8) var<storage, read_write> counts: array<vec4<u32>>;
 // the running average of the indirect light over the last frames (rgb)
 @group(1) @binding(9) var<storage, read_write> history: array<vec4<f32>>;
+// per-tile cuts: each tile's node indices (`tile_capacity` slots a tile), and per tile the
+// nodes it holds and the splits refused for want of room
+@group(1) @binding(10) var<storage, read_write> tile_cuts: array<u32>;
+@group(1) @binding(11) var<storage, read_write> tile_sizes: array<vec2<u32>>;
 // Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
@@ -119,9 +132,12 @@ fn visible(x: vec3<f32>, xp: vec3<f32>) -> bool {
     }
     return true;
 }
+// Splits of a per-tile cut refused because the tile's list was full (counted once a tile).
+var<private> refused_splits: u32;
+
 // Adds this invocation's work to pixel `index`'s counts.
 fn store_counts(index: u32) {
-    counts[index] += vec2<u32>(evaluations, fetches);
+    counts[index] += vec4<u32>(evaluations, fetches, bound_evaluations, refused_splits);
 }
 
 fn pixel_index(pixel: vec2<u32>) -> u32 {

@@ -1,0 +1,321 @@
+// Per-tile cuts (Lightcuts, Walter et al. 2005, with the light quadtree as the light tree and a
+// tile of 8x8 receivers in place of a pixel): one workgroup per tile refines the quadtree level
+// by level from its root, splitting a node while the bound of what it gives any receiver of the
+// tile (bound.wgsl, against each half of the tile's receivers) exceeds `tile_error` of the tile's
+// estimated irradiance (the nodes of level `tile_start` summed at a few of its pixels), down to
+// single VPLs where needed, then every pixel of the tile sums the tile's list.
+
+// TILE (the tile's side) comes from the prelude
+const TILE_PIXELS: u32 = TILE * TILE;
+
+// the tile's receivers: position and normal
+var<workgroup> tile_x: array<vec3<f32>, TILE_PIXELS>;
+var<workgroup> tile_n: array<vec3<f32>, TILE_PIXELS>;
+// reductions over the tile's pixels: the receivers' box and normals (summed; w: how many), of
+// the tile then of each half, each half's least cosine to its mean normal (x, y of reduce_n),
+// and the coarse estimate at each quadrant's sample pixel
+var<workgroup> reduce_lo: array<vec3<f32>, TILE_PIXELS>;
+var<workgroup> reduce_hi: array<vec3<f32>, TILE_PIXELS>;
+var<workgroup> reduce_n: array<vec4<f32>, TILE_PIXELS>;
+var<workgroup> reduce_e: array<vec4<f32>, TILE_PIXELS>;
+// per quadrant of the tile, its first covered pixel (TILE_PIXELS: none): the estimate's
+// sample pixels
+var<workgroup> quadrant_pixel: array<atomic<u32>, 4>;
+// the nodes of the level being refined and of the next (pyramid indices)
+var<workgroup> frontier: array<array<u32, TILE_FRONTIER>, 2>;
+var<workgroup> frontier_len: array<atomic<u32>, 2>;
+var<workgroup> list_len: atomic<u32>;
+// list slots promised: the list's nodes and the frontiers' (a split adds three), so that
+// every node of a frontier can still be listed when the tile's capacity stops refinement
+var<workgroup> reserved: atomic<u32>;
+var<workgroup> refused: atomic<u32>;
+// a level's verdict on each node of its frontier, four bytes to a word: VERDICT_LIST,
+// VERDICT_EMPTY, or the node wants a split and its bound is over the threshold by a factor of
+// 2^(verdict - 1) or more; how many nodes want a split in each bin; the bin at or below which
+// splits are refused (the one at it split while room is left)
+const VERDICT_LIST: u32 = 0u;
+const VERDICT_EMPTY: u32 = 255u;
+const SPLIT_BINS: u32 = 16u;
+var<workgroup> verdicts: array<atomic<u32>, TILE_FRONTIER / 4u>;
+var<workgroup> split_bins: array<atomic<u32>, SPLIT_BINS>;
+var<workgroup> split_cutoff: u32;
+// work of the threads whose pixel lies outside the picture, counted with the tile's first pixel
+var<workgroup> stray: array<atomic<u32>, 3>;
+
+// Stores every thread's counts: those outside the picture's with the tile's first pixel.
+fn store_tile_counts(pixel: vec2<u32>, inside: bool, local: u32) {
+    if (!inside) {
+        atomicAdd(&stray[0], evaluations);
+        atomicAdd(&stray[1], fetches);
+        atomicAdd(&stray[2], bound_evaluations);
+    }
+    workgroupBarrier();
+    if (local == 0u) {
+        evaluations += atomicLoad(&stray[0]);
+        fetches += atomicLoad(&stray[1]);
+        bound_evaluations += atomicLoad(&stray[2]);
+    }
+    if (inside) {
+        store_counts(pixel_index(pixel));
+    }
+}
+
+@compute @workgroup_size(TILE, TILE)
+fn indirect_tiles(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(workgroup_id) tile_xy: vec3<u32>,
+) {
+    let inside = id.x < shade.width && id.y < shade.height;
+    var r: Receiver;
+    if (inside) {
+        r = receiver(id.xy);
+    }
+    tile_x[local] = r.x;
+    tile_n[local] = r.n;
+    reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, r.covered);
+    reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, r.covered);
+    reduce_n[local] = select(vec4<f32>(0.0), vec4<f32>(r.n, 1.0), r.covered);
+    if (local < 4u) {
+        atomicStore(&quadrant_pixel[local], TILE_PIXELS);
+    }
+    if (local < 3u) {
+        atomicStore(&stray[local], 0u);
+    }
+    if (local < SPLIT_BINS) {
+        atomicStore(&split_bins[local], 0u);
+    }
+    for (var i = local; i < TILE_FRONTIER / 4u; i += TILE_PIXELS) {
+        atomicStore(&verdicts[i], 0u);
+    }
+    if (local == 0u) {
+        atomicStore(&frontier_len[1], 0u);
+        atomicStore(&list_len, 0u);
+        atomicStore(&refused, 0u);
+    }
+    workgroupBarrier();
+    if (r.covered) {
+        atomicMin(&quadrant_pixel[(local % TILE) / (TILE / 2u) + 2u * (local / (TILE_PIXELS / 2u))], local);
+    }
+    for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
+        if (local < stride) {
+            reduce_lo[local] = min(reduce_lo[local], reduce_lo[local + stride]);
+            reduce_hi[local] = max(reduce_hi[local], reduce_hi[local + stride]);
+            reduce_n[local] += reduce_n[local + stride];
+        }
+        workgroupBarrier();
+    }
+    let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
+    if (workgroupUniformLoad(&reduce_n[0]).w == 0.0) {
+        // nothing to light
+        if (local == 0u) {
+            tile_sizes[tile] = vec2<u32>(0u);
+        }
+        store_tile_counts(id.xy, inside, local);
+        return;
+    }
+    // two groups of receivers, the tile's box halved across its longest side: a tile on a
+    // depth discontinuity (an edge in front of a far wall) gets two boxes without the gap
+    // between them, and a node's bound is the larger of the two groups'
+    let extent = reduce_hi[0] - reduce_lo[0];
+    let split_axis = select(select(2u, 1u, extent.y >= extent.z), 0u, extent.x >= max(extent.y, extent.z));
+    let middle = 0.5 * (reduce_lo[0][split_axis] + reduce_hi[0][split_axis]);
+    let group = select(0u, 1u, r.x[split_axis] >= middle);
+    var group_lo: array<vec3<f32>, 2>;
+    var group_hi: array<vec3<f32>, 2>;
+    var group_axis: array<vec3<f32>, 2>;
+    for (var g = 0u; g < 2u; g++) {
+        workgroupBarrier();
+        let member = r.covered && group == g;
+        reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, member);
+        reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, member);
+        reduce_n[local] = select(vec4<f32>(0.0), vec4<f32>(r.n, 1.0), member);
+        workgroupBarrier();
+        for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
+            if (local < stride) {
+                reduce_lo[local] = min(reduce_lo[local], reduce_lo[local + stride]);
+                reduce_hi[local] = max(reduce_hi[local], reduce_hi[local + stride]);
+                reduce_n[local] += reduce_n[local + stride];
+            }
+            workgroupBarrier();
+        }
+        group_lo[g] = reduce_lo[0];
+        group_hi[g] = reduce_hi[0];
+        let sum_n = reduce_n[0].xyz;
+        group_axis[g] = select(vec3<f32>(0.0, 0.0, 1.0), normalize(sum_n), length(sum_n) > 0.0);
+    }
+    workgroupBarrier();
+    // each group's least cosine to its axis (x: group 0, y: group 1)
+    let cos_own = select(1.0, dot(r.n, group_axis[group]), r.covered);
+    reduce_n[local] = vec4<f32>(select(1.0, cos_own, group == 0u), select(1.0, cos_own, group == 1u), 0.0, 0.0);
+
+    // the coarse estimate: the nodes of level `tile_start` at each quadrant's sample pixel
+    let start = shade.tile_start;
+    let start_side = level_size(params, start);
+    let start_nodes = start_side * start_side;
+    let first = level_offset(params, start);
+    var e = vec4<f32>(0.0);
+    for (var i = local; i < start_nodes; i += TILE_PIXELS) {
+        fetches++;
+        let node = nodes[first + i];
+        if (node.flux.w > 0.5) {
+            for (var q = 0u; q < 4u; q++) {
+                let p = atomicLoad(&quadrant_pixel[q]);
+                if (p < TILE_PIXELS) {
+                    e[q] += luminance(vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], shade.r_min));
+                }
+            }
+        }
+    }
+    reduce_e[local] = e;
+    // refinement starts from the root, so that far tiles may keep clusters coarser than the
+    // estimate's
+    let root = params.levels - 1u;
+    if (local == 0u) {
+        frontier[0][0] = level_offset(params, root);
+        atomicStore(&frontier_len[0], 1u);
+        atomicStore(&reserved, 1u);
+    }
+    workgroupBarrier();
+    for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
+        if (local < stride) {
+            reduce_e[local] += reduce_e[local + stride];
+            reduce_n[local] = min(reduce_n[local], reduce_n[local + stride]);
+        }
+        workgroupBarrier();
+    }
+    // the mean of the sample pixels' estimates (their least refined more for as little error)
+    var total = 0.0;
+    var samples = 0.0;
+    for (var q = 0u; q < 4u; q++) {
+        if (atomicLoad(&quadrant_pixel[q]) < TILE_PIXELS) {
+            total += reduce_e[0][q];
+            samples += 1.0;
+        }
+    }
+    total /= samples;
+    let threshold = shade.tile_error * total;
+    let least_cos = reduce_n[0].xy;
+    let group_cos = cos(min(acos(clamp(least_cos, vec2<f32>(-1.0), vec2<f32>(1.0))) + CONE_SLACK, vec2<f32>(PI)));
+
+    // refinement, one level a step: first every node's verdict (empty, listed, or the bin of
+    // how far its bound exceeds the threshold), then as many splits as the list has room for,
+    // the nodes of the highest bins first (Lightcuts splits the largest bound first)
+    for (var step = 0u; step <= root; step++) {
+        let level = root - step;
+        let current = step & 1u;
+        let next = current ^ 1u;
+        let count = atomicLoad(&frontier_len[current]);
+        for (var i = local; i < count; i += TILE_PIXELS) {
+            let index = frontier[current][i];
+            fetches++;
+            let node = nodes[index];
+            var verdict = VERDICT_LIST;
+            if (node.flux.w < 0.5) {
+                verdict = VERDICT_EMPTY;
+                atomicSub(&reserved, 1u);
+            } else if (level > 0u) {
+                fetches++;
+                let b = bounds[index];
+                let bound = max(
+                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[0], group_hi[0], group_axis[0], group_cos.x, shade.r_min),
+                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[1], group_hi[1], group_axis[1], group_cos.y, shade.r_min),
+                );
+                if (bound > threshold) {
+                    // bins of powers of two of bound / threshold, 1..SPLIT_BINS
+                    let bin = 1u + u32(clamp(floor(log2(bound / threshold)), 0.0, f32(SPLIT_BINS - 1u)));
+                    atomicAdd(&split_bins[bin - 1u], 1u);
+                    verdict = bin;
+                }
+            }
+            atomicOr(&verdicts[i / 4u], verdict << (8u * (i % 4u)));
+        }
+        workgroupBarrier();
+        if (local == 0u) {
+            // the bins above the cutoff all fit and have their room reserved here; the cutoff
+            // bin's nodes split while room is left
+            var room = (shade.tile_capacity - atomicLoad(&reserved)) / 3u;
+            var granted = 0u;
+            split_cutoff = 0u;
+            for (var bin = SPLIT_BINS; bin > 0u; bin--) {
+                let wanted = atomicLoad(&split_bins[bin - 1u]);
+                if (wanted > room) {
+                    split_cutoff = bin;
+                    break;
+                }
+                room -= wanted;
+                granted += wanted;
+            }
+            atomicAdd(&reserved, 3u * granted);
+        }
+        workgroupBarrier();
+        let cutoff = split_cutoff;
+        let size = level_size(params, level);
+        let offset = level_offset(params, level);
+        for (var i = local; i < count; i += TILE_PIXELS) {
+            let verdict = (atomicLoad(&verdicts[i / 4u]) >> (8u * (i % 4u))) & 255u;
+            if (verdict == VERDICT_EMPTY) {
+                continue;
+            }
+            let index = frontier[current][i];
+            var split = verdict > cutoff;
+            if (verdict == cutoff && cutoff > 0u) {
+                split = atomicAdd(&reserved, 3u) + 3u <= shade.tile_capacity;
+                if (!split) {
+                    atomicSub(&reserved, 3u);
+                }
+            }
+            if (verdict != VERDICT_LIST && !split) {
+                atomicAdd(&refused, 1u);
+            }
+            if (split) {
+                let at = index - offset;
+                let xy = vec2<u32>(at % size, at / size);
+                let slot = atomicAdd(&frontier_len[next], 4u);
+                for (var c = 0u; c < 4u; c++) {
+                    let child = xy * 2u + vec2<u32>(c & 1u, c >> 1u);
+                    frontier[next][slot + c] = node_index(params, level - 1u, child);
+                }
+            } else {
+                tile_cuts[tile * shade.tile_capacity + atomicAdd(&list_len, 1u)] = index;
+            }
+        }
+        workgroupBarrier();
+        if (local == 0u) {
+            atomicStore(&frontier_len[current], 0u);
+        }
+        if (local < SPLIT_BINS) {
+            atomicStore(&split_bins[local], 0u);
+        }
+        for (var i = local; i < TILE_FRONTIER / 4u; i += TILE_PIXELS) {
+            atomicStore(&verdicts[i], 0u);
+        }
+        workgroupBarrier();
+    }
+
+    // the gather: the list copied once into workgroup memory (the frontier's, free now), then
+    // every pixel sums its nodes
+    storageBarrier();
+    let listed = atomicLoad(&list_len);
+    let base = tile * shade.tile_capacity;
+    for (var i = local; i < listed; i += TILE_PIXELS) {
+        fetches++;
+        frontier[0][i] = tile_cuts[base + i];
+    }
+    workgroupBarrier();
+    var irradiance = vec3<f32>(0.0);
+    if (r.covered) {
+        for (var i = 0u; i < listed; i++) {
+            fetches++;
+            irradiance += node_irradiance(nodes[frontier[0][i]], r);
+        }
+    }
+    if (inside) {
+        add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * irradiance, 0.0));
+    }
+    if (local == 0u) {
+        refused_splits = atomicLoad(&refused);
+        tile_sizes[tile] = vec2<u32>(listed, refused_splits);
+    }
+    store_tile_counts(id.xy, inside, local);
+}
