@@ -1,6 +1,6 @@
 //! The pictures of `quadray demo`: direct, indirect and combined light on the Cornell box with the
 //! brute force and the error heat map beside them; the paper's figure 9 (quadtree against RSM
-//! sampling at equal time and at 2040 samples); the atrium; the leak scene with and without
+//! sampling at equal time and at 2040 samples, and the per-tile cuts); the atrium; the leak scene with and without
 //! indirect shadows beside the ground truth with visibility.
 
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
@@ -70,11 +70,26 @@ pub fn render_demo(
     );
     files.push(save(&cut_picture, &out.join("cornell_cut.png"))?);
 
-    progress("figure 9: RSM sampling at equal time");
-    let mut tiles: Vec<(String, Rgba8Image)> = vec![(
-        format!("quadtree{} L1 {:.3}", caption_ms(quadtree_ms), e.rel_l1),
-        tile(&frame.indirect),
-    )];
+    progress("figure 9: RSM sampling at equal time, and per-tile cuts");
+    r.render(Method::QuadtreeTiles, true, false)?;
+    let per_tile_ms = r
+        .time(Method::QuadtreeTiles, false, FRAMES)?
+        .map(|t| t.total_ms);
+    let per_tile = r.read_frame()?.indirect;
+    let mut tiles: Vec<(String, Rgba8Image)> = vec![
+        (
+            format!("quadtree{} L1 {:.3}", caption_ms(quadtree_ms), e.rel_l1),
+            tile(&frame.indirect),
+        ),
+        (
+            format!(
+                "per-tile cuts{} L1 {:.3}",
+                caption_ms(per_tile_ms),
+                compare(&per_tile, &brute).rel_l1
+            ),
+            tile(&per_tile),
+        ),
+    ];
     let mut rsm_runs = Vec::new();
     for samples in [16, 64, 216, 2040] {
         let mut rs = Renderer::new(gpu, &scene, settings(gpu, size, size, samples))?;
@@ -107,7 +122,7 @@ pub fn render_demo(
         ));
     }
     files.push(save(
-        &montage(&tiles, 3),
+        &montage(&tiles, 2),
         &out.join("figure9_equal_time.png"),
     )?);
 
