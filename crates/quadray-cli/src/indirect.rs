@@ -65,9 +65,10 @@ pub struct IndirectArgs {
     #[arg(long, default_value_t = Settings::default().temporal_weight)]
     temporal_weight: f32,
     /// quadtree-tiles: split a cluster while a bound of its irradiance at any pixel of the tile
-    /// exceeds this fraction of the tile's estimated irradiance (0: every VPL).
-    #[arg(long, default_value_t = Settings::TILE_ERROR)]
-    tile_error: f32,
+    /// (or its estimated error, --tile-criterion) exceeds this fraction of the tile's estimated
+    /// irradiance (0: every VPL); default: 0.05 for the bound, 0.002 for the estimate.
+    #[arg(long)]
+    tile_error: Option<f32>,
     /// quadtree-tiles: what is compared with --tile-error: bound (an upper bound of the
     /// cluster's irradiance at the tile) or estimate (the estimated error of keeping the
     /// cluster rather than its children, at a few of the tile's pixels, where the bound is
@@ -166,7 +167,9 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         },
         shadow_thickness: args.shadow_thickness,
         temporal_weight: args.temporal_weight,
-        tile_error: args.tile_error,
+        tile_error: args
+            .tile_error
+            .unwrap_or(args.tile_criterion.default_error()),
         tile_criterion: args.tile_criterion,
         tile_capacity: args
             .tile_capacity

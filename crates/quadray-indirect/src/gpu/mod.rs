@@ -122,6 +122,15 @@ impl TileCriterion {
     /// Both criteria, in the order the CLI lists them.
     pub const ALL: [TileCriterion; 2] = [TileCriterion::Bound, TileCriterion::Estimate];
 
+    /// The default [`Settings::tile_error`] of the criterion (see BENCHMARKS.md, "Per-tile
+    /// cuts"): a node's estimated error is far below its bound.
+    pub fn default_error(self) -> f32 {
+        match self {
+            TileCriterion::Bound => 0.05,
+            TileCriterion::Estimate => 0.002,
+        }
+    }
+
     /// The criterion's name on the command line and in the stats (`--tile-criterion`).
     pub fn name(self) -> &'static str {
         match self {
@@ -282,14 +291,11 @@ impl Settings {
             shadow_steps: 0,
             shadow_thickness: 0.1,
             temporal_weight: 1.0,
-            tile_error: Self::TILE_ERROR,
+            tile_error: TileCriterion::Bound.default_error(),
             tile_criterion: TileCriterion::Bound,
             tile_capacity: Self::tile_capacity_for(width, height),
         }
     }
-
-    /// The default [`Settings::tile_error`] (see BENCHMARKS.md, "Per-tile cuts").
-    pub const TILE_ERROR: f32 = 0.05;
 
     /// The largest [`Settings::tile_capacity`], what a tile's frontier holds in workgroup memory.
     pub const MAX_TILE_CAPACITY: u32 = contract::TILE_FRONTIER;

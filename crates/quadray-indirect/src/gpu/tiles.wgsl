@@ -49,7 +49,9 @@ var<workgroup> stray: array<atomic<u32>, 3>;
 
 // The estimated error of keeping a node (at `at` of level `level`, `size` nodes a side) rather
 // than its four children: the largest luminance of the difference of their irradiances at the
-// tile's sample pixels.
+// tile's sample pixels (a node that lights none of them, e.g. one on the other wall of a tile
+// spanning a corner, is kept: taking the bound there split most floor nodes for floor tiles,
+// 0.031 rel L1 at 583 evaluations a pixel against 341 on the Cornell box).
 fn estimated_error(node: Node, at: u32, size: u32, level: u32) -> f32 {
     let xy = vec2<u32>(at % size, at / size);
     var children: array<Node, 4>;
@@ -70,13 +72,14 @@ fn estimated_error(node: Node, at: u32, size: u32, level: u32) -> f32 {
     for (var q = 0u; q < 5u; q++) {
         let p = select(nearest, atomicLoad(&quadrant_pixel[min(q, 3u)]), q < 4u);
         if (p < TILE_PIXELS) {
-            var difference = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], shade.r_min);
+            let own = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], shade.r_min);
+            var sum = vec3<f32>(0.0);
             for (var c = 0u; c < 4u; c++) {
                 if (children[c].flux.w > 0.5) {
-                    difference -= vpl_irradiance(children[c].flux.rgb, children[c].pos.xyz, children[c].normal.xyz, tile_x[p], tile_n[p], shade.r_min);
+                    sum += vpl_irradiance(children[c].flux.rgb, children[c].pos.xyz, children[c].normal.xyz, tile_x[p], tile_n[p], shade.r_min);
                 }
             }
-            error = max(error, abs(luminance(difference)));
+            error = max(error, abs(luminance(own - sum)));
         }
     }
     return error;
@@ -270,9 +273,10 @@ fn indirect_tiles(
                 // decides below the start level (above it a node's children are as coarse as
                 // itself, so their sum agrees with it however far both are from the truth:
                 // 0.10 rel L1 at 204 evaluations a pixel on the Cornell box, 0.031 at 341 from
-                // the start level down)
+                // the start level down); at a tile error of 0 the bound alone, so that every VPL
+                // that may light the tile is on its own
                 var excess = bound;
-                if (bound > threshold && shade.tile_estimate == 1u && level < start) {
+                if (bound > threshold && shade.tile_estimate == 1u && level < start && threshold > 0.0) {
                     let before = evaluations;
                     excess = estimated_error(node, index - offset, size, level);
                     atomicAdd(&estimated_nodes, 1u);
