@@ -6,7 +6,7 @@ use clap::Args;
 use quadray_bench::indirect::run::{RunOptions, run};
 use quadray_core::write_json;
 use quadray_gpu::Gpu;
-use quadray_indirect::{ClusterSettings, Method, Scene, Settings, Validity};
+use quadray_indirect::{ClusterSettings, Method, Scene, Settings, TileCriterion, Validity};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -65,9 +65,16 @@ pub struct IndirectArgs {
     #[arg(long, default_value_t = Settings::default().temporal_weight)]
     temporal_weight: f32,
     /// quadtree-tiles: split a cluster while a bound of its irradiance at any pixel of the tile
-    /// exceeds this fraction of the tile's estimated irradiance (0: every VPL).
-    #[arg(long, default_value_t = Settings::TILE_ERROR)]
-    tile_error: f32,
+    /// (or its estimated error, --tile-criterion) exceeds this fraction of the tile's estimated
+    /// irradiance (0: every VPL); default: 0.05 for the bound, 0.002 for the estimate.
+    #[arg(long)]
+    tile_error: Option<f32>,
+    /// quadtree-tiles: what is compared with --tile-error: bound (an upper bound of the
+    /// cluster's irradiance at the tile) or estimate (the estimated error of keeping the
+    /// cluster rather than its children, at a few of the tile's pixels, where the bound is
+    /// over the threshold).
+    #[arg(long, default_value = Settings::default().tile_criterion.name())]
+    tile_criterion: TileCriterion,
     /// quadtree-tiles: the most clusters a tile's cut holds (1..1024; past it refinement
     /// stops, counted as refused_splits); default: 1024, less where the picture's lists would
     /// take over 32 MiB (256 at 1920x1080).
@@ -160,7 +167,10 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         },
         shadow_thickness: args.shadow_thickness,
         temporal_weight: args.temporal_weight,
-        tile_error: args.tile_error,
+        tile_error: args
+            .tile_error
+            .unwrap_or(args.tile_criterion.default_error()),
+        tile_criterion: args.tile_criterion,
         tile_capacity: args
             .tile_capacity
             .unwrap_or(Settings::tile_capacity_for(args.size.0, args.size.1)),

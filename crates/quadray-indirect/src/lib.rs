@@ -35,6 +35,6 @@ pub enum IndirectError {
 pub use gpu::{
     ClusterSettings, CutNode, FLOAT_FORMAT, Frame, FrameTiming, GBufferViews, Gather,
     LightQuadtree, Method, OutputPass, OutputTerm, Pass, Renderer, RsmPass, RsmViews, Settings,
-    Spot, Validity, WorkCounts,
+    Spot, TileCriterion, Validity, WorkCounts,
 };
 pub use scene::Scene;

@@ -7,7 +7,9 @@ use glam::{Vec2, Vec3, Vec4};
 use quadray_gpu::Gpu;
 use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
 use quadray_indirect::gpu::Receiver;
-use quadray_indirect::{ClusterSettings, Method, Renderer, Scene, Settings, Validity, WorkCounts};
+use quadray_indirect::{
+    ClusterSettings, Method, Renderer, Scene, Settings, TileCriterion, Validity, WorkCounts,
+};
 
 const RSM: u32 = 32;
 
@@ -115,60 +117,121 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     // refinement from the root (every node visited read; a bound record read and evaluated
     // against both groups of receivers for the non-empty ones above level 0, which are listed or
     // split, the split ones' four children visited) and the gather (the list read once into
-    // workgroup memory, then each covered pixel reads and sums its nodes)
-    let tiles = counted(&mut r, Method::QuadtreeTiles);
-    let cuts = r.read_tile_cuts().unwrap();
+    // workgroup memory, then each covered pixel reads and sums its nodes). With the estimate
+    // criterion, a node below the start level whose bound is over the threshold also reads its
+    // four children and evaluates itself and its non-empty ones at the sample pixels and the
+    // receiver nearest it: every split node there, and some of the listed ones (the tile reports
+    // how many, checked between the two)
     let start = c.start_level;
     let root = RSM.ilog2();
+    let lit = |level: u32, x: u32, y: u32| nodes[node_index(level, x, y)][0][3] > 0.5;
     let start_nodes = u64::from((RSM >> start).pow(2));
     let lit_start = (0..start_nodes as u32)
-        .filter(|&i| {
-            let side = RSM >> start;
-            nodes[node_index(start, i % side, i / side)][0][3] > 0.5
-        })
+        .filter(|&i| lit(start, i % (RSM >> start), i / (RSM >> start)))
         .count() as u64;
-    let (mut evaluations, mut fetches, mut bounds) = (0, 3 * pixels, 0);
-    let tiles_x = s.width.div_ceil(8);
-    for (tile, cut) in cuts.iter().enumerate() {
-        let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
-        let covered = |lx: u32, ly: u32| {
-            let (x, y) = (tx * 8 + lx, ty * 8 + ly);
-            x < s.width && y < s.height && receivers[(y * s.width + x) as usize].is_some()
-        };
-        let pixels_lit = (0..64).filter(|i| covered(i % 8, i / 8)).count() as u64;
-        if pixels_lit == 0 {
-            assert!(cut.is_empty());
-            continue;
+    for criterion in TileCriterion::ALL {
+        let mut r = Renderer::new(
+            &gpu,
+            &scene,
+            Settings {
+                tile_criterion: criterion,
+                ..s.clone()
+            },
+        )
+        .unwrap();
+        let tiles = counted(&mut r, Method::QuadtreeTiles);
+        let cuts = r.read_tile_cuts().unwrap();
+        let estimates = r.read_tile_estimates().unwrap();
+        let (mut evaluations, mut fetches, mut bounds) = (0, 3 * pixels, 0);
+        let tiles_x = s.width.div_ceil(8);
+        for ((tile, cut), &(estimated, estimate_evaluations)) in
+            cuts.iter().enumerate().zip(&estimates)
+        {
+            let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
+            let covered = |lx: u32, ly: u32| {
+                let (x, y) = (tx * 8 + lx, ty * 8 + ly);
+                x < s.width && y < s.height && receivers[(y * s.width + x) as usize].is_some()
+            };
+            let pixels_lit = (0..64).filter(|i| covered(i % 8, i / 8)).count() as u64;
+            if pixels_lit == 0 {
+                assert!(cut.is_empty());
+                assert_eq!((estimated, estimate_evaluations), (0, 0));
+                continue;
+            }
+            let quadrants = (0..4)
+                .filter(|q| (0..16).any(|i| covered(q % 2 * 4 + i % 4, q / 2 * 4 + i / 4)))
+                .count() as u64;
+            let split: std::collections::BTreeSet<(u32, u32, u32)> = cut
+                .iter()
+                .flat_map(|n| {
+                    (n.level + 1..=root)
+                        .map(move |a| (a, n.x >> (a - n.level), n.y >> (a - n.level)))
+                })
+                .collect();
+            let listed = cut.len() as u64;
+            let listed_above_0 = cut.iter().filter(|n| n.level > 0).count() as u64;
+            // what estimating a node takes: (nodes, VPL evaluations)
+            let estimate = |(level, x, y): (u32, u32, u32)| {
+                let children = (0..4)
+                    .filter(|c| lit(level - 1, 2 * x + c % 2, 2 * y + c / 2))
+                    .count() as u64;
+                (1, (quadrants + 1) * (1 + children))
+            };
+            let sum = |a: (u64, u64), b: (u64, u64)| (a.0 + b.0, a.1 + b.1);
+            let below_start = |&(level, _, _): &(u32, u32, u32)| level < start;
+            let split_estimates = split
+                .iter()
+                .copied()
+                .filter(below_start)
+                .map(estimate)
+                .fold((0, 0), sum);
+            let listed_estimates = cut
+                .iter()
+                .map(|n| (n.level, n.x, n.y))
+                .filter(|n| n.0 > 0 && below_start(n))
+                .map(estimate)
+                .fold((0, 0), sum);
+            let reported = (u64::from(estimated), u64::from(estimate_evaluations));
+            if criterion == TileCriterion::Bound {
+                assert_eq!(reported, (0, 0));
+            } else {
+                let most = sum(split_estimates, listed_estimates);
+                assert!(
+                    split_estimates.0 <= reported.0 && reported.0 <= most.0,
+                    "tile {tile}: {reported:?} estimates, {split_estimates:?}..{most:?}"
+                );
+                assert!(
+                    split_estimates.1 <= reported.1 && reported.1 <= most.1,
+                    "tile {tile}: {reported:?} estimates, {split_estimates:?}..{most:?}"
+                );
+            }
+            let split = split.len() as u64;
+            // a bound for each of the tile's two groups of receivers
+            bounds += 2 * (listed_above_0 + split);
+            evaluations += lit_start * quadrants + pixels_lit * listed + reported.1;
+            fetches += start_nodes
+                + (1 + 4 * split)
+                + (listed_above_0 + split)
+                + listed
+                + pixels_lit * listed
+                + 4 * reported.0;
         }
-        let quadrants = (0..4)
-            .filter(|q| (0..16).any(|i| covered(q % 2 * 4 + i % 4, q / 2 * 4 + i / 4)))
-            .count() as u64;
-        let split: std::collections::BTreeSet<(u32, u32, u32)> = cut
-            .iter()
-            .flat_map(|n| {
-                (n.level + 1..=root).map(move |a| (a, n.x >> (a - n.level), n.y >> (a - n.level)))
-            })
-            .collect();
-        let split = split.len() as u64;
-        let listed = cut.len() as u64;
-        let listed_above_0 = cut.iter().filter(|n| n.level > 0).count() as u64;
-        // a bound for each of the tile's two groups of receivers
-        bounds += 2 * (listed_above_0 + split);
-        evaluations += lit_start * quadrants + pixels_lit * listed;
-        fetches +=
-            start_nodes + (1 + 4 * split) + (listed_above_0 + split) + listed + pixels_lit * listed;
+        println!("per-tile cuts, {criterion:?}: {tiles:?}");
+        assert_eq!(tiles.refused_splits, 0);
+        assert!(bounds > 0 && tiles.vpl_evaluations > 0);
+        assert_eq!(
+            (
+                tiles.vpl_evaluations,
+                tiles.texel_fetches,
+                tiles.bound_evaluations
+            ),
+            (evaluations, fetches, bounds)
+        );
+        if criterion == TileCriterion::Estimate {
+            let estimated: u32 = estimates.iter().map(|e| e.0).sum();
+            assert!(estimated > 0, "some node's error was estimated");
+        }
     }
-    println!("per-tile cuts: {tiles:?}");
-    assert_eq!(tiles.refused_splits, 0);
-    assert!(bounds > 0 && tiles.vpl_evaluations > 0);
-    assert_eq!(
-        (
-            tiles.vpl_evaluations,
-            tiles.texel_fetches,
-            tiles.bound_evaluations
-        ),
-        (evaluations, fetches, bounds)
-    );
 
     // RSM sampling: the shader's disk around each receiver's projection, in f32 as there
     let samples = rsm_samples(

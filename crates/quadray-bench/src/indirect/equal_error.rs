@@ -3,7 +3,8 @@
 //! pixel, the same on any hardware) and in GPU time, on every bundled scene of the technique at
 //! several RSM sizes. The quadtree runs at full resolution and sub-sampled (one gather per
 //! `k`^2 pixels, geometry-aware upsampling, recomputed pixels counted), and with a cut per tile
-//! (at full resolution, at several error fractions). RSM sampling is swept
+//! (at full resolution, at several error fractions, split by the bound or by the estimated
+//! error). RSM sampling is swept
 //! over sample counts at full resolution (the paper's baseline) and, as the fair extra row, at
 //! each sub-sampling the quadtree uses; its cost at the quadtree's error is interpolated log-log
 //! between the two counts whose errors bracket it.
@@ -13,7 +14,9 @@ use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::compare;
 use quadray_indirect::scene::scenes_dir;
-use quadray_indirect::{ClusterSettings, IndirectError, Method, Renderer, Scene, Settings};
+use quadray_indirect::{
+    ClusterSettings, IndirectError, Method, Renderer, Scene, Settings, TileCriterion,
+};
 use serde::Serialize;
 use std::path::Path;
 
@@ -28,8 +31,11 @@ const SCENES: [&str; 5] = [
 ];
 /// The quadtree's sub-samplings (1: full resolution), each also RSM sampling's.
 const SUBSAMPLES: [u32; 4] = [1, 2, 4, 8];
-/// Error fractions of the per-tile cuts compared (full resolution).
+/// Error fractions of the per-tile cuts compared (full resolution), split by the bound.
 const TILE_ERRORS: [f32; 5] = [1.0, 0.5, 0.2, 0.05, 0.02];
+/// Error fractions of the per-tile cuts split by the estimated error, which is far below the
+/// bound at the same node (BENCHMARKS.md, "Per-tile cuts").
+const ESTIMATE_ERRORS: [f32; 4] = [0.01, 0.002, 0.0005, 0.0002];
 /// RSM sample counts swept, up to where sampling reaches the quadtree's error.
 const SAMPLES: [u32; 10] = [16, 64, 216, 512, 1024, 2040, 4096, 8192, 16384, 32768];
 
@@ -65,7 +71,7 @@ impl EqualErrorOptions {
 /// One method at one setting: its error and its cost.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
-    /// The method's setting ("default", "paper", "tiles E", "N samples").
+    /// The method's setting ("default", "paper", "tiles E", "estimate E", "N samples").
     pub label: String,
     /// One gather per `subsample`^2 pixels (1: full resolution).
     pub subsample: u32,
@@ -234,17 +240,22 @@ fn scene_result(
             )?);
         }
     }
-    for tile_error in TILE_ERRORS {
-        progress(&format!("{name}: per-tile cuts, error {tile_error}"));
+    let tile_runs = TILE_ERRORS
+        .map(|e| (TileCriterion::Bound, e, "tiles"))
+        .into_iter()
+        .chain(ESTIMATE_ERRORS.map(|e| (TileCriterion::Estimate, e, "estimate")));
+    for (tile_criterion, tile_error, name_of) in tile_runs {
+        progress(&format!("{name}: per-tile cuts, {name_of} {tile_error}"));
         let mut r = Renderer::new(
             gpu,
             scene,
             Settings {
                 tile_error,
+                tile_criterion,
                 ..base.clone()
             },
         )?;
-        let label = format!("tiles {tile_error}");
+        let label = format!("{name_of} {tile_error}");
         quadtree.push(measure(
             &mut r,
             Method::QuadtreeTiles,

@@ -117,8 +117,9 @@ pub(crate) struct ShadeUniform {
     pub tile_capacity: u32,
     pub tile_start: u32,
     pub tiles_x: u32,
+    pub tile_estimate: u32,
     /// Up to the camera's 16-byte alignment.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
     /// Written by `Gather::set_camera`, the fields before by `Gather::set_light`.
     pub camera: [[f32; 4]; 4],
     pub eye: [f32; 4],
@@ -434,6 +435,7 @@ mod tests {
                     tile_capacity,
                     tile_start,
                     tiles_x,
+                    tile_estimate,
                     camera,
                     eye
                 ]

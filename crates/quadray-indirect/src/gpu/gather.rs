@@ -13,10 +13,10 @@ use super::contract::{
 use super::light::Spot;
 use super::quadtree::{BOUND_WGSL, COMMON_WGSL, CUT_RULE_WGSL, LightQuadtree};
 use super::rsm::{LIGHT_WGSL, RsmViews};
-use super::{Method, Settings};
+use super::{Method, Settings, TileCriterion};
 use crate::{IndirectError, baselines};
 use quadray_gpu::GpuTimer;
-use std::cell::Cell;
+use std::cell::{Cell, OnceCell};
 use wgpu::util::DeviceExt;
 
 /// The gather's shader, in order.
@@ -86,10 +86,30 @@ struct Outputs {
     counts: wgpu::Buffer,
     /// The temporal filter's running average of the indirect light (one texel without it).
     history: wgpu::Buffer,
+}
+
+/// The per-tile cuts' lists and their bind group (group 3).
+struct TileLists {
     /// Per tile, the per-tile cut's node indices (`tile_capacity` slots a tile).
-    tile_cuts: wgpu::Buffer,
-    /// Per tile, the nodes its list holds and the splits refused for want of room (two `u32`).
-    tile_sizes: wgpu::Buffer,
+    cuts: wgpu::Buffer,
+    /// Per tile, the nodes its list holds, the splits refused for want of room, the nodes whose
+    /// error it estimated and the VPL evaluations that took (four `u32`).
+    sizes: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
+impl TileLists {
+    fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, cuts: u64, tiles: u64) -> Self {
+        let cuts = storage_buffer(device, "per-tile cuts", cuts);
+        let sizes = storage_buffer(device, "per-tile cut sizes", tiles * 16);
+        let group = bind_group(
+            device,
+            "per-tile cuts",
+            layout,
+            vec![whole(&cuts), whole(&sizes)],
+        );
+        Self { cuts, sizes, group }
+    }
 }
 
 impl Outputs {
@@ -114,8 +134,6 @@ impl Outputs {
                 whole(&self.samples),
                 whole(&self.counts),
                 whole(&self.history),
-                whole(&self.tile_cuts),
-                whole(&self.tile_sizes),
             ],
         )
     }
@@ -146,6 +164,14 @@ pub struct Gather {
     frame_group: wgpu::BindGroup,
     /// Per dispatch: a level and a slice.
     dispatch_group: wgpu::BindGroup,
+    /// The per-tile cuts' lists, allocated by the first frame of [`Method::QuadtreeTiles`] (up
+    /// to [`Settings::MAX_TILE_LIST_BYTES`]), so that the other methods pay nothing for them.
+    tile_lists: OnceCell<TileLists>,
+    /// What group 3 holds until then: lists of one slot.
+    no_tile_lists: TileLists,
+    tile_layout: wgpu::BindGroupLayout,
+    /// To allocate the tile lists when first drawn.
+    device: wgpu::Device,
     /// The method whose frames the temporal filter's history averages; `None` when it holds
     /// nothing to continue from.
     history_of: Cell<Option<Method>>,
@@ -195,8 +221,14 @@ impl Gather {
                 storage_entry::<[f32; 4]>(7, true),
                 storage_entry::<[u32; 4]>(8, false),
                 storage_entry::<[f32; 4]>(9, false),
-                storage_entry::<u32>(10, false),
-                storage_entry::<[u32; 2]>(11, false),
+            ],
+        );
+        let tile_layout = layout(
+            device,
+            "per-tile cuts",
+            &[
+                storage_entry::<u32>(0, false),
+                storage_entry::<[u32; 4]>(1, false),
             ],
         );
         let dispatch_layout = layout(
@@ -208,12 +240,13 @@ impl Gather {
             ],
         );
         let module = shader_module(device, "gather", &SOURCES);
-        let pipelines = pipeline_layout(device, &[&light_layout, &frame_layout, &dispatch_layout]);
+        let pipelines = pipeline_layout(
+            device,
+            &[&light_layout, &frame_layout, &dispatch_layout, &tile_layout],
+        );
         let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry);
         let pixels = u64::from(s.width) * u64::from(s.height);
         let (lw, lh) = low_size(s);
-        let (tx, ty) = tiles(s);
-        let tile_count = u64::from(tx) * u64::from(ty);
         let samples = baselines::rsm_samples(
             s.samples,
             s.rsm_radius * s.rsm_size as f32 * std::f32::consts::SQRT_2,
@@ -240,8 +273,6 @@ impl Gather {
                     0
                 },
             ),
-            tile_cuts: storage_buffer(device, "per-tile cuts", tile_list_bytes(s)),
-            tile_sizes: storage_buffer(device, "per-tile cut sizes", tile_count * 8),
         };
         let slots = Slots::new(device, "gather slots", MAX_SLICES);
         Ok(Self {
@@ -265,6 +296,10 @@ impl Gather {
                 &dispatch_layout,
                 vec![slots.binding(), slots.binding()],
             ),
+            tile_lists: OnceCell::new(),
+            no_tile_lists: TileLists::new(device, &tile_layout, 4, 1),
+            tile_layout,
+            device: device.clone(),
             light_layout,
             frame_layout,
             light,
@@ -344,7 +379,8 @@ impl Gather {
                 tile_capacity: s.tile_capacity,
                 tile_start: tile_start_level(s),
                 tiles_x: tiles(s).0,
-                _pad: [0; 3],
+                tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
+                _pad: [0; 2],
                 camera: [[0.0; 4]; 4],
                 eye: [0.0; 4],
             })[..CAMERA_OFFSET],
@@ -369,6 +405,24 @@ impl Gather {
             (CAMERA_OFFSET + size_of::<[[f32; 4]; 4]>()) as u64,
             bytemuck::bytes_of(&camera.1),
         );
+    }
+
+    /// Binds the light's, the frame's and the tile lists' groups (the lists allocated first if
+    /// `method` draws them).
+    fn bind_groups(&self, pass: &mut wgpu::ComputePass, method: Option<Method>) {
+        pass.set_bind_group(0, &self.light_group, &[]);
+        pass.set_bind_group(1, &self.frame_group, &[]);
+        let lists = if method == Some(Method::QuadtreeTiles) {
+            self.tile_lists.get_or_init(|| {
+                let (tx, ty) = tiles(&self.settings);
+                let tiles = u64::from(tx) * u64::from(ty);
+                let cuts = tile_list_bytes(&self.settings);
+                TileLists::new(&self.device, &self.tile_layout, cuts, tiles)
+            })
+        } else {
+            self.tile_lists.get().unwrap_or(&self.no_tile_lists)
+        };
+        pass.set_bind_group(3, &lists.group, &[]);
     }
 
     fn bind(&self, pass: &mut wgpu::ComputePass, level: u32, slice: u32) {
@@ -418,8 +472,7 @@ impl Gather {
         {
             let stamps = timer.and_then(|(t, slot, _)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "indirect", stamps);
-            pass.set_bind_group(0, &self.light_group, &[]);
-            pass.set_bind_group(1, &self.frame_group, &[]);
+            self.bind_groups(&mut pass, Some(method));
             // the sum over `items` in slices; the first slice writes, the others add
             let sliced = |pass: &mut wgpu::ComputePass, level: u32, count: u32, w, h| {
                 for slice in 0..count {
@@ -470,8 +523,7 @@ impl Gather {
             // samples, in the same slices
             let stamps = timer.and_then(|(t, _, slot)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "upsample", stamps);
-            pass.set_bind_group(0, &self.light_group, &[]);
-            pass.set_bind_group(1, &self.frame_group, &[]);
+            self.bind_groups(&mut pass, Some(method));
             pass.set_pipeline(upsample);
             for slice in 0..low_slices {
                 self.bind(&mut pass, 0, slice);
@@ -509,8 +561,7 @@ impl Gather {
     ) {
         let stamps = timer.and_then(|(t, slot)| t.compute_pass(slot));
         let mut pass = compute_pass(encoder, "direct", stamps);
-        pass.set_bind_group(0, &self.light_group, &[]);
-        pass.set_bind_group(1, &self.frame_group, &[]);
+        self.bind_groups(&mut pass, None);
         self.bind(&mut pass, 0, 0);
         pass.set_pipeline(&self.direct_light);
         dispatch_2d(&mut pass, self.settings.width, self.settings.height);
@@ -537,13 +588,10 @@ impl Gather {
         &self.outputs.counts
     }
 
-    /// Per tile, the last per-tile cuts' node indices (`tile_capacity` `u32` slots a tile).
-    pub(crate) fn tile_cuts(&self) -> &wgpu::Buffer {
-        &self.outputs.tile_cuts
-    }
-
-    /// Per tile, its list's length and its refused splits (`[u32; 2]`).
-    pub(crate) fn tile_sizes(&self) -> &wgpu::Buffer {
-        &self.outputs.tile_sizes
+    /// The last per-tile cuts, `None` before the first frame of [`Method::QuadtreeTiles`]: per
+    /// tile, its node indices (`tile_capacity` `u32` slots a tile), and its list's length,
+    /// refused splits, nodes estimated and the estimates' VPL evaluations (`[u32; 4]`).
+    pub(crate) fn tile_lists(&self) -> Option<(&wgpu::Buffer, &wgpu::Buffer)> {
+        self.tile_lists.get().map(|t| (&t.cuts, &t.sizes))
     }
 }

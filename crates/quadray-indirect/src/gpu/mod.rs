@@ -105,6 +105,48 @@ impl std::str::FromStr for Method {
     }
 }
 
+/// When a per-tile cut splits a node ([`Settings::tile_criterion`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TileCriterion {
+    /// While an upper bound of its irradiance at any receiver of the tile exceeds
+    /// [`Settings::tile_error`] of the tile's estimated irradiance (Lightcuts).
+    Bound,
+    /// While the estimated error of keeping it, the largest |E(node) - sum of E(children)| at
+    /// the tile's sample pixels (those of the tile's estimate), exceeds that; nodes whose bound
+    /// is already below it are kept without an estimate.
+    Estimate,
+}
+
+impl TileCriterion {
+    /// Both criteria, in the order the CLI lists them.
+    pub const ALL: [TileCriterion; 2] = [TileCriterion::Bound, TileCriterion::Estimate];
+
+    /// The default [`Settings::tile_error`] of the criterion (see BENCHMARKS.md, "Per-tile
+    /// cuts"): a node's estimated error is far below its bound.
+    pub fn default_error(self) -> f32 {
+        match self {
+            TileCriterion::Bound => 0.05,
+            TileCriterion::Estimate => 0.002,
+        }
+    }
+
+    /// The criterion's name on the command line and in the stats (`--tile-criterion`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TileCriterion::Bound => "bound",
+            TileCriterion::Estimate => "estimate",
+        }
+    }
+}
+
+impl std::str::FromStr for TileCriterion {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "tile criterion")
+    }
+}
+
 /// Which clusters count as valid (see the spec).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -215,13 +257,16 @@ pub struct Settings {
     pub temporal_weight: f32,
     /// Per-tile cuts ([`Method::QuadtreeTiles`]): a node is split while an upper bound of its
     /// irradiance at any pixel of the tile exceeds this fraction of the tile's estimated
-    /// irradiance (0: every VPL on its own).
+    /// irradiance (0: every VPL on its own), or while its estimated error does
+    /// ([`Settings::tile_criterion`]).
     pub tile_error: f32,
+    /// Per-tile cuts: what is compared with [`Settings::tile_error`] of the tile's irradiance.
+    pub tile_criterion: TileCriterion,
     /// Per-tile cuts: the most nodes a tile's cut may hold (1..=1024); past it refinement stops
     /// (counted in [`WorkCounts::refused_splits`]). The lists take 4 bytes a node and tile of
-    /// GPU memory, allocated by every [`Gather`] whatever the method, at most
+    /// GPU memory, allocated by a [`Gather`]'s first frame of [`Method::QuadtreeTiles`], at most
     /// [`Self::MAX_TILE_LIST_BYTES`] ([`Self::tile_capacity_for`] keeps the default within
-    /// [`Self::DEFAULT_TILE_LIST_BYTES`]); set 1 where the per-tile cuts are never drawn.
+    /// [`Self::DEFAULT_TILE_LIST_BYTES`]).
     pub tile_capacity: u32,
 }
 
@@ -246,13 +291,11 @@ impl Settings {
             shadow_steps: 0,
             shadow_thickness: 0.1,
             temporal_weight: 1.0,
-            tile_error: Self::TILE_ERROR,
+            tile_error: TileCriterion::Bound.default_error(),
+            tile_criterion: TileCriterion::Bound,
             tile_capacity: Self::tile_capacity_for(width, height),
         }
     }
-
-    /// The default [`Settings::tile_error`] (see BENCHMARKS.md, "Per-tile cuts").
-    pub const TILE_ERROR: f32 = 0.05;
 
     /// The largest [`Settings::tile_capacity`], what a tile's frontier holds in workgroup memory.
     pub const MAX_TILE_CAPACITY: u32 = contract::TILE_FRONTIER;
@@ -260,9 +303,8 @@ impl Settings {
     /// Bytes the per-tile cuts' lists may take, a storage buffer every adapter binds.
     pub const MAX_TILE_LIST_BYTES: u64 = 128 << 20;
 
-    /// Bytes the per-tile cuts' lists take by default at most: every [`Gather`] allocates them,
-    /// whatever the method. A large picture's tiles cover less of the scene and need fewer
-    /// clusters (BENCHMARKS.md, "Per-tile cuts").
+    /// Bytes the per-tile cuts' lists take by default at most. A large picture's tiles cover
+    /// less of the scene and need fewer clusters (BENCHMARKS.md, "Per-tile cuts").
     pub const DEFAULT_TILE_LIST_BYTES: u64 = 32 << 20;
 
     /// The default [`Settings::tile_capacity`] of a `width` x `height` picture: the largest

@@ -295,24 +295,45 @@ impl<'g> Renderer<'g> {
     }
 
     /// The per-tile cuts of the last [`Method::QuadtreeTiles`] frame: each tile's clusters (tiles
-    /// of 8x8 pixels, row-major; empty where the tile sees no geometry), in no order.
+    /// of 8x8 pixels, row-major; empty where the tile sees no geometry), in no order; no tiles
+    /// before the first such frame.
     pub fn read_tile_cuts(&self) -> Result<Vec<Vec<CutNode>>, IndirectError> {
-        let read = |buffer| -> Result<Vec<u32>, IndirectError> {
-            Ok(bytemuck::pod_collect_to_vec(&quadray_gpu::read_buffer(
-                self.gpu, buffer,
-            )?))
-        };
-        let sizes = read(self.gather.tile_sizes())?;
-        let lists = read(self.gather.tile_cuts())?;
         let s = self.settings();
         let capacity = s.tile_capacity as usize;
-        let (tx, ty) = super::gather::tiles(s);
-        Ok((0..(tx * ty) as usize)
-            .map(|tile| {
-                let list = &lists[tile * capacity..][..sizes[2 * tile] as usize];
+        let Some((sizes, lists)) = self.read_tile_lists()? else {
+            return Ok(Vec::new());
+        };
+        Ok(sizes
+            .iter()
+            .enumerate()
+            .map(|(tile, size)| {
+                let list = &lists[tile * capacity..][..size[0] as usize];
                 list.iter().map(|&i| CutNode::at(s.rsm_size, i)).collect()
             })
             .collect())
+    }
+
+    /// Per tile of the last [`Method::QuadtreeTiles`] frame (as [`Self::read_tile_cuts`]), the
+    /// nodes whose error it estimated ([`crate::TileCriterion::Estimate`]) and the VPL
+    /// evaluations that took (counted in [`WorkCounts::vpl_evaluations`] too).
+    pub fn read_tile_estimates(&self) -> Result<Vec<(u32, u32)>, IndirectError> {
+        Ok(self.read_tile_lists()?.map_or_else(Vec::new, |(sizes, _)| {
+            sizes.iter().map(|s| (s[2], s[3])).collect()
+        }))
+    }
+
+    /// The per-tile cuts' records (length, refused splits, nodes estimated, their evaluations) and
+    /// lists, `None` before the first frame that drew them.
+    #[allow(clippy::type_complexity)]
+    fn read_tile_lists(&self) -> Result<Option<(Vec<[u32; 4]>, Vec<u32>)>, IndirectError> {
+        let Some((cuts, sizes)) = self.gather.tile_lists() else {
+            return Ok(None);
+        };
+        let read = |buffer| quadray_gpu::read_buffer(self.gpu, buffer);
+        let (tx, ty) = super::gather::tiles(self.settings());
+        let mut sizes: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&read(sizes)?);
+        sizes.truncate((tx * ty) as usize);
+        Ok(Some((sizes, bytemuck::pod_collect_to_vec(&read(cuts)?))))
     }
 
     /// The RSM's flux per texel, row-major (what the cut clusters).

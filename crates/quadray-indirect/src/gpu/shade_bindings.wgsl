@@ -20,13 +20,14 @@ struct Shade {
     shadow_thickness: f32,
     // weight of this frame in the running average of the indirect light (1: no filter)
     temporal_weight: f32,
-    // per-tile cuts: a node is split while its bound exceeds `tile_error` of the tile's
-    // irradiance estimated from the nodes of level `tile_start`; at most `tile_capacity` nodes
-    // a tile; tiles in a row of the picture
+    // per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its estimated
+    // error) exceeds `tile_error` of the tile's irradiance estimated from the nodes of level
+    // `tile_start`; at most `tile_capacity` nodes a tile; tiles in a row of the picture
     tile_error: f32,
     tile_capacity: u32,
     tile_start: u32,
     tiles_x: u32,
+    tile_estimate: u32,
     // the camera the G-buffer was rendered from (set with the camera, not with the light)
     camera: mat4x4<f32>,
     eye: vec4<f32>,
@@ -58,14 +59,16 @@ struct Shade {
 @group(1) @binding(8) var<storage, read_write> counts: array<vec4<u32>>;
 // the running average of the indirect light over the last frames (rgb)
 @group(1) @binding(9) var<storage, read_write> history: array<vec4<f32>>;
-// per-tile cuts: each tile's node indices (`tile_capacity` slots a tile), and per tile the
-// nodes it holds and the splits refused for want of room
-@group(1) @binding(10) var<storage, read_write> tile_cuts: array<u32>;
-@group(1) @binding(11) var<storage, read_write> tile_sizes: array<vec2<u32>>;
 // Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
 @group(2) @binding(1) var<uniform> slice: Level;
+// Group 3, the per-tile cuts' lists (bound only once a frame draws them; a placeholder of one
+// slot before): each tile's node indices (`tile_capacity` slots a tile), and per tile the nodes
+// it holds, the splits refused for want of room, the nodes whose error it estimated and the VPL
+// evaluations that took
+@group(3) @binding(0) var<storage, read_write> tile_cuts: array<u32>;
+@group(3) @binding(1) var<storage, read_write> tile_sizes: array<vec4<u32>>;
 
 struct Receiver {
     x: vec3<f32>,
