@@ -103,6 +103,23 @@ fn store_tile_counts(pixel: vec2<u32>, inside: bool, local: u32) {
     }
 }
 
+// The box of the positions and the summed normals (w: how many) of the tile's receivers where
+// `member`, left in reduce_lo[0], reduce_hi[0] and reduce_n[0]. Every invocation calls it.
+fn reduce_receivers(local: u32, r: Receiver, member: bool) {
+    reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, member);
+    reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, member);
+    reduce_n[local] = select(vec4<f32>(0.0), vec4<f32>(r.n, 1.0), member);
+    workgroupBarrier();
+    for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
+        if (local < stride) {
+            reduce_lo[local] = min(reduce_lo[local], reduce_lo[local + stride]);
+            reduce_hi[local] = max(reduce_hi[local], reduce_hi[local + stride]);
+            reduce_n[local] += reduce_n[local + stride];
+        }
+        workgroupBarrier();
+    }
+}
+
 @compute @workgroup_size(TILE, TILE)
 fn indirect_tiles(
     @builtin(global_invocation_id) id: vec3<u32>,
@@ -117,9 +134,6 @@ fn indirect_tiles(
     // an uncovered pixel far away: never the one nearest a node
     tile_x[local] = select(vec3<f32>(EMPTY_BOX), r.x, r.covered);
     tile_n[local] = r.n;
-    reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, r.covered);
-    reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, r.covered);
-    reduce_n[local] = select(vec4<f32>(0.0), vec4<f32>(r.n, 1.0), r.covered);
     if (local < 4u) {
         atomicStore(&quadrant_pixel[local], TILE_PIXELS);
     }
@@ -139,17 +153,10 @@ fn indirect_tiles(
         atomicStore(&estimated_nodes, 0u);
         atomicStore(&estimate_evaluations, 0u);
     }
-    workgroupBarrier();
+    // (its first barrier also publishes the stores above before the atomicMin below)
+    reduce_receivers(local, r, r.covered);
     if (r.covered) {
         atomicMin(&quadrant_pixel[(local % TILE) / (TILE / 2u) + 2u * (local / (TILE_PIXELS / 2u))], local);
-    }
-    for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
-        if (local < stride) {
-            reduce_lo[local] = min(reduce_lo[local], reduce_lo[local + stride]);
-            reduce_hi[local] = max(reduce_hi[local], reduce_hi[local + stride]);
-            reduce_n[local] += reduce_n[local + stride];
-        }
-        workgroupBarrier();
     }
     let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
     if (workgroupUniformLoad(&reduce_n[0]).w == 0.0) {
@@ -172,19 +179,7 @@ fn indirect_tiles(
     var group_axis: array<vec3<f32>, 2>;
     for (var g = 0u; g < 2u; g++) {
         workgroupBarrier();
-        let member = r.covered && group == g;
-        reduce_lo[local] = select(vec3<f32>(EMPTY_BOX), r.x, member);
-        reduce_hi[local] = select(vec3<f32>(-EMPTY_BOX), r.x, member);
-        reduce_n[local] = select(vec4<f32>(0.0), vec4<f32>(r.n, 1.0), member);
-        workgroupBarrier();
-        for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
-            if (local < stride) {
-                reduce_lo[local] = min(reduce_lo[local], reduce_lo[local + stride]);
-                reduce_hi[local] = max(reduce_hi[local], reduce_hi[local + stride]);
-                reduce_n[local] += reduce_n[local + stride];
-            }
-            workgroupBarrier();
-        }
+        reduce_receivers(local, r, r.covered && group == g);
         group_lo[g] = reduce_lo[0];
         group_hi[g] = reduce_hi[0];
         let sum_n = reduce_n[0].xyz;
