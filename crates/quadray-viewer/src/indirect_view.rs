@@ -11,7 +11,9 @@ use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, tone_map};
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
-use quadray_indirect::{ClusterSettings, FrameTiming, Method, Renderer, Scene, Settings, Validity};
+use quadray_indirect::{
+    ClusterSettings, FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity,
+};
 use std::path::{Path, PathBuf};
 
 /// What the view shows.
@@ -325,6 +327,13 @@ impl IndirectView {
         if !c.flux_weighted {
             cmd += " --unweighted-means";
         }
+        if self.method == Method::QuadtreeTiles {
+            cmd += &format!(
+                " --tile-criterion {} --tile-error {}",
+                s.tile_criterion.name(),
+                s.tile_error
+            );
+        }
         if s.shadow_steps > 0 {
             cmd += &format!(
                 " --indirect-shadows --shadow-steps {} --shadow-thickness {}",
@@ -419,8 +428,20 @@ impl IndirectView {
                 .text("RSM samples"),
         );
         ui.add(egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling"));
+        let criterion = s.tile_criterion;
+        choice_box(
+            ui,
+            "tile criterion (quadtree-tiles)",
+            &mut s.tile_criterion,
+            &TileCriterion::ALL,
+            |c| c.name().into(),
+        );
+        if s.tile_criterion != criterion {
+            // the two criteria compare different things with the fraction
+            s.tile_error = s.tile_criterion.default_error();
+        }
         ui.add(
-            egui::Slider::new(&mut s.tile_error, 0.005..=1.0)
+            egui::Slider::new(&mut s.tile_error, 0.0002..=1.0)
                 .logarithmic(true)
                 .text("tile error (quadtree-tiles)"),
         );

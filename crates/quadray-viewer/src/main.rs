@@ -65,7 +65,7 @@ pub struct Args {
     /// An indirect-light scene file of your own (shown beside the bundled ones).
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// Indirect light: quadtree, quadtree-passes, rsm or reference.
+    /// Indirect light: quadtree, quadtree-passes, quadtree-tiles, rsm or reference.
     #[arg(long, default_value = "quadtree")]
     indirect_method: quadray_indirect::Method,
     /// Indirect light: what the view shows.
