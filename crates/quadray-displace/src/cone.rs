@@ -27,7 +27,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::path::Path;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 /// The ratio stored where no exit bounds the cone (a flat map): a step then reaches the texel's
 /// top, as an unbounded cone would, while every product in the shader stays finite.
@@ -151,6 +151,18 @@ impl ConeMap {
         addressing: Addressing,
         row_done: impl Fn() + Sync,
     ) -> Self {
+        Self::build_unless_cancelled(map, addressing, row_done, &AtomicBool::new(false))
+            .expect("never cancelled")
+    }
+
+    /// As [`ConeMap::build_with_progress`], with rows left unbuilt once `cancelled` is set; then
+    /// `None`. A build takes minutes on big maps, and a viewer that moved on drops it.
+    fn build_unless_cancelled(
+        map: &HeightMap,
+        addressing: Addressing,
+        row_done: impl Fn() + Sync,
+        cancelled: &AtomicBool,
+    ) -> Option<Self> {
         let field = Field {
             map,
             addressing,
@@ -180,6 +192,9 @@ impl ConeMap {
         let texels = (0..field.height)
             .into_par_iter()
             .flat_map_iter(|y| {
+                if cancelled.load(Ordering::Relaxed) {
+                    return Vec::new();
+                }
                 let row: Vec<[f32; 2]> = (0..field.width)
                     .map(|x| {
                         let ds = field.depth(x, y);
@@ -190,11 +205,14 @@ impl ConeMap {
                 row
             })
             .collect();
-        Self {
+        if cancelled.load(Ordering::Relaxed) {
+            return None;
+        }
+        Some(Self {
             width: map.width,
             height: map.height,
             texels,
-        }
+        })
     }
 
     /// The cone map as the texture `cone.wgsl` reads: Rg32Float, one mip, (depth, ratio).
@@ -211,30 +229,37 @@ impl ConeMap {
 }
 
 /// A cone map built on a thread of its own, so that an interactive program keeps drawing while it
-/// builds (quadray's viewer shows its progress).
+/// builds (quadray's viewer shows its progress). Dropping the job stops the build: its thread
+/// skips the rows not yet started and ends.
 pub struct ConeMapJob {
     rows_done: Arc<AtomicU32>,
     rows: u32,
-    thread: std::thread::JoinHandle<(ConeMap, f64)>,
+    cancelled: Arc<AtomicBool>,
+    // `None` only once `finish` has taken it.
+    thread: Option<std::thread::JoinHandle<Option<(ConeMap, f64)>>>,
 }
 
 impl ConeMapJob {
     /// Starts building the cone map of `map` for rays addressed as `addressing` says.
     pub fn spawn(map: HeightMap, addressing: Addressing) -> Self {
         let rows_done = Arc::new(AtomicU32::new(0));
+        let cancelled = Arc::new(AtomicBool::new(false));
         let counter = Arc::clone(&rows_done);
+        let stop = Arc::clone(&cancelled);
         let rows = map.height;
         let thread = std::thread::spawn(move || {
             let start = std::time::Instant::now();
-            let cones = ConeMap::build_with_progress(&map, addressing, || {
+            let row_done = || {
                 counter.fetch_add(1, Ordering::Relaxed);
-            });
-            (cones, start.elapsed().as_secs_f64())
+            };
+            ConeMap::build_unless_cancelled(&map, addressing, row_done, &stop)
+                .map(|cones| (cones, start.elapsed().as_secs_f64()))
         });
         Self {
             rows_done,
             rows,
-            thread,
+            cancelled,
+            thread: Some(thread),
         }
     }
 
@@ -245,14 +270,22 @@ impl ConeMapJob {
 
     /// Whether the build has ended, so that [`ConeMapJob::finish`] returns at once.
     pub fn is_finished(&self) -> bool {
-        self.thread.is_finished()
+        self.thread.as_ref().is_none_or(|t| t.is_finished())
     }
 
     /// The cone map and the seconds its build took, waiting for the build if it is still on.
-    pub fn finish(self) -> (ConeMap, f64) {
-        self.thread
+    pub fn finish(mut self) -> (ConeMap, f64) {
+        let thread = self.thread.take().expect("taken only here");
+        thread
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            .expect("only a dropped job is cancelled")
+    }
+}
+
+impl Drop for ConeMapJob {
+    fn drop(&mut self) {
+        self.cancelled.store(true, Ordering::Relaxed);
     }
 }
 
@@ -416,6 +449,34 @@ mod tests {
             rows.fetch_add(1, Ordering::Relaxed);
         });
         assert_eq!(rows.into_inner(), 9);
+    }
+
+    #[test]
+    fn a_dropped_job_stops_building() {
+        let map = random_map(16, 256, 11, 3);
+        let cancelled = AtomicBool::new(false);
+        let rows = AtomicU32::new(0);
+        let cones = ConeMap::build_unless_cancelled(
+            &map,
+            Addressing::Wrap,
+            || {
+                // cancelled once the first rows are done, as a viewer dropping its job would
+                if rows.fetch_add(1, Ordering::Relaxed) == 2 {
+                    cancelled.store(true, Ordering::Relaxed);
+                }
+            },
+            &cancelled,
+        );
+        assert!(cones.is_none());
+        assert!(
+            rows.into_inner() < 256,
+            "every row was built after the cancel"
+        );
+        // A job sets the flag when dropped: its build (seconds at 1024^2) ends without a map.
+        let mut job = ConeMapJob::spawn(random_map(1024, 1024, 5, 4), Addressing::Wrap);
+        let thread = job.thread.take().expect("running");
+        drop(job);
+        assert!(thread.join().unwrap().is_none());
     }
 
     #[test]
