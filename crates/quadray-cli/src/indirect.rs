@@ -75,6 +75,11 @@ pub struct IndirectArgs {
     /// over the threshold).
     #[arg(long, default_value = Settings::default().tile_criterion.name())]
     tile_criterion: TileCriterion,
+    /// quadtree-tiles: gather a cluster farther from the tile's pixels than this times their
+    /// extent once at each corner of the tile and interpolate it (a receiver hierarchy; 0:
+    /// every pixel evaluates every cluster).
+    #[arg(long, default_value_t = Settings::default().tile_share)]
+    tile_share: f32,
     /// quadtree-tiles: the most clusters a tile's cut holds (1..1024; past it refinement
     /// stops, counted as refused_splits); default: 1024, less where the picture's lists would
     /// take over 32 MiB (256 at 1920x1080).
@@ -171,6 +176,7 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             .tile_error
             .unwrap_or(args.tile_criterion.default_error()),
         tile_criterion: args.tile_criterion,
+        tile_share: args.tile_share,
         tile_capacity: args
             .tile_capacity
             .unwrap_or(Settings::tile_capacity_for(args.size.0, args.size.1)),

@@ -107,7 +107,7 @@ fn per_tile_cuts_report_their_bounds_and_clusters() {
     let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
     assert!(rel_l1 > 0.0 && rel_l1 < 0.05, "{rel_l1}");
 
-    // the estimate criterion, at its own default error
+    // the estimate criterion, at its own default error, with receiver sharing
     quadray_writes(
         &[
             "indirect",
@@ -115,6 +115,8 @@ fn per_tile_cuts_report_their_bounds_and_clusters() {
             "quadtree-tiles",
             "--tile-criterion",
             "estimate",
+            "--tile-share",
+            "2",
             "--rsm-size",
             "32",
             "--size",
@@ -128,6 +130,7 @@ fn per_tile_cuts_report_their_bounds_and_clusters() {
     );
     let json = read_json(&stats);
     assert_eq!(json["settings"]["tile_criterion"], "estimate");
+    assert_eq!(json["settings"]["tile_share"].as_f64(), Some(2.0));
     let tile_error = json["settings"]["tile_error"].as_f64().unwrap();
     assert!((tile_error - 0.002).abs() < 1e-6, "{tile_error}");
     let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
@@ -140,7 +143,7 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
     let out = dir.join("x.png");
     let scene = dir.join("bad.toml");
     std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();
-    let cases: [(Vec<&str>, &str); 10] = [
+    let cases: [(Vec<&str>, &str); 12] = [
         (vec!["--scene", scene.to_str().unwrap()], "bad.toml"),
         (vec!["--scene", "/nonexistent/scene.toml"], "scene.toml"),
         (vec!["--rsm-size", "100"], "power of two"),
@@ -154,6 +157,8 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         (vec!["--tile-capacity", "0"], "tile capacity 0"),
         (vec!["--tile-error=-1"], "tile error -1"),
         (vec!["--tile-criterion", "exact"], "tile criterion"),
+        (vec!["--tile-share", "NaN"], "tile share NaN"),
+        (vec!["--tile-share=-2"], "tile share -2"),
     ];
     for (extra, needle) in cases {
         let mut args = vec![

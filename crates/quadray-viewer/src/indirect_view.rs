@@ -329,9 +329,10 @@ impl IndirectView {
         }
         if self.method == Method::QuadtreeTiles {
             cmd += &format!(
-                " --tile-criterion {} --tile-error {}",
+                " --tile-criterion {} --tile-error {} --tile-share {}",
                 s.tile_criterion.name(),
-                s.tile_error
+                s.tile_error,
+                s.tile_share
             );
         }
         if s.shadow_steps > 0 {
@@ -444,6 +445,10 @@ impl IndirectView {
             egui::Slider::new(&mut s.tile_error, 0.0002..=1.0)
                 .logarithmic(true)
                 .text("tile error (quadtree-tiles)"),
+        );
+        ui.add(
+            egui::Slider::new(&mut s.tile_share, 0.0..=8.0)
+                .text("shared beyond, tile extents (quadtree-tiles, 0: off)"),
         );
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)

@@ -8,7 +8,7 @@ use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, tone_map};
 use quadray_indirect::reference::{compare, error_map, ground_truth};
 use quadray_indirect::scene::scenes_dir;
-use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
+use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings, TileCriterion};
 use std::path::{Path, PathBuf};
 
 const EXPOSURE: f32 = 1.0;
@@ -153,32 +153,63 @@ pub fn render_demo(
 const SHADOW_STEPS: u32 = 8;
 
 /// The leak scene's indirect light without and with indirect shadows, beside one bounce from
-/// every VPL with exact visibility (the ground truth on the CPU; a 32^2 RSM keeps it to seconds).
+/// every VPL with exact visibility (the ground truth on the CPU; a 32^2 RSM keeps it to seconds):
+/// the one cut marching from every pixel, then the per-tile cuts (estimate, far clusters shared)
+/// marching from the tiles' corners, with the latter's error against the ground truth.
 fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join("leak.toml"))?;
-    let rsm_size = 32;
-    let plain = Settings::sized(size, size, rsm_size);
-    let mut r = Renderer::new(gpu, &scene, plain.clone())?;
-    let leaky = r.render_frame(Method::Quadtree)?.indirect;
-    let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
-    let shadowed_settings = Settings {
-        shadow_steps: SHADOW_STEPS,
-        ..plain
+    let plain = Settings::sized(size, size, 32);
+    let tiled = Settings {
+        tile_criterion: TileCriterion::Estimate,
+        tile_error: TileCriterion::Estimate.default_error(),
+        tile_share: 2.0,
+        ..plain.clone()
     };
-    let shadowed = Renderer::new(gpu, &scene, shadowed_settings)?
-        .render_frame(Method::Quadtree)?
-        .indirect;
+    // (a frame first: it renders the RSM and the G-buffer the ground truth reads)
+    let mut r = Renderer::new(gpu, &scene, plain.clone())?;
+    r.render_frame(Method::Quadtree)?;
+    let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
+    let indirect = |settings: &Settings, method, shadow_steps| {
+        let settings = Settings {
+            shadow_steps,
+            ..settings.clone()
+        };
+        Ok::<_, IndirectError>(
+            Renderer::new(gpu, &scene, settings)?
+                .render_frame(method)?
+                .indirect,
+        )
+    };
+    let rows = [
+        ("one cut", &plain, Method::Quadtree),
+        ("per-tile", &tiled, Method::QuadtreeTiles),
+    ];
     let tile = |v: &[[f32; 3]]| tone_map(size, size, v, EXPOSURE);
     let l1 = |v: &[[f32; 3]]| compare(v, &truth).rel_l1;
-    let picture = montage(
-        &[
-            (format!("no shadow L1 {:.2}", l1(&leaky)), tile(&leaky)),
-            (format!("shadows L1 {:.2}", l1(&shadowed)), tile(&shadowed)),
-            ("ground truth".into(), tile(&truth)),
-        ],
-        3,
-    );
-    save(&picture, path)
+    let mut pictures = Vec::new();
+    for (name, settings, method) in rows {
+        let (leaky, shadowed) = (
+            indirect(settings, method, 0)?,
+            indirect(settings, method, SHADOW_STEPS)?,
+        );
+        pictures.push((
+            format!("{name}, no shadow L1 {:.2}", l1(&leaky)),
+            tile(&leaky),
+        ));
+        pictures.push((
+            format!("{name}, shadows L1 {:.2}", l1(&shadowed)),
+            tile(&shadowed),
+        ));
+        if method == Method::Quadtree {
+            pictures.push(("ground truth".into(), tile(&truth)));
+        } else {
+            pictures.push((
+                "error of per-tile shadows".into(),
+                heat_map(size, size, &error_map(&shadowed, &truth), 0.5),
+            ));
+        }
+    }
+    save(&montage(&pictures, 3), path)
 }
 
 fn save(image: &Rgba8Image, path: &Path) -> Result<PathBuf, IndirectError> {

@@ -35,7 +35,10 @@ const SUBSAMPLES: [u32; 4] = [1, 2, 4, 8];
 const TILE_ERRORS: [f32; 5] = [1.0, 0.5, 0.2, 0.05, 0.02];
 /// Error fractions of the per-tile cuts split by the estimated error, which is far below the
 /// bound at the same node (BENCHMARKS.md, "Per-tile cuts").
-const ESTIMATE_ERRORS: [f32; 4] = [0.01, 0.002, 0.0005, 0.0002];
+const ESTIMATE_ERRORS: [f32; 6] = [0.01, 0.002, 0.0005, 0.0002, 0.0001, 0.00005];
+/// Receiver sharing of the per-tile cuts split by the estimated error (`Settings::tile_share`,
+/// 0: off): clusters farther than this many tile extents are gathered at the tile's corners.
+const TILE_SHARES: [f32; 3] = [0.0, 2.0, 3.0];
 /// RSM sample counts swept, up to where sampling reaches the quadtree's error.
 const SAMPLES: [u32; 10] = [16, 64, 216, 512, 1024, 2040, 4096, 8192, 16384, 32768];
 
@@ -71,7 +74,8 @@ impl EqualErrorOptions {
 /// One method at one setting: its error and its cost.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
-    /// The method's setting ("default", "paper", "tiles E", "estimate E", "N samples").
+    /// The method's setting ("default", "paper", "tiles E", "estimate E", "estimate+shareF E",
+    /// "N samples").
     pub label: String,
     /// One gather per `subsample`^2 pixels (1: full resolution).
     pub subsample: u32,
@@ -241,21 +245,26 @@ fn scene_result(
         }
     }
     let tile_runs = TILE_ERRORS
-        .map(|e| (TileCriterion::Bound, e, "tiles"))
+        .map(|e| (TileCriterion::Bound, e, 0.0))
         .into_iter()
-        .chain(ESTIMATE_ERRORS.map(|e| (TileCriterion::Estimate, e, "estimate")));
-    for (tile_criterion, tile_error, name_of) in tile_runs {
-        progress(&format!("{name}: per-tile cuts, {name_of} {tile_error}"));
+        .chain(
+            TILE_SHARES
+                .into_iter()
+                .flat_map(|share| ESTIMATE_ERRORS.map(|e| (TileCriterion::Estimate, e, share))),
+        );
+    for (tile_criterion, tile_error, tile_share) in tile_runs {
+        let label = format!("{} {tile_error}", tile_family(tile_criterion, tile_share));
+        progress(&format!("{name}: per-tile cuts, {label}"));
         let mut r = Renderer::new(
             gpu,
             scene,
             Settings {
                 tile_error,
                 tile_criterion,
+                tile_share,
                 ..base.clone()
             },
         )?;
-        let label = format!("{name_of} {tile_error}");
         quadtree.push(measure(
             &mut r,
             Method::QuadtreeTiles,
@@ -451,7 +460,31 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             });
             series.push(Series {
                 name: format!("{} {}^2 quadtree, subsample {k}", s.scene, s.rsm_size),
-                points: points(&mut s.comparisons.iter().map(|c| &c.quadtree).filter(at)),
+                points: points(
+                    &mut s
+                        .comparisons
+                        .iter()
+                        .map(|c| &c.quadtree)
+                        .filter(at)
+                        // the one cut ("default", "paper"); the per-tile cuts follow
+                        .filter(|p| !p.label.contains(' ')),
+                ),
+            });
+        }
+        // the per-tile cuts (full resolution), a line for each criterion and sharing
+        let mut families: Vec<&str> = Vec::new();
+        for c in &s.comparisons {
+            if let Some((family, _)) = c.quadtree.label.rsplit_once(' ')
+                && !families.contains(&family)
+            {
+                families.push(family);
+            }
+        }
+        for family in families {
+            let of = |p: &&Point| p.label.rsplit_once(' ').is_some_and(|(f, _)| f == family);
+            series.push(Series {
+                name: format!("{} {}^2 per-tile cuts, {family}", s.scene, s.rsm_size),
+                points: points(&mut s.comparisons.iter().map(|c| &c.quadtree).filter(of)),
             });
         }
     }
@@ -467,6 +500,16 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
         &series,
     )?;
     Ok(())
+}
+
+/// The name of the per-tile cuts' rows of a criterion and sharing, before their error
+/// fraction: "tiles" (the bound), "estimate", "estimate+share2".
+fn tile_family(criterion: TileCriterion, share: f32) -> String {
+    match (criterion, share > 0.0) {
+        (TileCriterion::Bound, _) => "tiles".into(),
+        (TileCriterion::Estimate, false) => "estimate".into(),
+        (TileCriterion::Estimate, true) => format!("estimate+share{share}"),
+    }
 }
 
 #[cfg(test)]

@@ -82,3 +82,15 @@ fn vpl_irradiance(flux: vec3<f32>, xp: vec3<f32>, np: vec3<f32>, x: vec3<f32>, n
     let d2 = max(dot(d, d), r_min * r_min);
     return flux * (max(0.0, dot(np, d)) * max(0.0, dot(n, -d)) / (PI * d2 * d2));
 }
+
+// The vector irradiance at x from a VPL or cluster: `vpl_irradiance` without the receiver's
+// cosine, one column a colour channel, so that transpose(V) * n is `vpl_irradiance` for every
+// receiver normal n that faces the VPL (per-tile cuts gather far clusters this way once per
+// tile corner and interpolate).
+fn vpl_vector(flux: vec3<f32>, xp: vec3<f32>, np: vec3<f32>, x: vec3<f32>, r_min: f32) -> mat3x3<f32> {
+    evaluations++;
+    let d = x - xp;
+    let d2 = max(dot(d, d), r_min * r_min);
+    let v = -d * (max(0.0, dot(np, d)) / (PI * d2 * d2));
+    return mat3x3<f32>(v * flux.r, v * flux.g, v * flux.b);
+}

@@ -118,8 +118,9 @@ pub(crate) struct ShadeUniform {
     pub tile_start: u32,
     pub tiles_x: u32,
     pub tile_estimate: u32,
+    pub tile_share: f32,
     /// Up to the camera's 16-byte alignment.
-    pub _pad: [u32; 2],
+    pub _pad: [u32; 1],
     /// Written by `Gather::set_camera`, the fields before by `Gather::set_light`.
     pub camera: [[f32; 4]; 4],
     pub eye: [f32; 4],
@@ -436,6 +437,7 @@ mod tests {
                     tile_start,
                     tiles_x,
                     tile_estimate,
+                    tile_share,
                     camera,
                     eye
                 ]

@@ -246,6 +246,9 @@ pub struct Settings {
     pub subsample: u32,
     /// Indirect shadows for the quadtree methods: points marched between each receiver and
     /// cluster, tested against the camera's and the light's depth (0: none, as in the paper).
+    /// The per-tile cuts march from each tile's four corner receivers only, and a pixel weighs
+    /// each cluster by the corners' visibility interpolated (a pixel off the corners' surface,
+    /// across a depth edge, marches its own).
     pub shadow_steps: u32,
     /// How far behind a surface a depth map sees a marched point counts as inside an occluder,
     /// as a fraction of the scene's extent.
@@ -268,6 +271,12 @@ pub struct Settings {
     /// [`Self::MAX_TILE_LIST_BYTES`] ([`Self::tile_capacity_for`] keeps the default within
     /// [`Self::DEFAULT_TILE_LIST_BYTES`]).
     pub tile_capacity: u32,
+    /// Per-tile cuts: a node of a tile's cut farther from the tile's receivers than this times
+    /// their box's diagonal (and in front of the tile's corner receivers) is evaluated once at
+    /// each corner of the tile, as vector irradiance, and interpolated bilinearly to its pixels
+    /// (a receiver hierarchy, as in Multidimensional Lightcuts); pixels off the corners'
+    /// surface evaluate it themselves. 0: every pixel evaluates every node.
+    pub tile_share: f32,
 }
 
 impl Default for Settings {
@@ -294,6 +303,7 @@ impl Settings {
             tile_error: TileCriterion::Bound.default_error(),
             tile_criterion: TileCriterion::Bound,
             tile_capacity: Self::tile_capacity_for(width, height),
+            tile_share: 0.0,
         }
     }
 
@@ -392,6 +402,9 @@ impl Settings {
         }
         if !(s.tile_error.is_finite() && s.tile_error >= 0.0) {
             return Err(format!("tile error {} must be >= 0", s.tile_error));
+        }
+        if !(s.tile_share.is_finite() && (0.0..=1000.0).contains(&s.tile_share)) {
+            return Err(format!("tile share {} must be in 0..1000", s.tile_share));
         }
         if !(1..=Self::MAX_TILE_CAPACITY).contains(&s.tile_capacity) {
             return Err(format!(

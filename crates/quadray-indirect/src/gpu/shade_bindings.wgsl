@@ -28,6 +28,9 @@ struct Shade {
     tile_start: u32,
     tiles_x: u32,
     tile_estimate: u32,
+    // per-tile cuts: nodes farther than this times the tile's receivers' diagonal are gathered
+    // at the tile's corners and interpolated (0: every pixel evaluates every node)
+    tile_share: f32,
     // the camera the G-buffer was rendered from (set with the camera, not with the light)
     camera: mat4x4<f32>,
     eye: vec4<f32>,
@@ -98,10 +101,10 @@ fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
 }
 
 // Whether `p` lies in the thin layer (bias, thickness) behind the surface a depth map sees in
-// its direction: the G-buffer from the camera or the RSM from the light (world units).
-fn inside_occluder(p: vec3<f32>) -> bool {
+// its direction: the G-buffer from the camera or the RSM from the light (world units). `c` and
+// `l` are p's clip coordinates in the camera's and the light's view.
+fn inside_occluder(p: vec3<f32>, c: vec4<f32>, l: vec4<f32>) -> bool {
     let bias = 0.1 * shade.shadow_thickness;
-    let c = shade.camera * vec4<f32>(p, 1.0);
     let uv = vec2<f32>(c.x / c.w * 0.5 + 0.5, 0.5 - c.y / c.w * 0.5);
     if (c.w > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0))) {
         fetches++;
@@ -112,7 +115,6 @@ fn inside_occluder(p: vec3<f32>) -> bool {
             return true;
         }
     }
-    let l = light.view_proj * vec4<f32>(p, 1.0);
     let st = vec2<f32>(l.x / l.w * 0.5 + 0.5, 0.5 - l.y / l.w * 0.5);
     if (l.w > 0.0 && all(st >= vec2<f32>(0.0)) && all(st < vec2<f32>(1.0))) {
         fetches++;
@@ -126,15 +128,20 @@ fn inside_occluder(p: vec3<f32>) -> bool {
 }
 
 // Approximate visibility between a receiver and a cluster: no point marched between them is
-// inside an occluder as the camera's or the light's depth sees it.
+// inside an occluder as the camera's or the light's depth sees it. Clip coordinates are linear
+// along the segment, so the ends are projected once and the points' interpolated.
 fn visible(x: vec3<f32>, xp: vec3<f32>) -> bool {
+    let camera = array<vec4<f32>, 2>(shade.camera * vec4<f32>(x, 1.0), shade.camera * vec4<f32>(xp, 1.0));
+    let lit = array<vec4<f32>, 2>(light.view_proj * vec4<f32>(x, 1.0), light.view_proj * vec4<f32>(xp, 1.0));
     for (var i = 1u; i <= shade.shadow_steps; i++) {
-        if (inside_occluder(mix(x, xp, f32(i) / f32(shade.shadow_steps + 1u)))) {
+        let t = f32(i) / f32(shade.shadow_steps + 1u);
+        if (inside_occluder(mix(x, xp, t), mix(camera[0], camera[1], t), mix(lit[0], lit[1], t))) {
             return false;
         }
     }
     return true;
 }
+
 // Splits of a per-tile cut refused because the tile's list was full (counted once a tile).
 var<private> refused_splits: u32;
 

@@ -85,6 +85,93 @@ fn estimated_error(node: Node, at: u32, size: u32, level: u32) -> f32 {
     return error;
 }
 
+// Receiver sharing (`tile_share` > 0, Multidimensional Lightcuts' idea with the tile as the
+// receiver cluster): a node of the tile's list farther than `tile_share` times the diagonal of
+// the tile's receivers' box, and in front of the planes of the tile's four corner receivers, is
+// evaluated once per corner as vector irradiance (linear in the receiver's normal) and
+// interpolated bilinearly over the tile: its light varies slowly across the tile.
+const SHARED: u32 = 0x80000000u;
+const CORNERS: array<u32, 4> = array<u32, 4>(0u, TILE - 1u, TILE_PIXELS - TILE, TILE_PIXELS - 1u);
+var<workgroup> shared_count: atomic<u32>;
+var<workgroup> shared_total: u32;
+
+fn all_corners_covered() -> bool {
+    for (var c = 0u; c < 4u; c++) {
+        if (tile_x[CORNERS[c]].x >= EMPTY_BOX) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// Whether a node with bounds `b` is farther than `far` from the box [lo, hi] and wholly in front
+// of every corner receiver.
+fn shareable(b: NodeBounds, lo: vec3<f32>, hi: vec3<f32>, far: f32) -> bool {
+    let gap = max(vec3<f32>(0.0), max(b.lo.xyz - hi, lo - b.hi.xyz));
+    if (dot(gap, gap) <= far * far) {
+        return false;
+    }
+    let centre = 0.5 * (b.lo.xyz + b.hi.xyz);
+    let half = 0.5 * (b.hi.xyz - b.lo.xyz);
+    for (var c = 0u; c < 4u; c++) {
+        let n = tile_n[CORNERS[c]];
+        if (dot(n, centre - tile_x[CORNERS[c]]) - dot(abs(n), half) <= 0.0) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// Indirect shadows per tile: bit c set where the point `p` (a node's mean) is visible from the
+// tile's corner receiver c (shade.wgsl's march); a pixel on the corners' surface weighs each of
+// its tile's nodes by the corners' visibility interpolated, so that a tile marches four shadow
+// rays a node instead of one a pixel.
+fn corner_visibility(p: vec3<f32>) -> u32 {
+    var seen = 0u;
+    for (var c = 0u; c < 4u; c++) {
+        if (visible(tile_x[CORNERS[c]], p)) {
+            seen |= 1u << c;
+        }
+    }
+    return seen;
+}
+
+// The shared nodes' vector irradiance at each corner receiver (with indirect shadows, those the
+// corner sees): a quarter of the workgroup per
+// corner, each thread a share of the nodes, then summed per corner (one colour channel in each
+// of the reduction arrays). Every invocation calls it.
+fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat3x3<f32>, 4> {
+    let x = tile_x[CORNERS[local % 4u]];
+    var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var i = local / 4u; i < listed; i += TILE_PIXELS / 4u) {
+        let entry = frontier[0][i];
+        if ((entry & SHARED) != 0u) {
+            fetches++;
+            let node = nodes[entry & ~SHARED];
+            // (evaluated either way, as a pixel's own sum does before its shadow test)
+            let seen = !corner_shadows || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
+            v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, shade.r_min) * f32(seen);
+        }
+    }
+    reduce_lo[local] = v[0];
+    reduce_hi[local] = v[1];
+    reduce_n[local] = vec4<f32>(v[2], 0.0);
+    workgroupBarrier();
+    for (var stride = TILE_PIXELS / 2u; stride >= 4u; stride >>= 1u) {
+        if (local < stride) {
+            reduce_lo[local] += reduce_lo[local + stride];
+            reduce_hi[local] += reduce_hi[local + stride];
+            reduce_n[local] += reduce_n[local + stride];
+        }
+        workgroupBarrier();
+    }
+    var corners: array<mat3x3<f32>, 4>;
+    for (var c = 0u; c < 4u; c++) {
+        corners[c] = mat3x3<f32>(reduce_lo[c], reduce_hi[c], reduce_n[c].xyz);
+    }
+    return corners;
+}
+
 // Stores every thread's counts: those outside the picture's with the tile's first pixel.
 fn store_tile_counts(pixel: vec2<u32>, inside: bool, local: u32) {
     if (!inside) {
@@ -347,21 +434,93 @@ fn indirect_tiles(
         workgroupBarrier();
     }
 
-    // the gather: the list copied once into workgroup memory (the frontier's, free now), then
-    // every pixel sums its nodes
+    // the gather: the list copied once into workgroup memory (the frontier's, free now), far
+    // nodes marked to be shared, with indirect shadows each node's visibility from the tile's
+    // corners, then every pixel sums its nodes
     storageBarrier();
     let listed = atomicLoad(&list_len);
     let base = tile * shade.tile_capacity;
-    for (var i = local; i < listed; i += TILE_PIXELS) {
-        fetches++;
-        frontier[0][i] = tile_cuts[base + i];
+    let tile_lo = min(group_lo[0], group_lo[1]);
+    let tile_hi = max(group_hi[0], group_hi[1]);
+    let corners_covered = all_corners_covered();
+    let sharing = shade.tile_share > 0.0 && corners_covered;
+    let corner_shadows = shade.shadow_steps > 0u && corners_covered;
+    // how far a shared node must be from the tile's receivers' box
+    let far = shade.tile_share * length(tile_hi - tile_lo);
+    if (local == 0u) {
+        atomicStore(&shared_count, 0u);
     }
     workgroupBarrier();
+    for (var i = local; i < listed; i += TILE_PIXELS) {
+        fetches++;
+        var index = tile_cuts[base + i];
+        if (corner_shadows) {
+            fetches++;
+            frontier[1][i] = corner_visibility(nodes[index].pos.xyz);
+        }
+        if (sharing) {
+            fetches++;
+            if (shareable(bounds[index], tile_lo, tile_hi, far)) {
+                index |= SHARED;
+                atomicAdd(&shared_count, 1u);
+            }
+        }
+        frontier[0][i] = index;
+    }
+    workgroupBarrier();
+    if (local == 0u) {
+        shared_total = atomicLoad(&shared_count);
+    }
+    let shared_nodes = workgroupUniformLoad(&shared_total);
+    var corner_vectors: array<mat3x3<f32>, 4>;
+    if (shared_nodes > 0u) {
+        corner_vectors = gather_at_corners(local, listed, corner_shadows);
+    }
     var irradiance = vec3<f32>(0.0);
     if (r.covered) {
+        // where the pixel lies on the corners' bilinear patch it takes the shared nodes
+        // interpolated (else, across a depth edge, it evaluates them too), and with shadows the
+        // visibility of the corners on its own surface (none: it marches its own shadow rays)
+        let t = vec2<f32>(f32(local % TILE), f32(local / TILE)) / f32(TILE - 1u);
+        let w = vec4<f32>((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);
+        var on_patch = false;
+        var seen_weights = vec4<f32>(0.0);
+        if (corners_covered) {
+            var x = vec3<f32>(0.0);
+            for (var c = 0u; c < 4u; c++) {
+                let corner = CORNERS[c];
+                x += w[c] * tile_x[corner];
+                let same_surface = dot(tile_n[corner], r.n) > shade.normal_agreement
+                    && abs(dot(r.x - tile_x[corner], tile_n[corner])) < shade.plane_agreement;
+                seen_weights[c] = select(0.0, max(w[c], 1e-3), same_surface);
+            }
+            on_patch = distance(x, r.x) <= shade.plane_agreement;
+            if (on_patch) {
+                seen_weights = w;
+            }
+        }
+        let seen_total = seen_weights.x + seen_weights.y + seen_weights.z + seen_weights.w;
+        let corner_seen = corner_shadows && seen_total > 0.0;
+        seen_weights /= max(seen_total, 1e-6);
+        if (shared_nodes > 0u && on_patch) {
+            var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+            for (var c = 0u; c < 4u; c++) {
+                v += corner_vectors[c] * w[c];
+            }
+            irradiance += max(vec3<f32>(0.0), r.n * v);
+        }
         for (var i = 0u; i < listed; i++) {
-            fetches++;
-            irradiance += node_irradiance(nodes[frontier[0][i]], r);
+            let entry = frontier[0][i];
+            if ((entry & SHARED) == 0u || !on_patch) {
+                fetches++;
+                let node = nodes[entry & ~SHARED];
+                if (corner_seen) {
+                    let seen = vec4<f32>((vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u)) & vec4<u32>(1u));
+                    irradiance += dot(seen_weights, seen) * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, shade.r_min);
+                } else {
+                    irradiance += node_irradiance(node, r);
+                }
+            }
         }
     }
     if (inside) {
