@@ -180,9 +180,10 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
                 .indirect,
         )
     };
+    // (short captions: the demo's smallest pictures are 128 pixels wide)
     let rows = [
         ("one cut", &plain, Method::Quadtree),
-        ("per-tile", &tiled, Method::QuadtreeTiles),
+        ("tiles", &tiled, Method::QuadtreeTiles),
     ];
     let tile = |v: &[[f32; 3]]| tone_map(size, size, v, EXPOSURE);
     let l1 = |v: &[[f32; 3]]| compare(v, &truth).rel_l1;
@@ -192,19 +193,13 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
             indirect(settings, method, 0)?,
             indirect(settings, method, SHADOW_STEPS)?,
         );
-        pictures.push((
-            format!("{name}, no shadow L1 {:.2}", l1(&leaky)),
-            tile(&leaky),
-        ));
-        pictures.push((
-            format!("{name}, shadows L1 {:.2}", l1(&shadowed)),
-            tile(&shadowed),
-        ));
+        pictures.push((format!("{name}, L1 {:.2}", l1(&leaky)), tile(&leaky)));
+        pictures.push((format!("shadows, L1 {:.2}", l1(&shadowed)), tile(&shadowed)));
         if method == Method::Quadtree {
             pictures.push(("ground truth".into(), tile(&truth)));
         } else {
             pictures.push((
-                "error of per-tile shadows".into(),
+                "error (shadows)".into(),
                 heat_map(size, size, &error_map(&shadowed, &truth), 0.5),
             ));
         }
