@@ -255,6 +255,18 @@ pub fn bench_equal_error(
     Ok(())
 }
 
+/// `quadray bench indirect --cut-study`.
+pub fn bench_cut_study(size: u32, rsm_size: u32, scenes: &[String], out: &Path) -> Result<()> {
+    let gpu = Gpu::new()?;
+    let bar = crate::spinner("bench indirect --cut-study");
+    quadray_bench::indirect::cut_study::run(&gpu, out, size, rsm_size, scenes, |m| {
+        bar.set_message(format!("bench indirect --cut-study: {m}"))
+    })?;
+    bar.finish_and_clear();
+    println!("{}", std::fs::read_to_string(out.join("cut_study.md"))?);
+    Ok(())
+}
+
 /// The indirect-light pictures of `quadray demo`.
 pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
     let bar = crate::spinner("indirect light");

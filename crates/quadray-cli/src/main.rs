@@ -89,7 +89,13 @@ enum Bench {
         /// fetches and time, on every bundled scene (image side 128, quick 64).
         #[arg(long)]
         equal_error: bool,
-        /// With --equal-error: only this bundled scene (file stem, e.g. cornell; repeatable).
+        /// Only the CPU study of the per-tile cuts: how their error and size depend on the split
+        /// criterion (children, grandchildren, an oracle) and the cluster's representative (point,
+        /// second order), on the Cornell box or the --scene given (image side 128, RSM 256).
+        #[arg(long, conflicts_with = "equal_error")]
+        cut_study: bool,
+        /// With --equal-error or --cut-study: only this bundled scene (file stem, e.g. cornell;
+        /// repeatable).
         #[arg(long = "scene")]
         scenes: Vec<String>,
         #[arg(long, default_value = "out/bench/indirect")]
@@ -181,11 +187,19 @@ fn main() -> Result<()> {
                     size,
                     rsm_size,
                     equal_error,
+                    cut_study,
                     scenes,
                     out,
                 },
         } => {
-            if equal_error {
+            if cut_study {
+                indirect::bench_cut_study(
+                    size.unwrap_or(128),
+                    rsm_size.unwrap_or(256),
+                    &scenes,
+                    &out,
+                )?
+            } else if equal_error {
                 let options = quadray_bench::indirect::equal_error::EqualErrorOptions::new(
                     quick, size, rsm_size, scenes,
                 );

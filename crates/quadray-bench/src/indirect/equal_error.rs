@@ -207,6 +207,27 @@ fn compare_at_error(quadtree: Point, rsm: &[Point]) -> Comparison {
     }
 }
 
+/// The bundled scenes of the technique named by file stem (empty: all of them), in [`SCENES`]'s
+/// order; an unknown name is refused.
+pub(crate) fn bundled_scenes(names: &[String]) -> Result<Vec<Scene>, IndirectError> {
+    if let Some(unknown) = names.iter().find(|s| {
+        !SCENES
+            .iter()
+            .any(|f| f.trim_end_matches(".toml") == s.as_str())
+    }) {
+        return Err(IndirectError::Settings(format!(
+            "no bundled scene `{unknown}` (cornell, cornell_bunny, cornell_buddha, atrium, leak)"
+        )));
+    }
+    SCENES
+        .into_iter()
+        .filter(|file| {
+            names.is_empty() || names.iter().any(|s| s == file.trim_end_matches(".toml"))
+        })
+        .map(|file| Scene::load(&scenes_dir().join(file)).map_err(IndirectError::from))
+        .collect()
+}
+
 fn scene_result(
     gpu: &Gpu,
     scene: &Scene,
@@ -325,21 +346,7 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<EqualErrorResults, IndirectError> {
     let mut scenes = Vec::new();
-    let chosen = |file: &str| {
-        let stem = file.trim_end_matches(".toml");
-        options.scenes.is_empty() || options.scenes.iter().any(|s| s == stem)
-    };
-    if let Some(unknown) = options.scenes.iter().find(|s| {
-        !SCENES
-            .iter()
-            .any(|f| f.trim_end_matches(".toml") == s.as_str())
-    }) {
-        return Err(IndirectError::Settings(format!(
-            "no bundled scene `{unknown}` (cornell, cornell_bunny, cornell_buddha, atrium, leak)"
-        )));
-    }
-    for file in SCENES.into_iter().filter(|f| chosen(f)) {
-        let scene = Scene::load(&scenes_dir().join(file))?;
+    for scene in bundled_scenes(&options.scenes)? {
         for &rsm_size in &options.rsm_sizes {
             let base = Settings::sized(options.size, options.size, rsm_size);
             scenes.push(scene_result(
