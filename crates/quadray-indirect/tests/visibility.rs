@@ -5,7 +5,7 @@
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::{brute_force, compare, ground_truth};
 use quadray_indirect::scene::scenes_dir;
-use quadray_indirect::{Method, Renderer, Scene, Settings, TileCriterion};
+use quadray_indirect::{Frame, Method, Renderer, Scene, Settings, TileCriterion};
 
 /// 48x48 pixels and a 32^2 RSM: the ground truth traces 2.4M rays.
 fn small() -> Settings {
@@ -47,6 +47,47 @@ fn the_leak_scene_leaks_without_visibility_and_the_ground_truth_stops_it() {
     assert!(e.rel_l1 > 0.05, "{e:?}");
 }
 
+/// `method`'s frames without and with indirect shadows (8 marched points) at `settings`, and the
+/// ground truth with visibility.
+fn without_and_with_shadows(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &Settings,
+    method: Method,
+) -> (Frame, Frame, Vec<[f32; 3]>) {
+    let mut r = Renderer::new(gpu, scene, settings.clone()).unwrap();
+    let plain = r.render_frame(method).unwrap();
+    let truth = ground_truth(&r.read_vpls().unwrap(), &r.read_receivers().unwrap(), scene);
+    let shadowed = Renderer::new(gpu, scene, shadowed(settings))
+        .unwrap()
+        .render_frame(method)
+        .unwrap();
+    (plain, shadowed, truth)
+}
+
+fn shadowed(settings: &Settings) -> Settings {
+    Settings {
+        shadow_steps: 8,
+        ..settings.clone()
+    }
+}
+
+/// Shadows take at least 30% of `what`'s error to the ground truth away, with the same
+/// evaluations and more fetches.
+fn assert_shadows_help(what: &str, plain: &Frame, shadowed: &Frame, truth: &[[f32; 3]]) {
+    let (before, after) = (
+        compare(&plain.indirect, truth).rel_l1,
+        compare(&shadowed.indirect, truth).rel_l1,
+    );
+    println!("{what}: rel_l1 to the ground truth {before:.4} -> {after:.4}");
+    assert!(after < 0.7 * before, "{what}: {before} -> {after}");
+    assert_eq!(
+        shadowed.counts.vpl_evaluations,
+        plain.counts.vpl_evaluations
+    );
+    assert!(shadowed.counts.texel_fetches > plain.counts.texel_fetches);
+}
+
 /// Indirect shadows (marching against the camera's and the light's depth) bring the quadtree
 /// closer to the ground truth on the leak scene and the Cornell box, with the same cut, and so
 /// do the per-tile cuts' shadows marched from the tiles' corners.
@@ -55,70 +96,28 @@ fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     for file in ["leak.toml", "cornell.toml"] {
         let scene = Scene::load(&scenes_dir().join(file)).unwrap();
-        let settings = small();
-        let mut r = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
-        let plain = r.render_frame(Method::Quadtree).unwrap();
-        let truth = ground_truth(
-            &r.read_vpls().unwrap(),
-            &r.read_receivers().unwrap(),
-            &scene,
-        );
-        let shadowed_settings = Settings {
-            shadow_steps: 8,
-            ..settings
-        };
-        let mut s = Renderer::new(&gpu, &scene, shadowed_settings).unwrap();
-        let shadowed = s.render_frame(Method::Quadtree).unwrap();
-        let passes = s.render_frame(Method::QuadtreePasses).unwrap();
-        let (before, after) = (
-            compare(&plain.indirect, &truth).rel_l1,
-            compare(&shadowed.indirect, &truth).rel_l1,
-        );
-        println!("{file}: rel_l1 to the ground truth {before:.4} -> {after:.4}");
-        assert!(after < 0.7 * before, "{file}: {before} -> {after}");
-        assert_eq!(
-            shadowed.counts.vpl_evaluations,
-            plain.counts.vpl_evaluations
-        );
-        assert!(shadowed.counts.texel_fetches > plain.counts.texel_fetches);
+        let (plain, with, truth) =
+            without_and_with_shadows(&gpu, &scene, &small(), Method::Quadtree);
+        assert_shadows_help(file, &plain, &with, &truth);
         // the per-level passes shadow the same clusters the same way
-        assert!(compare(&passes.indirect, &shadowed.indirect).rel_max < 1e-4);
+        let passes = Renderer::new(&gpu, &scene, shadowed(&small()))
+            .unwrap()
+            .render_frame(Method::QuadtreePasses)
+            .unwrap();
+        assert!(compare(&passes.indirect, &with.indirect).rel_max < 1e-4);
 
         // per-tile cuts (with far clusters shared): each tile marches from its corners, and
         // pixels weigh each cluster by the corners' visibility interpolated; at 96x96, where a
         // tile spans a twelfth of the picture (at 48x48 the Cornell box's error only falls
         // 0.187 -> 0.144)
-        let sized = Settings {
+        let tiled = Settings {
             tile_criterion: TileCriterion::Estimate,
             tile_error: TileCriterion::Estimate.default_error(),
             tile_share: 2.0,
             ..Settings::sized(96, 96, 32)
         };
-        let mut r = Renderer::new(&gpu, &scene, sized.clone()).unwrap();
-        let plain = r.render_frame(Method::QuadtreeTiles).unwrap();
-        let truth = ground_truth(
-            &r.read_vpls().unwrap(),
-            &r.read_receivers().unwrap(),
-            &scene,
-        );
-        let shadowed_settings = Settings {
-            shadow_steps: 8,
-            ..sized
-        };
-        let shadowed = Renderer::new(&gpu, &scene, shadowed_settings)
-            .unwrap()
-            .render_frame(Method::QuadtreeTiles)
-            .unwrap();
-        let (before, after) = (
-            compare(&plain.indirect, &truth).rel_l1,
-            compare(&shadowed.indirect, &truth).rel_l1,
-        );
-        println!("{file}, per-tile cuts: rel_l1 to the ground truth {before:.4} -> {after:.4}");
-        assert!(after < 0.7 * before, "{file}: {before} -> {after}");
-        assert_eq!(
-            shadowed.counts.vpl_evaluations,
-            plain.counts.vpl_evaluations
-        );
-        assert!(shadowed.counts.texel_fetches > plain.counts.texel_fetches);
+        let (plain, with, truth) =
+            without_and_with_shadows(&gpu, &scene, &tiled, Method::QuadtreeTiles);
+        assert_shadows_help(&format!("{file}, per-tile cuts"), &plain, &with, &truth);
     }
 }
