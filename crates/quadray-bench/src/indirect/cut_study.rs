@@ -2,7 +2,8 @@
 //! CPU from what the GPU rendered (the RSM's texels and the G-buffer, read back). Every 8x8 tile
 //! refines the quadtree from its root as `--method quadtree-tiles --tile-criterion estimate`
 //! does (the coarse estimate from the start level's nodes at the first covered pixel of each
-//! quadrant, every node above the start level split, below it a node split while its error at
+//! quadrant, every node down to the start level split (the shader splits
+//! those by its bound, which is far above the threshold there), below it a node split while its error at
 //! those pixels and at the tile's receiver nearest it exceeds `tau` of the estimate; no bound,
 //! no list capacity), with three ways to know a node's error:
 //! - children: |E(node) - sum E(children)|, the shader's estimate;
@@ -261,7 +262,7 @@ fn tile_cut(
         if !node.lit {
             continue;
         }
-        let split = at.0 > start
+        let split = at.0 >= start
             || (at.0 > 0 && {
                 let nearest = receivers
                     .iter()
