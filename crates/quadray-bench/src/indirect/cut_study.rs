@@ -32,6 +32,9 @@ use std::path::Path;
 const TAUS: [f64; 5] = [0.01, 0.002, 0.0005, 0.0002, 0.00005];
 /// The tile's side in pixels (the shader's `TILE`).
 const TILE: usize = 8;
+/// Pixel and VPL pairs the CPU brute force (and the oracle, as much again) may sum: the
+/// default 128x128 picture over a 256^2 RSM is 2^30, about 20 s a scene on two cores.
+const MAX_PAIRS: u64 = 1 << 32;
 
 /// How a node's error is known when deciding to split it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -456,6 +459,13 @@ pub fn run(
     scenes: &[String],
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<StudyScene>, IndirectError> {
+    let pairs = u64::from(size).pow(2) * u64::from(rsm_size).pow(2);
+    if pairs > MAX_PAIRS {
+        return Err(IndirectError::Settings(format!(
+            "the cut study sums every VPL at every pixel on the CPU: {size}x{size} pixels x {rsm_size}^2 VPLs is {pairs:.3e} pairs, over the limit of {:.3e}; use a smaller --size or --rsm-size",
+            MAX_PAIRS as f64
+        )));
+    }
     let chosen = if scenes.is_empty() {
         vec!["cornell".to_string()]
     } else {
