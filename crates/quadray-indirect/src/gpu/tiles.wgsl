@@ -123,7 +123,7 @@ fn shareable(b: NodeBounds, lo: vec3<f32>, hi: vec3<f32>, far: f32) -> bool {
 }
 
 // Indirect shadows per tile: bit c set where the point `p` (a node's mean) is visible from the
-// tile's corner receiver c (shade.wgsl's march); a pixel on the corners' surface weighs each of
+// tile's corner receiver c (`visible`, shade_bindings.wgsl); a pixel on the corners' surface weighs each of
 // its tile's nodes by the corners' visibility interpolated, so that a tile marches four shadow
 // rays a node instead of one a pixel.
 fn corner_visibility(p: vec3<f32>) -> u32 {
@@ -137,9 +137,9 @@ fn corner_visibility(p: vec3<f32>) -> u32 {
 }
 
 // The shared nodes' vector irradiance at each corner receiver (with indirect shadows, those the
-// corner sees): a quarter of the workgroup per
-// corner, each thread a share of the nodes, then summed per corner (one colour channel in each
-// of the reduction arrays). Every invocation calls it.
+// corner sees): a quarter of the workgroup per corner, each thread a share of the nodes, then
+// summed per corner (one colour channel in each of the reduction arrays). Every invocation
+// calls it.
 fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat3x3<f32>, 4> {
     let x = tile_x[CORNERS[local % 4u]];
     var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
