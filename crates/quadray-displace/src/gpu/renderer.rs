@@ -235,8 +235,8 @@ impl Renderer {
                 Lod::Auto => -1,
                 Lod::Level(l) => l.min(self.map.levels()) as i32,
             },
-            layers_min: s.layers.0 as f32,
-            layers_max: s.layers.1 as f32,
+            layers_min: s.layers.min as f32,
+            layers_max: s.layers.max as f32,
             binary_steps: s.binary_steps,
             shadows: u32::from(s.shadows),
             show_iterations: u32::from(s.show_iterations),
@@ -248,7 +248,13 @@ impl Renderer {
     fn targets(gpu: &Gpu, s: &Settings, debug_outputs: bool) -> Vec<wgpu::Texture> {
         let make = |format, label| {
             let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-            texture_2d(&gpu.device, label, (s.width, s.height), format, usage)
+            texture_2d(
+                &gpu.device,
+                label,
+                (s.size.width, s.size.height),
+                format,
+                usage,
+            )
         };
         let mut t = vec![make(COLOR_FORMAT, "color"), make(DEPTH_FORMAT, "depth")];
         if debug_outputs {
@@ -271,7 +277,7 @@ impl Renderer {
         self.prepare(gpu, method);
         let map_group = match (&self.cone, method) {
             (Some((cone_group, _)), Method::Cone) => cone_group,
-            _ if method.uses_conservative_pyramid() => &self.conservative_group,
+            _ if method.describe().conservative_pyramid => &self.conservative_group,
             _ => &self.point_group,
         };
         let geometry = if method == Method::Mesh {
@@ -357,8 +363,8 @@ impl Renderer {
         };
         Ok(Frame {
             color: Rgba8Image::from_bytes(
-                s.width,
-                s.height,
+                s.size.width,
+                s.size.height,
                 &read_texture_rgba8(gpu, &targets[0])?,
             ),
             hits: pixels(read_texture_f32(gpu, &targets[2], 0, 4)?),
