@@ -12,7 +12,7 @@ use crate::heightmap::HeightMap;
 use crate::method::Method;
 use crate::pyramid::Addressing;
 use crate::scene::{Plane, SurfaceKind, View};
-use crate::{DisplaceError, Lod, Settings};
+use crate::{DisplaceError, Settings};
 use quadray_core::image_out::Rgba8Image;
 use quadray_core::stats::Summary;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32, read_texture_rgba8, texture_2d};
@@ -225,23 +225,7 @@ impl Renderer {
     }
 
     fn write_frame(&self, gpu: &Gpu, s: &Settings, view: &View) {
-        let v4 = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
-        let params = FrameParams {
-            view_proj: view.view_proj.to_cols_array_2d(),
-            eye: v4(view.eye),
-            light: v4(view.light),
-            depth_scale: s.depth_scale,
-            lod: match s.lod {
-                Lod::Auto => -1,
-                Lod::Level(l) => l.min(self.map.levels()) as i32,
-            },
-            layers_min: s.layers.min as f32,
-            layers_max: s.layers.max as f32,
-            binary_steps: s.binary_steps,
-            shadows: u32::from(s.shadows),
-            show_iterations: u32::from(s.show_iterations),
-            _pad: 0,
-        };
+        let params = FrameParams::new(s, view, self.map.levels());
         self.pass.write_frame(&gpu.queue, &params);
     }
 
