@@ -82,6 +82,7 @@ impl FromStr for Layers {
     }
 }
 
+/// The size check `validate()` and `--size` share.
 fn check_size(size: &Size) -> Result<(), String> {
     size.check(Settings::SIDE)
 }
@@ -201,7 +202,7 @@ impl Settings {
     /// Refuses parameters that would make no picture or an absurd amount of work.
     pub fn validate(&self) -> Result<(), String> {
         Self::VIEW_ANGLE.check("view angle", self.view_angle_deg)?;
-        self.size.check(Self::SIDE)?;
+        check_size(&self.size)?;
         Self::DEPTH_SCALE.check("depth scale", self.depth_scale)?;
         self.layers.check()?;
         Self::BINARY_STEPS.check("binary steps", self.binary_steps)?;
