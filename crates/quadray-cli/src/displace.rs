@@ -8,7 +8,7 @@ use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::maps::load_color;
 use quadray_displace::pyramid::Addressing;
 use quadray_displace::scene::SurfaceKind;
-use quadray_displace::{Lod, Method, Renderer, Settings};
+use quadray_displace::{Method, Renderer, Settings};
 use quadray_gpu::Gpu;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -18,44 +18,8 @@ pub struct DisplaceArgs {
     /// Height map: 8/16-bit PNG or float EXR, any size up to 8192x8192.
     #[arg(long)]
     map: PathBuf,
-    /// pyramid, pyramid-ascend, pyramid-bilinear, bump, parallax, pom, relief, cone (relaxed cone
-    /// stepping; builds its cone map first) or mesh.
-    #[arg(long, default_value = "pyramid")]
-    method: Method,
-    /// Angle between the view direction at the surface centre and the normal (0..89).
-    #[arg(long, default_value_t = 45.0)]
-    view_angle: f32,
-    /// Image size WxH.
-    #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
-    size: (u32, u32),
-    /// Texture units per unit of depth (Bevy's default 0.1).
-    #[arg(long, default_value_t = 0.1)]
-    depth_scale: f32,
-    /// POM / relief layers MIN,MAX (head-on .. grazing). Bevy: 1,16; Godot: 8,32; three.js: 20,25.
-    /// Cone stepping takes MAX as its number of cone steps.
-    #[arg(long, default_value = "8,32", value_parser = parse_layers)]
-    layers: (u32, u32),
-    /// Relief mapping's and cone stepping's binary search steps (three.js: 5).
-    #[arg(long, default_value_t = 5)]
-    binary_steps: u32,
-    /// Finest pyramid level: `auto` (from screen-space derivatives) or a level number.
-    #[arg(long, default_value = "0")]
-    lod: Lod,
-    /// Self-shadowing by tracing from the light.
-    #[arg(long)]
-    shadows: bool,
-    /// Camera azimuth around the surface normal, degrees.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
-    azimuth: f32,
-    /// Camera distance as a multiple of the default.
-    #[arg(long, default_value_t = 1.0)]
-    zoom: f32,
-    /// Light azimuth around the surface normal, degrees.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
-    light_azimuth: f32,
-    /// Colour pixels by the iterations their search took (0..64: black, red, yellow, white).
-    #[arg(long)]
-    show_iterations: bool,
+    #[command(flatten)]
+    settings: Settings,
     /// Compare every pixel with the CPU ground truth; writes an error heat map beside --out.
     #[arg(long)]
     reference: bool,
@@ -82,21 +46,16 @@ pub struct DisplaceArgs {
     stats: Option<PathBuf>,
 }
 
-fn parse_layers(s: &str) -> Result<(u32, u32), String> {
-    quadray_core::parse_pair(s, ',', "MIN,MAX")
-}
-
+/// The stats JSON: the settings' own fields (method, width, height, view_angle_deg, ...), then
+/// what was measured.
 #[derive(Serialize)]
 struct Stats<'a> {
-    method: Method,
-    width: u32,
-    height: u32,
+    #[serde(flatten)]
+    settings: &'a Settings,
     map: &'a Path,
     /// The map's width and height in texels.
     map_size: [u32; 2],
     surface: SurfaceKind,
-    view_angle_deg: f32,
-    depth_scale: f32,
     adapter: String,
     gpu_time_ms: Option<f64>,
     frames: usize,
@@ -115,29 +74,8 @@ struct Stats<'a> {
     error_map: Option<PathBuf>,
 }
 
-impl DisplaceArgs {
-    /// The library's settings these flags spell (`Settings::to_args` spells them back).
-    fn settings(&self) -> Settings {
-        Settings {
-            method: self.method,
-            view_angle_deg: self.view_angle,
-            width: self.size.0,
-            height: self.size.1,
-            depth_scale: self.depth_scale,
-            layers: self.layers,
-            binary_steps: self.binary_steps,
-            lod: self.lod,
-            shadows: self.shadows,
-            azimuth_deg: self.azimuth,
-            zoom: self.zoom,
-            light_azimuth_deg: self.light_azimuth,
-            show_iterations: self.show_iterations,
-        }
-    }
-}
-
 pub fn run(args: DisplaceArgs) -> Result<()> {
-    let settings = args.settings();
+    let settings = &args.settings;
     if let Err(e) = settings.validate() {
         bail!("{e}");
     }
@@ -160,17 +98,18 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
         renderer.build_cone_map(&gpu, || bar.inc(1));
         bar.finish_and_clear();
     }
-    let frame = renderer.render(&gpu, &settings)?;
+    let frame = renderer.render(&gpu, settings)?;
     frame.color.save_png(&args.out)?;
-    let timing = renderer.time(&gpu, &settings, args.frames)?;
+    let timing = renderer.time(&gpu, settings, args.frames)?;
     let cost = Cost::of(&frame);
-    let (accuracy, error_map) = if args.reference && settings.method.traces_rays() {
+    let truth = settings.method.truth().filter(|_| args.reference);
+    let (accuracy, error_map) = if let Some(truth) = truth {
         let addressing = if args.surface.wraps() {
             Addressing::Wrap
         } else {
             Addressing::Clamp
         };
-        let acc = Accuracy::measure(&frame, &map, addressing, settings.method.truth());
+        let acc = Accuracy::measure(&frame, &map, addressing, truth);
         let path = args.out.with_extension("error.png");
         acc.heat_map().save_png(&path)?;
         (Some(acc), Some(path))
@@ -181,14 +120,10 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
         (None, None)
     };
     let stats = Stats {
-        method: settings.method,
-        width: settings.width,
-        height: settings.height,
+        settings,
         map: &args.map,
         map_size: [map.width, map.height],
         surface: args.surface,
-        view_angle_deg: settings.view_angle_deg,
-        depth_scale: settings.depth_scale,
         adapter: gpu.describe(),
         gpu_time_ms: timing.map(|t| t.median_ms),
         frames: args.frames,
@@ -215,6 +150,8 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
 mod tests {
     use super::*;
     use clap::Parser;
+    use proptest::prelude::*;
+    use quadray_displace::{Layers, Lod, Size};
 
     #[derive(Parser)]
     struct Cli {
@@ -222,34 +159,100 @@ mod tests {
         args: DisplaceArgs,
     }
 
-    /// The viewer prints `Settings::to_args` beside its screenshots: every setting must come back
-    /// through these flags unchanged, defaults and otherwise.
-    #[test]
-    fn settings_round_trip_through_the_flags() {
-        let changed = Settings {
-            method: Method::Relief,
-            view_angle_deg: 71.5,
-            width: 96,
-            height: 64,
-            depth_scale: 0.25,
-            layers: (3, 40),
-            binary_steps: 7,
-            lod: Lod::Auto,
-            shadows: true,
-            azimuth_deg: -12.25,
-            zoom: 1.5,
-            light_azimuth_deg: -200.0,
-            show_iterations: true,
+    fn parsed(settings: &Settings) -> Settings {
+        let mut argv = vec![
+            "displace".to_string(),
+            "--map=m.png".into(),
+            "--out=o.png".into(),
+        ];
+        argv.extend(settings.to_args());
+        Cli::try_parse_from(&argv)
+            .unwrap_or_else(|e| panic!("{argv:?}: {e}"))
+            .args
+            .settings
+    }
+
+    /// Valid settings, every field drawn from its declared limits.
+    fn valid_settings() -> impl Strategy<Value = Settings> {
+        let f = |l: quadray_core::settings::Limits<f32>, lo: f32, hi: f32| {
+            (lo..=hi).prop_filter("inside the limits", move |v| l.contains(*v))
         };
-        for settings in [Settings::default(), changed] {
-            let mut argv = vec![
-                "displace".to_string(),
-                "--map=m.png".into(),
-                "--out=o.png".into(),
-            ];
-            argv.extend(settings.to_args());
-            let cli = Cli::try_parse_from(&argv).unwrap();
-            assert_eq!(cli.args.settings(), settings, "{argv:?}");
+        let side = Settings::SIDE.min..=Settings::SIDE.max;
+        let count = Layers::COUNT.min..=Layers::COUNT.max;
+        let lod = prop_oneof![Just(Lod::Auto), (0u32..16).prop_map(Lod::Level)];
+        (
+            (
+                proptest::sample::select(Method::ALL.to_vec()),
+                f(Settings::VIEW_ANGLE, 0.0, 89.0),
+                (side.clone(), side),
+                f(Settings::DEPTH_SCALE, 0.0, 10.0),
+                (count.clone(), count),
+                Settings::BINARY_STEPS.min..=Settings::BINARY_STEPS.max,
+            ),
+            (
+                lod,
+                any::<bool>(),
+                f(Settings::AZIMUTH, -1e6, 1e6),
+                f(Settings::ZOOM, 0.0, 20.0),
+                f(Settings::AZIMUTH, -1e6, 1e6),
+                any::<bool>(),
+            ),
+        )
+            .prop_map(
+                |(
+                    (method, view_angle_deg, (w, h), depth_scale, (a, b), binary_steps),
+                    (lod, shadows, azimuth_deg, zoom, light_azimuth_deg, show_iterations),
+                )| Settings {
+                    method,
+                    view_angle_deg,
+                    size: Size::new(w, h),
+                    depth_scale,
+                    layers: Layers {
+                        min: a.min(b),
+                        max: a.max(b),
+                    },
+                    binary_steps,
+                    lod,
+                    shadows,
+                    azimuth_deg,
+                    zoom,
+                    light_azimuth_deg,
+                    show_iterations,
+                },
+            )
+    }
+
+    /// No flags: the library's defaults.
+    #[test]
+    fn the_flags_defaults_are_the_settings_defaults() {
+        let cli = Cli::try_parse_from(["displace", "--map=m.png", "--out=o.png"]).unwrap();
+        assert_eq!(cli.args.settings, Settings::DEFAULT);
+    }
+
+    /// The flags refuse what `validate()` refuses, with the same limits.
+    #[test]
+    fn the_flags_refuse_values_outside_the_limits() {
+        for (flag, value) in [
+            ("--view-angle", "89.5"),
+            ("--size", "0x10"),
+            ("--depth-scale", "0"),
+            ("--layers", "9,3"),
+            ("--binary-steps", "65"),
+            ("--zoom", "NaN"),
+            ("--azimuth", "inf"),
+        ] {
+            let argv = ["displace", "--map=m.png", "--out=o.png", flag, value];
+            assert!(Cli::try_parse_from(argv).is_err(), "{flag} {value}");
+        }
+    }
+
+    proptest! {
+        /// The viewer prints `Settings::to_args` beside its screenshots: every valid setting must
+        /// come back through the CLI's flags unchanged.
+        #[test]
+        fn settings_round_trip_through_the_flags(settings in valid_settings()) {
+            prop_assert!(settings.validate().is_ok(), "{settings:?}");
+            prop_assert_eq!(parsed(&settings), settings);
         }
     }
 }

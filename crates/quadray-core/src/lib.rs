@@ -5,6 +5,7 @@
 pub mod image_out;
 pub mod mesh;
 pub mod scene;
+pub mod settings;
 pub mod stats;
 
 use serde::Serialize;

@@ -45,4 +45,5 @@ pub use gpu::{
     Frame, HeightPyramid, PyramidBuilder, PyramidInfo, PyramidKind, Renderer, TRACE_WGSL, Targets,
 };
 pub use method::Method;
-pub use settings::{Lod, Settings};
+pub use quadray_core::settings::Size;
+pub use settings::{Layers, Lod, Settings};

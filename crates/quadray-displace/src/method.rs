@@ -1,12 +1,16 @@
-//! The methods `quadray displace --method` accepts and what each is measured against.
+//! The methods `quadray displace --method` accepts, each described once in [`DESCRIPTIONS`]: its
+//! name, help line, ground truth, how a caption spells its budget, and the settings the demo and
+//! the benchmarks run it with. The command line's choices, the captions and every benchmark's
+//! list of methods are read from there.
 
 use crate::reference::Surface;
+use crate::settings::{Layers, Settings};
 use std::fmt;
 use std::str::FromStr;
 
-/// A way to find where a view ray meets the height field.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
+/// A way to find where a view ray meets the height field. The variants' order is the shader-id
+/// order and the order of [`DESCRIPTIONS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Method {
     /// The paper: top-down pyramid traversal with node crossing (sections 3.2, 4).
     Pyramid,
@@ -29,38 +33,222 @@ pub enum Method {
     Mesh,
 }
 
+/// How a caption spells the work a method may do per pixel (the settings it reads).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Budget {
+    /// No budget: `pyramid`.
+    None,
+    /// Layers from head-on to grazing: `pom 1-16` (`pom 16` when fixed).
+    Layers,
+    /// Layers, then binary search steps: `relief 20-25+5`.
+    LayersAndBinary,
+    /// The maximum layer count as cone steps, then binary steps: `cone 15+8`.
+    ConeSteps,
+}
+
+/// Everything quadray's programs need to know about a method.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Description {
+    /// The method described.
+    pub method: Method,
+    /// The name `--method` takes.
+    pub name: &'static str,
+    /// `--method`'s help for it.
+    pub help: &'static str,
+    /// The surface whose exact intersection is its ground truth: the pyramid methods trace
+    /// point-sampled columns, and the cone map is built for them; the other baselines sample
+    /// bilinearly, as engines do. `None`: no traced ray to compare pixel by pixel (the mesh is
+    /// rasterised; its "ray" is the camera's).
+    pub truth: Option<Surface>,
+    /// Whether it searches the height field; bump mapping only bends the normal, so its hits are
+    /// the flat surface's and an error heat map of them says nothing.
+    pub searches: bool,
+    /// Whether it traces the conservative pyramid (section 3.3) rather than the point one.
+    pub conservative_pyramid: bool,
+    /// How its caption spells its budget.
+    pub budget: Budget,
+    /// The settings the demo and the accuracy tables show it with: the budget an engine ships
+    /// where one does.
+    pub shown: Settings,
+    /// The settings the timing tables run: the paper's 16 layers (and 5 binary steps) where
+    /// layers count, the chapter's budget for cone stepping.
+    pub timed: Settings,
+}
+
+/// The paper's equal budget for the timing tables.
+const fn sixteen_layers(method: Method) -> Settings {
+    Settings {
+        method,
+        layers: Layers { min: 16, max: 16 },
+        binary_steps: 5,
+        ..Settings::DEFAULT
+    }
+}
+
+const fn defaults(method: Method) -> Settings {
+    Settings {
+        method,
+        ..Settings::DEFAULT
+    }
+}
+
+/// Relaxed cone step mapping with 15 cone steps and 8 binary steps: a fixed budget in the range
+/// the chapter's shaders use.
+const RELAXED_CONE: Settings = Settings {
+    method: Method::Cone,
+    layers: Layers { min: 15, max: 15 },
+    binary_steps: 8,
+    ..Settings::DEFAULT
+};
+
+/// Every method's description, in [`Method`]'s order.
+pub const DESCRIPTIONS: [Description; 9] = [
+    Description {
+        method: Method::Pyramid,
+        name: "pyramid",
+        help: "the paper: top-down pyramid traversal with node crossing",
+        truth: Some(Surface::Point),
+        searches: true,
+        conservative_pyramid: false,
+        budget: Budget::None,
+        shown: defaults(Method::Pyramid),
+        timed: sixteen_layers(Method::Pyramid),
+    },
+    Description {
+        method: Method::PyramidAscend,
+        name: "pyramid-ascend",
+        help: "after a node crossing go one level up (maximum mipmaps)",
+        truth: Some(Surface::Point),
+        searches: true,
+        conservative_pyramid: false,
+        budget: Budget::None,
+        shown: defaults(Method::PyramidAscend),
+        timed: sixteen_layers(Method::PyramidAscend),
+    },
+    Description {
+        method: Method::PyramidBilinear,
+        name: "pyramid-bilinear",
+        help: "the bilinear surface, on the conservative pyramid",
+        truth: Some(Surface::Bilinear),
+        searches: true,
+        conservative_pyramid: true,
+        budget: Budget::None,
+        shown: defaults(Method::PyramidBilinear),
+        timed: sixteen_layers(Method::PyramidBilinear),
+    },
+    Description {
+        method: Method::Bump,
+        name: "bump",
+        help: "bump mapping: no search, only the shading normal changes",
+        truth: Some(Surface::Bilinear),
+        searches: false,
+        conservative_pyramid: false,
+        budget: Budget::None,
+        shown: defaults(Method::Bump),
+        timed: sixteen_layers(Method::Bump),
+    },
+    Description {
+        method: Method::Parallax,
+        name: "parallax",
+        help: "parallax mapping with offset limiting",
+        truth: Some(Surface::Bilinear),
+        searches: true,
+        conservative_pyramid: false,
+        budget: Budget::None,
+        shown: defaults(Method::Parallax),
+        timed: sixteen_layers(Method::Parallax),
+    },
+    Description {
+        method: Method::Pom,
+        name: "pom",
+        help: "parallax occlusion mapping: linear search, secant between the last two samples",
+        truth: Some(Surface::Bilinear),
+        searches: true,
+        conservative_pyramid: false,
+        budget: Budget::Layers,
+        // As Bevy ships it: 16 layers at grazing angles down to 1 head-on.
+        shown: Settings {
+            layers: Layers { min: 1, max: 16 },
+            ..defaults(Method::Pom)
+        },
+        timed: sixteen_layers(Method::Pom),
+    },
+    Description {
+        method: Method::Relief,
+        name: "relief",
+        help: "relief mapping: linear search, then binary search",
+        truth: Some(Surface::Bilinear),
+        searches: true,
+        conservative_pyramid: false,
+        budget: Budget::LayersAndBinary,
+        // As three.js's example ships it: 20..25 layers and 5 binary steps.
+        shown: Settings {
+            layers: Layers { min: 20, max: 25 },
+            binary_steps: 5,
+            ..defaults(Method::Relief)
+        },
+        timed: sixteen_layers(Method::Relief),
+    },
+    Description {
+        method: Method::Cone,
+        name: "cone",
+        help: "relaxed cone stepping, then binary search (builds its cone map first)",
+        truth: Some(Surface::Point),
+        searches: true,
+        conservative_pyramid: false,
+        budget: Budget::ConeSteps,
+        shown: RELAXED_CONE,
+        timed: RELAXED_CONE,
+    },
+    Description {
+        method: Method::Mesh,
+        name: "mesh",
+        help: "a real grid mesh displaced by the map",
+        truth: None,
+        searches: false,
+        conservative_pyramid: false,
+        budget: Budget::None,
+        shown: defaults(Method::Mesh),
+        timed: sixteen_layers(Method::Mesh),
+    },
+];
+
+// Each description sits at its method's index and its settings run that method.
+const _: () = {
+    let mut i = 0;
+    while i < DESCRIPTIONS.len() {
+        let d = &DESCRIPTIONS[i];
+        assert!(d.method as usize == i);
+        assert!(d.shown.method as usize == i && d.timed.method as usize == i);
+        i += 1;
+    }
+};
+
 impl Method {
     /// Every method, in shader-id order.
-    pub const ALL: [Method; 9] = [
-        Method::Pyramid,
-        Method::PyramidAscend,
-        Method::PyramidBilinear,
-        Method::Bump,
-        Method::Parallax,
-        Method::Pom,
-        Method::Relief,
-        Method::Cone,
-        Method::Mesh,
-    ];
+    pub const ALL: [Method; DESCRIPTIONS.len()] = {
+        let mut all = [Method::Pyramid; DESCRIPTIONS.len()];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = DESCRIPTIONS[i].method;
+            i += 1;
+        }
+        all
+    };
+
+    /// Everything about the method, from [`DESCRIPTIONS`].
+    pub fn describe(self) -> &'static Description {
+        &DESCRIPTIONS[self as usize]
+    }
 
     /// The name `--method` takes.
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Pyramid => "pyramid",
-            Method::PyramidAscend => "pyramid-ascend",
-            Method::PyramidBilinear => "pyramid-bilinear",
-            Method::Bump => "bump",
-            Method::Parallax => "parallax",
-            Method::Pom => "pom",
-            Method::Relief => "relief",
-            Method::Cone => "cone",
-            Method::Mesh => "mesh",
-        }
+        self.describe().name
     }
 
     /// The method's id in WGSL: the value of the surface shader's METHOD override constant.
     pub fn shader_id(self) -> u32 {
-        Self::ALL.iter().position(|&m| m == self).expect("listed") as u32
+        self as u32
     }
 
     /// WGSL constants naming every id, `const METHOD_PYRAMID_ASCEND: u32 = 1u;` and so on: the
@@ -75,25 +263,19 @@ impl Method {
             .collect()
     }
 
-    /// The surface whose exact intersection is this method's ground truth: the pyramid methods
-    /// trace point-sampled columns, and the cone map is built for them; the other baselines
-    /// sample bilinearly, as engines do.
-    pub fn truth(self) -> Surface {
-        match self {
-            Method::Pyramid | Method::PyramidAscend | Method::Cone => Surface::Point,
-            _ => Surface::Bilinear,
-        }
+    /// See [`Description::truth`].
+    pub fn truth(self) -> Option<Surface> {
+        self.describe().truth
     }
 
-    /// Methods that trace a ray per pixel and can be checked against the ground truth pixel by
-    /// pixel (the mesh is rasterised; its "ray" is the camera's).
-    pub fn traces_rays(self) -> bool {
-        self != Method::Mesh
+    /// See [`Description::shown`].
+    pub fn shown(self) -> Settings {
+        self.describe().shown.clone()
     }
 
-    /// Methods that trace the conservative pyramid (section 3.3) rather than the point one.
-    pub fn uses_conservative_pyramid(self) -> bool {
-        self == Method::PyramidBilinear
+    /// See [`Description::timed`].
+    pub fn timed(self) -> Settings {
+        self.describe().timed.clone()
     }
 }
 
@@ -107,5 +289,53 @@ impl FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         quadray_core::parse_named(s, &Self::ALL, Self::name, "method")
+    }
+}
+
+impl serde::Serialize for Method {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
+/// `--method`'s choices and their help, from [`DESCRIPTIONS`].
+#[cfg(feature = "cli")]
+impl clap::ValueEnum for Method {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Self::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()).help(self.describe().help))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse_back_and_are_unique() {
+        for m in Method::ALL {
+            assert_eq!(m.name().parse::<Method>(), Ok(m));
+            assert_eq!(
+                Method::ALL.iter().filter(|o| o.name() == m.name()).count(),
+                1
+            );
+        }
+        assert!(
+            "steep"
+                .parse::<Method>()
+                .unwrap_err()
+                .contains("pyramid-ascend")
+        );
+    }
+
+    #[test]
+    fn every_preset_is_valid() {
+        for m in Method::ALL {
+            m.shown().validate().unwrap();
+            m.timed().validate().unwrap();
+        }
     }
 }

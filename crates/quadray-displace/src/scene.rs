@@ -251,7 +251,7 @@ impl View {
             kind,
             [s.view_angle_deg, s.azimuth_deg, s.light_azimuth_deg],
             s.zoom,
-            s.width as f32 / s.height as f32,
+            s.size.width as f32 / s.size.height as f32,
         )
     }
 

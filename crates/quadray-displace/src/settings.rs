@@ -1,7 +1,11 @@
-//! The one set of displacement parameters the library, `quadray displace` and the viewer share,
-//! with the command-line flags that spell them.
+//! The one set of displacement parameters the library, `quadray displace` and the viewer share.
+//! Each is declared once, here: its field, its doc comment (the `--help` text), its default in
+//! [`Settings::DEFAULT`] and its valid values in a [`Limits`] const that both
+//! [`Settings::validate`] and the flag's parser use. With the `cli` feature the struct is
+//! `quadray displace`'s clap arguments; [`Settings::to_args`] spells them back.
 
 use crate::method::Method;
+use quadray_core::settings::{Limits, Size};
 use std::fmt;
 use std::str::FromStr;
 
@@ -37,152 +41,291 @@ impl FromStr for Lod {
     }
 }
 
+/// POM / relief layer counts, from head-on (`min`) to grazing (`max`); written `MIN,MAX`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Layers {
+    /// Layers head-on.
+    pub min: u32,
+    /// Layers at grazing angles (cone stepping's cone steps).
+    pub max: u32,
+}
+
+impl Layers {
+    /// Either count.
+    pub const COUNT: Limits<u32> = Limits::closed(1, 4096);
+
+    /// Both counts within [`Layers::COUNT`], `min` not above `max`.
+    pub fn check(&self) -> Result<(), String> {
+        let c = Self::COUNT;
+        if c.contains(self.min) && c.contains(self.max) && self.min <= self.max {
+            Ok(())
+        } else {
+            Err(format!(
+                "layers {self} must satisfy {} <= min <= max <= {}",
+                c.min, c.max
+            ))
+        }
+    }
+}
+
+impl fmt::Display for Layers {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{},{}", self.min, self.max)
+    }
+}
+
+impl FromStr for Layers {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (min, max) = quadray_core::parse_pair(s, ',', "MIN,MAX")?;
+        Ok(Self { min, max })
+    }
+}
+
+/// The size check `validate()` and `--size` share.
+fn check_size(size: &Size) -> Result<(), String> {
+    size.check(Settings::SIDE)
+}
+
 /// Everything a frame depends on besides the map and the surface.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct Settings {
     /// The search (or the mesh baseline).
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_enum, default_value_t = Settings::DEFAULT.method)
+    )]
     pub method: Method,
-    /// Angle between the view direction at the surface centre and the normal, degrees (0..89).
+    /// Angle between the view direction at the surface centre and the normal, degrees.
+    #[cfg_attr(feature = "cli", arg(
+        long = "view-angle",
+        default_value_t = Settings::DEFAULT.view_angle_deg,
+        value_parser = Settings::VIEW_ANGLE.parser(),
+    ))]
     pub view_angle_deg: f32,
-    /// Frame width in pixels.
-    pub width: u32,
-    /// Frame height in pixels.
-    pub height: u32,
+    /// Frame size in pixels, WxH.
+    #[serde(flatten)]
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.size,
+        value_parser = quadray_core::settings::checked(check_size),
+    ))]
+    pub size: Size,
     /// Texture units per unit of depth (Bevy's default 0.1).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.depth_scale,
+        value_parser = Settings::DEPTH_SCALE.parser(),
+    ))]
     pub depth_scale: f32,
-    /// POM / relief layer counts, from head-on (min) to grazing (max); cone stepping takes the
-    /// max as its number of cone steps.
-    pub layers: (u32, u32),
-    /// Relief mapping's and cone stepping's binary search steps.
+    /// POM / relief layers MIN,MAX (head-on .. grazing). Bevy: 1,16; Godot: 8,32; three.js:
+    /// 20,25. Cone stepping takes MAX as its number of cone steps.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.layers,
+        value_parser = quadray_core::settings::checked(Layers::check),
+    ))]
+    pub layers: Layers,
+    /// Relief mapping's and cone stepping's binary search steps (three.js: 5).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.binary_steps,
+        value_parser = Settings::BINARY_STEPS.parser(),
+    ))]
     pub binary_steps: u32,
-    /// Finest pyramid level the traversal reaches.
+    /// Finest pyramid level: `auto` (from screen-space derivatives) or a level number.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = Settings::DEFAULT.lod))]
     pub lod: Lod,
     /// Self-shadowing by tracing from the light.
+    #[cfg_attr(feature = "cli", arg(long))]
     pub shadows: bool,
-    /// Camera azimuth around the surface normal (degrees): the benchmark keeps the default; the
-    /// viewer moves it.
+    /// Camera azimuth around the surface normal, degrees (the benchmark keeps the default; the
+    /// viewer moves it).
+    #[cfg_attr(feature = "cli", arg(
+        long = "azimuth",
+        default_value_t = Settings::DEFAULT.azimuth_deg,
+        value_parser = Settings::AZIMUTH.parser(),
+        allow_negative_numbers = true,
+    ))]
     pub azimuth_deg: f32,
     /// Camera distance as a multiple of the surface's default.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.zoom,
+        value_parser = Settings::ZOOM.parser(),
+    ))]
     pub zoom: f32,
     /// The light's azimuth around the surface normal, degrees.
+    #[cfg_attr(feature = "cli", arg(
+        long = "light-azimuth",
+        default_value_t = Settings::DEFAULT.light_azimuth_deg,
+        value_parser = Settings::AZIMUTH.parser(),
+        allow_negative_numbers = true,
+    ))]
     pub light_azimuth_deg: f32,
-    /// Colour each pixel by the iterations its search took (0..64, black to white).
+    /// Colour pixels by the iterations their search took (0..64: black, red, yellow, white).
+    #[cfg_attr(feature = "cli", arg(long))]
     pub show_iterations: bool,
 }
 
-impl Default for Settings {
-    fn default() -> Self {
-        Self {
-            method: Method::Pyramid,
-            view_angle_deg: 45.0,
-            width: 512,
-            height: 512,
-            depth_scale: 0.1,
-            layers: (8, 32),
-            binary_steps: 5,
-            lod: Lod::Level(0),
-            shadows: false,
-            azimuth_deg: 30.0,
-            zoom: 1.0,
-            light_azimuth_deg: 30.0,
-            show_iterations: false,
-        }
-    }
-}
-
 impl Settings {
-    /// POM as Bevy ships it: 16 layers at grazing angles down to 1 head-on, depth scale 0.1.
-    pub fn bevy_pom() -> Self {
-        Self {
-            method: Method::Pom,
-            layers: (1, 16),
-            ..Default::default()
-        }
-    }
+    /// Every parameter's default (the flags' defaults too).
+    pub const DEFAULT: Settings = Settings {
+        method: Method::Pyramid,
+        view_angle_deg: 45.0,
+        size: Size::new(512, 512),
+        depth_scale: 0.1,
+        layers: Layers { min: 8, max: 32 },
+        binary_steps: 5,
+        lod: Lod::Level(0),
+        shadows: false,
+        azimuth_deg: 30.0,
+        zoom: 1.0,
+        light_azimuth_deg: 30.0,
+        show_iterations: false,
+    };
 
-    /// Relief mapping as three.js's example ships it: 20..25 layers and 5 binary steps.
-    pub fn threejs_relief() -> Self {
-        Self {
-            method: Method::Relief,
-            layers: (20, 25),
-            binary_steps: 5,
-            ..Default::default()
-        }
-    }
-
-    /// Relaxed cone step mapping with 15 cone steps and 8 binary steps: a fixed budget in the
-    /// range the chapter's shaders use.
-    pub fn relaxed_cone() -> Self {
-        Self {
-            method: Method::Cone,
-            layers: (15, 15),
-            binary_steps: 8,
-            ..Default::default()
-        }
-    }
+    /// [`Settings::view_angle_deg`]: grazing, not beyond.
+    pub const VIEW_ANGLE: Limits<f32> = Limits::closed(0.0, 89.0);
+    /// Either side of [`Settings::size`].
+    pub const SIDE: Limits<u32> = Limits::closed(1, 8192);
+    /// [`Settings::depth_scale`]: a flat surface makes no search.
+    pub const DEPTH_SCALE: Limits<f32> = Limits::above(0.0, 10.0);
+    /// [`Settings::binary_steps`].
+    pub const BINARY_STEPS: Limits<u32> = Limits::closed(0, 64);
+    /// [`Settings::azimuth_deg`] and [`Settings::light_azimuth_deg`]: any finite angle.
+    pub const AZIMUTH: Limits<f32> = Limits::closed(-f32::MAX, f32::MAX);
+    /// [`Settings::zoom`].
+    pub const ZOOM: Limits<f32> = Limits::closed(0.05, 20.0);
 
     /// Refuses parameters that would make no picture or an absurd amount of work.
     pub fn validate(&self) -> Result<(), String> {
-        let s = self;
-        if !(s.view_angle_deg.is_finite() && (0.0..=89.0).contains(&s.view_angle_deg)) {
-            return Err(format!(
-                "view angle {} is outside 0..89 degrees",
-                s.view_angle_deg
-            ));
-        }
-        if !(1..=8192).contains(&s.width) || !(1..=8192).contains(&s.height) {
-            return Err(format!(
-                "size {}x{} is outside 1x1..8192x8192",
-                s.width, s.height
-            ));
-        }
-        if !(s.depth_scale.is_finite() && s.depth_scale > 0.0 && s.depth_scale <= 10.0) {
-            return Err(format!("depth scale {} is outside (0, 10]", s.depth_scale));
-        }
-        if s.layers.0 < 1 || s.layers.0 > s.layers.1 || s.layers.1 > 4096 {
-            return Err(format!(
-                "layers {},{} must satisfy 1 <= min <= max <= 4096",
-                s.layers.0, s.layers.1
-            ));
-        }
-        if !(s.azimuth_deg.is_finite() && s.light_azimuth_deg.is_finite()) {
-            return Err("azimuths must be finite".into());
-        }
-        if !(s.zoom.is_finite() && (0.05..=20.0).contains(&s.zoom)) {
-            return Err(format!("zoom {} is outside 0.05..20", s.zoom));
-        }
-        if s.binary_steps > 64 {
-            return Err(format!("{} binary steps is more than 64", s.binary_steps));
-        }
+        Self::VIEW_ANGLE.check("view angle", self.view_angle_deg)?;
+        check_size(&self.size)?;
+        Self::DEPTH_SCALE.check("depth scale", self.depth_scale)?;
+        self.layers.check()?;
+        Self::BINARY_STEPS.check("binary steps", self.binary_steps)?;
+        Self::AZIMUTH.check("azimuth", self.azimuth_deg)?;
+        Self::ZOOM.check("zoom", self.zoom)?;
+        Self::AZIMUTH.check("light azimuth", self.light_azimuth_deg)?;
         Ok(())
     }
 
     /// The `quadray displace` flags that render these settings (the viewer prints them beside its
     /// screenshots; the CLI's tests parse them back).
     pub fn to_args(&self) -> Vec<String> {
+        let s = self;
         let mut args: Vec<String> = [
-            ("--method", self.method.to_string()),
-            ("--view-angle", self.view_angle_deg.to_string()),
-            ("--azimuth", self.azimuth_deg.to_string()),
-            ("--zoom", self.zoom.to_string()),
-            ("--light-azimuth", self.light_azimuth_deg.to_string()),
-            ("--size", format!("{}x{}", self.width, self.height)),
-            ("--depth-scale", self.depth_scale.to_string()),
-            ("--layers", format!("{},{}", self.layers.0, self.layers.1)),
-            ("--binary-steps", self.binary_steps.to_string()),
-            ("--lod", self.lod.to_string()),
+            ("--method", s.method.to_string()),
+            ("--view-angle", s.view_angle_deg.to_string()),
+            ("--azimuth", s.azimuth_deg.to_string()),
+            ("--zoom", s.zoom.to_string()),
+            ("--light-azimuth", s.light_azimuth_deg.to_string()),
+            ("--size", s.size.to_string()),
+            ("--depth-scale", s.depth_scale.to_string()),
+            ("--layers", s.layers.to_string()),
+            ("--binary-steps", s.binary_steps.to_string()),
+            ("--lod", s.lod.to_string()),
         ]
         .into_iter()
         .flat_map(|(flag, value)| [flag.to_string(), value])
         .collect();
         for (on, flag) in [
-            (self.shadows, "--shadows"),
-            (self.show_iterations, "--show-iterations"),
+            (s.shadows, "--shadows"),
+            (s.show_iterations, "--show-iterations"),
         ] {
             if on {
                 args.push(flag.into());
             }
         }
         args
+    }
+
+    /// What a picture of these settings is called: the method and the budget it was given
+    /// (`pom 1-16`, `relief 16+5`, `cone 15+8`, `pyramid lod-auto`).
+    pub fn caption(&self) -> String {
+        use crate::method::Budget;
+        let Layers { min, max } = self.layers;
+        let layers = if min == max {
+            max.to_string()
+        } else {
+            format!("{min}-{max}")
+        };
+        let mut caption = match self.method.describe().budget {
+            Budget::None => self.method.to_string(),
+            Budget::Layers => format!("{} {layers}", self.method),
+            Budget::LayersAndBinary => format!("{} {layers}+{}", self.method, self.binary_steps),
+            Budget::ConeSteps => format!("{} {max}+{}", self.method, self.binary_steps),
+        };
+        if self.lod == Lod::Auto {
+            caption += " lod-auto";
+        }
+        caption
+    }
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validate_uses_the_declared_limits() {
+        let ok = Settings::default();
+        assert!(ok.validate().is_ok());
+        let bad = [
+            Settings {
+                view_angle_deg: 89.5,
+                ..ok.clone()
+            },
+            Settings {
+                size: Size::new(0, 10),
+                ..ok.clone()
+            },
+            Settings {
+                depth_scale: 0.0,
+                ..ok.clone()
+            },
+            Settings {
+                layers: Layers { min: 9, max: 3 },
+                ..ok.clone()
+            },
+            Settings {
+                binary_steps: 65,
+                ..ok.clone()
+            },
+            Settings {
+                light_azimuth_deg: f32::INFINITY,
+                ..ok.clone()
+            },
+            Settings {
+                zoom: f32::NAN,
+                ..ok.clone()
+            },
+        ];
+        for s in bad {
+            assert!(s.validate().is_err(), "{s:?}");
+        }
+    }
+
+    #[test]
+    fn captions_name_the_budget() {
+        let caption = |m: Method| m.shown().caption();
+        assert_eq!(caption(Method::Pyramid), "pyramid");
+        assert_eq!(caption(Method::Pom), "pom 1-16");
+        assert_eq!(caption(Method::Relief), "relief 20-25+5");
+        assert_eq!(caption(Method::Cone), "cone 15+8");
+        assert_eq!(Method::Pom.timed().caption(), "pom 16");
+        let auto = Settings {
+            lod: Lod::Auto,
+            ..Settings::DEFAULT
+        };
+        assert_eq!(auto.caption(), "pyramid lod-auto");
     }
 }

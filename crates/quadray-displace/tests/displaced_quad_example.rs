@@ -8,7 +8,7 @@ mod example;
 
 use quadray_core::image_out::Rgba8Image;
 use quadray_displace::scene::{SurfaceKind, View};
-use quadray_displace::{Method, Renderer, Settings};
+use quadray_displace::{Method, Renderer, Settings, Size};
 use quadray_gpu::Gpu;
 
 /// Mean FLIP error the example's picture may differ by: its shading approximates quadray's (the
@@ -34,8 +34,7 @@ fn the_example_draws_what_quadray_displace_draws() {
         azimuth_deg: 0.0,
         light_azimuth_deg: 0.0,
         shadows: true,
-        width: example::SIZE,
-        height: example::SIZE,
+        size: Size::new(example::SIZE, example::SIZE),
         ..Default::default()
     };
     let view = View::of(SurfaceKind::Wall, &settings);

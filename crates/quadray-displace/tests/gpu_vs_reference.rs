@@ -10,7 +10,7 @@ use quadray_displace::heightmap::HeightMap;
 use quadray_displace::pyramid::{Addressing, Pyramid};
 use quadray_displace::reference::Surface;
 use quadray_displace::scene::SurfaceKind;
-use quadray_displace::{HeightPyramid, Lod, Method, PyramidKind, Renderer, Settings};
+use quadray_displace::{HeightPyramid, Layers, Lod, Method, PyramidKind, Renderer, Settings, Size};
 use quadray_gpu::{Gpu, read_texture_f32};
 
 const ANGLES: [f32; 6] = [0.0, 30.0, 60.0, 70.0, 80.0, 85.0];
@@ -27,8 +27,7 @@ fn settings(method: Method, angle: f32) -> Settings {
     Settings {
         method,
         view_angle_deg: angle,
-        width: 64,
-        height: 64,
+        size: Size::new(64, 64),
         ..Default::default()
     }
 }
@@ -44,7 +43,12 @@ fn wrong_hit_fraction(
 ) -> f64 {
     let surface = renderer.surface();
     let frame = renderer.render(gpu, &settings(method, angle)).unwrap();
-    let acc = Accuracy::measure(&frame, map, addressing(surface), method.truth());
+    let acc = Accuracy::measure(
+        &frame,
+        map,
+        addressing(surface),
+        method.truth().expect("a traced method"),
+    );
     let cost = Cost::of(&frame);
     let at = format!("{name} {surface:?} {method} {angle} deg");
     assert!(
@@ -153,17 +157,18 @@ fn cone_stepping_converges_to_the_ground_truth_and_its_budget_error_is_bounded()
                 let measure = |renderer: &mut Renderer, s: Settings| {
                     let frame = renderer.render(&gpu, &s).unwrap();
                     let cost = Cost::of(&frame);
-                    assert!(cost.texel_fetches_per_pixel <= f64::from(s.layers.1 + s.binary_steps));
+                    assert!(
+                        cost.texel_fetches_per_pixel <= f64::from(s.layers.max + s.binary_steps)
+                    );
                     Accuracy::measure(&frame, &map, addressing(surface), Surface::Point)
                 };
                 let budget = Settings {
                     view_angle_deg: angle,
-                    width: 64,
-                    height: 64,
-                    ..Settings::relaxed_cone()
+                    size: Size::new(64, 64),
+                    ..Method::Cone.shown()
                 };
                 let spare = Settings {
-                    layers: (256, 256),
+                    layers: Layers { min: 256, max: 256 },
                     ..budget.clone()
                 };
                 let at = format!("{name} {surface:?} {angle} deg");
@@ -270,14 +275,20 @@ fn pom_and_relief_at_engine_defaults_miss_where_the_pyramid_does_not() {
     let mut renderer = Renderer::new(&gpu, &map, None, SurfaceKind::Wall);
     let measure = |renderer: &mut Renderer, s: Settings| {
         let frame = renderer.render(&gpu, &s).unwrap();
-        Accuracy::measure(&frame, &map, Addressing::Wrap, s.method.truth()).wrong_hit_fraction
+        Accuracy::measure(
+            &frame,
+            &map,
+            Addressing::Wrap,
+            s.method.truth().expect("a traced method"),
+        )
+        .wrong_hit_fraction
     };
     let bevy_pom = Settings {
-        layers: (1, 16),
+        layers: Layers { min: 1, max: 16 },
         ..settings(Method::Pom, 80.0)
     };
     let three_relief = Settings {
-        layers: (20, 25),
+        layers: Layers { min: 20, max: 25 },
         binary_steps: 5,
         ..settings(Method::Relief, 80.0)
     };

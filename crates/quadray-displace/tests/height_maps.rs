@@ -4,7 +4,7 @@
 mod common;
 
 use quadray_displace::heightmap::{Convention, Fit, HeightMap, HeightMapError};
-use quadray_displace::{Method, Settings};
+use quadray_displace::{Layers, Method, Settings, Size};
 
 #[test]
 fn odd_sizes_load_as_stored_or_resampled_on_request() {
@@ -95,15 +95,18 @@ fn absurd_parameters_are_refused() {
             ..ok.clone()
         },
         Settings {
-            width: 0,
+            size: Size::new(0, 64),
             ..ok.clone()
         },
         Settings {
-            layers: (32, 8),
+            layers: Layers { min: 32, max: 8 },
             ..ok.clone()
         },
         Settings {
-            layers: (1, 1_000_000),
+            layers: Layers {
+                min: 1,
+                max: 1_000_000,
+            },
             ..ok.clone()
         },
         Settings {

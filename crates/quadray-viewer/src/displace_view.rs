@@ -10,7 +10,7 @@ use quadray_displace::cone::ConeMapJob;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::maps::{BUNDLED, assets_dir, load_color};
 use quadray_displace::scene::{SurfaceKind, View};
-use quadray_displace::{Lod, Method, Renderer, Settings, Targets};
+use quadray_displace::{Lod, Method, Renderer, Settings, Size, Targets};
 use quadray_gpu::{Gpu, GpuTimer, read_texture_rgba8};
 use std::path::{Path, PathBuf};
 
@@ -38,6 +38,9 @@ impl MapChoice {
             .collect()
     }
 }
+
+/// The zoom the slider, the wheel and the keys move within: a useful part of [`Settings::ZOOM`].
+const ZOOM: std::ops::RangeInclusive<f32> = 0.2..=4.0;
 
 pub struct DisplaceView {
     pub maps: Vec<MapChoice>,
@@ -117,8 +120,7 @@ impl DisplaceView {
         if self.animate_light {
             self.settings.light_azimuth_deg = (self.settings.light_azimuth_deg + 40.0 * dt) % 360.0;
         }
-        self.settings.width = size[0];
-        self.settings.height = size[1];
+        self.settings.size = Size::new(size[0], size[1]);
         let resized =
             !matches!(&self.target, Some((t, ..)) if t.width() == size[0] && t.height() == size[1]);
         if resized {
@@ -246,13 +248,26 @@ impl DisplaceView {
         choice_box(ui, "method", &mut s.method, &Method::ALL, |m| {
             m.name().into()
         });
-        ui.add(egui::Slider::new(&mut s.view_angle_deg, 0.0..=89.0).text("view angle"));
+        ui.label(s.method.describe().help);
+        if ui
+            .button("reset")
+            .on_hover_text("this method's settings as the demo and the benchmarks show it")
+            .clicked()
+        {
+            *s = Settings {
+                size: s.size,
+                ..s.method.shown()
+            };
+        }
+        // The sliders span the useful part of each setting's limits.
+        let view_angle = Settings::VIEW_ANGLE.min..=Settings::VIEW_ANGLE.max;
+        ui.add(egui::Slider::new(&mut s.view_angle_deg, view_angle).text("view angle"));
         ui.add(egui::Slider::new(&mut s.azimuth_deg, -180.0..=180.0).text("azimuth"));
-        ui.add(egui::Slider::new(&mut s.zoom, 0.2..=4.0).text("zoom"));
+        ui.add(egui::Slider::new(&mut s.zoom, ZOOM).text("zoom"));
         ui.add(egui::Slider::new(&mut s.depth_scale, 0.01..=0.5).text("depth scale"));
-        ui.add(egui::Slider::new(&mut s.layers.0, 1..=256).text("layers min"));
-        ui.add(egui::Slider::new(&mut s.layers.1, 1..=256).text("layers max"));
-        s.layers.1 = s.layers.1.max(s.layers.0);
+        ui.add(egui::Slider::new(&mut s.layers.min, 1..=256).text("layers min"));
+        ui.add(egui::Slider::new(&mut s.layers.max, 1..=256).text("layers max"));
+        s.layers.max = s.layers.max.max(s.layers.min);
         ui.add(egui::Slider::new(&mut s.binary_steps, 0..=16).text("binary steps"));
         let mut auto = s.lod == Lod::Auto;
         ui.checkbox(&mut auto, "LOD from derivatives");
@@ -275,13 +290,18 @@ impl DisplaceView {
         }
     }
 
+    /// A view angle moved by the mouse or the keys, kept within its limits.
+    fn tilt(view_angle_deg: f32) -> f32 {
+        view_angle_deg.clamp(Settings::VIEW_ANGLE.min, Settings::VIEW_ANGLE.max)
+    }
+
     /// Orbit with the left button, move the light with the right, zoom with the wheel.
     pub fn handle_pointer(&mut self, response: &egui::Response, ui: &egui::Ui) {
         let s = &mut self.settings;
         if response.dragged_by(egui::PointerButton::Primary) {
             let d = response.drag_delta();
             s.azimuth_deg = (s.azimuth_deg - d.x * 0.3 + 540.0) % 360.0 - 180.0;
-            s.view_angle_deg = (s.view_angle_deg - d.y * 0.3).clamp(0.0, 89.0);
+            s.view_angle_deg = Self::tilt(s.view_angle_deg - d.y * 0.3);
         }
         if response.dragged_by(egui::PointerButton::Secondary) {
             s.light_azimuth_deg =
@@ -289,7 +309,7 @@ impl DisplaceView {
         }
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            s.zoom = (s.zoom * (1.0 - scroll * 0.002)).clamp(0.2, 4.0);
+            s.zoom = (s.zoom * (1.0 - scroll * 0.002)).clamp(*ZOOM.start(), *ZOOM.end());
         }
     }
 
@@ -299,10 +319,10 @@ impl DisplaceView {
         ui.input(|i| {
             let rate = 60.0 * dt;
             if i.key_down(egui::Key::W) {
-                s.view_angle_deg = (s.view_angle_deg - rate).max(0.0);
+                s.view_angle_deg = Self::tilt(s.view_angle_deg - rate);
             }
             if i.key_down(egui::Key::S) {
-                s.view_angle_deg = (s.view_angle_deg + rate).min(89.0);
+                s.view_angle_deg = Self::tilt(s.view_angle_deg + rate);
             }
             if i.key_down(egui::Key::A) {
                 s.azimuth_deg -= rate;
@@ -311,10 +331,10 @@ impl DisplaceView {
                 s.azimuth_deg += rate;
             }
             if i.key_down(egui::Key::Q) {
-                s.zoom = (s.zoom * (1.0 - dt)).max(0.2);
+                s.zoom = (s.zoom * (1.0 - dt)).max(*ZOOM.start());
             }
             if i.key_down(egui::Key::E) {
-                s.zoom = (s.zoom * (1.0 + dt)).min(4.0);
+                s.zoom = (s.zoom * (1.0 + dt)).min(*ZOOM.end());
             }
             if i.key_pressed(egui::Key::L) {
                 self.animate_light = !self.animate_light;

@@ -1,13 +1,13 @@
 //! Accuracy against the CPU ground truth: every method by view angle on every bundled map, and
 //! how many POM layers match the pyramid.
 
-use super::{AccuracyRow, Bench, Ratios, addressing, fixed_layers, ms, ratio, ratio_text};
+use super::{AccuracyRow, Bench, Ratios, addressing, fixed_layers, ms, ratio, ratio_text, traced};
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::maps::{BUNDLED, resized};
 use quadray_displace::pyramid::Addressing;
-use quadray_displace::{DisplaceError, Method, Renderer, Settings};
+use quadray_displace::{DisplaceError, Method, Renderer, Settings, Size};
 use std::path::Path;
 
 /// Wrong-hit fraction and texel fetches per pixel by view angle, every method, every bundled map:
@@ -24,25 +24,7 @@ pub fn by_view_angle(
     } else {
         &[0.0, 15.0, 30.0, 45.0, 60.0, 70.0, 75.0, 80.0, 85.0]
     };
-    let default_with = |method| Settings {
-        method,
-        ..Default::default()
-    };
-    let candidates = [
-        default_with(Method::Pyramid),
-        default_with(Method::PyramidAscend),
-        default_with(Method::PyramidBilinear),
-        Settings::bevy_pom(),
-        Settings::threejs_relief(),
-        Settings::relaxed_cone(),
-        default_with(Method::Parallax),
-        default_with(Method::Bump),
-    ];
-    let label = |s: &Settings| match s.method {
-        Method::Pom | Method::Relief => format!("{} {}-{}", s.method, s.layers.0, s.layers.1),
-        Method::Cone => format!("cone {}+{}", s.layers.1, s.binary_steps),
-        m => m.to_string(),
-    };
+    let candidates = traced(Method::shown);
     let mut accuracy = Vec::new();
     for b in &BUNDLED {
         let map = b.load()?;
@@ -67,25 +49,25 @@ pub fn by_view_angle(
         };
         let mut series = Vec::new();
         for c in &candidates {
-            let mut row = vec![label(c)];
-            let mut fetch_row = vec![label(c)];
+            let truth = c.method.truth().expect("a traced method");
+            let mut row = vec![c.caption()];
+            let mut fetch_row = vec![c.caption()];
             let mut points = Vec::new();
             for &angle in angles {
                 let s = Settings {
                     view_angle_deg: angle,
-                    width: acc_size,
-                    height: acc_size,
+                    size: Size::new(acc_size, acc_size),
                     ..c.clone()
                 };
                 let frame = r.render(gpu, &s)?;
-                let acc = Accuracy::measure(&frame, &map, addressing(b), c.method.truth());
+                let acc = Accuracy::measure(&frame, &map, addressing(b), truth);
                 let cost = Cost::of(&frame);
                 row.push(format!("{:.4}", acc.wrong_hit_fraction));
                 fetch_row.push(format!("{:.1}", cost.texel_fetches_per_pixel));
                 points.push((f64::from(angle), acc.wrong_hit_fraction));
                 accuracy.push(AccuracyRow {
                     map: b.name.into(),
-                    method: label(c),
+                    method: c.caption(),
                     view_angle_deg: angle,
                     wrong_hit_fraction: acc.wrong_hit_fraction,
                     mean_error_texels: acc.mean_error_texels,
@@ -98,7 +80,7 @@ pub fn by_view_angle(
             table.row(row);
             fetch_table.row(fetch_row);
             series.push(Series {
-                name: label(c),
+                name: c.caption(),
                 points,
             });
         }
@@ -131,16 +113,16 @@ pub fn pom_layers_to_match(
     let map = resized(tiles, 256);
     let mut r = Renderer::new(gpu, &map, None, BUNDLED[0].surface);
     let grazing = |s: Settings| Settings {
-        width: paper,
-        height: paper,
+        size: Size::new(paper, paper),
         view_angle_deg: 80.0,
         ..s
     };
     let measure = |r: &mut Renderer, s: &Settings| -> Result<f64, DisplaceError> {
         let frame = r.render(gpu, s)?;
-        Ok(Accuracy::measure(&frame, &map, Addressing::Wrap, s.method.truth()).wrong_hit_fraction)
+        let truth = s.method.truth().expect("a traced method");
+        Ok(Accuracy::measure(&frame, &map, Addressing::Wrap, truth).wrong_hit_fraction)
     };
-    let pyramid_settings = grazing(fixed_layers(Method::Pyramid, 16));
+    let pyramid_settings = grazing(Method::Pyramid.timed());
     let pyramid_wrong = measure(&mut r, &pyramid_settings)?;
     let pyramid_time = bench.time("pom-match", "tiles", &map, &mut r, &pyramid_settings)?;
     let target = pyramid_wrong.max(0.001);

@@ -5,17 +5,17 @@ use quadray_core::image_out::{Rgba8Image, montage};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::maps::BUNDLED;
 use quadray_displace::pyramid::Addressing;
+use quadray_displace::reference::Surface;
 use quadray_displace::scene::SurfaceKind;
-use quadray_displace::{DisplaceError, Lod, Method, Renderer, Settings};
+use quadray_displace::{DisplaceError, Lod, Method, Renderer, Settings, Size};
 use quadray_gpu::Gpu;
 use std::path::{Path, PathBuf};
 
-fn caption(s: &Settings) -> String {
-    match s.method {
-        Method::Pom | Method::Relief => format!("{} {}-{}", s.method, s.layers.0, s.layers.1),
-        Method::Cone => format!("cone {}+{}", s.layers.1, s.binary_steps),
-        m => m.to_string(),
-    }
+/// The ground truth of a method that searches the height field: an error heat map of it shows
+/// where the search went wrong (bump mapping's hits are the flat surface's; the mesh is
+/// rasterised).
+fn searched_truth(method: Method) -> Option<Surface> {
+    method.truth().filter(|_| method.describe().searches)
 }
 
 /// Renders the demo into `out` (side `size` pixels per picture); returns the files written.
@@ -37,64 +37,23 @@ pub fn render_demo(
             Addressing::Clamp
         };
         for angle in [35.0, 65.0, 80.0] {
-            let base = Settings {
+            let methods = Method::ALL.map(|m| Settings {
                 view_angle_deg: angle,
-                width: size,
-                height: size,
-                ..Default::default()
-            };
-            let methods = [
-                Settings {
-                    method: Method::Pyramid,
-                    ..base.clone()
-                },
-                Settings {
-                    method: Method::PyramidBilinear,
-                    ..base.clone()
-                },
-                Settings {
-                    method: Method::Mesh,
-                    ..base.clone()
-                },
-                Settings {
-                    method: Method::Bump,
-                    ..base.clone()
-                },
-                Settings {
-                    view_angle_deg: angle,
-                    width: size,
-                    height: size,
-                    ..Settings::bevy_pom()
-                },
-                Settings {
-                    view_angle_deg: angle,
-                    width: size,
-                    height: size,
-                    ..Settings::threejs_relief()
-                },
-                Settings {
-                    view_angle_deg: angle,
-                    width: size,
-                    height: size,
-                    ..Settings::relaxed_cone()
-                },
-                Settings {
-                    method: Method::Parallax,
-                    ..base.clone()
-                },
-            ];
+                size: Size::new(size, size),
+                ..m.shown()
+            });
             let mut tiles: Vec<(String, Rgba8Image)> = Vec::new();
             let mut heat: Vec<(String, Rgba8Image)> = Vec::new();
             for s in &methods {
                 let frame = renderer.render(gpu, s)?;
-                if s.method.traces_rays() && s.method != Method::Bump {
-                    let acc = Accuracy::measure(&frame, &map, addressing, s.method.truth());
+                if let Some(truth) = searched_truth(s.method) {
+                    let acc = Accuracy::measure(&frame, &map, addressing, truth);
                     heat.push((
-                        format!("{} err {:.1}%", caption(s), acc.wrong_hit_fraction * 100.0),
+                        format!("{} err {:.1}%", s.caption(), acc.wrong_hit_fraction * 100.0),
                         acc.heat_map(),
                     ));
                 }
-                tiles.push((caption(s), frame.color));
+                tiles.push((s.caption(), frame.color));
             }
             tiles.extend(heat);
             let path = out.join(format!("{}_{angle:.0}deg.png", bundled.name));
@@ -103,40 +62,33 @@ pub fn render_demo(
         }
         // A curved mesh whose tangents MikkTSpace generated.
         let mut torus = Renderer::new(gpu, &map, color.as_ref(), SurfaceKind::Torus);
-        let at = |s: Settings| Settings {
-            view_angle_deg: 50.0,
-            width: size,
-            height: size,
-            ..s
-        };
         let mut tiles = Vec::new();
-        for s in [
-            Settings {
-                method: Method::PyramidBilinear,
+        for (method, truth) in Method::ALL
+            .into_iter()
+            .filter_map(|m| Some((m, searched_truth(m)?)))
+        {
+            let s = Settings {
+                view_angle_deg: 50.0,
+                size: Size::new(size, size),
                 shadows: true,
-                ..Default::default()
-            },
-            Settings::bevy_pom(),
-            Settings::threejs_relief(),
-        ] {
-            let s = at(s);
+                ..method.shown()
+            };
             let frame = torus.render(gpu, &s)?;
-            let acc = Accuracy::measure(&frame, &map, Addressing::Wrap, s.method.truth());
+            let acc = Accuracy::measure(&frame, &map, Addressing::Wrap, truth);
             let label = format!(
                 "torus {} err {:.1}%",
-                caption(&s),
+                s.caption(),
                 acc.wrong_hit_fraction * 100.0
             );
             tiles.push((label, frame.color));
         }
         let path = out.join(format!("{}_torus.png", bundled.name));
-        montage(&tiles, 3).save_png(&path)?;
+        montage(&tiles, 4).save_png(&path)?;
         written.push(path);
         // Self-shadowing, and the cost of the search per pixel.
         let s = Settings {
             view_angle_deg: 60.0,
-            width: size,
-            height: size,
+            size: Size::new(size, size),
             ..Default::default()
         };
         let plain = renderer.render(gpu, &s)?;

@@ -12,7 +12,7 @@ use quadray_core::{write_json, write_text};
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::maps::BundledMap;
 use quadray_displace::pyramid::Addressing;
-use quadray_displace::{DisplaceError, Lod, Method, Renderer, Settings};
+use quadray_displace::{DisplaceError, Layers, Method, Renderer, Settings, Size};
 use quadray_gpu::Gpu;
 use serde::Serialize;
 use std::path::Path;
@@ -112,21 +112,13 @@ impl Bench<'_> {
         s: &Settings,
     ) -> Result<Option<f64>, DisplaceError> {
         let summary = renderer.time(self.gpu, s, self.frames)?;
-        let mut label = match s.method {
-            Method::Pom | Method::Relief => format!("{}-{}", s.method, s.layers.1),
-            Method::Cone => format!("cone-{}+{}", s.layers.1, s.binary_steps),
-            m => m.to_string(),
-        };
-        if s.lod == Lod::Auto {
-            label += " lod-auto";
-        }
         self.timings.push(TimingRow {
             experiment: experiment.into(),
             map: name.into(),
             map_size: [map.width, map.height],
-            method: label,
-            width: s.width,
-            height: s.height,
+            method: s.caption(),
+            width: s.size.width,
+            height: s.size.height,
             view_angle_deg: s.view_angle_deg,
             gpu_time_ms: summary.map(|t| t.median_ms),
             p10_ms: summary.map(|t| t.p10_ms),
@@ -140,22 +132,32 @@ impl Bench<'_> {
     /// `s` at the paper's screen size and its 60 degree view.
     pub fn paper_view(&self, s: Settings) -> Settings {
         Settings {
-            width: self.paper,
-            height: self.paper,
+            size: Size::new(self.paper, self.paper),
             view_angle_deg: 60.0,
             ..s
         }
     }
 }
 
-/// A method with a fixed POM / relief layer count.
+/// `method`'s timed settings with a fixed POM / relief layer count.
 pub fn fixed_layers(method: Method, layers: u32) -> Settings {
     Settings {
-        method,
-        layers: (layers, layers),
-        binary_steps: 5,
-        ..Default::default()
+        layers: Layers {
+            min: layers,
+            max: layers,
+        },
+        ..method.timed()
     }
+}
+
+/// The methods traced per pixel, which every timing and accuracy table compares (the
+/// rasterised mesh is figure 20's), with `settings` of each.
+pub fn traced(settings: fn(Method) -> Settings) -> Vec<Settings> {
+    Method::ALL
+        .into_iter()
+        .filter(|m| m.truth().is_some())
+        .map(settings)
+        .collect()
 }
 
 fn ms(v: Option<f64>) -> String {

@@ -1,7 +1,7 @@
 //! The paper's timing tables and figures (tables 1 and 2, figures 20 and 21, the pyramid build),
 //! the cone map build and today's frame size, each as the rows it measured.
 
-use super::{Bench, Ratios, addressing, fixed_layers, ms, ratio, ratio_text};
+use super::{Bench, Ratios, addressing, ms, ratio, ratio_text, traced};
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_core::stats::{Summary, time_cpu};
 use quadray_displace::accuracy::Cost;
@@ -11,10 +11,18 @@ use quadray_displace::maps::{BUNDLED, resized};
 use quadray_displace::pyramid::Pyramid;
 use quadray_displace::scene::SurfaceKind;
 use quadray_displace::{
-    DisplaceError, Lod, Method, PyramidBuilder, PyramidKind, Renderer, Settings,
+    DisplaceError, Lod, Method, PyramidBuilder, PyramidKind, Renderer, Settings, Size,
 };
 use quadray_gpu::GpuTimer;
 use std::path::Path;
+
+/// `s` with the LOD of section 3.4 chosen from screen-space derivatives.
+fn lod_auto(s: Settings) -> Settings {
+    Settings {
+        lod: Lod::Auto,
+        ..s
+    }
+}
 
 /// The map sides of figure 21 and the pyramid build table.
 fn map_sizes(quick: bool) -> &'static [u32] {
@@ -64,7 +72,7 @@ pub fn tables_1_2_figure_20(
         let map = resized(&b.load()?, 256);
         let mut r = Renderer::new(gpu, &map, None, b.surface);
         let mut time = |experiment, method| {
-            let s = bench.paper_view(fixed_layers(method, 16));
+            let s = bench.paper_view(Method::timed(method));
             bench.time(experiment, b.name, &map, &mut r, &s)
         };
         let point = time("table1", Method::Pyramid)?;
@@ -92,7 +100,7 @@ pub fn tables_1_2_figure_20(
             // One copy of the map, as in the paper's figure: 2 * 256^2 triangles for the mesh.
             let mut one = Renderer::new(gpu, &map, None, SurfaceKind::Terrain);
             for method in [Method::Pyramid, Method::Mesh] {
-                let s = bench.paper_view(fixed_layers(method, 16));
+                let s = bench.paper_view(method.timed());
                 let t = bench.time("figure20", b.name, &map, &mut one, &s)?;
                 let mb = one.memory_bytes(method) as f64 / 1e6;
                 f20.row(vec![
@@ -127,20 +135,14 @@ pub fn figure_21(
         ],
     );
     let variants = [
-        ("pyramid", fixed_layers(Method::Pyramid, 16)),
-        ("pyramid-ascend", fixed_layers(Method::PyramidAscend, 16)),
-        (
-            "pyramid lod-auto",
-            Settings {
-                lod: Lod::Auto,
-                ..fixed_layers(Method::Pyramid, 16)
-            },
-        ),
+        Method::Pyramid.timed(),
+        Method::PyramidAscend.timed(),
+        lod_auto(Method::Pyramid.timed()),
     ];
     let mut f21_series: Vec<Series> = variants
         .iter()
-        .map(|(name, _)| Series {
-            name: name.to_string(),
+        .map(|s| Series {
+            name: s.caption(),
             points: vec![],
         })
         .collect();
@@ -149,7 +151,7 @@ pub fn figure_21(
         let map = resized(tiles, size);
         let mut r = Renderer::new(gpu, &map, None, BUNDLED[0].surface);
         let mut times = [None; 3];
-        for (k, (_, s)) in variants.iter().enumerate() {
+        for (k, s) in variants.iter().enumerate() {
             times[k] = bench.time(
                 "figure21",
                 "tiles",
@@ -270,45 +272,41 @@ pub fn todays_frame(
     };
     let mut r = Renderer::new(gpu, tiles, None, BUNDLED[0].surface);
     let today = |s: Settings| Settings {
-        width: w,
-        height: h,
+        size: Size::new(w, h),
         view_angle_deg: 60.0,
         ..s
     };
-    let columns = [
-        ("pom-16", fixed_layers(Method::Pom, 16)),
-        ("pyramid", fixed_layers(Method::Pyramid, 16)),
-        ("pyramid-ascend", fixed_layers(Method::PyramidAscend, 16)),
-        (
-            "pyramid-bilinear",
-            fixed_layers(Method::PyramidBilinear, 16),
-        ),
-        (
-            "pyramid lod-auto",
-            Settings {
-                lod: Lod::Auto,
-                ..fixed_layers(Method::Pyramid, 16)
-            },
-        ),
-        ("relief-16+5", fixed_layers(Method::Relief, 16)),
-        ("cone-15+8", Settings::relaxed_cone()),
-    ];
+    let mut columns = traced(Method::timed);
+    columns.push(lod_auto(Method::Pyramid.timed()));
     let mut times = Vec::new();
-    for (_, s) in &columns {
+    for s in &columns {
         times.push(bench.time("today", "tiles", tiles, &mut r, &today(s.clone()))?);
     }
-    ratios.pyramid_over_pom16_today = ratio(times[1], times[0]);
-    ratios.pyramid_lod_auto_over_pom16_today = ratio(times[4], times[0]);
-    let mut header: Vec<&str> = columns.iter().map(|(n, _)| *n).collect();
-    header.extend(["pyramid / pom-16", "lod-auto / pom-16"]);
+    let time_of = |wanted: &Settings| {
+        let k = columns.iter().position(|s| s == wanted);
+        times[k.expect("a column")]
+    };
+    let pom = time_of(&Method::Pom.timed());
+    let over_pom = [
+        time_of(&Method::Pyramid.timed()),
+        time_of(&lod_auto(Method::Pyramid.timed())),
+    ]
+    .map(|t| ratio(t, pom));
+    ratios.pyramid_over_pom16_today = over_pom[0];
+    ratios.pyramid_lod_auto_over_pom16_today = over_pom[1];
+    let mut header: Vec<String> = columns.iter().map(Settings::caption).collect();
+    let pom_caption = Method::Pom.timed().caption();
+    header.extend([
+        format!("pyramid / {pom_caption}"),
+        format!("lod-auto / {pom_caption}"),
+    ]);
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut t = Table::new(
         format!("Today's frame: {w}x{h}, tiles 1024^2, 60 deg, GPU ms"),
         &header,
     );
     let mut row: Vec<String> = times.iter().map(|&t| ms(t)).collect();
-    for k in [1, 4] {
-        row.push(ratio_text(ratio(times[k], times[0])));
-    }
+    row.extend(over_pom.map(ratio_text));
     t.row(row);
     let angles = [0.0, 45.0, 60.0, 70.0, 85.0];
     let mut angle_columns = vec!["method".to_string()];
@@ -320,8 +318,8 @@ pub fn todays_frame(
         columns: angle_columns,
         rows: vec![],
     };
-    for (name, s) in &columns {
-        let mut row = vec![name.to_string()];
+    for s in &columns {
+        let mut row = vec![s.caption()];
         for angle in angles {
             let s = Settings {
                 view_angle_deg: angle,

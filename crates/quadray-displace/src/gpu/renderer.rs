@@ -12,7 +12,7 @@ use crate::heightmap::HeightMap;
 use crate::method::Method;
 use crate::pyramid::Addressing;
 use crate::scene::{Plane, SurfaceKind, View};
-use crate::{DisplaceError, Lod, Settings};
+use crate::{DisplaceError, Settings};
 use quadray_core::image_out::Rgba8Image;
 use quadray_core::stats::Summary;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32, read_texture_rgba8, texture_2d};
@@ -225,30 +225,20 @@ impl Renderer {
     }
 
     fn write_frame(&self, gpu: &Gpu, s: &Settings, view: &View) {
-        let v4 = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
-        let params = FrameParams {
-            view_proj: view.view_proj.to_cols_array_2d(),
-            eye: v4(view.eye),
-            light: v4(view.light),
-            depth_scale: s.depth_scale,
-            lod: match s.lod {
-                Lod::Auto => -1,
-                Lod::Level(l) => l.min(self.map.levels()) as i32,
-            },
-            layers_min: s.layers.0 as f32,
-            layers_max: s.layers.1 as f32,
-            binary_steps: s.binary_steps,
-            shadows: u32::from(s.shadows),
-            show_iterations: u32::from(s.show_iterations),
-            _pad: 0,
-        };
+        let params = FrameParams::new(s, view, self.map.levels());
         self.pass.write_frame(&gpu.queue, &params);
     }
 
     fn targets(gpu: &Gpu, s: &Settings, debug_outputs: bool) -> Vec<wgpu::Texture> {
         let make = |format, label| {
             let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-            texture_2d(&gpu.device, label, (s.width, s.height), format, usage)
+            texture_2d(
+                &gpu.device,
+                label,
+                (s.size.width, s.size.height),
+                format,
+                usage,
+            )
         };
         let mut t = vec![make(COLOR_FORMAT, "color"), make(DEPTH_FORMAT, "depth")];
         if debug_outputs {
@@ -271,7 +261,7 @@ impl Renderer {
         self.prepare(gpu, method);
         let map_group = match (&self.cone, method) {
             (Some((cone_group, _)), Method::Cone) => cone_group,
-            _ if method.uses_conservative_pyramid() => &self.conservative_group,
+            _ if method.describe().conservative_pyramid => &self.conservative_group,
             _ => &self.point_group,
         };
         let geometry = if method == Method::Mesh {
@@ -357,8 +347,8 @@ impl Renderer {
         };
         Ok(Frame {
             color: Rgba8Image::from_bytes(
-                s.width,
-                s.height,
+                s.size.width,
+                s.size.height,
                 &read_texture_rgba8(gpu, &targets[0])?,
             ),
             hits: pixels(read_texture_f32(gpu, &targets[2], 0, 4)?),

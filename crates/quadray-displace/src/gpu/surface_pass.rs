@@ -5,6 +5,8 @@
 
 use super::height_pyramid::PyramidInfo;
 use crate::method::Method;
+use crate::scene::View;
+use crate::settings::{Lod, Settings};
 use quadray_gpu::{cleared_attachment, nearest_depth};
 use std::collections::HashMap;
 use wgpu::util::DeviceExt;
@@ -43,6 +45,30 @@ pub(super) struct FrameParams {
     pub shadows: u32,
     pub show_iterations: u32,
     pub _pad: u32,
+}
+
+impl FrameParams {
+    /// The uniform for `s` seen from `view`, on a map whose coarsest level is `top_level`: the
+    /// one place the settings reach the shader.
+    pub fn new(s: &Settings, view: &View, top_level: u32) -> Self {
+        let v4 = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
+        Self {
+            view_proj: view.view_proj.to_cols_array_2d(),
+            eye: v4(view.eye),
+            light: v4(view.light),
+            depth_scale: s.depth_scale,
+            lod: match s.lod {
+                Lod::Auto => -1,
+                Lod::Level(l) => l.min(top_level) as i32,
+            },
+            layers_min: s.layers.min as f32,
+            layers_max: s.layers.max as f32,
+            binary_steps: s.binary_steps,
+            shadows: u32::from(s.shadows),
+            show_iterations: u32::from(s.show_iterations),
+            _pad: 0,
+        }
+    }
 }
 
 /// The surface shader's whole source: the method ids, the tracing module, the cone trace, the
