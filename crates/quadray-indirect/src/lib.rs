@@ -13,10 +13,12 @@
 #![warn(missing_docs)]
 
 pub mod baselines;
+mod frame;
 pub mod gpu;
 pub mod picture;
 pub mod reference;
 pub mod scene;
+mod settings;
 
 /// Anything that can go wrong between a scene file and a measured picture.
 #[derive(Debug, thiserror::Error)]
@@ -32,9 +34,10 @@ pub enum IndirectError {
     Settings(String),
 }
 
+pub use frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
 pub use gpu::{
-    ClusterSettings, CutNode, FLOAT_FORMAT, Frame, FrameTiming, GBufferViews, Gather,
-    LightQuadtree, Method, OutputPass, OutputTerm, Pass, Renderer, RsmPass, RsmViews, Settings,
-    Spot, TileCriterion, Validity, WorkCounts,
+    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, OutputPass, OutputTerm, Renderer, RsmPass,
+    RsmViews, Spot,
 };
+pub use settings::{ClusterSettings, Method, Settings, TileCriterion, Validity};
 pub use scene::Scene;

@@ -6,14 +6,15 @@
 
 use super::contract::{
     ClusterUniform, GpuNode, GpuNodeBounds, LEVEL_SLICE, LevelSlot, LightUniform, MAX_SLICES,
-    SLICE, ShadeUniform, Slots, TILE, bind_group, compute_pass, compute_pipeline, dispatch_2d,
+    SLICE, ShadeUniform, Slots, bind_group, compute_pass, compute_pipeline, dispatch_2d,
     layout, pipeline_layout, shader_module, slices, storage_buffer, storage_entry, tex,
     texture_entry, uniform_buffer, uniform_entry, whole,
 };
+use super::gbuffer::GBufferViews;
 use super::light::Spot;
 use super::quadtree::{BOUND_WGSL, COMMON_WGSL, CUT_RULE_WGSL, LightQuadtree};
 use super::rsm::{LIGHT_WGSL, RsmViews};
-use super::{Method, Settings, TileCriterion};
+use crate::settings::{Method, Settings, TileCriterion};
 use crate::{IndirectError, baselines};
 use quadray_gpu::GpuTimer;
 use std::cell::{Cell, OnceCell};
@@ -31,48 +32,8 @@ pub(crate) const SOURCES: [&str; 8] = [
     baselines::WGSL,
 ];
 
-/// The caller's G-buffer: three textures of the output's size, any float format `textureLoad`
-/// reads (quadray's are [`super::FLOAT_FORMAT`]).
-#[derive(Clone, Copy)]
-pub struct GBufferViews<'a> {
-    /// xyz: world position; w: 1 where geometry is seen, 0 elsewhere (no light there).
-    pub position: &'a wgpu::TextureView,
-    /// xyz: unit normal, turned towards the viewer.
-    pub normal: &'a wgpu::TextureView,
-    /// rgb: diffuse albedo.
-    pub albedo: &'a wgpu::TextureView,
-}
-
 /// Where the camera starts in the shading uniform: `set_light` writes what comes before.
 const CAMERA_OFFSET: usize = std::mem::offset_of!(ShadeUniform, camera);
-
-/// Where a low-resolution indirect sample's pixel is (one sample per `subsample`^2 pixels).
-fn low_size(s: &Settings) -> (u32, u32) {
-    (
-        s.width.div_ceil(s.subsample),
-        s.height.div_ceil(s.subsample),
-    )
-}
-
-/// Tiles of [`TILE`]^2 pixels across and down the picture (per-tile cuts).
-pub(crate) fn tiles(s: &Settings) -> (u32, u32) {
-    (s.width.div_ceil(TILE), s.height.div_ceil(TILE))
-}
-
-/// Bytes the per-tile cuts' lists take ([`Settings::tile_capacity`] node indices a tile).
-pub(crate) fn tile_list_bytes(s: &Settings) -> u64 {
-    let (tx, ty) = tiles(s);
-    u64::from(tx) * u64::from(ty) * u64::from(s.tile_capacity) * 4
-}
-
-/// The level whose nodes make a tile's coarse estimate of its irradiance (per-tile cuts): the
-/// quadtree's start level, or a coarser one where its nodes would outnumber a tile's list.
-pub(crate) fn tile_start_level(s: &Settings) -> u32 {
-    let top = s.rsm_size.ilog2();
-    (s.cluster.start_level..top)
-        .find(|&level| (s.rsm_size >> level).pow(2) <= s.tile_capacity)
-        .unwrap_or(top)
-}
 
 /// The per-frame buffers: sizes, radiance out, RSM samples, work counts.
 struct Outputs {
@@ -246,7 +207,7 @@ impl Gather {
         );
         let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry);
         let pixels = u64::from(s.width) * u64::from(s.height);
-        let (lw, lh) = low_size(s);
+        let (lw, lh) = s.low_size();
         let samples = baselines::rsm_samples(
             s.samples,
             s.rsm_radius * s.rsm_size as f32 * std::f32::consts::SQRT_2,
@@ -356,7 +317,7 @@ impl Gather {
         let s = &self.settings;
         queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&spot.uniform()));
         let texel_side = spot.texel_side(s.rsm_size);
-        let (low_width, low_height) = low_size(s);
+        let (low_width, low_height) = s.low_size();
         queue.write_buffer(
             &self.outputs.shade,
             0,
@@ -377,8 +338,8 @@ impl Gather {
                 temporal_weight: s.temporal_weight,
                 tile_error: s.tile_error,
                 tile_capacity: s.tile_capacity,
-                tile_start: tile_start_level(s),
-                tiles_x: tiles(s).0,
+                tile_start: s.tile_start_level(),
+                tiles_x: s.tiles().0,
                 tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
                 tile_share: s.tile_share,
                 _pad: [0; 1],
@@ -415,9 +376,9 @@ impl Gather {
         pass.set_bind_group(1, &self.frame_group, &[]);
         let lists = if method == Some(Method::QuadtreeTiles) {
             self.tile_lists.get_or_init(|| {
-                let (tx, ty) = tiles(&self.settings);
+                let (tx, ty) = self.settings.tiles();
                 let tiles = u64::from(tx) * u64::from(ty);
-                let cuts = tile_list_bytes(&self.settings);
+                let cuts = self.settings.tile_list_bytes();
                 TileLists::new(&self.device, &self.tile_layout, cuts, tiles)
             })
         } else {
@@ -485,7 +446,7 @@ impl Gather {
             match method {
                 _ if subsampled => {
                     pass.set_pipeline(low);
-                    let (lw, lh) = low_size(s);
+                    let (lw, lh) = s.low_size();
                     sliced(&mut pass, 0, low_slices, lw, lh);
                 }
                 Method::Quadtree => {
@@ -496,7 +457,7 @@ impl Gather {
                     // one workgroup a tile; a list of at most TILE_FRONTIER nodes fits a slice
                     pass.set_pipeline(&self.indirect_tiles);
                     self.bind(&mut pass, 0, 0);
-                    let (tx, ty) = tiles(s);
+                    let (tx, ty) = s.tiles();
                     pass.dispatch_workgroups(tx, ty, 1);
                 }
                 Method::QuadtreePasses => {

@@ -6,11 +6,10 @@ use super::gbuffer::GBufferPass;
 use super::light::Spot;
 use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
-use super::{
-    ClusterSettings, CutNode, Frame, FrameTiming, Gather, Method, Pass, Receiver, Settings, Vpl,
-    WorkCounts,
-};
+use super::gather::Gather;
 use crate::IndirectError;
+use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
+use crate::settings::{ClusterSettings, Method, Settings};
 use crate::scene::Scene;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use std::collections::BTreeMap;
@@ -330,7 +329,7 @@ impl<'g> Renderer<'g> {
             return Ok(None);
         };
         let read = |buffer| quadray_gpu::read_buffer(self.gpu, buffer);
-        let (tx, ty) = super::gather::tiles(self.settings());
+        let (tx, ty) = self.settings().tiles();
         let mut sizes: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&read(sizes)?);
         sizes.truncate((tx * ty) as usize);
         Ok(Some((sizes, bytemuck::pod_collect_to_vec(&read(cuts)?))))
