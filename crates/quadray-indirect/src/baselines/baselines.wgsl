@@ -10,14 +10,14 @@ fn texel_irradiance(t: vec2<i32>, r: Receiver) -> vec3<f32> {
         fetches += 2u;
         let p = textureLoad(rsm_pos, t, 0);
         let flux = textureLoad(rsm_flux, t, 0).rgb;
-        e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, shade.r_min);
+        e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, terms.r_min);
     }
     return e;
 }
 
 @compute @workgroup_size(8, 8)
 fn brute_force(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.width || id.y >= shade.height) {
+    if (id.x >= viewer.width || id.y >= viewer.height) {
         return;
     }
     let r = receiver(id.xy);
@@ -65,7 +65,7 @@ fn sampled_irradiance(r: Receiver) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8)
 fn rsm_sampling(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.width || id.y >= shade.height) {
+    if (id.x >= viewer.width || id.y >= viewer.height) {
         return;
     }
     let r = receiver(id.xy);

@@ -104,22 +104,16 @@ pub(crate) struct ClusterUniform {
     pub normal_threshold: f32,
 }
 
-/// WGSL `Shade`: sizes and constants of the per-pixel passes.
+/// WGSL `Shade`: the gather's settings, written once.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct ShadeUniform {
-    pub width: u32,
-    pub height: u32,
-    pub r_min: f32,
     pub sample_count: u32,
     pub subsample: u32,
     pub low_width: u32,
     pub low_height: u32,
-    pub depth_bias: f32,
     pub normal_agreement: f32,
-    pub plane_agreement: f32,
     pub shadow_steps: u32,
-    pub shadow_thickness: f32,
     pub temporal_weight: f32,
     pub tile_error: f32,
     pub tile_capacity: u32,
@@ -127,11 +121,30 @@ pub(crate) struct ShadeUniform {
     pub tiles_x: u32,
     pub tile_estimate: u32,
     pub tile_share: f32,
-    /// Up to the camera's 16-byte alignment.
-    pub _pad: [u32; 1],
-    /// Written by `Gather::set_camera`, the fields before by `Gather::set_light`.
-    pub camera: [[f32; 4]; 4],
+}
+
+/// WGSL `LightTerms`: the gather's per-light values (the kernel's clamp, the lengths that scale
+/// with the scene), written with the light.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct LightTermsUniform {
+    pub r_min: f32,
+    pub depth_bias: f32,
+    pub plane_agreement: f32,
+    pub shadow_thickness: f32,
+}
+
+/// WGSL `Camera`: the gather's per-camera values (the G-buffer's view and size), written with
+/// the camera.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct CameraUniform {
+    pub view_proj: [[f32; 4]; 4],
     pub eye: [f32; 4],
+    pub width: u32,
+    pub height: u32,
+    /// Up to the struct's 16-byte alignment.
+    pub _pad: [u32; 2],
 }
 
 /// WGSL `Level`: one slot of the per-dispatch uniforms (a level, or a slice of a long sum).

@@ -5,12 +5,12 @@
 //! [`super::OutputPass`] copies into the caller's texture.
 
 use super::contract::{
-    ClusterUniform, GpuNode, GpuNodeBounds, LEVEL_SLICE, LevelSlot, LightUniform, MAX_SLICES,
-    SLICE, ShadeUniform, Slots, bind_group, compute_pass, compute_pipeline, dispatch_2d,
+    CameraUniform, ClusterUniform, GpuNode, GpuNodeBounds, LEVEL_SLICE, LevelSlot,
+    LightTermsUniform, LightUniform, MAX_SLICES, SLICE, ShadeUniform, Slots, bind_group, compute_pass, compute_pipeline, dispatch_2d,
     layout, pipeline_layout, shader_module, slices, storage_buffer, storage_entry, tex,
     texture_entry, uniform_buffer, uniform_entry, whole,
 };
-use super::gbuffer::GBufferViews;
+use super::gbuffer::{GBufferViews, camera_uniform};
 use super::light::Spot;
 use super::quadtree::{BOUND_WGSL, COMMON_WGSL, CUT_RULE_WGSL, LightQuadtree};
 use super::rsm::{LIGHT_WGSL, RsmViews};
@@ -32,12 +32,30 @@ pub(crate) const SOURCES: [&str; 8] = [
     baselines::WGSL,
 ];
 
-/// Where the camera starts in the shading uniform: `set_light` writes what comes before.
-const CAMERA_OFFSET: usize = std::mem::offset_of!(ShadeUniform, camera);
+/// The gather's settings as the shaders read them (written once: a gather's settings are fixed).
+fn shade_uniform(s: &Settings) -> ShadeUniform {
+    let (low_width, low_height) = s.low_size();
+    ShadeUniform {
+        sample_count: s.samples,
+        subsample: s.subsample,
+        low_width,
+        low_height,
+        normal_agreement: 0.9,
+        shadow_steps: s.shadow_steps,
+        temporal_weight: s.temporal_weight,
+        tile_error: s.tile_error,
+        tile_capacity: s.tile_capacity,
+        tile_start: s.tile_start_level(),
+        tiles_x: s.tiles().0,
+        tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
+        tile_share: s.tile_share,
+    }
+}
 
-/// The per-frame buffers: sizes, radiance out, RSM samples, work counts.
+/// The per-frame buffers: settings, camera, radiance out, RSM samples, work counts.
 struct Outputs {
     shade: wgpu::Buffer,
+    camera: wgpu::Buffer,
     indirect: wgpu::Buffer,
     direct: wgpu::Buffer,
     low: wgpu::Buffer,
@@ -86,6 +104,7 @@ impl Outputs {
             layout,
             vec![
                 whole(&self.shade),
+                whole(&self.camera),
                 tex(gbuffer.position),
                 tex(gbuffer.normal),
                 tex(gbuffer.albedo),
@@ -117,6 +136,7 @@ pub struct Gather {
     light_layout: wgpu::BindGroupLayout,
     frame_layout: wgpu::BindGroupLayout,
     light: wgpu::Buffer,
+    light_terms: wgpu::Buffer,
     outputs: Outputs,
     slots: Slots,
     /// Per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
@@ -159,13 +179,14 @@ impl Gather {
             &[
                 uniform_entry::<ClusterUniform>(0, compute, false),
                 uniform_entry::<LightUniform>(1, compute, false),
-                texture_entry(2),
+                uniform_entry::<LightTermsUniform>(2, compute, false),
                 texture_entry(3),
                 texture_entry(4),
-                storage_entry::<GpuNode>(5, true),
+                texture_entry(5),
                 storage_entry::<GpuNode>(6, true),
-                storage_entry::<u32>(7, true),
-                storage_entry::<GpuNodeBounds>(8, true),
+                storage_entry::<GpuNode>(7, true),
+                storage_entry::<u32>(8, true),
+                storage_entry::<GpuNodeBounds>(9, true),
             ],
         );
         let frame_layout = layout(
@@ -173,15 +194,16 @@ impl Gather {
             "gather frame",
             &[
                 uniform_entry::<ShadeUniform>(0, compute, false),
-                texture_entry(1),
+                uniform_entry::<CameraUniform>(1, compute, false),
                 texture_entry(2),
                 texture_entry(3),
-                storage_entry::<[f32; 4]>(4, false),
+                texture_entry(4),
                 storage_entry::<[f32; 4]>(5, false),
                 storage_entry::<[f32; 4]>(6, false),
-                storage_entry::<[f32; 4]>(7, true),
-                storage_entry::<[u32; 4]>(8, false),
-                storage_entry::<[f32; 4]>(9, false),
+                storage_entry::<[f32; 4]>(7, false),
+                storage_entry::<[f32; 4]>(8, true),
+                storage_entry::<[u32; 4]>(9, false),
+                storage_entry::<[f32; 4]>(10, false),
             ],
         );
         let tile_layout = layout(
@@ -214,8 +236,14 @@ impl Gather {
             baselines::SAMPLE_SEED,
         );
         let light = uniform_buffer::<LightUniform>(device, "gather light");
+        let light_terms = uniform_buffer::<LightTermsUniform>(device, "gather light terms");
         let outputs = Outputs {
-            shade: uniform_buffer::<ShadeUniform>(device, "shade"),
+            shade: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shade"),
+                contents: bytemuck::bytes_of(&shade_uniform(s)),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            camera: uniform_buffer::<CameraUniform>(device, "gather camera"),
             indirect: storage_buffer(device, "indirect", pixels * 16),
             direct: storage_buffer(device, "direct", pixels * 16),
             low: storage_buffer(device, "low-resolution indirect", u64::from(lw * lh) * 16),
@@ -249,7 +277,7 @@ impl Gather {
             brute_force: pipeline("brute_force"),
             rsm_sampling: pipeline("rsm_sampling"),
             temporal_blend: pipeline("temporal_blend"),
-            light_group: Self::light_group(device, &light_layout, &light, quadtree, rsm),
+            light_group: Self::light_group(device, &light_layout, [&light, &light_terms], quadtree, rsm),
             frame_group: outputs.frame_group(device, &frame_layout, gbuffer),
             dispatch_group: bind_group(
                 device,
@@ -264,6 +292,7 @@ impl Gather {
             light_layout,
             frame_layout,
             light,
+            light_terms,
             outputs,
             slots,
             history_of: Cell::new(None),
@@ -274,7 +303,7 @@ impl Gather {
     fn light_group(
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
-        light: &wgpu::Buffer,
+        [light, terms]: [&wgpu::Buffer; 2],
         quadtree: &LightQuadtree,
         rsm: RsmViews,
     ) -> wgpu::BindGroup {
@@ -285,6 +314,7 @@ impl Gather {
             vec![
                 whole(quadtree.params()),
                 whole(light),
+                whole(terms),
                 tex(rsm.flux),
                 tex(rsm.position),
                 tex(rsm.normal),
@@ -299,8 +329,8 @@ impl Gather {
     /// Reads another quadtree or RSM from now on (when the caller's RSM textures change).
     pub fn bind_rsm(&mut self, device: &wgpu::Device, quadtree: &LightQuadtree, rsm: RsmViews) {
         self.reset_history();
-        self.light_group =
-            Self::light_group(device, &self.light_layout, &self.light, quadtree, rsm);
+        let buffers = [&self.light, &self.light_terms];
+        self.light_group = Self::light_group(device, &self.light_layout, buffers, quadtree, rsm);
     }
 
     /// Shades another G-buffer of the same size from now on (when the caller's targets change).
@@ -314,39 +344,9 @@ impl Gather {
     /// Sets the light (per light update) and the clamp `r_min` of the VPL kernel's 1/r^4
     /// (world units).
     pub fn set_light(&self, queue: &wgpu::Queue, spot: &Spot, r_min: f32) {
-        let s = &self.settings;
         queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&spot.uniform()));
-        let texel_side = spot.texel_side(s.rsm_size);
-        let (low_width, low_height) = s.low_size();
-        queue.write_buffer(
-            &self.outputs.shade,
-            0,
-            &bytemuck::bytes_of(&ShadeUniform {
-                width: s.width,
-                height: s.height,
-                r_min,
-                sample_count: s.samples,
-                subsample: s.subsample,
-                low_width,
-                low_height,
-                // a few shadow-map texels' worth of depth at the far side of the scene
-                depth_bias: 0.005 + 3.0 * texel_side * spot.far / spot.extent,
-                normal_agreement: 0.9,
-                plane_agreement: 0.02 * spot.extent,
-                shadow_steps: s.shadow_steps,
-                shadow_thickness: s.shadow_thickness * spot.extent,
-                temporal_weight: s.temporal_weight,
-                tile_error: s.tile_error,
-                tile_capacity: s.tile_capacity,
-                tile_start: s.tile_start_level(),
-                tiles_x: s.tiles().0,
-                tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
-                tile_share: s.tile_share,
-                _pad: [0; 1],
-                camera: [[0.0; 4]; 4],
-                eye: [0.0; 4],
-            })[..CAMERA_OFFSET],
-        );
+        let terms = spot.terms(&self.settings, r_min);
+        queue.write_buffer(&self.light_terms, 0, bytemuck::bytes_of(&terms));
     }
 
     /// Sets the camera the G-buffer is rendered from (`view_proj`: world -> clip, `eye`: its
@@ -356,17 +356,9 @@ impl Gather {
         if self.camera.replace(Some((view_proj, eye))) != Some((view_proj, eye)) {
             self.reset_history();
         }
-        let camera = (view_proj.to_cols_array_2d(), eye.extend(1.0).to_array());
-        queue.write_buffer(
-            &self.outputs.shade,
-            CAMERA_OFFSET as u64,
-            bytemuck::bytes_of(&camera.0),
-        );
-        queue.write_buffer(
-            &self.outputs.shade,
-            (CAMERA_OFFSET + size_of::<[[f32; 4]; 4]>()) as u64,
-            bytemuck::bytes_of(&camera.1),
-        );
+        let s = &self.settings;
+        let camera = camera_uniform(view_proj, eye, (s.width, s.height));
+        queue.write_buffer(&self.outputs.camera, 0, bytemuck::bytes_of(&camera));
     }
 
     /// Binds the light's, the frame's and the tile lists' groups (the lists allocated first if

@@ -3,7 +3,7 @@
 //! triangles from the camera into position, normal and albedo targets.
 
 use super::contract::{
-    RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry, whole,
+    CameraUniform, RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry, whole,
 };
 use super::rsm::{RASTER_WGSL, RasterTargets, raster_pipeline, record_raster};
 use glam::{Mat4, Vec3};
@@ -18,6 +18,18 @@ pub struct GBufferViews<'a> {
     pub normal: &'a wgpu::TextureView,
     /// rgb: diffuse albedo.
     pub albedo: &'a wgpu::TextureView,
+}
+
+/// The gather's per-camera uniform: the camera a `width` x `height` G-buffer was rendered from
+/// (`view_proj`: world -> clip, `eye`: its position).
+pub(crate) fn camera_uniform(view_proj: Mat4, eye: Vec3, (width, height): (u32, u32)) -> CameraUniform {
+    CameraUniform {
+        view_proj: view_proj.to_cols_array_2d(),
+        eye: eye.extend(1.0).to_array(),
+        width,
+        height,
+        _pad: [0; 2],
+    }
 }
 
 /// The G-buffer pass's shader, in order.

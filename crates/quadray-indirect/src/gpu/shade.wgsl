@@ -15,7 +15,7 @@ fn cut_irradiance(r: Receiver) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8)
 fn indirect_cut(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.width || id.y >= shade.height) {
+    if (id.x >= viewer.width || id.y >= viewer.height) {
         return;
     }
     let r = receiver(id.xy);
@@ -31,7 +31,7 @@ fn indirect_cut(@builtin(global_invocation_id) id: vec3<u32>) {
 // so; adds to what the coarser levels' passes left (the buffer is cleared before the first).
 @compute @workgroup_size(8, 8)
 fn indirect_level(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.width || id.y >= shade.height) {
+    if (id.x >= viewer.width || id.y >= viewer.height) {
         return;
     }
     let r = receiver(id.xy);
@@ -58,7 +58,7 @@ fn indirect_level(@builtin(global_invocation_id) id: vec3<u32>) {
 // The full-resolution pixel a low-resolution sample stands for.
 fn low_pixel(low_xy: vec2<u32>) -> vec2<u32> {
     let p = low_xy * shade.subsample + vec2<u32>(shade.subsample / 2u);
-    return min(p, vec2<u32>(shade.width - 1u, shade.height - 1u));
+    return min(p, vec2<u32>(viewer.width - 1u, viewer.height - 1u));
 }
 
 // This dispatch's slice of the sum a sub-sampled method gathers: the cut's clusters, or RSM
@@ -87,7 +87,7 @@ fn low_sample(low_xy: vec2<u32>, sampled: bool) {
         low[index] += vec4<f32>(e, 0.0);
     }
     let full = low_pixel(low_xy);
-    store_counts(full.y * shade.width + full.x);
+    store_counts(full.y * viewer.width + full.x);
 }
 
 @compute @workgroup_size(8, 8)
@@ -104,7 +104,7 @@ fn sampled_low(@builtin(global_invocation_id) id: vec3<u32>) {
 // and planes agree); where none does, the pixel is recomputed at full resolution, one slice per
 // dispatch like the low-resolution pass.
 fn upsample_pixel(pixel: vec2<u32>, sampled: bool) {
-    if (pixel.x >= shade.width || pixel.y >= shade.height) {
+    if (pixel.x >= viewer.width || pixel.y >= viewer.height) {
         return;
     }
     let r = receiver(pixel);
@@ -125,7 +125,7 @@ fn upsample_pixel(pixel: vec2<u32>, sampled: bool) {
         let s = clamp(base + o, vec2<i32>(0), vec2<i32>(i32(shade.low_width) - 1, i32(shade.low_height) - 1));
         let q = receiver(low_pixel(vec2<u32>(s)));
         let agree = q.covered && dot(q.n, r.n) > shade.normal_agreement
-            && abs(dot(q.x - r.x, r.n)) < shade.plane_agreement;
+            && abs(dot(q.x - r.x, r.n)) < terms.plane_agreement;
         let w = select(1.0 - t.x, t.x, o.x == 1) * select(1.0 - t.y, t.y, o.y == 1);
         if (agree && w > 0.0) {
             fetches++;
@@ -156,7 +156,7 @@ fn sampled_upsample(@builtin(global_invocation_id) id: vec3<u32>) {
 // Direct light from the spot, shadowed by the RSM depth.
 @compute @workgroup_size(8, 8)
 fn direct_light(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.width || id.y >= shade.height) {
+    if (id.x >= viewer.width || id.y >= viewer.height) {
         return;
     }
     let r = receiver(id.xy);
@@ -170,7 +170,7 @@ fn direct_light(@builtin(global_invocation_id) id: vec3<u32>) {
         let occluder = textureLoad(rsm_pos, texel, 0);
         let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0)) && clip.w > 0.0;
         let lit = textureLoad(rsm_normal, texel, 0).w < 0.5
-            || light_depth(light, r.x) <= occluder.w + shade.depth_bias;
+            || light_depth(light, r.x) <= occluder.w + terms.depth_bias;
         if (inside && lit) {
             let to_light = light.position.xyz - r.x;
             let d2 = dot(to_light, to_light);
@@ -185,7 +185,7 @@ fn direct_light(@builtin(global_invocation_id) id: vec3<u32>) {
 // indirect light, and the frame shows the average (the recomputed flag stays this frame's).
 @compute @workgroup_size(8, 8)
 fn temporal_blend(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= shade.width || id.y >= shade.height) {
+    if (id.x >= viewer.width || id.y >= viewer.height) {
         return;
     }
     let index = pixel_index(id.xy);

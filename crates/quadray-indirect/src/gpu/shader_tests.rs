@@ -49,29 +49,27 @@ fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
             "Shade",
             ShadeUniform,
             [
-                width,
-                height,
-                r_min,
                 sample_count,
                 subsample,
                 low_width,
                 low_height,
-                depth_bias,
                 normal_agreement,
-                plane_agreement,
                 shadow_steps,
-                shadow_thickness,
                 temporal_weight,
                 tile_error,
                 tile_capacity,
                 tile_start,
                 tiles_x,
                 tile_estimate,
-                tile_share,
-                camera,
-                eye
+                tile_share
             ]
         ),
+        shared!(
+            "LightTerms",
+            LightTermsUniform,
+            [r_min, depth_bias, plane_agreement, shadow_thickness]
+        ),
+        shared!("Camera", CameraUniform, [view_proj, eye, width, height]),
         shared!("Level", LevelSlot, [level]),
         shared!("Node", GpuNode, [flux, pos, normal]),
         shared!("NodeBounds", GpuNodeBounds, [lo, hi]),
