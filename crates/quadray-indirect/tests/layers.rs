@@ -22,6 +22,7 @@ const LAYERS: &[&[&str]] = &[
     &["gpu::gbuffer"],
     &["gpu::quadtree"],
     &["gpu::gather::resources"],
+    &["gpu::gather::upsample"],
     &[
         "gpu::gather::cut",
         "gpu::gather::passes",
@@ -31,7 +32,6 @@ const LAYERS: &[&[&str]] = &[
         "gpu::gather::direct",
         "gpu::gather::temporal",
     ],
-    &["gpu::gather::upsample"],
     &["gpu::gather"],
     &["gpu::output"],
     &["gpu::renderer"],
@@ -103,7 +103,13 @@ fn named_paths(module: &str, text: &str) -> Vec<(usize, String)> {
         let (root, after) = if rest.starts_with("crate::") {
             (Vec::new(), "crate::".len())
         } else if rest.starts_with("super::") {
-            (parent(line_of[start].1), "super::".len())
+            // each further `super::` goes one module up
+            let ups = (0..)
+                .take_while(|i| rest[i * "super::".len()..].starts_with("super::"))
+                .count();
+            let mut root = parent(line_of[start].1);
+            root.truncate(root.len().saturating_sub(ups - 1));
+            (root, ups * "super::".len())
         } else {
             continue;
         };

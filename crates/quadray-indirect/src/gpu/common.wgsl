@@ -1,5 +1,5 @@
 // Shared by every pass that reads clusters: the node layout, pyramid addressing, the VPL kernel
-// and the top-down cut rule. Concatenated in front of cluster.wgsl, shade.wgsl and baselines.wgsl.
+// and the top-down cut rule. Concatenated in front of cluster.wgsl and every gather pass.
 
 // One light cluster (a level-0 node is one RSM texel = one VPL).
 //   flux.rgb: summed flux, flux.w: number of texels that see geometry

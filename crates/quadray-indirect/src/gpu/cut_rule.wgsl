@@ -1,6 +1,6 @@
 // The top-down rule, shared by the compacted cut (cluster.wgsl) and the per-level passes
-// (shade.wgsl): a node is used when it is accepted (valid, or at the limit level) and none of its
-// ancestors up to the start level was. This is the paper's "revisit" of ancestors.
+// (gather/passes.wgsl): a node is used when it is accepted (valid, or at the limit level) and
+// none of its ancestors up to the start level was. This is the paper's "revisit" of ancestors.
 fn accepted(p: ClusterParams, level: u32, xy: vec2<u32>) -> bool {
     if (level == p.limit_level) {
         return true;

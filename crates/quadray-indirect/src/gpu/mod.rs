@@ -38,11 +38,16 @@ pub use crate::settings::{ClusterSettings, Method, Settings, TileCriterion, Vali
 #[cfg(test)]
 pub(crate) fn shaders() -> Vec<(&'static str, Vec<String>)> {
     let owned = |parts: &[&str]| parts.iter().map(|p| p.to_string()).collect();
-    vec![
+    let mut shaders = vec![
         ("rsm", owned(&rsm::SOURCES)),
         ("gbuffer", owned(&gbuffer::SOURCES)),
         ("quadtree", owned(&quadtree::SOURCES)),
-        ("gather", owned(&gather::SOURCES)),
         ("output", output::sources("rgba16float").to_vec()),
-    ]
+    ];
+    shaders.extend(
+        gather::shaders()
+            .into_iter()
+            .map(|(name, parts)| (name, owned(&parts))),
+    );
+    shaders
 }

@@ -1,38 +1,5 @@
-// The reference (every VPL of the RSM, no clustering) and RSM sampling (Dachsbacher & Stamminger
-// 2005: N samples around the pixel's projection into the RSM, weights compensating the density).
-
-// Irradiance at `r` from the VPL of RSM texel `t`; an empty texel gives none.
-fn texel_irradiance(t: vec2<i32>, r: Receiver) -> vec3<f32> {
-    var e = vec3<f32>(0.0);
-    fetches++;
-    let n = textureLoad(rsm_normal, t, 0);
-    if (n.w > 0.5) {
-        fetches += 2u;
-        let p = textureLoad(rsm_pos, t, 0);
-        let flux = textureLoad(rsm_flux, t, 0).rgb;
-        e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, terms.r_min);
-    }
-    return e;
-}
-
-@compute @workgroup_size(8, 8)
-fn brute_force(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= viewer.width || id.y >= viewer.height) {
-        return;
-    }
-    let r = receiver(id.xy);
-    var e = vec3<f32>(0.0);
-    if (r.covered) {
-        let size = params.rsm_size;
-        let range = slice_range(size * size, SLICE);
-        for (var i = range.x; i < range.y; i++) {
-            let t = vec2<i32>(i32(i % size), i32(i / size));
-            e += texel_irradiance(t, r);
-        }
-    }
-    add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
-    store_counts(pixel_index(id.xy));
-}
+// RSM sampling (Dachsbacher & Stamminger 2005): N samples around the pixel's projection into the
+// RSM, weights compensating the density.
 
 // This dispatch's slice of the Poisson-disk samples around `r`'s projection into the RSM.
 fn sampled_irradiance(r: Receiver) -> vec3<f32> {
@@ -75,4 +42,9 @@ fn rsm_sampling(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
     store_counts(pixel_index(id.xy));
+}
+
+// What the sub-sampled passes (upsample.wgsl) gather: this dispatch's slice of the samples.
+fn gathered_irradiance(r: Receiver) -> vec3<f32> {
+    return sampled_irradiance(r);
 }

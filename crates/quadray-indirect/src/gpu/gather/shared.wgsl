@@ -1,4 +1,6 @@
-// What every per-pixel shading pass sees (the quadtree's, the baselines' and the reference's).
+// What every gather pass sees (the quadtree's, the baselines' and the reference's): the settings,
+// light, camera and per-dispatch uniforms, the RSM, quadtree and G-buffer, the outputs, and the
+// helpers every pass shares.
 
 // The gather's settings, written once.
 struct Shade {
@@ -80,13 +82,6 @@ struct Camera {
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
 @group(2) @binding(1) var<uniform> slice: Level;
-// Group 3, the per-tile cuts' lists (bound only once a frame draws them; a placeholder of one
-// slot before): each tile's node indices (`tile_capacity` slots a tile), and per tile the nodes
-// it holds, the splits refused for want of room, the nodes whose error it estimated and the VPL
-// evaluations that took
-@group(3) @binding(0) var<storage, read_write> tile_cuts: array<u32>;
-@group(3) @binding(1) var<storage, read_write> tile_sizes: array<vec4<u32>>;
-
 struct Receiver {
     x: vec3<f32>,
     n: vec3<f32>,
@@ -181,4 +176,18 @@ fn add_indirect(index: u32, value: vec4<f32>) {
     } else {
         indirect[index] += value;
     }
+}
+
+// Irradiance at `r` from the VPL of RSM texel `t`; an empty texel gives none.
+fn texel_irradiance(t: vec2<i32>, r: Receiver) -> vec3<f32> {
+    var e = vec3<f32>(0.0);
+    fetches++;
+    let n = textureLoad(rsm_normal, t, 0);
+    if (n.w > 0.5) {
+        fetches += 2u;
+        let p = textureLoad(rsm_pos, t, 0);
+        let flux = textureLoad(rsm_flux, t, 0).rgb;
+        e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, terms.r_min);
+    }
+    return e;
 }

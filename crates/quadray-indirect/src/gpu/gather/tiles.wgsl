@@ -7,6 +7,13 @@
 // pixels both do, down to single VPLs where needed, then every pixel of the tile sums the tile's
 // list.
 
+// Group 3, this pass's own: the per-tile cuts' lists (allocated by the first frame that draws
+// them): each tile's node indices (`tile_capacity` slots a tile), and per tile the nodes it
+// holds, the splits refused for want of room, the nodes whose error it estimated and the VPL
+// evaluations that took
+@group(3) @binding(0) var<storage, read_write> tile_cuts: array<u32>;
+@group(3) @binding(1) var<storage, read_write> tile_sizes: array<vec4<u32>>;
+
 // TILE (the tile's side) comes from the prelude
 const TILE_PIXELS: u32 = TILE * TILE;
 
@@ -123,9 +130,9 @@ fn shareable(b: NodeBounds, lo: vec3<f32>, hi: vec3<f32>, far: f32) -> bool {
 }
 
 // Indirect shadows per tile: bit c set where the point `p` (a node's mean) is visible from the
-// tile's corner receiver c (`visible`, shade_bindings.wgsl); a pixel on the corners' surface weighs each of
-// its tile's nodes by the corners' visibility interpolated, so that a tile marches four shadow
-// rays a node instead of one a pixel.
+// tile's corner receiver c (`visible`, shared.wgsl); a pixel on the corners' surface weighs each
+// of its tile's nodes by the corners' visibility interpolated, so that a tile marches four
+// shadow rays a node instead of one a pixel.
 fn corner_visibility(p: vec3<f32>) -> u32 {
     var seen = 0u;
     for (var c = 0u; c < 4u; c++) {
