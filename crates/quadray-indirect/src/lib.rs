@@ -19,6 +19,7 @@ pub mod picture;
 pub mod reference;
 pub mod scene;
 mod settings;
+pub mod wgsl;
 
 /// Anything that can go wrong between a scene file and a measured picture.
 #[derive(Debug, thiserror::Error)]

@@ -169,7 +169,10 @@ fn re_exports(src: &Path) -> BTreeMap<String, String> {
     for (facade, file) in [("", "lib.rs"), ("gpu", "gpu/mod.rs")] {
         let text = std::fs::read_to_string(src.join(file)).unwrap();
         let own: Vec<&str> = facade.split("::").filter(|s| !s.is_empty()).collect();
-        let code: String = text.lines().map(|l| code(l).to_string() + "\n").collect();
+        let code: String = text
+            .lines()
+            .map(|l| code(l).replace("pub(crate) use ", "pub use ") + "\n")
+            .collect();
         for statement in code.split("pub use ").skip(1) {
             let statement = &statement[..statement.find(';').unwrap()];
             let (root, tail) = if let Some(t) = statement.strip_prefix("crate::") {

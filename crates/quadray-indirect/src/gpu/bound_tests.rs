@@ -6,7 +6,7 @@ use super::contract::{
     bind_group, compute_pipeline, layout, pipeline_layout, shader_module, storage_buffer,
     storage_entry, whole,
 };
-use super::quadtree::{BOUND_WGSL, COMMON_WGSL};
+use crate::wgsl;
 use crate::baselines::SplitMix;
 use crate::frame::{Receiver, Vpl};
 use crate::reference::brute_force;
@@ -54,7 +54,7 @@ fn bounds_on_the_gpu(cases: &[BoundCase]) -> Vec<f32> {
             storage_entry::<f32>(1, false),
         ],
     );
-    let module = shader_module(d, "bound cases", &[COMMON_WGSL, BOUND_WGSL, ENTRY]);
+    let module = shader_module(d, "bound cases", &[wgsl::NODE, wgsl::KERNEL, wgsl::BOUND, ENTRY]);
     let pipeline = compute_pipeline(
         d,
         &pipeline_layout(d, &[&group_layout]),

@@ -22,6 +22,7 @@ mod rsm;
 mod shader_tests;
 
 pub use contract::OutputTerm;
+pub(crate) use contract::prelude;
 pub use gather::Gather;
 pub use gbuffer::GBufferViews;
 pub use light::Spot;

@@ -9,13 +9,17 @@ use super::contract::{
 };
 use super::rsm::RsmViews;
 use crate::settings::{ClusterSettings, Validity};
+use crate::wgsl;
 use quadray_gpu::GpuTimer;
 
-pub(crate) const COMMON_WGSL: &str = include_str!("common.wgsl");
-pub(crate) const CUT_RULE_WGSL: &str = include_str!("cut_rule.wgsl");
-pub(crate) const BOUND_WGSL: &str = include_str!("bound.wgsl");
-/// The quadtree pass's shader, in order.
-pub(crate) const SOURCES: [&str; 3] = [COMMON_WGSL, CUT_RULE_WGSL, include_str!("cluster.wgsl")];
+/// The quadtree pass's shader, in order: `cluster.wgsl` holds its bindings, the accessor the cut
+/// rule reads nodes with, and its entry points.
+pub(crate) const SOURCES: [&str; 4] = [
+    wgsl::NODE,
+    wgsl::KERNEL,
+    wgsl::CUT_RULE,
+    include_str!("cluster.wgsl"),
+];
 
 /// Total nodes of the pyramid of an RSM of side `rsm_size`.
 pub(crate) fn node_count(rsm_size: u32) -> u64 {

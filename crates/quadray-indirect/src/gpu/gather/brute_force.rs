@@ -2,11 +2,12 @@
 
 use crate::gpu::contract::{SLICE, slices};
 use super::resources::Resources;
+use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 1] = [include_str!("brute_force.wgsl")];
+pub(crate) const WGSL: [&str; 2] = [wgsl::GATHER_VPLS, include_str!("brute_force.wgsl")];
 
 pub(crate) struct BruteForce {
     pipeline: wgpu::ComputePipeline,

@@ -1,14 +1,14 @@
-// Indirect light from the light quadtree's compacted cut: every pixel sums the cut's clusters.
+// Indirect light from the light quadtree's compacted cut: every pixel sums the cut's clusters
+// (the sum in wgsl/gather_cut.wgsl).
 
 // This dispatch's slice of the cut.
 fn cut_irradiance(r: Receiver) -> vec3<f32> {
-    var e = vec3<f32>(0.0);
-    let range = slice_range(min(cut_count, arrayLength(&cut)), SLICE);
-    for (var i = range.x; i < range.y; i++) {
-        e += node_irradiance(cut[i], r);
-    }
-    fetches += range.y - min(range.x, range.y);
-    return e;
+    return cut_sum(r, slice_range(min(cut_count, arrayLength(&cut)), SLICE));
+}
+
+// The accessor wgsl/gather_cut.wgsl reads the cut with.
+fn load_cut_node(i: u32) -> Node {
+    return cut[i];
 }
 
 @compute @workgroup_size(8, 8)

@@ -2,13 +2,18 @@
 //! quadtree, each pixel adding the level's nodes that the top-down cut rule takes.
 
 use crate::gpu::contract::{LEVEL_SLICE, slices};
-use crate::gpu::quadtree::{CUT_RULE_WGSL, LightQuadtree};
+use crate::gpu::quadtree::LightQuadtree;
 use super::resources::Resources;
+use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 2] = [CUT_RULE_WGSL, include_str!("passes.wgsl")];
+pub(crate) const WGSL: [&str; 3] = [
+    wgsl::CUT_RULE,
+    wgsl::GATHER_LEVEL,
+    include_str!("passes.wgsl"),
+];
 
 pub(crate) struct Passes {
     pipeline: wgpu::ComputePipeline,

@@ -1,4 +1,5 @@
-// Indirect light from the light quadtree the paper's way: one pass per level.
+// Indirect light from the light quadtree the paper's way: one pass per level (the sum in
+// wgsl/gather_level.wgsl).
 
 // One level of the paper's traversal: every node of the level, used when the top-down rule says
 // so; adds to what the coarser levels' passes left (the buffer is cleared before the first).
@@ -15,15 +16,7 @@ fn indirect_level(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let level = current.level;
     let size = level_size(params, level);
-    var e = vec3<f32>(0.0);
-    let range = slice_range(size * size, LEVEL_SLICE);
-    for (var i = range.x; i < range.y; i++) {
-        let xy = vec2<u32>(i % size, i / size);
-        if (in_cut(params, level, xy)) {
-            fetches++;
-            e += node_irradiance(nodes[level_offset(params, level) + i], r);
-        }
-    }
+    let e = level_sum(params, level, r, slice_range(size * size, LEVEL_SLICE));
     indirect[index] += vec4<f32>(r.albedo / PI * e, 0.0);
     store_counts(index);
 }

@@ -12,15 +12,23 @@ use crate::gpu::contract::{
 };
 use crate::gpu::gbuffer::{GBufferViews, camera_uniform};
 use crate::gpu::light::Spot;
-use crate::gpu::quadtree::{COMMON_WGSL, LightQuadtree};
-use crate::gpu::rsm::{LIGHT_WGSL, RsmViews};
+use crate::gpu::quadtree::LightQuadtree;
+use crate::gpu::rsm::RsmViews;
 use crate::baselines;
 use crate::settings::{Settings, TileCriterion};
+use crate::wgsl;
 use wgpu::util::DeviceExt;
 
 /// What every gather pass's shader starts with (after the prelude): the node layout and kernel,
-/// the light, and `shared.wgsl` (the bindings of groups 0-2 and the helpers every pass uses).
-const SHARED_WGSL: [&str; 3] = [COMMON_WGSL, LIGHT_WGSL, include_str!("shared.wgsl")];
+/// the light, the receiver, and `shared.wgsl` (the bindings of groups 0-2, the accessors the
+/// engine-neutral modules read them with, and the helpers every pass uses).
+const SHARED_WGSL: [&str; 5] = [
+    wgsl::NODE,
+    wgsl::KERNEL,
+    wgsl::LIGHT,
+    wgsl::RECEIVER,
+    include_str!("shared.wgsl"),
+];
 
 /// A gather pass's whole shader: the shared parts, then the pass's `own` in order.
 pub(crate) fn shader(own: &[&'static str]) -> Vec<&'static str> {

@@ -5,11 +5,16 @@
 use crate::gpu::contract::{SLICE, slices};
 use super::resources::Resources;
 use super::upsample::{self, Upsampled};
+use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 2] = [include_str!("rsm_sampling.wgsl"), upsample::WGSL];
+pub(crate) const WGSL: [&str; 3] = [
+    wgsl::GATHER_VPLS,
+    include_str!("rsm_sampling.wgsl"),
+    upsample::WGSL,
+];
 
 pub(crate) struct RsmSampling {
     full: wgpu::ComputePipeline,

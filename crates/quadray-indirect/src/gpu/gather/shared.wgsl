@@ -82,11 +82,10 @@ struct Camera {
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
 @group(2) @binding(1) var<uniform> slice: Level;
-struct Receiver {
-    x: vec3<f32>,
-    n: vec3<f32>,
-    albedo: vec3<f32>,
-    covered: bool,
+// The accessors of the engine-neutral modules (wgsl/): node `i` of the pyramid, and a pixel's
+// receiver from the G-buffer.
+fn load_node(i: u32) -> Node {
+    return nodes[i];
 }
 
 fn receiver(pixel: vec2<u32>) -> Receiver {
@@ -101,6 +100,7 @@ fn receiver(pixel: vec2<u32>) -> Receiver {
     return r;
 }
 
+// The kernel with indirect shadows (the accessor of wgsl/gather_cut.wgsl and gather_level.wgsl).
 fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
     let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
     if (shade.shadow_steps == 0u || all(e == vec3<f32>(0.0)) || !visible(r.x, node.pos.xyz)) {
@@ -178,16 +178,20 @@ fn add_indirect(index: u32, value: vec4<f32>) {
     }
 }
 
-// Irradiance at `r` from the VPL of RSM texel `t`; an empty texel gives none.
-fn texel_irradiance(t: vec2<i32>, r: Receiver) -> vec3<f32> {
-    var e = vec3<f32>(0.0);
-    fetches++;
-    let n = textureLoad(rsm_normal, t, 0);
-    if (n.w > 0.5) {
-        fetches += 2u;
-        let p = textureLoad(rsm_pos, t, 0);
-        let flux = textureLoad(rsm_flux, t, 0).rgb;
-        e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, terms.r_min);
-    }
-    return e;
+// The accessors of wgsl/gather_vpls.wgsl: an RSM texel's normal (w: 1 where the light sees
+// geometry), position and flux, and RSM sampling's pattern.
+fn load_rsm_normal(t: vec2<i32>) -> vec4<f32> {
+    return textureLoad(rsm_normal, t, 0);
+}
+
+fn load_rsm_position(t: vec2<i32>) -> vec4<f32> {
+    return textureLoad(rsm_pos, t, 0);
+}
+
+fn load_rsm_flux(t: vec2<i32>) -> vec3<f32> {
+    return textureLoad(rsm_flux, t, 0).rgb;
+}
+
+fn load_rsm_sample(i: u32) -> vec4<f32> {
+    return samples[i];
 }

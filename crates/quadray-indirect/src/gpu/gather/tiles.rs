@@ -3,14 +3,14 @@
 //! sum it. The tiles' lists are this pass's own group 3.
 
 use crate::gpu::contract::{bind_group, layout, storage_buffer, storage_entry, whole};
-use crate::gpu::quadtree::BOUND_WGSL;
 use super::resources::Resources;
+use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
 use std::cell::OnceCell;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 2] = [BOUND_WGSL, include_str!("tiles.wgsl")];
+pub(crate) const WGSL: [&str; 2] = [wgsl::BOUND, include_str!("tiles.wgsl")];
 
 /// The per-tile cuts' lists and their bind group (group 3).
 struct TileLists {
