@@ -2,11 +2,16 @@
 //! recording, all recording into the caller's `wgpu::CommandEncoder` on the caller's device:
 //! [`RsmPass`] (the spot's reflective shadow map; or bring your own [`RsmViews`]),
 //! [`LightQuadtree`] (pyramid, validity, compacted cut), [`Gather`] (indirect light into the
-//! caller's G-buffer from the cut or the paper's per-level passes, the baselines of the same
-//! shape, the direct light) and [`OutputPass`] (the radiance into the caller's texture). Bindings
-//! are grouped by how often they change: per light update, per frame, per dispatch.
-//! [`Renderer`] is quadray's own user of these passes. The Rust <-> WGSL contract (shared
-//! structs, the generated WGSL prelude) is in `contract.rs`.
+//! caller's G-buffer from the cut, the paper's per-level passes or per-tile cuts, the baselines
+//! of the same shape, the direct light; one file a pass under `gather/`) and [`OutputPass`] (the
+//! radiance into the caller's texture). Bindings are grouped by how often they change: per light
+//! update, per frame, per dispatch; the light, the camera and the settings each have their own
+//! uniform buffer. [`Renderer`] is quadray's own user of these passes.
+//!
+//! Layers, bottom first: `contract.rs` (the shared structs, the generated WGSL prelude, the
+//! layout and pipeline helpers), `light.rs`, `rsm.rs`, `gbuffer.rs`, `quadtree.rs`, `gather/`,
+//! `output.rs`, `renderer.rs`. The shaders are the engine-neutral modules of [`crate::wgsl`]
+//! with each pass's bindings file and entry points.
 
 #[cfg(test)]
 mod bound_tests;

@@ -82,6 +82,7 @@ struct Camera {
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
 @group(2) @binding(1) var<uniform> slice: Level;
+
 // The accessors of the engine-neutral modules (wgsl/): node `i` of the pyramid, and a pixel's
 // receiver from the G-buffer.
 fn load_node(i: u32) -> Node {
