@@ -46,5 +46,5 @@ pub use gpu::{
     FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, OutputPass, OutputTerm, Renderer, RsmPass,
     RsmViews, Spot,
 };
-pub use settings::{ClusterSettings, Method, Settings, TileCriterion, Validity};
 pub use scene::Scene;
+pub use settings::{ClusterSettings, Method, Settings, TileCriterion, Validity};

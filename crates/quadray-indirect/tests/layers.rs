@@ -138,7 +138,9 @@ fn items(tail: &str) -> Vec<String> {
         .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == ':')
         .collect();
     let rest = &tail[run.len()..];
-    let Some(group) = rest.strip_prefix('{').filter(|_| run.is_empty() || run.ends_with("::"))
+    let Some(group) = rest
+        .strip_prefix('{')
+        .filter(|_| run.is_empty() || run.ends_with("::"))
     else {
         return vec![run.trim_end_matches(':').to_string()];
     };
@@ -196,7 +198,11 @@ fn re_exports(src: &Path) -> BTreeMap<String, String> {
                         .map(str::to_string),
                 );
                 let name = path.last().unwrap().clone();
-                let exported = own.iter().map(|s| s.to_string()).chain([name]).collect::<Vec<_>>();
+                let exported = own
+                    .iter()
+                    .map(|s| s.to_string())
+                    .chain([name])
+                    .collect::<Vec<_>>();
                 map.insert(exported.join("::"), path.join("::"));
             }
         }
@@ -270,6 +276,10 @@ fn every_module_imports_only_its_layer_or_below() {
     for w in &wrong {
         println!("{w}");
     }
-    println!("{} files checked, {} imports upward", files.len(), wrong.len());
+    println!(
+        "{} files checked, {} imports upward",
+        files.len(),
+        wrong.len()
+    );
     assert!(wrong.is_empty(), "{wrong:#?}");
 }

@@ -6,10 +6,10 @@ use super::contract::{
     bind_group, compute_pipeline, layout, pipeline_layout, shader_module, storage_buffer,
     storage_entry, whole,
 };
-use crate::wgsl;
 use crate::baselines::SplitMix;
 use crate::frame::{Receiver, Vpl};
 use crate::reference::brute_force;
+use crate::wgsl;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
@@ -54,7 +54,11 @@ fn bounds_on_the_gpu(cases: &[BoundCase]) -> Vec<f32> {
             storage_entry::<f32>(1, false),
         ],
     );
-    let module = shader_module(d, "bound cases", &[wgsl::NODE, wgsl::KERNEL, wgsl::BOUND, ENTRY]);
+    let module = shader_module(
+        d,
+        "bound cases",
+        &[wgsl::NODE, wgsl::KERNEL, wgsl::BOUND, ENTRY],
+    );
     let pipeline = compute_pipeline(
         d,
         &pipeline_layout(d, &[&group_layout]),

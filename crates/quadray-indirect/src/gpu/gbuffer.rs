@@ -3,7 +3,8 @@
 //! triangles from the camera into position, normal and albedo targets.
 
 use super::contract::{
-    CameraUniform, RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry, whole,
+    CameraUniform, RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry,
+    whole,
 };
 use super::rsm::{RASTER_WGSL, RasterTargets, raster_pipeline, record_raster};
 use glam::{Mat4, Vec3};
@@ -22,7 +23,11 @@ pub struct GBufferViews<'a> {
 
 /// The gather's per-camera uniform: the camera a `width` x `height` G-buffer was rendered from
 /// (`view_proj`: world -> clip, `eye`: its position).
-pub(crate) fn camera_uniform(view_proj: Mat4, eye: Vec3, (width, height): (u32, u32)) -> CameraUniform {
+pub(crate) fn camera_uniform(
+    view_proj: Mat4,
+    eye: Vec3,
+    (width, height): (u32, u32),
+) -> CameraUniform {
     CameraUniform {
         view_proj: view_proj.to_cols_array_2d(),
         eye: eye.extend(1.0).to_array(),

@@ -2,8 +2,8 @@
 //! the per-light uniforms made from them (the light itself, the gather's per-light terms).
 
 use super::contract::{LightTermsUniform, LightUniform};
-use crate::settings::Settings;
 use crate::scene::Scene;
+use crate::settings::Settings;
 use glam::{Mat4, Vec3};
 
 /// A spot light and the projection of its reflective shadow map.

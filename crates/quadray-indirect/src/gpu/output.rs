@@ -1,8 +1,8 @@
 //! The output pass: the gather's radiance written into the caller's texture.
 
 use super::contract::{
-    OutputTerm, bind_group, compute_pass, dispatch_2d, layout, pipeline_layout, shader_module, storage_entry,
-    whole,
+    OutputTerm, bind_group, compute_pass, dispatch_2d, layout, pipeline_layout, shader_module,
+    storage_entry, whole,
 };
 use super::gather::Gather;
 use crate::IndirectError;

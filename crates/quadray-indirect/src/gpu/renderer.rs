@@ -2,15 +2,15 @@
 //! the public passes (RSM, light quadtree, gather) recorded in one encoder per frame, timed per
 //! pass. The CLI, the viewer and the benchmarks render through it.
 
+use super::gather::Gather;
 use super::gbuffer::GBufferPass;
 use super::light::Spot;
 use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
-use super::gather::Gather;
 use crate::IndirectError;
 use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
-use crate::settings::{ClusterSettings, Method, Settings};
 use crate::scene::Scene;
+use crate::settings::{ClusterSettings, Method, Settings};
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use std::collections::BTreeMap;
 use wgpu::util::DeviceExt;

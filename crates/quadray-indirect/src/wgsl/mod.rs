@@ -95,7 +95,14 @@ fn load_rsm_sample(i: u32) -> vec4<f32> { return vec4<f32>(0.0); }
             ("bound", vec![NODE, KERNEL, BOUND]),
             (
                 "gather cut",
-                vec![NODE, KERNEL, RECEIVER, GATHER_CUT, NODE_ACCESSORS, CUT_ACCESSORS],
+                vec![
+                    NODE,
+                    KERNEL,
+                    RECEIVER,
+                    GATHER_CUT,
+                    NODE_ACCESSORS,
+                    CUT_ACCESSORS,
+                ],
             ),
             (
                 "gather level",

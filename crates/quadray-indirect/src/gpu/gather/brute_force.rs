@@ -1,10 +1,10 @@
 //! The brute force over every VPL of the RSM ([`Method::Reference`], the GPU reference).
 
-use crate::gpu::contract::{SLICE, slices};
 use super::resources::Resources;
-use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
+use crate::gpu::contract::{SLICE, slices};
+use crate::wgsl;
 
 /// The pass's own shader parts, after the shared ones.
 pub(crate) const WGSL: [&str; 2] = [wgsl::GATHER_VPLS, include_str!("brute_force.wgsl")];

@@ -1,20 +1,16 @@
 //! The compacted cut ([`Method::Quadtree`]): every pixel sums the light quadtree's cut, at full
 //! resolution or sub-sampled.
 
-use crate::gpu::contract::{SLICE, slices};
-use crate::gpu::quadtree::LightQuadtree;
 use super::resources::Resources;
 use super::upsample::{self, Upsampled};
-use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
+use crate::gpu::contract::{SLICE, slices};
+use crate::gpu::quadtree::LightQuadtree;
+use crate::wgsl;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 3] = [
-    wgsl::GATHER_CUT,
-    include_str!("cut.wgsl"),
-    upsample::WGSL,
-];
+pub(crate) const WGSL: [&str; 3] = [wgsl::GATHER_CUT, include_str!("cut.wgsl"), upsample::WGSL];
 
 pub(crate) struct Cut {
     full: wgpu::ComputePipeline,

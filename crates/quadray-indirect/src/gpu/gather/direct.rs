@@ -1,7 +1,7 @@
 //! The spot's direct light on the G-buffer, shadowed by the RSM depth as a shadow map.
 
-use crate::gpu::contract::dispatch_2d;
 use super::resources::Resources;
+use crate::gpu::contract::dispatch_2d;
 
 /// The pass's own shader parts, after the shared ones.
 pub(crate) const WGSL: [&str; 1] = [include_str!("direct.wgsl")];

@@ -43,7 +43,10 @@ pub(crate) fn shaders() -> Vec<(&'static str, Vec<&'static str>)> {
         ("gather cut", resources::shader(&cut::WGSL)),
         ("gather passes", resources::shader(&passes::WGSL)),
         ("gather tiles", resources::shader(&tiles::WGSL)),
-        ("gather rsm sampling", resources::shader(&rsm_sampling::WGSL)),
+        (
+            "gather rsm sampling",
+            resources::shader(&rsm_sampling::WGSL),
+        ),
         ("gather brute force", resources::shader(&brute_force::WGSL)),
         ("gather direct", resources::shader(&direct::WGSL)),
         ("gather temporal", resources::shader(&temporal::WGSL)),

@@ -1,12 +1,12 @@
 //! The paper's per-level passes ([`Method::QuadtreePasses`]): one pass per level of the light
 //! quadtree, each pixel adding the level's nodes that the top-down cut rule takes.
 
-use crate::gpu::contract::{LEVEL_SLICE, slices};
-use crate::gpu::quadtree::LightQuadtree;
 use super::resources::Resources;
-use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
+use crate::gpu::contract::{LEVEL_SLICE, slices};
+use crate::gpu::quadtree::LightQuadtree;
+use crate::wgsl;
 
 /// The pass's own shader parts, after the shared ones.
 pub(crate) const WGSL: [&str; 3] = [

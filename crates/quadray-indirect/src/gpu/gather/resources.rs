@@ -4,6 +4,7 @@
 //! slice), the buffers behind them, and how a pass makes its shader and pipelines against them.
 //! A pass that needs more binds its own groups from 3 on.
 
+use crate::baselines;
 use crate::gpu::contract::{
     CameraUniform, ClusterUniform, GpuNode, GpuNodeBounds, LevelSlot, LightTermsUniform,
     LightUniform, MAX_SLICES, ShadeUniform, Slots, bind_group, compute_pipeline, dispatch_2d,
@@ -14,7 +15,6 @@ use crate::gpu::gbuffer::{GBufferViews, camera_uniform};
 use crate::gpu::light::Spot;
 use crate::gpu::quadtree::LightQuadtree;
 use crate::gpu::rsm::RsmViews;
-use crate::baselines;
 use crate::settings::{Settings, TileCriterion};
 use crate::wgsl;
 use wgpu::util::DeviceExt;
@@ -89,7 +89,7 @@ impl Outputs {
                 contents: bytemuck::bytes_of(&shade_uniform(s)),
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
-            camera: uniform_buffer::<CameraUniform>(device, "gather camera"),
+            camera: storage_buffer(device, "gather camera", size_of::<CameraUniform>() as u64),
             indirect: storage_buffer(device, "indirect", pixels * 16),
             direct: storage_buffer(device, "direct", pixels * 16),
             low: storage_buffer(device, "low-resolution indirect", u64::from(lw * lh) * 16),
@@ -172,7 +172,7 @@ impl Resources {
             &[
                 uniform_entry::<ClusterUniform>(0, compute, false),
                 uniform_entry::<LightUniform>(1, compute, false),
-                uniform_entry::<LightTermsUniform>(2, compute, false),
+                storage_entry::<LightTermsUniform>(2, true),
                 texture_entry(3),
                 texture_entry(4),
                 texture_entry(5),
@@ -187,7 +187,7 @@ impl Resources {
             "gather frame",
             &[
                 uniform_entry::<ShadeUniform>(0, compute, false),
-                uniform_entry::<CameraUniform>(1, compute, false),
+                storage_entry::<CameraUniform>(1, true),
                 texture_entry(2),
                 texture_entry(3),
                 texture_entry(4),
@@ -215,7 +215,12 @@ impl Resources {
             vec![slots.binding(), slots.binding()],
         );
         let light = uniform_buffer::<LightUniform>(device, "gather light");
-        let light_terms = uniform_buffer::<LightTermsUniform>(device, "gather light terms");
+        // storage, not uniform: see shared.wgsl
+        let light_terms = storage_buffer(
+            device,
+            "gather light terms",
+            size_of::<LightTermsUniform>() as u64,
+        );
         let light_group = light_group(device, &light_layout, [&light, &light_terms], quadtree, rsm);
         let outputs = Outputs::new(device, s);
         Self {
@@ -276,11 +281,14 @@ impl Resources {
         own_groups: &[&wgpu::BindGroupLayout],
     ) -> [wgpu::ComputePipeline; N] {
         let module = shader_module(device, label, &shader(own));
-        let groups: Vec<&wgpu::BindGroupLayout> =
-            [&self.light_layout, &self.frame_layout, &self.dispatch_layout]
-                .into_iter()
-                .chain(own_groups.iter().copied())
-                .collect();
+        let groups: Vec<&wgpu::BindGroupLayout> = [
+            &self.light_layout,
+            &self.frame_layout,
+            &self.dispatch_layout,
+        ]
+        .into_iter()
+        .chain(own_groups.iter().copied())
+        .collect();
         let layout = pipeline_layout(device, &groups);
         entries.map(|entry| compute_pipeline(device, &layout, &module, entry))
     }

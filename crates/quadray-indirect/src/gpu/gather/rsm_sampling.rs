@@ -2,12 +2,12 @@
 //! sums Poisson-disk samples around its projection into the RSM, at full resolution or
 //! sub-sampled. The pattern is made in [`crate::baselines`].
 
-use crate::gpu::contract::{SLICE, slices};
 use super::resources::Resources;
 use super::upsample::{self, Upsampled};
-use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
+use crate::gpu::contract::{SLICE, slices};
+use crate::wgsl;
 
 /// The pass's own shader parts, after the shared ones.
 pub(crate) const WGSL: [&str; 3] = [

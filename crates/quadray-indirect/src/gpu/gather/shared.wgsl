@@ -52,7 +52,9 @@ struct Camera {
 // Group 0, per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
 @group(0) @binding(0) var<uniform> params: ClusterParams;
 @group(0) @binding(1) var<uniform> light: Light;
-@group(0) @binding(2) var<uniform> terms: LightTerms;
+// (the light's terms and the camera are read-only storage: lavapipe, Mesa 22.3, crashes running
+// the shadow march with them as uniforms beside `shade`)
+@group(0) @binding(2) var<storage, read> terms: LightTerms;
 @group(0) @binding(3) var rsm_flux: texture_2d<f32>;
 @group(0) @binding(4) var rsm_pos: texture_2d<f32>;
 @group(0) @binding(5) var rsm_normal: texture_2d<f32>;
@@ -63,7 +65,7 @@ struct Camera {
 // Group 1, per frame (its targets): the settings, the camera, the G-buffer, the outputs and the
 // RSM samples.
 @group(1) @binding(0) var<uniform> shade: Shade;
-@group(1) @binding(1) var<uniform> viewer: Camera;
+@group(1) @binding(1) var<storage, read> viewer: Camera;
 @group(1) @binding(2) var g_pos: texture_2d<f32>;
 @group(1) @binding(3) var g_normal: texture_2d<f32>;
 @group(1) @binding(4) var g_albedo: texture_2d<f32>;

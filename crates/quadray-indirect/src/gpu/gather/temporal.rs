@@ -1,8 +1,8 @@
 //! The temporal filter: a running average of the indirect light over frames of one method
 //! ([`crate::Settings::temporal_weight`]), not reprojected.
 
-use crate::gpu::contract::dispatch_2d;
 use super::resources::Resources;
+use crate::gpu::contract::dispatch_2d;
 use crate::settings::Method;
 use std::cell::Cell;
 
@@ -43,7 +43,12 @@ impl Temporal {
     }
 
     /// Records the start of an average of `method`'s frames from this frame.
-    pub fn record_start(&self, encoder: &mut wgpu::CommandEncoder, res: &Resources, method: Method) {
+    pub fn record_start(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        res: &Resources,
+        method: Method,
+    ) {
         let o = &res.outputs;
         encoder.copy_buffer_to_buffer(&o.indirect, 0, &o.history, 0, o.indirect.size());
         self.history_of.set(Some(method));

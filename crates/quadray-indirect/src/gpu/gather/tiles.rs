@@ -2,11 +2,11 @@
 //! its own cut of the light quadtree against a bound of each node's contribution, then its pixels
 //! sum it. The tiles' lists are this pass's own group 3.
 
-use crate::gpu::contract::{bind_group, layout, storage_buffer, storage_entry, whole};
 use super::resources::Resources;
-use crate::wgsl;
 #[cfg(doc)]
 use crate::Method;
+use crate::gpu::contract::{bind_group, layout, storage_buffer, storage_entry, whole};
+use crate::wgsl;
 use std::cell::OnceCell;
 
 /// The pass's own shader parts, after the shared ones.
