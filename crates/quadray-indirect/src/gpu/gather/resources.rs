@@ -89,7 +89,17 @@ impl Outputs {
                 contents: bytemuck::bytes_of(&shade_uniform(s)),
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
-            camera: storage_buffer(device, "gather camera", size_of::<CameraUniform>() as u64),
+            // the picture's size from the start: a caller without indirect shadows may never
+            // set the camera
+            camera: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("gather camera"),
+                contents: bytemuck::bytes_of(&camera_uniform(
+                    glam::Mat4::IDENTITY,
+                    glam::Vec3::ZERO,
+                    (s.width, s.height),
+                )),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            }),
             indirect: storage_buffer(device, "indirect", pixels * 16),
             direct: storage_buffer(device, "direct", pixels * 16),
             low: storage_buffer(device, "low-resolution indirect", u64::from(lw * lh) * 16),
