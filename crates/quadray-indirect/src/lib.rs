@@ -5,6 +5,12 @@
 //! Data flows one way: [`scene`] (load) -> [`gpu`] (RSM, quadtree, cut, shading) -> measured
 //! against [`reference`](mod@reference) (CPU brute force) and the GPU brute force of [`baselines`].
 //!
+//! The modules are layers, each naming only the ones below it (`tests/layers.rs` checks it):
+//! the settings ([`Settings`], no GPU) and the read-back types ([`Frame`], ...), the scene, the
+//! baselines' sample pattern and the CPU reference, then the GPU side from the Rust <-> WGSL
+//! contract and the engine-neutral shader modules ([`wgsl`]) up through the light, the RSM, the
+//! G-buffer, the light quadtree, the gather passes and the output to quadray's [`Renderer`].
+//!
 //! To add the bounce to your own wgpu renderer, record the passes into your encoder:
 //! [`RsmPass`] (or your own [`RsmViews`]) -> [`LightQuadtree`] (build, cut) -> [`Gather`] into your
 //! [`GBufferViews`] -> [`OutputPass`] into your texture, all configured by one [`Settings`].
@@ -13,10 +19,13 @@
 #![warn(missing_docs)]
 
 pub mod baselines;
+mod frame;
 pub mod gpu;
 pub mod picture;
 pub mod reference;
 pub mod scene;
+mod settings;
+pub mod wgsl;
 
 /// Anything that can go wrong between a scene file and a measured picture.
 #[derive(Debug, thiserror::Error)]
@@ -32,9 +41,10 @@ pub enum IndirectError {
     Settings(String),
 }
 
+pub use frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
 pub use gpu::{
-    ClusterSettings, CutNode, FLOAT_FORMAT, Frame, FrameTiming, GBufferViews, Gather,
-    LightQuadtree, Method, OutputPass, OutputTerm, Pass, Renderer, RsmPass, RsmViews, Settings,
-    Spot, TileCriterion, Validity, WorkCounts,
+    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, OutputPass, OutputTerm, Renderer, RsmPass,
+    RsmViews, Spot,
 };
 pub use scene::Scene;
+pub use settings::{ClusterSettings, Method, Settings, TileCriterion, Validity};

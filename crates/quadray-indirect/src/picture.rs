@@ -1,7 +1,7 @@
 //! Pictures of a frame as `quadray indirect` and the viewer show them: tone mapping, the cut over
 //! the RSM, and the mean FLIP between two pictures.
 
-use crate::gpu::CutNode;
+use crate::frame::CutNode;
 use quadray_core::image_out::Rgba8Image;
 
 /// Exposure, then 1 - exp(-x) and the sRGB curve.

@@ -1,9 +1,7 @@
-//! The baselines the quadtree is measured against, both in `baselines.wgsl` (driven by
-//! [`crate::gpu`] with the shading passes' bindings): the brute force over every VPL (the GPU
-//! reference), and RSM sampling (Dachsbacher & Stamminger 2005) whose sample pattern is made here.
-
-/// WGSL of the GPU reference and of RSM sampling.
-pub const WGSL: &str = include_str!("baselines.wgsl");
+//! The baselines the quadtree is measured against, both gather passes of [`crate::Gather`]
+//! (`gpu/gather/brute_force.rs`, `gpu/gather/rsm_sampling.rs`): the brute force over every VPL
+//! (the GPU reference), and RSM sampling (Dachsbacher & Stamminger 2005) whose sample pattern is
+//! made here.
 
 /// The seed of the RSM-sampling pattern the gather uses.
 pub const SAMPLE_SEED: u64 = 0x5eed;

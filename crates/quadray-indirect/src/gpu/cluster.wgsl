@@ -16,6 +16,11 @@
 // Group 1, per dispatch: the level (a dynamic offset into slots 0, 1, 2, ...).
 @group(1) @binding(0) var<uniform> current: Level;
 
+// The accessor of wgsl/cut_rule.wgsl.
+fn load_node(i: u32) -> Node {
+    return nodes[i];
+}
+
 @compute @workgroup_size(8, 8)
 fn pack(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= params.rsm_size || id.y >= params.rsm_size) {

@@ -4,6 +4,7 @@
 //! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
 //! shared struct's size and field offsets against these.
 
+pub(crate) use crate::settings::{TILE, TILE_FRONTIER};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -17,13 +18,20 @@ pub(crate) const SLICE: u32 = 32768;
 pub(crate) const LEVEL_SLICE: u32 = 2048;
 /// Bound on the pyramid's levels (a 1024^2 RSM has 11).
 pub(crate) const MAX_LEVELS: u32 = 16;
-/// Nodes a tile's frontier holds in workgroup memory (per-tile cuts, two levels of it): the
-/// most a tile's list may hold ([`super::Settings::tile_capacity`]).
-pub(crate) const TILE_FRONTIER: u32 = 1024;
-/// Side of a tile of receivers that shares one per-tile cut (the gather's workgroup).
-pub(crate) const TILE: u32 = 8;
 /// Slice uniform slots: enough for level 0 of a 1024^2 RSM in level slices, the longest sum.
 pub(crate) const MAX_SLICES: u32 = 1024 * 1024 / LEVEL_SLICE;
+
+/// Which light the output pass writes (its values are WGSL constants of the prelude).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum OutputTerm {
+    /// The one-bounce indirect light alone (to add to the caller's own direct light).
+    Indirect = 0,
+    /// The spot's direct light, shadowed by the RSM.
+    Direct = 1,
+    /// Direct plus indirect: what `quadray indirect` pictures.
+    Combined = 2,
+}
 
 /// The WGSL constants every shader starts with, generated from the Rust ones.
 pub(crate) fn prelude() -> String {
@@ -39,9 +47,9 @@ pub(crate) fn prelude() -> String {
          const OUTPUT_DIRECT: u32 = {}u;\n\
          const OUTPUT_COMBINED: u32 = {}u;\n",
         std::f32::consts::PI,
-        crate::gpu::output::OutputTerm::Indirect as u32,
-        crate::gpu::output::OutputTerm::Direct as u32,
-        crate::gpu::output::OutputTerm::Combined as u32,
+        OutputTerm::Indirect as u32,
+        OutputTerm::Direct as u32,
+        OutputTerm::Combined as u32,
     )
 }
 
@@ -96,22 +104,16 @@ pub(crate) struct ClusterUniform {
     pub normal_threshold: f32,
 }
 
-/// WGSL `Shade`: sizes and constants of the per-pixel passes.
+/// WGSL `Shade`: the gather's settings, written once.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct ShadeUniform {
-    pub width: u32,
-    pub height: u32,
-    pub r_min: f32,
     pub sample_count: u32,
     pub subsample: u32,
     pub low_width: u32,
     pub low_height: u32,
-    pub depth_bias: f32,
     pub normal_agreement: f32,
-    pub plane_agreement: f32,
     pub shadow_steps: u32,
-    pub shadow_thickness: f32,
     pub temporal_weight: f32,
     pub tile_error: f32,
     pub tile_capacity: u32,
@@ -119,11 +121,30 @@ pub(crate) struct ShadeUniform {
     pub tiles_x: u32,
     pub tile_estimate: u32,
     pub tile_share: f32,
-    /// Up to the camera's 16-byte alignment.
-    pub _pad: [u32; 1],
-    /// Written by `Gather::set_camera`, the fields before by `Gather::set_light`.
-    pub camera: [[f32; 4]; 4],
+}
+
+/// WGSL `LightTerms`: the gather's per-light values (the kernel's clamp, the lengths that scale
+/// with the scene), written with the light.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct LightTermsUniform {
+    pub r_min: f32,
+    pub depth_bias: f32,
+    pub plane_agreement: f32,
+    pub shadow_thickness: f32,
+}
+
+/// WGSL `Camera`: the gather's per-camera values (the G-buffer's view and size), written with
+/// the camera.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(crate) struct CameraUniform {
+    pub view_proj: [[f32; 4]; 4],
     pub eye: [f32; 4],
+    pub width: u32,
+    pub height: u32,
+    /// Up to the struct's 16-byte alignment.
+    pub _pad: [u32; 2],
 }
 
 /// WGSL `Level`: one slot of the per-dispatch uniforms (a level, or a slice of a long sum).
@@ -356,7 +377,6 @@ pub(crate) fn compute_pass<'e>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::mem::offset_of;
 
     #[test]
     fn slices_cover_the_longest_sums_that_settings_allow() {
@@ -373,107 +393,6 @@ mod tests {
         }
         assert_eq!(slices(0, SLICE), 1, "an empty sum still writes its zeros");
         assert_eq!(slices(u64::from(SLICE) + 1, SLICE), 2);
-    }
-
-    /// A shared struct: its WGSL name, Rust size and Rust field offsets by name.
-    struct Shared {
-        wgsl: &'static str,
-        size: usize,
-        fields: Vec<(&'static str, usize)>,
-    }
-
-    macro_rules! shared {
-        ($wgsl:literal, $rust:ty, [$($field:ident),*]) => {
-            Shared {
-                wgsl: $wgsl,
-                size: size_of::<$rust>(),
-                fields: vec![$((stringify!($field), offset_of!($rust, $field))),*],
-            }
-        };
-    }
-
-    #[test]
-    fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
-        let shared = [
-            shared!(
-                "Light",
-                LightUniform,
-                [view_proj, position, direction, intensity]
-            ),
-            shared!("Raster", RasterUniform, [view_proj, eye, texel]),
-            shared!(
-                "ClusterParams",
-                ClusterUniform,
-                [
-                    rsm_size,
-                    levels,
-                    start_level,
-                    limit_level,
-                    recursive,
-                    flux_weighted,
-                    depth_threshold,
-                    normal_threshold
-                ]
-            ),
-            shared!(
-                "Shade",
-                ShadeUniform,
-                [
-                    width,
-                    height,
-                    r_min,
-                    sample_count,
-                    subsample,
-                    low_width,
-                    low_height,
-                    depth_bias,
-                    normal_agreement,
-                    plane_agreement,
-                    shadow_steps,
-                    shadow_thickness,
-                    temporal_weight,
-                    tile_error,
-                    tile_capacity,
-                    tile_start,
-                    tiles_x,
-                    tile_estimate,
-                    tile_share,
-                    camera,
-                    eye
-                ]
-            ),
-            shared!("Level", LevelSlot, [level]),
-            shared!("Node", GpuNode, [flux, pos, normal]),
-            shared!("NodeBounds", GpuNodeBounds, [lo, hi]),
-        ];
-        let mut seen = std::collections::BTreeSet::new();
-        for (name, parts) in crate::gpu::shaders() {
-            let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
-            let source = shader_source(&parts);
-            let module = naga::front::wgsl::parse_str(&source)
-                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-            naga::valid::Validator::new(Default::default(), naga::valid::Capabilities::all())
-                .validate(&module)
-                .unwrap_or_else(|e| panic!("{name}: {e:?}"));
-            for (_, ty) in module.types.iter() {
-                let naga::TypeInner::Struct { members, span } = &ty.inner else {
-                    continue;
-                };
-                let Some(s) = shared.iter().find(|s| ty.name.as_deref() == Some(s.wgsl)) else {
-                    continue;
-                };
-                assert_eq!(*span as usize, s.size, "{name}: size of {}", s.wgsl);
-                let wgsl: Vec<(&str, usize)> = members
-                    .iter()
-                    .map(|m| (m.name.as_deref().unwrap_or(""), m.offset as usize))
-                    .collect();
-                assert_eq!(wgsl, s.fields, "{name}: fields of {}", s.wgsl);
-                seen.insert(s.wgsl);
-            }
-        }
-        for s in &shared {
-            assert!(seen.contains(s.wgsl), "no shader declares {}", s.wgsl);
-        }
     }
 
     #[test]

@@ -1,12 +1,41 @@
-//! quadray's own G-buffer pass (a renderer embedding the gather brings its own): the scene's
+//! The camera's side: the G-buffer the gather reads ([`GBufferViews`], the caller's or quadray's),
+//! and quadray's own G-buffer pass (a renderer embedding the gather brings its own): the scene's
 //! triangles from the camera into position, normal and albedo targets.
 
 use super::contract::{
-    RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry, whole,
+    CameraUniform, RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry,
+    whole,
 };
-use super::gather::GBufferViews;
 use super::rsm::{RASTER_WGSL, RasterTargets, raster_pipeline, record_raster};
 use glam::{Mat4, Vec3};
+
+/// The caller's G-buffer: three textures of the output's size, any float format `textureLoad`
+/// reads (quadray's are [`crate::FLOAT_FORMAT`]).
+#[derive(Clone, Copy)]
+pub struct GBufferViews<'a> {
+    /// xyz: world position; w: 1 where geometry is seen, 0 elsewhere (no light there).
+    pub position: &'a wgpu::TextureView,
+    /// xyz: unit normal, turned towards the viewer.
+    pub normal: &'a wgpu::TextureView,
+    /// rgb: diffuse albedo.
+    pub albedo: &'a wgpu::TextureView,
+}
+
+/// The gather's per-camera uniform: the camera a `width` x `height` G-buffer was rendered from
+/// (`view_proj`: world -> clip, `eye`: its position).
+pub(crate) fn camera_uniform(
+    view_proj: Mat4,
+    eye: Vec3,
+    (width, height): (u32, u32),
+) -> CameraUniform {
+    CameraUniform {
+        view_proj: view_proj.to_cols_array_2d(),
+        eye: eye.extend(1.0).to_array(),
+        width,
+        height,
+        _pad: [0; 2],
+    }
+}
 
 /// The G-buffer pass's shader, in order.
 pub(crate) const SOURCES: [&str; 2] = [RASTER_WGSL, include_str!("gbuffer.wgsl")];

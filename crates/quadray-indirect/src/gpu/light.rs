@@ -1,7 +1,9 @@
-//! The spot light as the passes see it: plain values a renderer fills from its own scene.
+//! The spot light as the passes see it: plain values a renderer fills from its own scene, and
+//! the per-light uniforms made from them (the light itself, the gather's per-light terms).
 
-use super::contract::LightUniform;
+use super::contract::{LightTermsUniform, LightUniform};
 use crate::scene::Scene;
+use crate::settings::Settings;
 use glam::{Mat4, Vec3};
 
 /// A spot light and the projection of its reflective shadow map.
@@ -45,6 +47,19 @@ impl Spot {
     /// Side of an RSM texel on the plane at unit distance along the axis.
     pub(crate) fn texel_side(&self, rsm_size: u32) -> f32 {
         2.0 * self.cone_deg.to_radians().tan() / rsm_size as f32
+    }
+
+    /// The gather's per-light values for `settings`, with the clamp `r_min` of the VPL kernel's
+    /// 1/r^4 (world units).
+    pub(crate) fn terms(&self, settings: &Settings, r_min: f32) -> LightTermsUniform {
+        let texel_side = self.texel_side(settings.rsm_size);
+        LightTermsUniform {
+            r_min,
+            // a few shadow-map texels' worth of depth at the far side of the scene
+            depth_bias: 0.005 + 3.0 * texel_side * self.far / self.extent,
+            plane_agreement: 0.02 * self.extent,
+            shadow_thickness: settings.shadow_thickness * self.extent,
+        }
     }
 
     pub(crate) fn uniform(&self) -> LightUniform {

@@ -1,25 +1,13 @@
 //! The output pass: the gather's radiance written into the caller's texture.
 
 use super::contract::{
-    bind_group, compute_pass, dispatch_2d, layout, pipeline_layout, shader_module, storage_entry,
-    whole,
+    OutputTerm, bind_group, compute_pass, dispatch_2d, layout, pipeline_layout, shader_module,
+    storage_entry, whole,
 };
 use super::gather::Gather;
 use crate::IndirectError;
 
 const WGSL: &str = include_str!("output.wgsl");
-
-/// Which light the output pass writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub enum OutputTerm {
-    /// The one-bounce indirect light alone (to add to the caller's own direct light).
-    Indirect = 0,
-    /// The spot's direct light, shadowed by the RSM.
-    Direct = 1,
-    /// Direct plus indirect: what `quadray indirect` pictures.
-    Combined = 2,
-}
 
 /// The WGSL name of a storage-texture format the output pass writes.
 fn wgsl_format(format: wgpu::TextureFormat) -> Option<&'static str> {

@@ -2,16 +2,15 @@
 //! the public passes (RSM, light quadtree, gather) recorded in one encoder per frame, timed per
 //! pass. The CLI, the viewer and the benchmarks render through it.
 
+use super::gather::Gather;
 use super::gbuffer::GBufferPass;
 use super::light::Spot;
 use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
-use super::{
-    ClusterSettings, CutNode, Frame, FrameTiming, Gather, Method, Pass, Receiver, Settings, Vpl,
-    WorkCounts,
-};
 use crate::IndirectError;
+use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
 use crate::scene::Scene;
+use crate::settings::{ClusterSettings, Method, Settings};
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use std::collections::BTreeMap;
 use wgpu::util::DeviceExt;
@@ -330,7 +329,7 @@ impl<'g> Renderer<'g> {
             return Ok(None);
         };
         let read = |buffer| quadray_gpu::read_buffer(self.gpu, buffer);
-        let (tx, ty) = super::gather::tiles(self.settings());
+        let (tx, ty) = self.settings().tiles();
         let mut sizes: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&read(sizes)?);
         sizes.truncate((tx * ty) as usize);
         Ok(Some((sizes, bytemuck::pod_collect_to_vec(&read(cuts)?))))

@@ -8,6 +8,7 @@ use super::contract::{
 };
 use super::light::Spot;
 use crate::scene::Vertex;
+use crate::wgsl;
 use quadray_gpu::{GpuTimer, cleared_attachment, nearest_depth, texture_2d};
 
 /// Format of every RSM and G-buffer colour target.
@@ -17,10 +18,9 @@ pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth3
 const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
 
-pub(crate) const LIGHT_WGSL: &str = include_str!("light.wgsl");
 pub(crate) const RASTER_WGSL: &str = include_str!("raster.wgsl");
 /// The RSM pass's shader, in order.
-pub(crate) const SOURCES: [&str; 3] = [LIGHT_WGSL, RASTER_WGSL, include_str!("rsm.wgsl")];
+pub(crate) const SOURCES: [&str; 3] = [wgsl::LIGHT, RASTER_WGSL, include_str!("rsm.wgsl")];
 
 /// The RSM as the quadtree and the gather read it, whoever renders it: three square textures of
 /// the same side (a power of two), any float format `textureLoad` reads (quadray's are

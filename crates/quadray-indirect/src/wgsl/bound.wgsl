@@ -2,7 +2,8 @@
 // kernel of `vpl_irradiance`, flux cos_p cos |d|^2 / (pi max(|d|^2, r_min^2)^2), is at most
 // flux cos_p cos / (pi max(|d|^2, r_min^2)), which falls with the distance, so the boxes' nearest
 // distance and bounds of the two cosines over the boxes and normal cones bound it (Walter et al.
-// 2005, Lightcuts, section 4.1, with cones as Conty & Kulla 2018).
+// 2005, Lightcuts, section 4.1, with cones as Conty & Kulla 2018). Engine-neutral: no bindings,
+// no accessors (needs node.wgsl and kernel.wgsl).
 
 // A bound of max(0, dot(n, normalize(d))) over unit n within `half_cos` of `axis` and d in the
 // box [lo, hi]: the box turned into a frame whose z is the axis (the box of the turned box), the

@@ -1,23 +1,18 @@
-// What every per-pixel shading pass sees (the quadtree's, the baselines' and the reference's).
+// What every gather pass sees (the quadtree's, the baselines' and the reference's): the settings,
+// light, camera and per-dispatch uniforms, the RSM, quadtree and G-buffer, the outputs, and the
+// helpers every pass shares.
 
+// The gather's settings, written once.
 struct Shade {
-    width: u32,
-    height: u32,
-    r_min: f32,
     sample_count: u32,
     // sub-sampled indirect: one sample per `subsample` x `subsample` pixels
     subsample: u32,
     low_width: u32,
     low_height: u32,
-    // shadow-map bias in RSM depth units
-    depth_bias: f32,
-    // geometry agreement for upsampling: normals' dot and plane distance (world units)
+    // geometry agreement for upsampling: normals' dot
     normal_agreement: f32,
-    plane_agreement: f32,
-    // indirect shadows: points marched between a receiver and a cluster (0: none), and how deep
-    // behind a depth map's surface a point counts as inside the occluder (world units)
+    // indirect shadows: points marched between a receiver and a cluster (0: none)
     shadow_steps: u32,
-    shadow_thickness: f32,
     // weight of this frame in the running average of the indirect light (1: no filter)
     temporal_weight: f32,
     // per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its estimated
@@ -31,53 +26,69 @@ struct Shade {
     // per-tile cuts: nodes farther than this times the tile's receivers' diagonal are gathered
     // at the tile's corners and interpolated (0: every pixel evaluates every node)
     tile_share: f32,
-    // the camera the G-buffer was rendered from (set with the camera, not with the light)
-    camera: mat4x4<f32>,
+}
+
+// Per light update, with the light: the kernel's clamp and the lengths that scale with the scene.
+struct LightTerms {
+    // the clamp of the VPL kernel's 1/r^4 (world units)
+    r_min: f32,
+    // shadow-map bias in RSM depth units
+    depth_bias: f32,
+    // geometry agreement for upsampling: plane distance (world units)
+    plane_agreement: f32,
+    // indirect shadows: how deep behind a depth map's surface a point counts as inside the
+    // occluder (world units)
+    shadow_thickness: f32,
+}
+
+// Per camera: the view the G-buffer was rendered from, and its size in pixels.
+struct Camera {
+    view_proj: mat4x4<f32>,
     eye: vec4<f32>,
+    width: u32,
+    height: u32,
 }
 
 // Group 0, per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
 @group(0) @binding(0) var<uniform> params: ClusterParams;
 @group(0) @binding(1) var<uniform> light: Light;
-@group(0) @binding(2) var rsm_flux: texture_2d<f32>;
-@group(0) @binding(3) var rsm_pos: texture_2d<f32>;
-@group(0) @binding(4) var rsm_normal: texture_2d<f32>;
-@group(0) @binding(5) var<storage, read> nodes: array<Node>;
-@group(0) @binding(6) var<storage, read> cut: array<Node>;
-@group(0) @binding(7) var<storage, read> cut_count: u32;
-@group(0) @binding(8) var<storage, read> bounds: array<NodeBounds>;
-// Group 1, per frame (its targets): the sizes, the G-buffer, the outputs and the RSM samples.
+// (the light's terms and the camera are read-only storage: lavapipe, Mesa 22.3, crashes running
+// the shadow march with them as uniforms beside `shade`)
+@group(0) @binding(2) var<storage, read> terms: LightTerms;
+@group(0) @binding(3) var rsm_flux: texture_2d<f32>;
+@group(0) @binding(4) var rsm_pos: texture_2d<f32>;
+@group(0) @binding(5) var rsm_normal: texture_2d<f32>;
+@group(0) @binding(6) var<storage, read> nodes: array<Node>;
+@group(0) @binding(7) var<storage, read> cut: array<Node>;
+@group(0) @binding(8) var<storage, read> cut_count: u32;
+@group(0) @binding(9) var<storage, read> bounds: array<NodeBounds>;
+// Group 1, per frame (its targets): the settings, the camera, the G-buffer, the outputs and the
+// RSM samples.
 @group(1) @binding(0) var<uniform> shade: Shade;
-@group(1) @binding(1) var g_pos: texture_2d<f32>;
-@group(1) @binding(2) var g_normal: texture_2d<f32>;
-@group(1) @binding(3) var g_albedo: texture_2d<f32>;
+@group(1) @binding(1) var<storage, read> viewer: Camera;
+@group(1) @binding(2) var g_pos: texture_2d<f32>;
+@group(1) @binding(3) var g_normal: texture_2d<f32>;
+@group(1) @binding(4) var g_albedo: texture_2d<f32>;
 // rgb: indirect radiance (or irradiance for the low-resolution pass), w: 1 when recomputed
-@group(1) @binding(4) var<storage, read_write> indirect: array<vec4<f32>>;
-@group(1) @binding(5) var<storage, read_write> direct: array<vec4<f32>>;
-@group(1) @binding(6) var<storage, read_write> low: array<vec4<f32>>;
+@group(1) @binding(5) var<storage, read_write> indirect: array<vec4<f32>>;
+@group(1) @binding(6) var<storage, read_write> direct: array<vec4<f32>>;
+@group(1) @binding(7) var<storage, read_write> low: array<vec4<f32>>;
 // xy: offset in RSM texels, z: weight, w: the pattern's radius
-@group(1) @binding(7) var<storage, read> samples: array<vec4<f32>>;
+@group(1) @binding(8) var<storage, read> samples: array<vec4<f32>>;
 // per pixel: VPL evaluations, fetches, bound evaluations and refused splits of the indirect
 // passes (cleared before them)
-@group(1) @binding(8) var<storage, read_write> counts: array<vec4<u32>>;
+@group(1) @binding(9) var<storage, read_write> counts: array<vec4<u32>>;
 // the running average of the indirect light over the last frames (rgb)
-@group(1) @binding(9) var<storage, read_write> history: array<vec4<f32>>;
+@group(1) @binding(10) var<storage, read_write> history: array<vec4<f32>>;
 // Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
 @group(2) @binding(1) var<uniform> slice: Level;
-// Group 3, the per-tile cuts' lists (bound only once a frame draws them; a placeholder of one
-// slot before): each tile's node indices (`tile_capacity` slots a tile), and per tile the nodes
-// it holds, the splits refused for want of room, the nodes whose error it estimated and the VPL
-// evaluations that took
-@group(3) @binding(0) var<storage, read_write> tile_cuts: array<u32>;
-@group(3) @binding(1) var<storage, read_write> tile_sizes: array<vec4<u32>>;
 
-struct Receiver {
-    x: vec3<f32>,
-    n: vec3<f32>,
-    albedo: vec3<f32>,
-    covered: bool,
+// The accessors of the engine-neutral modules (wgsl/): node `i` of the pyramid, and a pixel's
+// receiver from the G-buffer.
+fn load_node(i: u32) -> Node {
+    return nodes[i];
 }
 
 fn receiver(pixel: vec2<u32>) -> Receiver {
@@ -92,8 +103,9 @@ fn receiver(pixel: vec2<u32>) -> Receiver {
     return r;
 }
 
+// The kernel with indirect shadows (the accessor of wgsl/gather_cut.wgsl and gather_level.wgsl).
 fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
-    let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, shade.r_min);
+    let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
     if (shade.shadow_steps == 0u || all(e == vec3<f32>(0.0)) || !visible(r.x, node.pos.xyz)) {
         return select(vec3<f32>(0.0), e, shade.shadow_steps == 0u);
     }
@@ -104,14 +116,14 @@ fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
 // its direction: the G-buffer from the camera or the RSM from the light (world units). `c` and
 // `l` are p's clip coordinates in the camera's and the light's view.
 fn inside_occluder(p: vec3<f32>, c: vec4<f32>, l: vec4<f32>) -> bool {
-    let bias = 0.1 * shade.shadow_thickness;
+    let bias = 0.1 * terms.shadow_thickness;
     let uv = vec2<f32>(c.x / c.w * 0.5 + 0.5, 0.5 - c.y / c.w * 0.5);
     if (c.w > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv < vec2<f32>(1.0))) {
         fetches++;
-        let size = vec2<f32>(f32(shade.width), f32(shade.height));
+        let size = vec2<f32>(f32(viewer.width), f32(viewer.height));
         let seen = textureLoad(g_pos, vec2<i32>(uv * size), 0);
-        let behind = distance(p, shade.eye.xyz) - distance(seen.xyz, shade.eye.xyz);
-        if (seen.w > 0.5 && behind > bias && behind < shade.shadow_thickness) {
+        let behind = distance(p, viewer.eye.xyz) - distance(seen.xyz, viewer.eye.xyz);
+        if (seen.w > 0.5 && behind > bias && behind < terms.shadow_thickness) {
             return true;
         }
     }
@@ -120,7 +132,7 @@ fn inside_occluder(p: vec3<f32>, c: vec4<f32>, l: vec4<f32>) -> bool {
         fetches++;
         let seen = textureLoad(rsm_pos, vec2<i32>(st * f32(params.rsm_size)), 0);
         let behind = (light_depth(light, p) - seen.w) / light.position.w;
-        if (seen.w > 0.0 && behind > bias && behind < shade.shadow_thickness) {
+        if (seen.w > 0.0 && behind > bias && behind < terms.shadow_thickness) {
             return true;
         }
     }
@@ -131,7 +143,7 @@ fn inside_occluder(p: vec3<f32>, c: vec4<f32>, l: vec4<f32>) -> bool {
 // inside an occluder as the camera's or the light's depth sees it. Clip coordinates are linear
 // along the segment, so the ends are projected once and the points' interpolated.
 fn visible(x: vec3<f32>, xp: vec3<f32>) -> bool {
-    let camera = array<vec4<f32>, 2>(shade.camera * vec4<f32>(x, 1.0), shade.camera * vec4<f32>(xp, 1.0));
+    let camera = array<vec4<f32>, 2>(viewer.view_proj * vec4<f32>(x, 1.0), viewer.view_proj * vec4<f32>(xp, 1.0));
     let lit = array<vec4<f32>, 2>(light.view_proj * vec4<f32>(x, 1.0), light.view_proj * vec4<f32>(xp, 1.0));
     for (var i = 1u; i <= shade.shadow_steps; i++) {
         let t = f32(i) / f32(shade.shadow_steps + 1u);
@@ -151,7 +163,7 @@ fn store_counts(index: u32) {
 }
 
 fn pixel_index(pixel: vec2<u32>) -> u32 {
-    return pixel.y * shade.width + pixel.x;
+    return pixel.y * viewer.width + pixel.x;
 }
 
 // This dispatch's items of a sum over `count` items, `per_slice` at a time: [x, y).
@@ -167,4 +179,22 @@ fn add_indirect(index: u32, value: vec4<f32>) {
     } else {
         indirect[index] += value;
     }
+}
+
+// The accessors of wgsl/gather_vpls.wgsl: an RSM texel's normal (w: 1 where the light sees
+// geometry), position and flux, and RSM sampling's pattern.
+fn load_rsm_normal(t: vec2<i32>) -> vec4<f32> {
+    return textureLoad(rsm_normal, t, 0);
+}
+
+fn load_rsm_position(t: vec2<i32>) -> vec4<f32> {
+    return textureLoad(rsm_pos, t, 0);
+}
+
+fn load_rsm_flux(t: vec2<i32>) -> vec3<f32> {
+    return textureLoad(rsm_flux, t, 0).rgb;
+}
+
+fn load_rsm_sample(i: u32) -> vec4<f32> {
+    return samples[i];
 }

@@ -1,4 +1,5 @@
-// The spot light and the receiver side, shared by the raster passes and the shading passes.
+// The spot light: its uniform's layout, its intensity by direction and the RSM's depth.
+// Engine-neutral: no bindings, no accessors.
 
 struct Light {
     view_proj: mat4x4<f32>,

@@ -7,6 +7,13 @@
 // pixels both do, down to single VPLs where needed, then every pixel of the tile sums the tile's
 // list.
 
+// Group 3, this pass's own: the per-tile cuts' lists (allocated by the first frame that draws
+// them): each tile's node indices (`tile_capacity` slots a tile), and per tile the nodes it
+// holds, the splits refused for want of room, the nodes whose error it estimated and the VPL
+// evaluations that took
+@group(3) @binding(0) var<storage, read_write> tile_cuts: array<u32>;
+@group(3) @binding(1) var<storage, read_write> tile_sizes: array<vec4<u32>>;
+
 // TILE (the tile's side) comes from the prelude
 const TILE_PIXELS: u32 = TILE * TILE;
 
@@ -72,11 +79,11 @@ fn estimated_error(node: Node, at: u32, size: u32, level: u32) -> f32 {
     for (var q = 0u; q < 5u; q++) {
         let p = select(nearest, atomicLoad(&quadrant_pixel[min(q, 3u)]), q < 4u);
         if (p < TILE_PIXELS) {
-            let own = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], shade.r_min);
+            let own = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], terms.r_min);
             var sum = vec3<f32>(0.0);
             for (var c = 0u; c < 4u; c++) {
                 if (children[c].flux.w > 0.5) {
-                    sum += vpl_irradiance(children[c].flux.rgb, children[c].pos.xyz, children[c].normal.xyz, tile_x[p], tile_n[p], shade.r_min);
+                    sum += vpl_irradiance(children[c].flux.rgb, children[c].pos.xyz, children[c].normal.xyz, tile_x[p], tile_n[p], terms.r_min);
                 }
             }
             error = max(error, abs(luminance(own - sum)));
@@ -123,9 +130,9 @@ fn shareable(b: NodeBounds, lo: vec3<f32>, hi: vec3<f32>, far: f32) -> bool {
 }
 
 // Indirect shadows per tile: bit c set where the point `p` (a node's mean) is visible from the
-// tile's corner receiver c (`visible`, shade_bindings.wgsl); a pixel on the corners' surface weighs each of
-// its tile's nodes by the corners' visibility interpolated, so that a tile marches four shadow
-// rays a node instead of one a pixel.
+// tile's corner receiver c (`visible`, shared.wgsl); a pixel on the corners' surface weighs each
+// of its tile's nodes by the corners' visibility interpolated, so that a tile marches four
+// shadow rays a node instead of one a pixel.
 fn corner_visibility(p: vec3<f32>) -> u32 {
     var seen = 0u;
     for (var c = 0u; c < 4u; c++) {
@@ -150,7 +157,7 @@ fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat
             let node = nodes[entry & ~SHARED];
             // (evaluated either way, as a pixel's own sum does before its shadow test)
             let seen = !corner_shadows || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
-            v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, shade.r_min) * f32(seen);
+            v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, terms.r_min) * f32(seen);
         }
     }
     reduce_lo[local] = v[0];
@@ -213,7 +220,7 @@ fn indirect_tiles(
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) tile_xy: vec3<u32>,
 ) {
-    let inside = id.x < shade.width && id.y < shade.height;
+    let inside = id.x < viewer.width && id.y < viewer.height;
     var r: Receiver;
     if (inside) {
         r = receiver(id.xy);
@@ -290,7 +297,7 @@ fn indirect_tiles(
             for (var q = 0u; q < 4u; q++) {
                 let p = atomicLoad(&quadrant_pixel[q]);
                 if (p < TILE_PIXELS) {
-                    e[q] += luminance(vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], shade.r_min));
+                    e[q] += luminance(vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, tile_x[p], tile_n[p], terms.r_min));
                 }
             }
         }
@@ -348,8 +355,8 @@ fn indirect_tiles(
                 fetches++;
                 let b = bounds[index];
                 let bound = max(
-                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[0], group_hi[0], group_axis[0], group_cos.x, shade.r_min),
-                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[1], group_hi[1], group_axis[1], group_cos.y, shade.r_min),
+                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[0], group_hi[0], group_axis[0], group_cos.x, terms.r_min),
+                    node_bound(node.flux.rgb, b, node.normal.xyz, group_lo[1], group_hi[1], group_axis[1], group_cos.y, terms.r_min),
                 );
                 // a node under the threshold by its bound cannot matter; over it, the estimate
                 // decides below the start level (above it a node's children are as coarse as
@@ -491,10 +498,10 @@ fn indirect_tiles(
                 let corner = CORNERS[c];
                 x += w[c] * tile_x[corner];
                 let same_surface = dot(tile_n[corner], r.n) > shade.normal_agreement
-                    && abs(dot(r.x - tile_x[corner], tile_n[corner])) < shade.plane_agreement;
+                    && abs(dot(r.x - tile_x[corner], tile_n[corner])) < terms.plane_agreement;
                 seen_weights[c] = select(0.0, max(w[c], 1e-3), same_surface);
             }
-            on_patch = distance(x, r.x) <= shade.plane_agreement;
+            on_patch = distance(x, r.x) <= terms.plane_agreement;
             if (on_patch) {
                 seen_weights = w;
             }
@@ -516,7 +523,7 @@ fn indirect_tiles(
                 let node = nodes[entry & ~SHARED];
                 if (corner_seen) {
                     let seen = vec4<f32>((vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u)) & vec4<u32>(1u));
-                    irradiance += dot(seen_weights, seen) * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, shade.r_min);
+                    irradiance += dot(seen_weights, seen) * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
                 } else {
                     irradiance += node_irradiance(node, r);
                 }

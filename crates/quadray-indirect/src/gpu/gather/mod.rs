@@ -1,0 +1,224 @@
+//! The gather: deferred shading of the caller's G-buffer from the light quadtree (the compacted
+//! cut, the paper's one pass per level, per-tile cuts; the cut and RSM sampling optionally at low
+//! resolution with geometry-aware upsampling), the baselines of the same shape (RSM sampling,
+//! the brute force over every VPL), the temporal filter, and the direct light of the spot with the
+//! RSM depth as shadow map. Writes radiance buffers an [`super::OutputPass`] copies into the
+//! caller's texture.
+//!
+//! One file a pass, each owning its shader, pipelines and recording, over the resources every
+//! pass shares (`resources.rs`); [`Gather`] only picks and orders them.
+
+mod brute_force;
+mod cut;
+mod direct;
+mod passes;
+mod resources;
+mod rsm_sampling;
+mod temporal;
+mod tiles;
+mod upsample;
+
+use super::contract::compute_pass;
+use super::gbuffer::GBufferViews;
+use super::light::Spot;
+use super::quadtree::LightQuadtree;
+use super::rsm::RsmViews;
+use crate::IndirectError;
+use crate::settings::{Method, Settings};
+use brute_force::BruteForce;
+use cut::Cut;
+use direct::Direct;
+use passes::Passes;
+use quadray_gpu::GpuTimer;
+use resources::Resources;
+use rsm_sampling::RsmSampling;
+use std::cell::Cell;
+use temporal::Temporal;
+use tiles::Tiles;
+
+/// Every gather pass's whole shader (before the prelude), by name: what the contract test parses.
+#[cfg(test)]
+pub(crate) fn shaders() -> Vec<(&'static str, Vec<&'static str>)> {
+    vec![
+        ("gather cut", resources::shader(&cut::WGSL)),
+        ("gather passes", resources::shader(&passes::WGSL)),
+        ("gather tiles", resources::shader(&tiles::WGSL)),
+        (
+            "gather rsm sampling",
+            resources::shader(&rsm_sampling::WGSL),
+        ),
+        ("gather brute force", resources::shader(&brute_force::WGSL)),
+        ("gather direct", resources::shader(&direct::WGSL)),
+        ("gather temporal", resources::shader(&temporal::WGSL)),
+    ]
+}
+
+/// The shading passes and the radiance they write, at one set of sizes.
+pub struct Gather {
+    res: Resources,
+    cut: Cut,
+    passes: Passes,
+    tiles: Tiles,
+    rsm_sampling: RsmSampling,
+    brute_force: BruteForce,
+    direct: Direct,
+    temporal: Temporal,
+    /// The camera last set, to restart the (not reprojected) average when it moves.
+    camera: Cell<Option<(glam::Mat4, glam::Vec3)>>,
+}
+
+impl Gather {
+    /// The gather of `settings` (sizes, samples, subsampling) reading `quadtree`, the RSM it was
+    /// built from and the caller's G-buffer (`settings.width` x `settings.height`).
+    pub fn new(
+        device: &wgpu::Device,
+        settings: &Settings,
+        quadtree: &LightQuadtree,
+        rsm: RsmViews,
+        gbuffer: GBufferViews,
+    ) -> Result<Self, IndirectError> {
+        settings.validate().map_err(IndirectError::Settings)?;
+        let res = Resources::new(device, settings, quadtree, rsm, gbuffer);
+        Ok(Self {
+            cut: Cut::new(device, &res),
+            passes: Passes::new(device, &res),
+            tiles: Tiles::new(device, &res),
+            rsm_sampling: RsmSampling::new(device, &res),
+            brute_force: BruteForce::new(device, &res),
+            direct: Direct::new(device, &res),
+            temporal: Temporal::new(device, &res),
+            camera: Cell::new(None),
+            res,
+        })
+    }
+
+    /// Reads another quadtree or RSM from now on (when the caller's RSM textures change).
+    pub fn bind_rsm(&mut self, device: &wgpu::Device, quadtree: &LightQuadtree, rsm: RsmViews) {
+        self.reset_history();
+        self.res.bind_rsm(device, quadtree, rsm);
+    }
+
+    /// Shades another G-buffer of the same size from now on (when the caller's targets change).
+    pub fn bind_gbuffer(&mut self, device: &wgpu::Device, gbuffer: GBufferViews) {
+        self.reset_history();
+        self.res.bind_gbuffer(device, gbuffer);
+    }
+
+    /// Sets the light (per light update) and the clamp `r_min` of the VPL kernel's 1/r^4
+    /// (world units).
+    pub fn set_light(&self, queue: &wgpu::Queue, spot: &Spot, r_min: f32) {
+        self.res.set_light(queue, spot, r_min);
+    }
+
+    /// Sets the camera the G-buffer is rendered from (`view_proj`: world -> clip, `eye`: its
+    /// position): indirect shadows read the G-buffer as a depth map. A camera that moves
+    /// restarts the temporal filter's average.
+    pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
+        if self.camera.replace(Some((view_proj, eye))) != Some((view_proj, eye)) {
+            self.reset_history();
+        }
+        self.res.set_camera(queue, view_proj, eye);
+    }
+
+    /// Forgets the temporal filter's average: the next frame starts it anew (when what the
+    /// frames show changes other than by the light moving, e.g. new cluster settings).
+    pub fn reset_history(&self) {
+        self.temporal.reset();
+    }
+
+    /// Records the indirect light of `method` (after `quadtree`'s build, and its cut for
+    /// [`Method::Quadtree`]) into `timer`'s `indirect` and `upsample` slots; with a temporal
+    /// weight below 1 (not for the brute force) the frame is then averaged with the last ones,
+    /// in the last of those slots.
+    pub fn record_indirect(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        method: Method,
+        quadtree: &LightQuadtree,
+        timer: Option<(&GpuTimer, u32, u32)>,
+    ) {
+        let res = &self.res;
+        let s = res.settings();
+        // the sub-sampled methods: their passes, and the slices of their sum
+        let upsampled = match method {
+            Method::Quadtree => Some((&self.cut.upsampled, Cut::slices(quadtree))),
+            Method::Rsm => Some((&self.rsm_sampling.upsampled, RsmSampling::slices(res))),
+            _ => None,
+        }
+        .filter(|_| method.subsamples() && s.subsample > 1);
+        let filtered = s.temporal_weight < 1.0 && method != Method::Reference;
+        let blend = filtered && self.temporal.continues(method);
+        if method == Method::QuadtreePasses {
+            self.passes.record_clear(encoder, res);
+        }
+        encoder.clear_buffer(&res.outputs.counts, 0, None);
+        {
+            let stamps = timer.and_then(|(t, slot, _)| t.compute_pass(slot));
+            let mut pass = compute_pass(encoder, "indirect", stamps);
+            res.bind_groups(&mut pass);
+            match (method, upsampled) {
+                (_, Some((upsampled, slices))) => upsampled.record_low(&mut pass, res, slices),
+                (Method::Quadtree, None) => self.cut.record(&mut pass, res, quadtree),
+                (Method::QuadtreeTiles, None) => self.tiles.record(&mut pass, res),
+                (Method::QuadtreePasses, None) => self.passes.record(&mut pass, res, quadtree),
+                (Method::Rsm, None) => self.rsm_sampling.record(&mut pass, res),
+                (Method::Reference, None) => self.brute_force.record(&mut pass, res),
+            }
+            if blend && upsampled.is_none() {
+                self.temporal.record_blend(&mut pass, res);
+            }
+        }
+        if let Some((upsampled, slices)) = upsampled {
+            let stamps = timer.and_then(|(t, _, slot)| t.compute_pass(slot));
+            let mut pass = compute_pass(encoder, "upsample", stamps);
+            res.bind_groups(&mut pass);
+            upsampled.record_upsample(&mut pass, res, slices);
+            if blend {
+                self.temporal.record_blend(&mut pass, res);
+            }
+        }
+        if filtered && !blend {
+            self.temporal.record_start(encoder, res, method);
+        }
+    }
+
+    /// Records the direct light of the spot, shadowed by the RSM depth, into `timer`'s `slot`.
+    pub fn record_direct(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<(&GpuTimer, u32)>,
+    ) {
+        let stamps = timer.and_then(|(t, slot)| t.compute_pass(slot));
+        let mut pass = compute_pass(encoder, "direct", stamps);
+        self.res.bind_groups(&mut pass);
+        self.direct.record(&mut pass, &self.res);
+    }
+
+    /// The settings the gather was built with.
+    pub fn settings(&self) -> &Settings {
+        self.res.settings()
+    }
+
+    /// Indirect radiance per pixel, row-major: rgb, and w = 1 where the upsampler recomputed it.
+    pub(crate) fn indirect(&self) -> &wgpu::Buffer {
+        &self.res.outputs.indirect
+    }
+
+    /// Direct radiance per pixel, row-major (rgb, w = 1 where the G-buffer has geometry).
+    pub(crate) fn direct(&self) -> &wgpu::Buffer {
+        &self.res.outputs.direct
+    }
+
+    /// Per pixel, the last indirect passes' VPL evaluations, texel fetches, bound evaluations and
+    /// refused splits (`[u32; 4]`).
+    pub(crate) fn counts(&self) -> &wgpu::Buffer {
+        &self.res.outputs.counts
+    }
+
+    /// The last per-tile cuts, `None` before the first frame of [`Method::QuadtreeTiles`]: per
+    /// tile, its node indices (`tile_capacity` `u32` slots a tile), and its list's length,
+    /// refused splits, nodes estimated and the estimates' VPL evaluations (`[u32; 4]`).
+    pub(crate) fn tile_lists(&self) -> Option<(&wgpu::Buffer, &wgpu::Buffer)> {
+        self.tiles.lists()
+    }
+}

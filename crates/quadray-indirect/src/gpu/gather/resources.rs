@@ -1,0 +1,368 @@
+//! What every gather pass shares: the bind groups, by how often they change (group 0 per light
+//! update: the quadtree's settings, the light, the RSM, the quadtree and cut; group 1 per frame:
+//! the settings, the camera, the G-buffer and the outputs; group 2 per dispatch: a level and a
+//! slice), the buffers behind them, and how a pass makes its shader and pipelines against them.
+//! A pass that needs more binds its own groups from 3 on.
+
+use crate::baselines;
+use crate::gpu::contract::{
+    CameraUniform, ClusterUniform, GpuNode, GpuNodeBounds, LevelSlot, LightTermsUniform,
+    LightUniform, MAX_SLICES, ShadeUniform, Slots, bind_group, compute_pipeline, dispatch_2d,
+    layout, pipeline_layout, shader_module, storage_buffer, storage_entry, tex, texture_entry,
+    uniform_buffer, uniform_entry, whole,
+};
+use crate::gpu::gbuffer::{GBufferViews, camera_uniform};
+use crate::gpu::light::Spot;
+use crate::gpu::quadtree::LightQuadtree;
+use crate::gpu::rsm::RsmViews;
+use crate::settings::{Settings, TileCriterion};
+use crate::wgsl;
+use wgpu::util::DeviceExt;
+
+/// What every gather pass's shader starts with (after the prelude): the node layout and kernel,
+/// the light, the receiver, and `shared.wgsl` (the bindings of groups 0-2, the accessors the
+/// engine-neutral modules read them with, and the helpers every pass uses).
+const SHARED_WGSL: [&str; 5] = [
+    wgsl::NODE,
+    wgsl::KERNEL,
+    wgsl::LIGHT,
+    wgsl::RECEIVER,
+    include_str!("shared.wgsl"),
+];
+
+/// A gather pass's whole shader: the shared parts, then the pass's `own` in order.
+pub(crate) fn shader(own: &[&'static str]) -> Vec<&'static str> {
+    SHARED_WGSL.iter().chain(own).copied().collect()
+}
+
+/// The gather's settings as the shaders read them (written once: a gather's settings are fixed).
+fn shade_uniform(s: &Settings) -> ShadeUniform {
+    let (low_width, low_height) = s.low_size();
+    ShadeUniform {
+        sample_count: s.samples,
+        subsample: s.subsample,
+        low_width,
+        low_height,
+        normal_agreement: 0.9,
+        shadow_steps: s.shadow_steps,
+        temporal_weight: s.temporal_weight,
+        tile_error: s.tile_error,
+        tile_capacity: s.tile_capacity,
+        tile_start: s.tile_start_level(),
+        tiles_x: s.tiles().0,
+        tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
+        tile_share: s.tile_share,
+    }
+}
+
+/// The per-frame group's buffers: the settings, the camera, the radiance out, the RSM samples,
+/// the work counts.
+pub(crate) struct Outputs {
+    /// The settings (written once) and the camera.
+    shade: wgpu::Buffer,
+    camera: wgpu::Buffer,
+    /// Radiance per pixel, row-major: indirect (rgb, w = 1 where the upsampler recomputed it),
+    /// direct (rgb, w = 1 where the G-buffer has geometry), and the low-resolution samples.
+    pub indirect: wgpu::Buffer,
+    pub direct: wgpu::Buffer,
+    low: wgpu::Buffer,
+    samples: wgpu::Buffer,
+    /// Per pixel: VPL evaluations, texel fetches, bound evaluations and refused splits of the
+    /// last indirect passes (four `u32`).
+    pub counts: wgpu::Buffer,
+    /// The temporal filter's running average of the indirect light (one texel without it).
+    pub history: wgpu::Buffer,
+}
+
+impl Outputs {
+    fn new(device: &wgpu::Device, s: &Settings) -> Self {
+        let pixels = u64::from(s.width) * u64::from(s.height);
+        let (lw, lh) = s.low_size();
+        let samples = baselines::rsm_samples(
+            s.samples,
+            s.rsm_radius * s.rsm_size as f32 * std::f32::consts::SQRT_2,
+            baselines::SAMPLE_SEED,
+        );
+        Self {
+            shade: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shade"),
+                contents: bytemuck::bytes_of(&shade_uniform(s)),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            // the picture's size from the start: a caller without indirect shadows may never
+            // set the camera
+            camera: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("gather camera"),
+                contents: bytemuck::bytes_of(&camera_uniform(
+                    glam::Mat4::IDENTITY,
+                    glam::Vec3::ZERO,
+                    (s.width, s.height),
+                )),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            }),
+            indirect: storage_buffer(device, "indirect", pixels * 16),
+            direct: storage_buffer(device, "direct", pixels * 16),
+            low: storage_buffer(device, "low-resolution indirect", u64::from(lw * lh) * 16),
+            samples: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("rsm samples"),
+                contents: bytemuck::cast_slice(&samples),
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
+            counts: storage_buffer(device, "work counts", pixels * 16),
+            history: storage_buffer(
+                device,
+                "indirect history",
+                if s.temporal_weight < 1.0 {
+                    pixels * 16
+                } else {
+                    0
+                },
+            ),
+        }
+    }
+
+    fn frame_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        gbuffer: GBufferViews,
+    ) -> wgpu::BindGroup {
+        bind_group(
+            device,
+            "gather frame",
+            layout,
+            vec![
+                whole(&self.shade),
+                whole(&self.camera),
+                tex(gbuffer.position),
+                tex(gbuffer.normal),
+                tex(gbuffer.albedo),
+                whole(&self.indirect),
+                whole(&self.direct),
+                whole(&self.low),
+                whole(&self.samples),
+                whole(&self.counts),
+                whole(&self.history),
+            ],
+        )
+    }
+}
+
+/// The shared groups' layouts, buffers and bind groups, at one set of sizes.
+pub(crate) struct Resources {
+    settings: Settings,
+    light_layout: wgpu::BindGroupLayout,
+    frame_layout: wgpu::BindGroupLayout,
+    dispatch_layout: wgpu::BindGroupLayout,
+    /// Per light update: the light, and the gather's terms of it.
+    light: wgpu::Buffer,
+    light_terms: wgpu::Buffer,
+    pub outputs: Outputs,
+    slots: Slots,
+    light_group: wgpu::BindGroup,
+    frame_group: wgpu::BindGroup,
+    dispatch_group: wgpu::BindGroup,
+}
+
+impl Resources {
+    /// The shared resources of a gather of `settings` (checked) reading `quadtree`, the RSM it
+    /// was built from and the caller's G-buffer.
+    pub fn new(
+        device: &wgpu::Device,
+        settings: &Settings,
+        quadtree: &LightQuadtree,
+        rsm: RsmViews,
+        gbuffer: GBufferViews,
+    ) -> Self {
+        let s = settings;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let light_layout = layout(
+            device,
+            "gather light",
+            &[
+                uniform_entry::<ClusterUniform>(0, compute, false),
+                uniform_entry::<LightUniform>(1, compute, false),
+                storage_entry::<LightTermsUniform>(2, true),
+                texture_entry(3),
+                texture_entry(4),
+                texture_entry(5),
+                storage_entry::<GpuNode>(6, true),
+                storage_entry::<GpuNode>(7, true),
+                storage_entry::<u32>(8, true),
+                storage_entry::<GpuNodeBounds>(9, true),
+            ],
+        );
+        let frame_layout = layout(
+            device,
+            "gather frame",
+            &[
+                uniform_entry::<ShadeUniform>(0, compute, false),
+                storage_entry::<CameraUniform>(1, true),
+                texture_entry(2),
+                texture_entry(3),
+                texture_entry(4),
+                storage_entry::<[f32; 4]>(5, false),
+                storage_entry::<[f32; 4]>(6, false),
+                storage_entry::<[f32; 4]>(7, false),
+                storage_entry::<[f32; 4]>(8, true),
+                storage_entry::<[u32; 4]>(9, false),
+                storage_entry::<[f32; 4]>(10, false),
+            ],
+        );
+        let dispatch_layout = layout(
+            device,
+            "gather dispatch",
+            &[
+                uniform_entry::<LevelSlot>(0, compute, true),
+                uniform_entry::<LevelSlot>(1, compute, true),
+            ],
+        );
+        let slots = Slots::new(device, "gather slots", MAX_SLICES);
+        let dispatch_group = bind_group(
+            device,
+            "gather dispatch",
+            &dispatch_layout,
+            vec![slots.binding(), slots.binding()],
+        );
+        let light = uniform_buffer::<LightUniform>(device, "gather light");
+        // storage, not uniform: see shared.wgsl
+        let light_terms = storage_buffer(
+            device,
+            "gather light terms",
+            size_of::<LightTermsUniform>() as u64,
+        );
+        let light_group = light_group(device, &light_layout, [&light, &light_terms], quadtree, rsm);
+        let outputs = Outputs::new(device, s);
+        Self {
+            settings: s.clone(),
+            light,
+            light_terms,
+            frame_group: outputs.frame_group(device, &frame_layout, gbuffer),
+            outputs,
+            slots,
+            light_group,
+            dispatch_group,
+            light_layout,
+            frame_layout,
+            dispatch_layout,
+        }
+    }
+
+    /// The settings the gather was built with.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Reads another quadtree or RSM from now on.
+    pub fn bind_rsm(&mut self, device: &wgpu::Device, quadtree: &LightQuadtree, rsm: RsmViews) {
+        let buffers = [&self.light, &self.light_terms];
+        self.light_group = light_group(device, &self.light_layout, buffers, quadtree, rsm);
+    }
+
+    /// Shades another G-buffer of the same size from now on.
+    pub fn bind_gbuffer(&mut self, device: &wgpu::Device, gbuffer: GBufferViews) {
+        self.frame_group = self
+            .outputs
+            .frame_group(device, &self.frame_layout, gbuffer);
+    }
+
+    /// Writes the light and the gather's terms of it (the kernel's clamp `r_min`, world units).
+    pub fn set_light(&self, queue: &wgpu::Queue, spot: &Spot, r_min: f32) {
+        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&spot.uniform()));
+        let terms = spot.terms(&self.settings, r_min);
+        queue.write_buffer(&self.light_terms, 0, bytemuck::bytes_of(&terms));
+    }
+
+    /// Writes the camera the G-buffer is rendered from.
+    pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
+        let s = &self.settings;
+        let camera = camera_uniform(view_proj, eye, (s.width, s.height));
+        queue.write_buffer(&self.outputs.camera, 0, bytemuck::bytes_of(&camera));
+    }
+
+    /// A pass's pipelines, one per entry point of its shader ([`shader`] of `own`), whose layout
+    /// is the shared groups then `own_groups` (from group 3 on).
+    pub fn pipelines<const N: usize>(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        own: &[&'static str],
+        entries: [&str; N],
+        own_groups: &[&wgpu::BindGroupLayout],
+    ) -> [wgpu::ComputePipeline; N] {
+        let module = shader_module(device, label, &shader(own));
+        let groups: Vec<&wgpu::BindGroupLayout> = [
+            &self.light_layout,
+            &self.frame_layout,
+            &self.dispatch_layout,
+        ]
+        .into_iter()
+        .chain(own_groups.iter().copied())
+        .collect();
+        let layout = pipeline_layout(device, &groups);
+        entries.map(|entry| compute_pipeline(device, &layout, &module, entry))
+    }
+
+    /// Binds the light's and the frame's groups.
+    pub fn bind_groups(&self, pass: &mut wgpu::ComputePass) {
+        pass.set_bind_group(0, &self.light_group, &[]);
+        pass.set_bind_group(1, &self.frame_group, &[]);
+    }
+
+    /// Binds the dispatch group: `level` and `slice`.
+    pub fn bind_dispatch(&self, pass: &mut wgpu::ComputePass, level: u32, slice: u32) {
+        pass.set_bind_group(
+            2,
+            &self.dispatch_group,
+            &[self.slots.offset(level), self.slots.offset(slice)],
+        );
+    }
+
+    /// A per-pixel sum over `width` x `height` pixels in `count` slices (the first writes, the
+    /// others add), at `level`, with the pipeline set.
+    pub fn sliced(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        level: u32,
+        count: u32,
+        (width, height): (u32, u32),
+    ) {
+        for slice in 0..count {
+            self.bind_dispatch(pass, level, slice);
+            dispatch_2d(pass, width, height);
+        }
+    }
+
+    /// The picture's size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.settings.width, self.settings.height)
+    }
+}
+
+/// The per-light group: `quadtree`'s settings, the light and its terms, the RSM, the quadtree's
+/// nodes, cut and bounds.
+fn light_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    [light, terms]: [&wgpu::Buffer; 2],
+    quadtree: &LightQuadtree,
+    rsm: RsmViews,
+) -> wgpu::BindGroup {
+    bind_group(
+        device,
+        "gather light",
+        layout,
+        vec![
+            whole(quadtree.params()),
+            whole(light),
+            whole(terms),
+            tex(rsm.flux),
+            tex(rsm.position),
+            tex(rsm.normal),
+            whole(quadtree.nodes()),
+            whole(quadtree.cut()),
+            whole(quadtree.cut_count()),
+            whole(quadtree.bounds()),
+        ],
+    )
+}

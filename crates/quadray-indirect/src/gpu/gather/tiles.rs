@@ -1,0 +1,89 @@
+//! Per-tile cuts ([`Method::QuadtreeTiles`]): one workgroup a tile of 8x8 pixels refines
+//! its own cut of the light quadtree against a bound of each node's contribution, then its pixels
+//! sum it. The tiles' lists are this pass's own group 3.
+
+use super::resources::Resources;
+#[cfg(doc)]
+use crate::Method;
+use crate::gpu::contract::{bind_group, layout, storage_buffer, storage_entry, whole};
+use crate::wgsl;
+use std::cell::OnceCell;
+
+/// The pass's own shader parts, after the shared ones.
+pub(crate) const WGSL: [&str; 2] = [wgsl::BOUND, include_str!("tiles.wgsl")];
+
+/// The per-tile cuts' lists and their bind group (group 3).
+struct TileLists {
+    /// Per tile, the per-tile cut's node indices (`tile_capacity` slots a tile).
+    cuts: wgpu::Buffer,
+    /// Per tile, the nodes its list holds, the splits refused for want of room, the nodes whose
+    /// error it estimated and the VPL evaluations that took (four `u32`).
+    sizes: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
+pub(crate) struct Tiles {
+    pipeline: wgpu::ComputePipeline,
+    lists_layout: wgpu::BindGroupLayout,
+    /// Allocated by the first frame (up to [`crate::Settings::MAX_TILE_LIST_BYTES`]), so that
+    /// the other methods pay nothing for them.
+    lists: OnceCell<TileLists>,
+    /// To allocate the lists when first drawn.
+    device: wgpu::Device,
+}
+
+impl Tiles {
+    pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
+        let lists_layout = layout(
+            device,
+            "per-tile cuts",
+            &[
+                storage_entry::<u32>(0, false),
+                storage_entry::<[u32; 4]>(1, false),
+            ],
+        );
+        let [pipeline] = res.pipelines(
+            device,
+            "gather tiles",
+            &WGSL,
+            ["indirect_tiles"],
+            &[&lists_layout],
+        );
+        Self {
+            pipeline,
+            lists_layout,
+            lists: OnceCell::new(),
+            device: device.clone(),
+        }
+    }
+
+    /// Records one workgroup a tile (a list of at most `TILE_FRONTIER` nodes fits a slice), the
+    /// lists allocated first.
+    pub fn record(&self, pass: &mut wgpu::ComputePass, res: &Resources) {
+        let s = res.settings();
+        let (tx, ty) = s.tiles();
+        let lists = self.lists.get_or_init(|| {
+            let cuts = storage_buffer(&self.device, "per-tile cuts", s.tile_list_bytes());
+            let tiles = u64::from(tx) * u64::from(ty);
+            let sizes = storage_buffer(&self.device, "per-tile cut sizes", tiles * 16);
+            let group = bind_group(
+                &self.device,
+                "per-tile cuts",
+                &self.lists_layout,
+                vec![whole(&cuts), whole(&sizes)],
+            );
+            TileLists { cuts, sizes, group }
+        });
+        pass.set_bind_group(3, &lists.group, &[]);
+        pass.set_pipeline(&self.pipeline);
+        res.bind_dispatch(pass, 0, 0);
+        pass.dispatch_workgroups(tx, ty, 1);
+    }
+
+    /// The last per-tile cuts, `None` before the first frame: per tile, its node indices
+    /// (`tile_capacity` `u32` slots a tile), and its list's length, refused splits, nodes
+    /// estimated and the estimates' VPL evaluations (`[u32; 4]`).
+    pub fn lists(&self) -> Option<(&wgpu::Buffer, &wgpu::Buffer)> {
+        self.lists.get().map(|t| (&t.cuts, &t.sizes))
+    }
+}
