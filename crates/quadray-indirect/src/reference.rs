@@ -6,8 +6,7 @@
 use crate::gpu::{Receiver, Vpl};
 use crate::scene::Scene;
 use glam::Vec3;
-use quadray_shadows::bvh::Bvh;
-use quadray_shadows::geom::{ConvexPolygon, Ray};
+use quadray_core::geom::{Bvh, ConvexPolygon, Ray};
 use rayon::prelude::*;
 
 /// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none), with

@@ -273,10 +273,10 @@ mod tests {
         storage_entry, whole,
     };
     use super::{BOUND_WGSL, COMMON_WGSL};
-    use crate::baselines::SplitMix;
     use crate::gpu::{Receiver, Vpl};
     use crate::reference::brute_force;
     use glam::Vec3;
+    use quadray_core::random::SplitMix;
     use wgpu::util::DeviceExt;
 
     /// `node_bound`'s inputs (one case), and the entry point that evaluates it per case.
