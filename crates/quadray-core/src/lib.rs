@@ -1,9 +1,12 @@
 //! What quadray's techniques share: image output and error heat maps, medians of timings, the
-//! JSON and text files the programs write, and the mesh loader (OBJ, glTF, PLY) the renderers
-//! share.
+//! JSON and text files the programs write, the mesh loader (OBJ, glTF, PLY) the renderers
+//! share, the CPU ray tracing geometry ([`geom`]: rays, convex polygons, a SAH BVH) and the
+//! random generator ([`random`]).
 
+pub mod geom;
 pub mod image_out;
 pub mod mesh;
+pub mod random;
 pub mod scene;
 pub mod settings;
 pub mod stats;

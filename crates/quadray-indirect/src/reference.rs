@@ -5,13 +5,24 @@
 
 use crate::gpu::{Receiver, Vpl};
 use crate::scene::Scene;
-use glam::Vec3;
-use quadray_shadows::bvh::Bvh;
-use quadray_shadows::geom::{ConvexPolygon, Ray};
+use glam::{DVec3, Vec3};
+use quadray_core::geom::{Bvh, ConvexPolygon, Ray};
 use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// The CPU's one VPL kernel (the shaders' in WGSL): with `d` from the VPL to the receiver,
+/// max(n_p . d, 0) max(-n . d, 0) / max(|d|^2, r_min^2)^2, which is cos_p cos / r^2 beyond
+/// `r_min` and falls off as r^2 inside it. A VPL of flux F gives the receiver the irradiance
+/// F / pi times this (a diffuse VPL's 1/pi).
+pub fn vpl_kernel(d: DVec3, receiver_normal: DVec3, vpl_normal: DVec3, r_min: f64) -> f64 {
+    let emit = vpl_normal.dot(d).max(0.0);
+    let receive = (-receiver_normal.dot(d)).max(0.0);
+    let r2 = d.length_squared().max(r_min * r_min);
+    emit * receive / (r2 * r2)
+}
 
 /// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none), with
-/// E_p = flux_p / pi * cos_p * cos / max(r^2, r_min^2) (the spec's kernel with a diffuse VPL's 1/pi).
+/// E_p = flux_p / pi * [`vpl_kernel`] (the spec's kernel with a diffuse VPL's 1/pi).
 pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> Vec<[f32; 3]> {
     sum_vpls(vpls, receivers, r_min, |_, _| true)
 }
@@ -74,32 +85,24 @@ fn sum_vpls(
     r_min: f32,
     visible: impl Fn(&Vpl, &Receiver) -> bool + Sync,
 ) -> Vec<[f32; 3]> {
-    let r_min2 = f64::from(r_min).powi(2);
+    let r_min = f64::from(r_min);
+    let v = |a: [f32; 3]| Vec3::from(a).as_dvec3();
     receivers
         .par_iter()
         .map(|r| {
             let Some(receiver) = r else {
                 return [0.0; 3];
             };
-            let r = receiver;
-            let v = |a: [f32; 3]| a.map(f64::from);
-            let (x, n) = (v(r.position), v(r.normal));
-            let mut e = [0.0f64; 3];
+            let (x, n) = (v(receiver.position), v(receiver.normal));
+            let mut e = DVec3::ZERO;
             for p in vpls {
-                let (xp, np) = (v(p.position), v(p.normal));
-                let d = [x[0] - xp[0], x[1] - xp[1], x[2] - xp[2]];
-                let d2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(r_min2);
-                let emit = (np[0] * d[0] + np[1] * d[1] + np[2] * d[2]).max(0.0);
-                let receive = -(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
-                let g = emit * receive.max(0.0) / (std::f64::consts::PI * d2 * d2);
+                let g = vpl_kernel(x - v(p.position), n, v(p.normal), r_min);
                 if g == 0.0 || !visible(p, receiver) {
                     continue;
                 }
-                for (e, flux) in e.iter_mut().zip(p.flux) {
-                    *e += f64::from(flux) * g;
-                }
+                e += v(p.flux) * (g / PI);
             }
-            std::array::from_fn(|c| (f64::from(r.albedo[c]) / std::f64::consts::PI * e[c]) as f32)
+            (v(receiver.albedo) / PI * e).as_vec3().to_array()
         })
         .collect()
 }

@@ -3,10 +3,10 @@
 //! constants measured by micro-benchmarks, and the measured decision costs the pilot renders
 //! ([`crate::pilot`]) bin. Nothing here renders.
 
-use crate::SplitMix;
-use crate::geom::{Aabb, ConvexPolygon, Ray};
 use crate::grid::{Grid, Mailbox};
 use glam::Vec3;
+use quadray_core::geom::{Aabb, ConvexPolygon, Ray};
+use quadray_core::random::SplitMix;
 use serde::Serialize;
 use std::hint::black_box;
 
@@ -130,13 +130,22 @@ pub fn extended_nth(c: &MachineCosts, s: &SceneStats, f: &FollowUp) -> f64 {
 pub fn calibrate() -> MachineCosts {
     let mut rng = SplitMix(1);
     let mut random_polygon = |sides: usize| {
-        let c = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 4.0 - 2.0;
+        let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - 2.0;
         let (u, v) = (
-            Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5).normalize(),
-            Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5),
+            Vec3::new(
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+            )
+            .normalize(),
+            Vec3::new(
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+            ),
         );
         let v = u.cross(v).normalize();
-        let r = 0.3 + rng.unit();
+        let r = 0.3 + rng.next_f32();
         ConvexPolygon::new(
             (0..sides)
                 .map(|i| {
@@ -151,8 +160,13 @@ pub fn calibrate() -> MachineCosts {
     let shadows: Vec<ConvexPolygon> = (0..256).map(|_| random_polygon(5)).collect();
     let rays: Vec<(Vec3, Vec3)> = (0..256)
         .map(|_| {
-            let o = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 6.0 - 3.0;
-            let d = Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5).normalize();
+            let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 6.0 - 3.0;
+            let d = Vec3::new(
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+            )
+            .normalize();
             (o, d)
         })
         .collect();

@@ -4,12 +4,12 @@
 //! test, so choosing one costs nothing per ray.
 
 use crate::cost::CostBins;
-use crate::geom::Ray;
 use crate::grid::{CellRecord, Mailbox};
 use crate::occlusion::Occluder;
 use crate::shadow::{LightState, ShadowVolumes, Subscheme};
 use crate::stats::RenderStats;
 use glam::Vec3;
+use quadray_core::geom::Ray;
 
 /// One tile's working memory: mailboxes, the cells of the current ray segment and the counts.
 pub struct Scratch<R> {

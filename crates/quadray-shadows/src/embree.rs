@@ -1,10 +1,10 @@
 //! Today's production baseline: shadow rays as Intel Embree 3 occlusion queries (Debian's
 //! libembree-dev; `scripts/setup.sh --embree` installs it). Built only with the `embree` feature.
 
-use crate::geom::{ConvexPolygon, Ray};
 use crate::occlusion::Occluder;
 use embree::sys;
 use glam::Vec3;
+use quadray_core::geom::{ConvexPolygon, Ray};
 
 /// A committed Embree scene of the polygons, fanned into triangles.
 pub struct EmbreeScene {

@@ -1,8 +1,9 @@
 //! The uniform grid (Fujimoto's SEADS): resolution by a density rule, exact registration of convex
 //! polygons in the cells they touch, 3DDDA traversal (Amanatides & Woo) and per-ray mailboxes.
 
-use crate::geom::{Aabb, Ray, clip_slab};
+use crate::clip::clip_slab;
 use glam::Vec3;
+use quadray_core::geom::{Aabb, Ray};
 use rayon::prelude::*;
 
 /// Cells per polygon of the density rule. The paper's four grids hold 42-54 cells per polygon

@@ -4,13 +4,15 @@
 //! Intel Embree) as today's baselines.
 //!
 //! Rooms, from the bottom up: [`scene`] (a scene built in code with [`Scene::new`] and its
-//! `add_` methods, procedural look-alikes of the paper's scenes, TOML scene files), [`geom`]
-//! ([`Ray`], convex polygons), [`grid`] (SEADS, 3DDDA, mailboxes), [`occlusion`] (the
-//! [`Occluder`] interface of shadow rays: the grid, [`bvh`], `embree`), [`shadow`] (shadow
-//! polygons and HST's state machine), [`mod@prepare`] (what a scheme builds before rendering),
+//! `add_` methods, procedural look-alikes of the paper's scenes, TOML scene files), [`clip`]
+//! (polygon clipping), [`grid`] (SEADS, 3DDDA, mailboxes), [`occlusion`] (the [`Occluder`]
+//! interface of shadow rays: the grid, the BVH, `embree`), [`shadow`] (shadow polygons and HST's
+//! state machine), [`mod@prepare`] (what a scheme builds before rendering),
 //! [`decide`] (the shadow tests the tracer is generic over: shadow rays through any occluder,
 //! shadow volumes, HST), [`trace`] (the renderer), [`cost`] (equations 1-12 and the
 //! micro-benchmarks; it renders nothing) and [`pilot`] (the pilot renders that calibrate it).
+//! Rays, convex polygons and the SAH BVH are [`quadray_core::geom`]'s, shared with the indirect
+//! crate's ground truth.
 //!
 //! A scene built in code and rendered with HST (the whole program is
 //! `examples/hst_scene.rs`):
@@ -79,12 +81,11 @@
 
 #![warn(missing_docs)]
 
-pub mod bvh;
+pub mod clip;
 pub mod cost;
 pub mod decide;
 #[cfg(feature = "embree")]
 pub mod embree;
-pub mod geom;
 pub mod grid;
 pub mod occlusion;
 pub mod pilot;
@@ -98,7 +99,6 @@ pub mod trace;
 mod tests;
 
 use cost::{MachineCosts, SceneStats};
-pub use geom::Ray;
 pub use occlusion::Occluder;
 pub use prepare::{Prepared, Scheme};
 use quadray_core::image_out::Rgba8Image;
@@ -401,25 +401,6 @@ fn report(
         shadow_polygon_tests: r.shadow_polygon_tests,
         shadow_polygon_entries: r.shadow_polygon_entries,
         forced_conventional: r.forced_conventional,
-    }
-}
-
-/// A small deterministic generator (SplitMix64) for sampling and tests.
-pub struct SplitMix(pub u64);
-
-impl SplitMix {
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
     }
 }
 

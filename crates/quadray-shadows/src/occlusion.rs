@@ -1,10 +1,10 @@
-//! The occlusion interface every shadow-ray back end answers: the uniform grid here, the SAH
-//! BVH ([`crate::bvh`]) and Intel Embree (`embree`, with the `embree` feature). The
+//! The occlusion interface every shadow-ray back end answers: the uniform grid and the SAH BVH
+//! (quadray-core's [`Bvh`]) here, and Intel Embree (`embree`, with the `embree` feature). The
 //! tracer is generic over it, so a back end's query compiles into the shading loop with no call
 //! through a pointer per ray.
 
-use crate::geom::{ConvexPolygon, Ray};
 use crate::grid::{CellLists, CellRecord, CellSet, Grid, Hit, Mailbox};
+use quadray_core::geom::{Bvh, ConvexPolygon, Ray};
 
 /// Answers shadow rays: is anything hit between a point and a light?
 pub trait Occluder: Sync {
@@ -85,6 +85,26 @@ impl Occluder for GridOccluder<'_> {
             blocked
         });
         blocked
+    }
+}
+
+/// Shadow rays through a [`Bvh`] built on `polygons`.
+#[derive(Clone, Copy)]
+pub struct BvhOccluder<'a> {
+    /// The hierarchy.
+    pub bvh: &'a Bvh,
+    /// The polygons it was built on.
+    pub polygons: &'a [ConvexPolygon],
+}
+
+impl Occluder for BvhOccluder<'_> {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    #[inline]
+    fn occluded(&self, ray: &Ray, skip: Option<u32>, _: &mut ()) -> bool {
+        self.bvh.occluded(self.polygons, ray, skip)
     }
 }
 

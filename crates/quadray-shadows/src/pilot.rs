@@ -2,15 +2,15 @@
 //! (p, alpha, N_c, C_s per registered shadow polygon) and the small renders of [`FollowUp`]. It
 //! sits above the tracer it runs and the equations it feeds ([`crate::cost`]).
 
-use crate::SplitMix;
 use crate::cost::{
     FollowUp, MachineCosts, SceneStats, break_even, extended_nth, median_ns, predicted_nth,
 };
-use crate::geom::{ConvexPolygon, Ray};
 use crate::grid::{CellRecord, Grid, Mailbox};
 use crate::prepare::{Prepared, Scheme};
 use crate::trace::{Pinhole, Settings, render};
 use glam::Vec3;
+use quadray_core::geom::{ConvexPolygon, Ray};
+use quadray_core::random::SplitMix;
 use std::hint::black_box;
 
 impl Prepared {
@@ -121,11 +121,15 @@ fn surface_points(polygons: &[&ConvexPolygon], count: usize, rng: &mut SplitMix)
     (0..count)
         .map(|_| {
             let pick = cumulative
-                .partition_point(|&c| c < rng.unit() as f64 * total)
+                .partition_point(|&c| c < rng.next_f32() as f64 * total)
                 .min(polygons.len() - 1);
             let poly = polygons[pick];
             // A point inside the convex polygon: random convex weights of its vertices.
-            let w: Vec<f32> = poly.vertices.iter().map(|_| rng.unit() + 1e-3).collect();
+            let w: Vec<f32> = poly
+                .vertices
+                .iter()
+                .map(|_| rng.next_f32() + 1e-3)
+                .collect();
             let ws: f32 = w.iter().sum();
             poly.vertices
                 .iter()

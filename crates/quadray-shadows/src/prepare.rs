@@ -1,13 +1,12 @@
 //! What is built before rendering: the polygons, the grid and its cell lists, and the shadow
 //! polygons, BVH or Embree scene the shadow scheme needs.
 
-use crate::bvh::{Bvh, BvhOccluder};
 use crate::cost::{FollowUp, SceneStats};
-use crate::geom::{Aabb, ConvexPolygon};
 use crate::grid::{CellLists, Grid};
-use crate::occlusion::GridOccluder;
+use crate::occlusion::{BvhOccluder, GridOccluder};
 use crate::scene::Scene;
 use crate::shadow::ShadowVolumes;
+use quadray_core::geom::{Aabb, Bvh, ConvexPolygon};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 

@@ -6,9 +6,9 @@
 mod file;
 mod lookalikes;
 
-use crate::geom::ConvexPolygon;
 use glam::Vec3;
 use lookalikes::{desk, glasses, kaist, stars};
+use quadray_core::geom::ConvexPolygon;
 use std::path::Path;
 use thiserror::Error;
 

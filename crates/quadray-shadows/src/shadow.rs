@@ -19,10 +19,10 @@
 //! light starts with an unknown condition (it may have left the shadow), which the next reflection
 //! point resolves with a conventional test instead of sustaining it.
 
-use crate::geom::{Aabb, ConvexPolygon, Ray};
 use crate::grid::{CellLists, CellSet, Grid, Mailbox};
 use crate::scene::{Face, MAX_LIGHTS, Scene};
 use glam::{Vec3, Vec4};
+use quadray_core::geom::{Aabb, ConvexPolygon, Ray};
 use rayon::prelude::*;
 use serde::Serialize;
 

@@ -3,14 +3,15 @@
 //! shadow condition against the conventional test at every shading point.
 
 use crate::cost::{self, MachineCosts};
-use crate::geom::{ConvexPolygon, Ray};
 use crate::grid::{CellRecord, CellSet, Mailbox};
 use crate::occlusion::{GridOccluder, Occluder};
 use crate::prepare::{Prepared, Scheme};
 use crate::scene::{BUILTINS, Face, Scene};
 use crate::shadow::{LightState, ShadowVolumes, depth_at};
-use crate::{Nth, RunOptions, SchemeChoice, SplitMix, run};
+use crate::{Nth, RunOptions, SchemeChoice, run};
 use glam::Vec3;
+use quadray_core::geom::{ConvexPolygon, Ray};
+use quadray_core::random::SplitMix;
 use std::path::Path;
 
 fn brute_closest(polys: &[ConvexPolygon], o: Vec3, d: Vec3, t_min: f32) -> Option<(f32, u32)> {
@@ -45,13 +46,19 @@ fn scene_with_degenerates(name: &str) -> Scene {
 fn test_rays(prep: &Prepared, count: usize) -> Vec<(Vec3, Vec3)> {
     let mut rng = SplitMix(11);
     let b = prep.grid.bounds;
-    let point =
-        |rng: &mut SplitMix| b.min + b.extent() * Vec3::new(rng.unit(), rng.unit(), rng.unit());
+    let point = |rng: &mut SplitMix| {
+        b.min + b.extent() * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32())
+    };
     let mut rays = Vec::new();
     for i in 0..count {
         let o = point(&mut rng);
         if i % 2 == 0 {
-            let d = Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5).normalize();
+            let d = Vec3::new(
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+            )
+            .normalize();
             rays.push((o, d));
         } else {
             // Snap two coordinates onto cell boundaries, walk along the third axis.
@@ -122,8 +129,9 @@ fn grid_closest_hit_equals_brute_force() {
 /// (how every light's shadow polygons are registered at once).
 #[test]
 fn registration_equals_clipping_to_every_cell() {
-    use crate::geom::{Aabb, clip_slab};
+    use crate::clip::clip_slab;
     use crate::grid::Grid;
+    use quadray_core::geom::Aabb;
     use rayon::prelude::*;
     let bounds = Aabb {
         min: Vec3::new(-1.0, -2.0, 0.5),
@@ -132,7 +140,8 @@ fn registration_equals_clipping_to_every_cell() {
     let grid = Grid::with_resolution(bounds, [7, 5, 4]);
     let mut rng = SplitMix(17);
     let mut point = |reach: f32| {
-        let u = Vec3::new(rng.unit(), rng.unit(), rng.unit()) * (2.0 * reach + 1.0) - reach;
+        let u =
+            Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * (2.0 * reach + 1.0) - reach;
         bounds.min + u * bounds.extent()
     };
     let triangles: Vec<Vec<Vec3>> = (0..300)

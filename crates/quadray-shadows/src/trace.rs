@@ -3,7 +3,6 @@
 //! rayon over image tiles (deterministic: every pixel depends only on its own rays).
 
 use crate::decide::{Arrival, Decision, Hybrid, Scratch, ShadowRays, ShadowTest, Volumes};
-use crate::geom::Ray;
 use crate::grid::{CellRecord, Mailbox};
 use crate::occlusion::Occluder;
 use crate::prepare::{Prepared, Scheme};
@@ -11,6 +10,7 @@ use crate::scene::MAX_LIGHTS;
 use crate::shadow::LightState;
 use crate::stats::RenderStats;
 use glam::Vec3;
+use quadray_core::geom::Ray;
 use quadray_core::image_out::Rgba8Image;
 use rayon::prelude::*;
 use std::time::Instant;

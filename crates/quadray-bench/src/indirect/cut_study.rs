@@ -21,7 +21,7 @@ use crate::report::{PlotSpec, Series, Table, line_plot};
 use glam::DVec3;
 use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
-use quadray_indirect::reference::{brute_force, compare};
+use quadray_indirect::reference::{brute_force, compare, vpl_kernel};
 use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -141,20 +141,20 @@ impl Cluster {
         )
     }
 
-    /// Irradiance (rgb) at `x` (normal `n`): the shader's kernel, flux cos_p cos / (pi
-    /// max(r^2, r_min^2)), with the second-order term where asked and where both cosines are
-    /// positive (the kernel is smooth there).
+    /// Irradiance (rgb) at `x` (normal `n`): flux / pi times the reference's [`vpl_kernel`], with
+    /// the second-order term where asked and where both cosines are positive (the kernel is
+    /// smooth there).
     fn irradiance(&self, x: DVec3, n: DVec3, r_min: f64, representative: Representative) -> DVec3 {
         let np = self.normal_sum.normalize_or_zero();
         let d = x - self.mean;
-        let (a, b) = (np.dot(d), -n.dot(d));
-        if !self.lit || a <= 0.0 || b <= 0.0 {
+        let mut kernel = vpl_kernel(d, n, np, r_min);
+        if !self.lit || kernel == 0.0 {
             return DVec3::ZERO;
         }
-        let q = d.dot(d);
-        let r2 = r_min * r_min;
-        let mut kernel = a * b / (q.max(r2) * q.max(r2));
         if representative == Representative::SecondOrder {
+            let (a, b) = (np.dot(d), -n.dot(d));
+            let q = d.dot(d);
+            let r2 = r_min * r_min;
             // half the trace of the kernel's Hessian in the VPL position times the covariance
             let c = &self.covariance;
             let trace = c[0] + c[1] + c[2];

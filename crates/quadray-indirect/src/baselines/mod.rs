@@ -6,20 +6,7 @@
 /// The seed of the RSM-sampling pattern the gather uses.
 pub const SAMPLE_SEED: u64 = 0x5eed;
 
-/// A small deterministic generator (SplitMix64), so every run samples the same pattern.
-pub(crate) struct SplitMix(pub(crate) u64);
-
-impl SplitMix {
-    /// Uniform in [0, 1).
-    pub(crate) fn next_f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+use quadray_core::random::SplitMix;
 
 /// `n` points in the unit square, no two closer than a radius that starts at 0.75 / sqrt(n) and
 /// shrinks when dart throwing stalls (a Poisson-disk pattern).

@@ -6,7 +6,7 @@ use super::contract::{
     bind_group, compute_pipeline, layout, pipeline_layout, shader_module, storage_buffer,
     storage_entry, whole,
 };
-use crate::baselines::SplitMix;
+use quadray_core::random::SplitMix;
 use crate::frame::{Receiver, Vpl};
 use crate::reference::brute_force;
 use crate::wgsl;

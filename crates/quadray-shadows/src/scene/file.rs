@@ -2,9 +2,9 @@
 //! TOML or glTF file, or a description made in code.
 
 use super::{Camera, Light, Material, Scene, SceneError, scene_error};
-use crate::geom::ConvexPolygon;
 use glam::Vec3;
 use quadray_core::FileError;
+use quadray_core::geom::ConvexPolygon;
 use quadray_core::scene::{Intensity, LUMENS_PER_WATT, SceneDescription, Shape};
 use std::collections::HashMap;
 use std::path::Path;

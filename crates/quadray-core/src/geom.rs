@@ -1,6 +1,11 @@
-//! Geometry shared by objects and shadow polygons: boxes, convex planar polygons prepared for ray
-//! tests, and polygon clipping (used for exact cell registration).
+//! The CPU ray tracing both techniques share: ray segments, boxes, convex planar polygons prepared
+//! for ray tests, and a binned-SAH [`Bvh`] over the polygons. The shadows crate traces its
+//! pictures and baseline shadow rays with them; the indirect crate's ground truth tests
+//! visibility between VPLs and receivers with them.
 
+mod bvh;
+
+pub use bvh::Bvh;
 use glam::{Vec3, Vec4};
 
 /// A ray segment: the points `origin + t dir` with `t` in `(t_min, t_max)`. `dir` need not be
@@ -228,47 +233,9 @@ impl ConvexPolygon {
 /// the polygon, as `(m, -m.a)` with `m` pointing into a counter-clockwise polygon; None for a
 /// zero-length edge.
 #[inline]
-pub fn edge_plane(normal: Vec3, a: Vec3, b: Vec3) -> Option<Vec4> {
+fn edge_plane(normal: Vec3, a: Vec3, b: Vec3) -> Option<Vec4> {
     let m = normal.cross(b - a).try_normalize()?;
     Some(m.extend(-m.dot(a)))
-}
-
-/// Keeps the part of a convex polygon with `p[axis] >= lo` (`keep_above`) or `p[axis] <= lo`.
-pub fn clip_axis(poly: &[Vec3], axis: usize, lo: f32, keep_above: bool, out: &mut Vec<Vec3>) {
-    out.clear();
-    let side = |p: Vec3| {
-        if keep_above {
-            p[axis] - lo
-        } else {
-            lo - p[axis]
-        }
-    };
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-        let (sa, sb) = (side(a), side(b));
-        if sa >= 0.0 {
-            out.push(a);
-        }
-        if (sa >= 0.0) != (sb >= 0.0) {
-            let t = sa / (sa - sb);
-            let mut p = a + (b - a) * t;
-            p[axis] = lo; // exactly on the clip plane, whatever the rounding
-            out.push(p);
-        }
-    }
-}
-
-/// Keeps the part of a convex polygon inside the slab `lo <= p[axis] <= hi`.
-pub fn clip_slab(
-    poly: &[Vec3],
-    axis: usize,
-    lo: f32,
-    hi: f32,
-    tmp: &mut Vec<Vec3>,
-    out: &mut Vec<Vec3>,
-) {
-    clip_axis(poly, axis, lo, true, tmp);
-    clip_axis(tmp, axis, hi, false, out);
 }
 
 #[cfg(test)]
@@ -300,22 +267,6 @@ mod tests {
         assert_eq!(
             p.intersect(Vec3::new(1.0, 0.0, 1.0), -Vec3::Z, 0.0, 10.0),
             None
-        );
-    }
-
-    #[test]
-    fn slab_clip_keeps_the_inside() {
-        let tri = [
-            Vec3::ZERO,
-            Vec3::new(4.0, 0.0, 0.0),
-            Vec3::new(0.0, 4.0, 0.0),
-        ];
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        clip_slab(&tri, 0, 1.0, 2.0, &mut a, &mut b);
-        let bx = Aabb::of_points(b.iter().copied());
-        assert_eq!(
-            (bx.min.x, bx.max.x, bx.min.y, bx.max.y),
-            (1.0, 2.0, 0.0, 3.0)
         );
     }
 }

@@ -1,8 +1,8 @@
-//! Today's baseline: a binned-SAH bounding volume hierarchy over the polygons, with an occlusion
-//! query that stops at the first blocking polygon.
+//! A binned-SAH bounding volume hierarchy over convex polygons, with an occlusion query that
+//! stops at the first blocking polygon (the ray tracer's baseline for shadow rays, the indirect
+//! ground truth's visibility).
 
-use crate::geom::{Aabb, ConvexPolygon, Ray};
-use crate::occlusion::Occluder;
+use super::{Aabb, ConvexPolygon, Ray};
 use glam::Vec3;
 
 const BINS: usize = 12;
@@ -67,26 +67,6 @@ impl Bvh {
             }
         }
         false
-    }
-}
-
-/// Shadow rays through a [`Bvh`] built on `polygons`.
-#[derive(Clone, Copy)]
-pub struct BvhOccluder<'a> {
-    /// The hierarchy.
-    pub bvh: &'a Bvh,
-    /// The polygons it was built on.
-    pub polygons: &'a [ConvexPolygon],
-}
-
-impl Occluder for BvhOccluder<'_> {
-    type Scratch = ();
-
-    fn scratch(&self) {}
-
-    #[inline]
-    fn occluded(&self, ray: &Ray, skip: Option<u32>, _: &mut ()) -> bool {
-        self.bvh.occluded(self.polygons, ray, skip)
     }
 }
 
@@ -166,4 +146,41 @@ fn build_node(
     nodes[me].start = right as u32;
     nodes[me].count = 0;
     me
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::SplitMix;
+
+    /// Occlusion through the hierarchy equals testing every polygon, skipped one included, on
+    /// random rays among random triangles (enough of them for inner nodes and SAH splits), plus
+    /// a degenerate one the build leaves out.
+    #[test]
+    fn occlusion_equals_brute_force() {
+        let mut rng = SplitMix(3);
+        let mut point = |scale: f32| {
+            Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 * scale - scale
+        };
+        let mut polygons: Vec<ConvexPolygon> = (0..300)
+            .map(|_| {
+                let c = point(2.0);
+                ConvexPolygon::new(vec![c + point(0.5), c + point(0.5), c + point(0.5)])
+            })
+            .collect();
+        polygons.push(ConvexPolygon::new(vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0]));
+        let bvh = Bvh::build(&polygons);
+        let mut hits = 0;
+        for i in 0..2000 {
+            let ray = Ray::segment(point(3.0), point(3.0), 0.0);
+            let skip = (i % 3 == 0).then_some(i % 300);
+            let brute = polygons.iter().enumerate().any(|(id, p)| {
+                Some(id as u32) != skip
+                    && p.intersect(ray.origin, ray.dir, 0.0, ray.t_max).is_some()
+            });
+            assert_eq!(bvh.occluded(&polygons, &ray, skip), brute, "ray {ray:?}");
+            hits += usize::from(brute);
+        }
+        assert!(hits > 200 && hits < 1800, "{hits} of 2000 rays blocked");
+    }
 }
