@@ -145,9 +145,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         None => args.frames.clone(),
     };
     if args.print_nth {
-        let frame = frames
-            .as_ref()
-            .map_or(args.frame.unwrap_or(0), |f| f.start);
+        let frame = frames.as_ref().map_or(args.frame.unwrap_or(0), |f| f.start);
         let prep =
             quadray_shadows::prepare(orbit(scene, degrees * frame as f32), SchemeChoice::Hst)
                 .map_err(invalid)?;

@@ -108,7 +108,13 @@ pub fn index_ranges(indices: &[u64]) -> String {
             _ => runs.push((i, i)),
         }
     }
-    let run = |&(a, b): &(u64, u64)| if a == b { a.to_string() } else { format!("{a}-{b}") };
+    let run = |&(a, b): &(u64, u64)| {
+        if a == b {
+            a.to_string()
+        } else {
+            format!("{a}-{b}")
+        }
+    };
     runs.iter().map(run).collect::<Vec<_>>().join(",")
 }
 

@@ -21,7 +21,8 @@ fn check(program: &str, args: &[&str]) -> Output {
 }
 
 fn assert_ok(what: &str, out: &Output) -> String {
-    let text = String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{what}:\n{text}");
     text
 }
@@ -69,7 +70,11 @@ fn kubernetes_manifests_match_the_api_schemas() {
     );
     println!("{report}");
     // Five files of one resource each, and the six resources run.sh fills in.
-    assert_eq!(report.matches(" passed for resource ").count(), 11, "{report}");
+    assert_eq!(
+        report.matches(" passed for resource ").count(),
+        11,
+        "{report}"
+    );
     // The settings reached the manifests: the items, the CPUs, the image, the render.
     assert!(manifests.contains("completions: 288\n"), "{manifests}");
     assert_eq!(manifests.matches("cpu: \"4\", memory").count(), 2);
@@ -123,8 +128,14 @@ fn the_indexed_jobs_pod_renders_its_item() {
     let pod = |index: &str, items: &str| {
         let out = Command::new("sh")
             .args(["-c", &script])
-            .env("PATH", format!("{}:{}", bin.display(), std::env::var("PATH").unwrap()))
-            .env("RENDER", "--builtin stars --size 24x16 --orbit 20 --frames 0..3")
+            .env(
+                "PATH",
+                format!("{}:{}", bin.display(), std::env::var("PATH").unwrap()),
+            )
+            .env(
+                "RENDER",
+                "--builtin stars --size 24x16 --orbit 20 --frames 0..3",
+            )
             .env("TILES", "2")
             .env("ITEMS", items)
             .env("JOB_COMPLETION_INDEX", index)
@@ -136,7 +147,11 @@ fn the_indexed_jobs_pod_renders_its_item() {
     let tiles = work.join("tiles");
     pod("1", "2 5");
     assert!(tiles.join("frame0002-tile0001.exr").exists());
-    assert_eq!(std::fs::read_dir(&tiles).unwrap().count(), 2, "a tile and its stats");
+    assert_eq!(
+        std::fs::read_dir(&tiles).unwrap().count(),
+        2,
+        "a tile and its stats"
+    );
     pod("3", "");
     assert!(tiles.join("frame0001-tile0001.exr").exists());
 }

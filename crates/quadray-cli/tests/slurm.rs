@@ -277,7 +277,9 @@ impl Drop for Cluster {
 
 /// stdout of a command that must succeed.
 fn command_stdout(command: &mut Command) -> String {
-    let out = command.output().unwrap_or_else(|e| panic!("{command:?}: {e}"));
+    let out = command
+        .output()
+        .unwrap_or_else(|e| panic!("{command:?}: {e}"));
     assert!(
         out.status.success(),
         "{command:?}: {}",
@@ -356,17 +358,14 @@ fn a_tiled_turntable_runs_on_slurm_fails_cleanly_and_resumes() {
         items as usize,
         "{states}"
     );
-    assert_eq!(
-        cluster.job_state(&merge),
-        "JobState=COMPLETED Reason=None"
-    );
+    assert_eq!(cluster.job_state(&merge), "JobState=COMPLETED Reason=None");
     // The extra sbatch option reached both jobs.
     for job in [format!("{array}_0"), merge.clone()] {
         let show = command_stdout(cluster.command("scontrol").args(["show", "job", &job]));
         assert!(show.contains("TimeLimit=00:10:00"), "{job}: {show}");
     }
-    let log = std::fs::read_to_string(clean.join(format!("tiles/logs/tile-{array}_4.out")))
-        .unwrap();
+    let log =
+        std::fs::read_to_string(clean.join(format!("tiles/logs/tile-{array}_4.out"))).unwrap();
     assert!(log.contains("100% (") && log.contains("1 CPUs"), "{log}");
 
     // The job's own RENDER with --frame F and its N_th renders frame F in one process.
@@ -398,8 +397,9 @@ fn a_tiled_turntable_runs_on_slurm_fails_cleanly_and_resumes() {
     let broken = dir.join("broken");
     let blocker = broken.join("tiles/frame0002-tile0001.exr.part");
     std::fs::create_dir_all(&blocker).unwrap();
-    let (_, array, merge) = submit(&cluster, &broken, &[]);
+    let (out, array, merge) = submit(&cluster, &broken, &[]);
     let array = array.expect("an array job");
+    let broken_nth = number_after(&out, "N_th").to_string();
     let tiles = broken.join("tiles");
     cluster.wait_done(&[&array, &merge], &tiles);
     let states = cluster.states(&array);
@@ -423,7 +423,11 @@ fn a_tiled_turntable_runs_on_slurm_fails_cleanly_and_resumes() {
         &["merge", tiles_arg, "--out", "x.png"],
         "1 of 6 items missing: frame 2 tile 1 (item 4)",
     );
-    let missing = command_stdout(cluster.command("quadray").args(["tiles", "missing", tiles_arg]));
+    let missing = command_stdout(
+        cluster
+            .command("quadray")
+            .args(["tiles", "missing", tiles_arg]),
+    );
     assert_eq!(missing, "4\n");
 
     // Fixed, the resume re-runs item 4 alone with the recorded settings, then merges.
@@ -431,14 +435,15 @@ fn a_tiled_turntable_runs_on_slurm_fails_cleanly_and_resumes() {
     let started = Instant::now();
     let (out, array, merge) = submit(&cluster, &broken, &["--resume", "tiles"]);
     let array = array.expect("an array job for the missing item");
-    assert!(out.contains("items 4,") && out.contains(&format!("N_th {nth},")), "{out}");
+    // The resume reuses the recorded N_th (each submission measures its own).
+    assert!(
+        out.contains("items 4,") && out.contains(&format!("N_th {broken_nth},")),
+        "{out}"
+    );
     cluster.wait_done(&[&array, &merge], &tiles);
     let states = cluster.states(&array);
     assert_eq!(states.trim(), format!("{array}_4 COMPLETED None"));
-    assert_eq!(
-        cluster.job_state(&merge),
-        "JobState=COMPLETED Reason=None"
-    );
+    assert_eq!(cluster.job_state(&merge), "JobState=COMPLETED Reason=None");
     for frame in [1, 2] {
         let name = format!("frames/turn.000{frame}.png");
         assert!(
@@ -450,6 +455,10 @@ fn a_tiled_turntable_runs_on_slurm_fails_cleanly_and_resumes() {
         "resume: item 4 and the merge in {:.1}s, frames byte-identical",
         started.elapsed().as_secs_f64()
     );
-    let none = command_stdout(cluster.command("quadray").args(["tiles", "missing", tiles_arg]));
+    let none = command_stdout(
+        cluster
+            .command("quadray")
+            .args(["tiles", "missing", tiles_arg]),
+    );
     assert_eq!(none, "");
 }
