@@ -33,6 +33,8 @@ enum Command {
     Raytrace(raytrace::RaytraceArgs),
     /// Assemble the tiles of `quadray raytrace --tiles N` (or `--frames A..B`) into pictures.
     Merge(merge::MergeArgs),
+    /// Work items of a tiled render: which are missing.
+    Tiles(merge::TilesArgs),
     /// One-bounce indirect light from a light quadtree, its baselines and reference.
     Indirect(indirect::IndirectArgs),
     /// Open the interactive viewer: runs the `quadray-view` program installed beside this one
@@ -138,6 +140,7 @@ fn main() -> Result<()> {
         Command::Displace(args) => displace::run(args)?,
         Command::Raytrace(args) => raytrace::run(args)?,
         Command::Merge(args) => merge::run(args)?,
+        Command::Tiles(args) => merge::run_tiles(args)?,
         Command::Bench {
             what: Bench::Shadows { quick, out },
         } => raytrace::bench(quick, &out)?,

@@ -7,6 +7,8 @@ use quadray_shadows::scene::{BUILTINS, Scene};
 use quadray_shadows::{Nth, Region, RunOptions, SchemeChoice, cost};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 #[derive(clap::Args)]
 pub struct RaytraceArgs {
@@ -61,8 +63,9 @@ pub struct RaytraceArgs {
     /// Degrees the camera turns about the scene's centre (around its up axis) per frame.
     #[arg(long, allow_hyphen_values = true)]
     orbit: Option<f32>,
-    /// Render this frame of the turntable in one process.
-    #[arg(long, requires = "orbit", conflicts_with = "frames")]
+    /// Render this frame of the turntable: in one process, or as --tiles N work items. It
+    /// overrides --frames, so that a job's options plus `--frame F` render its frame F alone.
+    #[arg(long, requires = "orbit")]
     frame: Option<u32>,
 }
 
@@ -137,11 +140,12 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         degrees.is_finite(),
         "--orbit {degrees}: not a number of degrees"
     );
+    let frames = match args.frame {
+        Some(_) => None,
+        None => args.frames.clone(),
+    };
     if args.print_nth {
-        let frame = args
-            .frames
-            .as_ref()
-            .map_or(args.frame.unwrap_or(0), |f| f.start);
+        let frame = frames.as_ref().map_or(args.frame.unwrap_or(0), |f| f.start);
         let prep =
             quadray_shadows::prepare(orbit(scene, degrees * frame as f32), SchemeChoice::Hst)
                 .map_err(invalid)?;
@@ -161,9 +165,9 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         check: args.check,
         costs: None,
     };
-    let job = (args.tiles.is_some() || args.frames.is_some()).then(|| WorkItems {
+    let job = (args.tiles.is_some() || frames.is_some()).then(|| WorkItems {
         tiles: args.tiles.unwrap_or(1),
-        frames: args.frames.clone().unwrap_or_else(|| {
+        frames: frames.unwrap_or_else(|| {
             let f = args.frame.unwrap_or(0);
             f..f + 1
         }),
@@ -248,8 +252,25 @@ fn render(
     let bar = ProgressBar::new(tiles).with_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} tiles {elapsed}",
     )?);
+    // Without a terminal (a scheduler's log) the bar is hidden: a line every tenth instead.
+    let (done, start, log) = (AtomicU64::new(0), Instant::now(), bar.is_hidden());
+    let step = || {
+        bar.inc(1);
+        let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+        if log && n * 10 / tiles != (n - 1) * 10 / tiles {
+            eprintln!(
+                "rows {}..{} of {}x{}: {}% ({n}/{tiles} blocks of 16x16) {:.1}s",
+                region.y,
+                region.y + region.height,
+                opts.width,
+                opts.height,
+                n * 100 / tiles,
+                start.elapsed().as_secs_f64()
+            );
+        }
+    };
     let (radiance, report) =
-        quadray_shadows::render_prepared_region(&prep, opts, &costs, region, &|| bar.inc(1));
+        quadray_shadows::render_prepared_region(&prep, opts, &costs, region, &step);
     bar.finish_and_clear();
     let t = &report.times_s;
     println!(

@@ -98,6 +98,26 @@ pub fn parse_frames(text: &str) -> Result<Range<u32>, String> {
     if a < b { Ok(a..b) } else { Err(bad()) }
 }
 
+/// Ascending `indices` as runs, `0-3,7,9-10`: the form of Slurm's `--array` and of a Kubernetes
+/// Indexed Job's `completedIndexes` and `failedIndexes`.
+pub fn index_ranges(indices: &[u64]) -> String {
+    let mut runs: Vec<(u64, u64)> = Vec::new();
+    for &i in indices {
+        match runs.last_mut() {
+            Some((_, end)) if *end + 1 == i => *end = i,
+            _ => runs.push((i, i)),
+        }
+    }
+    let run = |&(a, b): &(u64, u64)| {
+        if a == b {
+            a.to_string()
+        } else {
+            format!("{a}-{b}")
+        }
+    };
+    runs.iter().map(run).collect::<Vec<_>>().join(",")
+}
+
 /// A 64-bit FNV-1a hash of everything written into it: the fingerprint of a scene and its
 /// settings, the same on every machine and build (std's hasher promises neither).
 pub struct Fingerprint(u64);
@@ -202,8 +222,15 @@ pub fn write_exr(
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
     }
+    // Written aside and renamed, so that a work item killed while writing (cancelled, out of
+    // time) leaves no half file that the merge would take for its tile.
+    let mut partial = path.as_os_str().to_owned();
+    partial.push(".part");
+    let partial = PathBuf::from(partial);
     exr.write()
-        .to_file(path)
+        .to_file(&partial)
+        .with_context(|| format!("{}: cannot write the EXR", partial.display()))?;
+    std::fs::rename(&partial, path)
         .with_context(|| format!("{}: cannot write the EXR", path.display()))
 }
 
@@ -384,6 +411,13 @@ mod tests {
             "{e}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn indices_print_as_runs() {
+        assert_eq!(index_ranges(&[]), "");
+        assert_eq!(index_ranges(&[4]), "4");
+        assert_eq!(index_ranges(&[0, 1, 2, 3, 7, 9, 10]), "0-3,7,9-10");
     }
 
     #[test]
