@@ -1,7 +1,7 @@
 //! The `quadray displace` contract other tools rely on: option names, the stats JSON fields, the
 //! heat map beside the output, and clear errors (never a panic) on bad input.
 
-mod common;
+use crate::common;
 
 use common::{assets, quadray_refuses, quadray_writes, read_json, scratch};
 

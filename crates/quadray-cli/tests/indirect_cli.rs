@@ -1,7 +1,7 @@
 //! The `quadray indirect` contract: option names, the stats JSON fields, the pictures and the
 //! error heat map beside the output, and clear errors on bad scenes and parameters.
 
-mod common;
+use crate::common;
 
 use common::{quadray_ok, quadray_refuses, quadray_writes, read_json, scratch};
 

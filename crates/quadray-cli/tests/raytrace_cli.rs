@@ -1,7 +1,7 @@
 //! The `quadray raytrace` contract: option names, the stats JSON fields of issue 4, the demo scene
 //! file from the assets, and clear errors (never a panic) on bad input.
 
-mod common;
+use crate::common;
 
 use common::{assets, quadray_refuses, quadray_writes, read_json, scratch};
 

@@ -2,7 +2,7 @@
 //! in both (as the TOML Cornell box in `quadray indirect`; lit, shadowed, red left and green
 //! right in `quadray raytrace`), and bad scene files are refused with the file named.
 
-mod common;
+use crate::common;
 
 use common::{assets, quadray_ok, quadray_refuses, scratch};
 use std::path::Path;

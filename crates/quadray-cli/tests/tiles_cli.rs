@@ -2,7 +2,7 @@
 //! the variable Kubernetes (Indexed Job) or Slurm (job array) sets, and `quadray merge` must give
 //! back, bit for bit, what one process renders; bad tile sets are refused by name.
 
-mod common;
+use crate::common;
 
 use common::{quadray_ok, quadray_refuses, scratch};
 use std::path::Path;

@@ -5,7 +5,7 @@ use glam::{Mat4, Vec3};
 use quadray_core::mesh::{Mesh, MeshError, load_model};
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 
 use common::{asset, scratch};
 

@@ -6,7 +6,7 @@ use glam::Vec3;
 use quadray_core::scene::{Intensity, SceneDescription, Shape, Transform};
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 
 use common::{asset, scratch};
 

@@ -3,7 +3,7 @@
 //! angle the spec names. The tests print each case's wrong-hit fraction (`--nocapture`) as
 //! BENCHMARKS.md tabulates them.
 
-mod common;
+use crate::common;
 
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::HeightMap;

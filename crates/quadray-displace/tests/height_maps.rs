@@ -1,7 +1,7 @@
 //! Height maps in every supported format load as stored; bad maps and parameters get clear errors
 //! naming the file and the problem.
 
-mod common;
+use crate::common;
 
 use quadray_displace::heightmap::{Convention, Fit, HeightMap, HeightMapError};
 use quadray_displace::{Layers, Method, Settings, Size};

@@ -1,0 +1,12 @@
+//! quadray-cli's integration tests, one module per file, linked as one binary: one test harness to
+//! build instead of one per file. One file's tests:
+//! `cargo test --release -p quadray-cli --test suite -- displace_cli::`.
+
+mod common;
+mod displace_cli;
+mod fuzz_loaders;
+mod headless_cli;
+mod indirect_cli;
+mod raytrace_cli;
+mod scene_cli;
+mod tiles_cli;
