@@ -3,7 +3,7 @@
 //! API schemas kubernetes-validate bundles; the Dockerfile with hadolint; the shell scripts with
 //! shellcheck; and the Indexed Job's pod command, run here, picking a resume's items.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

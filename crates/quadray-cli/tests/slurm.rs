@@ -5,7 +5,7 @@
 //! `submit.sh --resume` must re-run exactly that item. The daemons are stopped however the test
 //! ends.
 
-mod common;
+use crate::common;
 
 use std::fs::File;
 use std::net::TcpListener;

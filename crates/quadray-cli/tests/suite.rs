@@ -3,10 +3,12 @@
 //! `cargo test --release -p quadray-cli --test suite -- displace_cli::`.
 
 mod common;
+mod deploy_files;
 mod displace_cli;
 mod fuzz_loaders;
 mod headless_cli;
 mod indirect_cli;
 mod raytrace_cli;
 mod scene_cli;
+mod slurm;
 mod tiles_cli;

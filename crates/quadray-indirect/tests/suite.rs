@@ -7,5 +7,6 @@ mod counts;
 #[path = "example.rs"]
 mod gi_gbuffer_example;
 mod gpu;
+mod layers;
 mod output;
 mod visibility;
