@@ -6,11 +6,11 @@ use super::contract::{
     bind_group, compute_pipeline, layout, pipeline_layout, shader_module, storage_buffer,
     storage_entry, whole,
 };
-use quadray_core::random::SplitMix;
 use crate::frame::{Receiver, Vpl};
 use crate::reference::brute_force;
 use crate::wgsl;
 use glam::Vec3;
+use quadray_core::random::SplitMix;
 use wgpu::util::DeviceExt;
 
 /// `node_bound`'s inputs (one case), and the entry point that evaluates it per case.
