@@ -1,4 +1,4 @@
-//! The `quadray raytrace` contract: option names, the stats JSON fields of issue 4, the demo scene
+//! The `quadray raytrace` contract: option names, the stats JSON fields the tables read, the demo scene
 //! file from the assets, and clear errors (never a panic) on bad input.
 
 use crate::common;
