@@ -6,7 +6,7 @@ use clap::Args;
 use quadray_bench::indirect::run::{RunOptions, run};
 use quadray_core::write_json;
 use quadray_gpu::Gpu;
-use quadray_indirect::{ClusterSettings, Method, Scene, Settings, TileCriterion, Validity};
+use quadray_indirect::{Method, Scene, Settings};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -17,77 +17,10 @@ pub struct IndirectArgs {
     /// quadtree (compacted cut), quadtree-passes (the paper's per-level passes), quadtree-tiles
     /// (a cut per 8x8 tile, refined where a cluster's bound exceeds --tile-error of the
     /// tile's light), rsm (RSM sampling) or reference (every VPL).
-    #[arg(long, default_value = "quadtree")]
+    #[arg(long, default_value_t = Method::Quadtree)]
     method: Method,
-    /// Side of the reflective shadow map (power of two).
-    #[arg(long, default_value_t = Settings::default().rsm_size)]
-    rsm_size: u32,
-    /// Level where every cluster is accepted (mip level: 0 = the RSM, each level halves the
-    /// side); default: the level of 64x64 nodes.
-    #[arg(long)]
-    limit_level: Option<u32>,
-    /// Level the traversal starts at; default: the level of 8x8 nodes.
-    #[arg(long)]
-    start_level: Option<u32>,
-    /// Max |child depth - mean depth| of a valid cluster (depth in units of the scene's extent).
-    #[arg(long, default_value_t = Settings::default().cluster.depth_threshold)]
-    depth_threshold: f32,
-    /// Min dot(child normal, mean normal) of a valid cluster.
-    #[arg(long, default_value_t = Settings::default().cluster.normal_threshold)]
-    normal_threshold: f32,
-    /// recursive (every child valid too) or local (the paper's).
-    #[arg(long, default_value = "recursive")]
-    validity: Validity,
-    /// Cluster means weighted by texel count instead of flux.
-    #[arg(long)]
-    unweighted_means: bool,
-    /// RSM-sampling samples per pixel.
-    #[arg(long, default_value_t = Settings::default().samples)]
-    samples: u32,
-    /// Indirect at one sample per KxK pixels, upsampled where the geometry agrees (quadtree,
-    /// rsm).
-    #[arg(long, default_value_t = Settings::default().subsample)]
-    subsample: u32,
-    /// Indirect shadows (quadtree methods): march between each receiver and cluster against the
-    /// camera's and the light's depth.
-    #[arg(long)]
-    indirect_shadows: bool,
-    /// Points marched per receiver and cluster with --indirect-shadows.
-    #[arg(long, default_value_t = 8)]
-    shadow_steps: u32,
-    /// Depth behind a seen surface that counts as inside an occluder (fraction of the scene's
-    /// extent), with --indirect-shadows.
-    #[arg(long, default_value_t = Settings::default().shadow_thickness)]
-    shadow_thickness: f32,
-    /// Weight of each frame's indirect light in a running average over frames (1: off), every
-    /// method but the brute force: damps the cut's popping under a moving light. Not
-    /// reprojected: it restarts when the camera moves.
-    #[arg(long, default_value_t = Settings::default().temporal_weight)]
-    temporal_weight: f32,
-    /// quadtree-tiles: split a cluster while a bound of its irradiance at any pixel of the tile
-    /// (or its estimated error, --tile-criterion) exceeds this fraction of the tile's estimated
-    /// irradiance (0: every VPL); default: 0.05 for the bound, 0.002 for the estimate.
-    #[arg(long)]
-    tile_error: Option<f32>,
-    /// quadtree-tiles: what is compared with --tile-error: bound (an upper bound of the
-    /// cluster's irradiance at the tile) or estimate (the estimated error of keeping the
-    /// cluster rather than its children, at a few of the tile's pixels, where the bound is
-    /// over the threshold).
-    #[arg(long, default_value = Settings::default().tile_criterion.name())]
-    tile_criterion: TileCriterion,
-    /// quadtree-tiles: gather a cluster farther from the tile's pixels than this times their
-    /// extent once at each corner of the tile and interpolate it (a receiver hierarchy; 0:
-    /// every pixel evaluates every cluster).
-    #[arg(long, default_value_t = Settings::default().tile_share)]
-    tile_share: f32,
-    /// quadtree-tiles: the most clusters a tile's cut holds (1..1024; past it refinement
-    /// stops, counted as refused_splits); default: 1024, less where the picture's lists would
-    /// take over 32 MiB (256 at 1920x1080).
-    #[arg(long)]
-    tile_capacity: Option<u32>,
-    /// Image size WxH.
-    #[arg(long, default_value = "512x512", value_parser = quadray_core::parse_size)]
-    size: (u32, u32),
+    #[command(flatten)]
+    settings: Settings,
     /// Also render the brute force; adds rmse / rel_l1 to the stats and an error heat map
     /// beside --out.
     #[arg(long)]
@@ -150,38 +83,6 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     scene
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;
-    let defaults = ClusterSettings::defaults(args.rsm_size.max(1));
-    let settings = Settings {
-        width: args.size.0,
-        height: args.size.1,
-        rsm_size: args.rsm_size,
-        cluster: ClusterSettings {
-            start_level: args.start_level.unwrap_or(defaults.start_level),
-            limit_level: args.limit_level.unwrap_or(defaults.limit_level),
-            depth_threshold: args.depth_threshold,
-            normal_threshold: args.normal_threshold,
-            validity: args.validity,
-            flux_weighted: !args.unweighted_means,
-        },
-        samples: args.samples,
-        subsample: args.subsample,
-        shadow_steps: if args.indirect_shadows {
-            args.shadow_steps
-        } else {
-            0
-        },
-        shadow_thickness: args.shadow_thickness,
-        temporal_weight: args.temporal_weight,
-        tile_error: args
-            .tile_error
-            .unwrap_or(args.tile_criterion.default_error()),
-        tile_criterion: args.tile_criterion,
-        tile_share: args.tile_share,
-        tile_capacity: args
-            .tile_capacity
-            .unwrap_or(Settings::tile_capacity_for(args.size.0, args.size.1)),
-        ..Settings::default()
-    };
     if let Some(degrees) = args.light_orbit {
         if !(degrees.is_finite() && degrees.abs() <= 180.0) {
             anyhow::bail!("--light-orbit {degrees} must be a finite angle within [-180, 180]");
@@ -197,7 +98,7 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     let outcome = run(
         &gpu,
         &scene,
-        settings,
+        args.settings,
         &RunOptions {
             method: args.method,
             frames: args.frames,
@@ -276,4 +177,144 @@ pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
         })?;
     bar.finish_and_clear();
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+    use proptest::prelude::*;
+    use quadray_core::settings::{Limits, Size};
+    use quadray_indirect::{ClusterSettings, TileCriterion, Validity};
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: IndirectArgs,
+    }
+
+    fn parsed(settings: &Settings) -> Settings {
+        let mut argv = vec!["indirect".to_string(), "--out=o.png".into()];
+        argv.extend(settings.to_args());
+        Cli::try_parse_from(&argv)
+            .unwrap_or_else(|e| panic!("{argv:?}: {e}"))
+            .args
+            .settings
+    }
+
+    /// Valid settings, every field drawn from its declared limits (levels and capacities left to
+    /// their rules or given).
+    fn valid_settings() -> impl Strategy<Value = Settings> {
+        let f = |l: Limits<f32>, lo: f32, hi: f32| {
+            (lo..=hi).prop_filter("inside the limits", move |v| l.contains(*v))
+        };
+        let u = |l: Limits<u32>| l.min..=l.max;
+        (
+            (
+                (8u32..=512, 8u32..=512),
+                2u32..=10,
+                proptest::option::of(0u32..=10),
+                proptest::option::of(0u32..=10),
+                f(ClusterSettings::DEPTH_THRESHOLD, 0.0, 10.0),
+                f(ClusterSettings::NORMAL_THRESHOLD, -1.0, 1.0),
+                proptest::sample::select(Validity::ALL.to_vec()),
+                any::<bool>(),
+            ),
+            (
+                u(Settings::SAMPLES),
+                f(Settings::RSM_RADIUS, 0.0, 1.0),
+                u(Settings::SUBSAMPLE),
+                any::<bool>(),
+                u(Settings::SHADOW_STEPS),
+                f(Settings::SHADOW_THICKNESS, 0.0, 1.0),
+                f(Settings::TEMPORAL_WEIGHT, 0.0, 1.0),
+            ),
+            (
+                proptest::option::of(f(Settings::TILE_ERROR, 0.0, 1.0)),
+                proptest::sample::select(TileCriterion::ALL.to_vec()),
+                proptest::option::of(u(Settings::TILE_CAPACITY)),
+                f(Settings::TILE_SHARE, 0.0, 1000.0),
+            ),
+        )
+            .prop_map(
+                |(
+                    ((w, h), rsm_log, start, limit, depth, normal, validity, flux_weighted),
+                    (samples, rsm_radius, subsample, shadows, steps, thickness, temporal),
+                    (tile_error, tile_criterion, tile_capacity, tile_share),
+                )| {
+                    // levels within the RSM's, the limit at or below the start (given or not)
+                    let start_level = start.map(|l| l.min(rsm_log));
+                    let start =
+                        start_level.unwrap_or(ClusterSettings::DEFAULT.levels(1 << rsm_log).start);
+                    let limit_level = match (start_level, limit) {
+                        (Some(_), limit) => Some(limit.unwrap_or(0).min(start)),
+                        (None, limit) => limit.map(|l| l.min(start)),
+                    };
+                    Settings {
+                        size: Size::new(w, h),
+                        rsm_size: 1 << rsm_log,
+                        cluster: ClusterSettings {
+                            start_level,
+                            limit_level,
+                            depth_threshold: depth,
+                            normal_threshold: normal,
+                            validity,
+                            flux_weighted,
+                        },
+                        samples,
+                        rsm_radius,
+                        subsample,
+                        indirect_shadows: shadows,
+                        shadow_steps: steps,
+                        shadow_thickness: thickness,
+                        temporal_weight: temporal,
+                        tile_error,
+                        tile_criterion,
+                        tile_capacity,
+                        tile_share,
+                    }
+                },
+            )
+    }
+
+    /// No flags: the library's defaults.
+    #[test]
+    fn the_flags_defaults_are_the_settings_defaults() {
+        let cli = Cli::try_parse_from(["indirect", "--out=o.png"]).unwrap();
+        assert_eq!(cli.args.settings, Settings::DEFAULT);
+        assert_eq!(cli.args.method, Method::Quadtree);
+    }
+
+    /// The flags refuse what `validate()` refuses, with the same limits.
+    #[test]
+    fn the_flags_refuse_values_outside_the_limits() {
+        for (flag, value) in [
+            ("--size", "0x10"),
+            ("--rsm-size", "96"),
+            ("--rsm-size", "2048"),
+            ("--limit-level", "11"),
+            ("--normal-threshold", "1.5"),
+            ("--depth-threshold", "NaN"),
+            ("--samples", "0"),
+            ("--subsample", "65"),
+            ("--shadow-steps", "0"),
+            ("--temporal-weight", "0"),
+            ("--tile-capacity", "2048"),
+            ("--tile-share", "-1"),
+            ("--validity", "global"),
+        ] {
+            let argv = ["indirect", "--out=o.png", flag, value];
+            assert!(Cli::try_parse_from(argv).is_err(), "{flag} {value}");
+        }
+    }
+
+    proptest! {
+        /// The viewer prints `Settings::to_args` beside its screenshots: every valid setting must
+        /// come back through the CLI's flags unchanged.
+        #[test]
+        fn settings_round_trip_through_the_flags(settings in valid_settings()) {
+            prop_assert!(settings.validate().is_ok(), "{settings:?}");
+            prop_assert_eq!(parsed(&settings), settings);
+        }
+    }
 }

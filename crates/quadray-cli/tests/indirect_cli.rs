@@ -154,11 +154,17 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
             vec!["--light-direction", "0,0,0"],
             "light direction is zero",
         ),
-        (vec!["--tile-capacity", "0"], "tile capacity 0"),
-        (vec!["--tile-error=-1"], "tile error -1"),
+        (
+            vec!["--tile-capacity", "0"],
+            "--tile-capacity <TILE_CAPACITY>': 0 is outside",
+        ),
+        (vec!["--tile-error=-1"], "-1 is outside"),
         (vec!["--tile-criterion", "exact"], "tile criterion"),
-        (vec!["--tile-share", "NaN"], "tile share NaN"),
-        (vec!["--tile-share=-2"], "tile share -2"),
+        (vec!["--tile-share", "NaN"], "NaN is outside"),
+        (
+            vec!["--tile-share=-2"],
+            "--tile-share <TILE_SHARE>': -2 is outside",
+        ),
     ];
     for (extra, needle) in cases {
         let mut args = vec![
@@ -262,7 +268,10 @@ fn a_turning_light_gives_the_temporal_figures() {
     assert_eq!(damped["reference_flicker"], t["reference_flicker"]);
     let out = out.to_str().unwrap();
     let zero_weight = ["indirect", "--out", out, "--temporal-weight", "0"];
-    quadray_refuses(&zero_weight, "temporal weight");
+    quadray_refuses(
+        &zero_weight,
+        "--temporal-weight <TEMPORAL_WEIGHT>': 0 is outside",
+    );
     let one_frame = [
         "indirect",
         "--out",

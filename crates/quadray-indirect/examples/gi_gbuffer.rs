@@ -129,7 +129,7 @@ pub fn render(
     queue: &wgpu::Queue,
 ) -> Result<Vec<[f32; 4]>, Box<dyn std::error::Error>> {
     let (scene, s) = (scene(), settings());
-    let size = (s.width, s.height);
+    let size = (s.size.width, s.size.height);
     let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("vertices"),
         contents: bytemuck::cast_slice(&scene.triangles),
@@ -145,7 +145,7 @@ pub fn render(
     let gbuffer = [(); 3].map(|_| view(FLOAT_FORMAT));
     let depth = view(wgpu::TextureFormat::Depth32Float);
     let camera = scene
-        .camera_view_proj(s.width as f32 / s.height as f32)
+        .camera_view_proj(s.size.width as f32 / s.size.height as f32)
         .to_cols_array();
     let eye = scene.camera.position;
     let camera = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -258,7 +258,7 @@ pub fn render(
     // Read the output back (256 pixels of 16 bytes: rows already 256-byte aligned).
     let readback = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
-        size: u64::from(s.width * s.height) * 16,
+        size: u64::from(s.size.width * s.size.height) * 16,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
@@ -268,7 +268,7 @@ pub fn render(
             buffer: &readback,
             layout: wgpu::TexelCopyBufferLayout {
                 offset: 0,
-                bytes_per_row: Some(s.width * 16),
+                bytes_per_row: Some(s.size.width * 16),
                 rows_per_image: None,
             },
         },
@@ -305,7 +305,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples/gi_gbuffer.png");
     std::fs::create_dir_all(path.parent().unwrap())?;
-    to_png(s.width, s.height, &radiance).save(&path)?;
+    to_png(s.size.width, s.size.height, &radiance).save(&path)?;
     println!("{}", path.display());
     Ok(())
 }

@@ -46,5 +46,6 @@ pub use gpu::{
     FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, OutputPass, OutputTerm, Renderer, RsmPass,
     RsmViews, Spot,
 };
+pub use quadray_core::settings::Size;
 pub use scene::Scene;
-pub use settings::{ClusterSettings, Method, Settings, TileCriterion, Validity};
+pub use settings::{ClusterSettings, Levels, Method, Settings, TileCriterion, Validity};

@@ -1,7 +1,15 @@
 //! What a user configures: the sizes, the method and every method's parameters, and the rule
 //! that refuses settings that make no picture. The bottom layer: plain values, no GPU.
+//!
+//! Each parameter is declared once, here: its field, its doc comment (the `--help` text), its
+//! default in [`Settings::DEFAULT`] and its valid values in a [`Limits`] const that both
+//! [`Settings::validate`] and the flag's parser use. With the `cli` feature the struct is
+//! `quadray indirect`'s clap arguments; [`Settings::to_args`] spells them back (the viewer's
+//! reproducing command line), and a round-trip test in the CLI parses them again.
 
+use quadray_core::settings::{Limits, Size};
 use serde::Serialize;
+use std::fmt;
 
 /// Side of a tile of receivers that shares one per-tile cut (the gather's workgroup).
 pub(crate) const TILE: u32 = 8;
@@ -74,6 +82,12 @@ impl std::str::FromStr for Method {
     }
 }
 
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// When a per-tile cut splits a node ([`Settings::tile_criterion`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -91,8 +105,8 @@ impl TileCriterion {
     /// Both criteria, in the order the CLI lists them.
     pub const ALL: [TileCriterion; 2] = [TileCriterion::Bound, TileCriterion::Estimate];
 
-    /// The default [`Settings::tile_error`] of the criterion (see BENCHMARKS.md, "Per-tile
-    /// cuts"): a node's estimated error is far below its bound.
+    /// The [`Settings::tile_error`] of the criterion when none is given (see BENCHMARKS.md,
+    /// "Per-tile cuts"): a node's estimated error is far below its bound.
     pub fn default_error(self) -> f32 {
         match self {
             TileCriterion::Bound => 0.05,
@@ -116,6 +130,12 @@ impl std::str::FromStr for TileCriterion {
     }
 }
 
+impl fmt::Display for TileCriterion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Which clusters count as valid (see the spec).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -126,47 +146,121 @@ pub enum Validity {
     Recursive,
 }
 
+impl Validity {
+    /// Both rules, in the order the CLI lists them.
+    pub const ALL: [Validity; 2] = [Validity::Local, Validity::Recursive];
+
+    /// The rule's name on the command line and in the stats (`--validity`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Validity::Local => "local",
+            Validity::Recursive => "recursive",
+        }
+    }
+}
+
 impl std::str::FromStr for Validity {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "local" => Ok(Validity::Local),
-            "recursive" => Ok(Validity::Recursive),
-            _ => Err(format!("unknown validity rule `{s}` (local, recursive)")),
-        }
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "validity rule")
     }
+}
+
+impl fmt::Display for Validity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The levels a cut spans on a given RSM, its settings' choices or their defaults.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Levels {
+    /// The coarsest level a cluster may be (the cut starts from its nodes).
+    pub start: u32,
+    /// The finest level a cluster may be.
+    pub limit: u32,
 }
 
 /// The light quadtree's parameters. Levels are mip levels: 0 is the RSM itself (one VPL per
 /// node), each level halves the side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct ClusterSettings {
-    /// The coarsest level a cluster may be: the cut starts from this level's nodes.
-    pub start_level: u32,
-    /// The finest level a cluster may be: nodes below it are never visited (0: single VPLs).
-    pub limit_level: u32,
-    /// A node is valid only where each child's depth (along the light's axis, in units of the
-    /// spot's extent) is closer than this to the node's mean.
+    /// Level the cut starts from (mip level: 0 is the RSM, each level halves the side); default:
+    /// the level of 8x8 nodes, as in the paper.
+    #[cfg_attr(feature = "cli", arg(long, value_parser = ClusterSettings::LEVEL.parser()))]
+    pub start_level: Option<u32>,
+    /// Level where every cluster is accepted: nodes below it are never visited (0: single VPLs);
+    /// default: the level of 64x64 nodes.
+    #[cfg_attr(feature = "cli", arg(long, value_parser = ClusterSettings::LEVEL.parser()))]
+    pub limit_level: Option<u32>,
+    /// Max |child depth - mean depth| of a valid cluster (depth along the light's axis, in units
+    /// of the spot's extent).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = ClusterSettings::DEFAULT.depth_threshold,
+        value_parser = ClusterSettings::DEPTH_THRESHOLD.parser(),
+    ))]
     pub depth_threshold: f32,
-    /// A node is valid only where each child's normal has a dot product above this with the
-    /// node's mean normal.
+    /// Min dot(child normal, mean normal) of a valid cluster.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = ClusterSettings::DEFAULT.normal_threshold,
+        value_parser = ClusterSettings::NORMAL_THRESHOLD.parser(),
+        allow_negative_numbers = true,
+    ))]
     pub normal_threshold: f32,
-    /// Which nodes' validity a node's own depends on.
+    /// Which nodes' validity a node's own depends on: recursive (every child valid too) or local
+    /// (the paper's).
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, default_value_t = ClusterSettings::DEFAULT.validity)
+    )]
     pub validity: Validity,
-    /// Means weighted by flux luminance (else by texel count).
+    /// Cluster means weighted by flux luminance (`--unweighted-means`: by texel count).
+    #[cfg_attr(
+        feature = "cli",
+        arg(long = "unweighted-means", action = clap::ArgAction::SetFalse)
+    )]
     pub flux_weighted: bool,
 }
 
 impl ClusterSettings {
-    /// Defaults for a given RSM: the paper's thresholds (depth 0.05, normal 0.9), start at 8x8 as
-    /// in the paper, limit at 64x64 (the paper's level 4; its 32x32 limit leaves about 7% rel. L1
+    /// The defaults: the paper's thresholds (depth 0.05, normal 0.9), start at 8x8 nodes as in
+    /// the paper, limit at 64x64 (the paper's level 4; its 32x32 limit leaves about 7% rel. L1
     /// error on the Cornell box, most of it at the limit level), and the recursive rule: on a
     /// 512^2 RSM the local rule leaves 5.1% with 360 clusters, the recursive 3.8% with 633, less
     /// than the local rule reaches with the same time at a finer limit (4.4% with 589).
-    pub fn defaults(rsm_size: u32) -> Self {
-        Self {
-            validity: Validity::Recursive,
-            ..Self::with_limit_side(rsm_size, 64)
+    pub const DEFAULT: ClusterSettings = ClusterSettings {
+        start_level: None,
+        limit_level: None,
+        depth_threshold: 0.05,
+        normal_threshold: 0.9,
+        validity: Validity::Recursive,
+        flux_weighted: true,
+    };
+
+    /// Nodes across the default start level.
+    pub const DEFAULT_START_NODES: u32 = 8;
+    /// Nodes across the default limit level.
+    pub const DEFAULT_LIMIT_NODES: u32 = 64;
+
+    /// [`ClusterSettings::start_level`] and [`ClusterSettings::limit_level`] (the RSM's own
+    /// levels bound them further in [`Settings::validate`]).
+    pub const LEVEL: Limits<u32> = Limits::closed(0, 10);
+    /// [`ClusterSettings::depth_threshold`].
+    pub const DEPTH_THRESHOLD: Limits<f32> = Limits::closed(0.0, f32::MAX);
+    /// [`ClusterSettings::normal_threshold`].
+    pub const NORMAL_THRESHOLD: Limits<f32> = Limits::closed(-1.0, 1.0);
+
+    /// The levels these settings span on an `rsm_size`^2 RSM: the given ones, else the levels of
+    /// [`Self::DEFAULT_START_NODES`] and [`Self::DEFAULT_LIMIT_NODES`] nodes across.
+    pub fn levels(&self, rsm_size: u32) -> Levels {
+        let top = rsm_size.max(1).ilog2();
+        let of = |nodes: u32| top.saturating_sub(nodes.ilog2());
+        Levels {
+            start: self.start_level.unwrap_or(of(Self::DEFAULT_START_NODES)),
+            limit: self.limit_level.unwrap_or(of(Self::DEFAULT_LIMIT_NODES)),
         }
     }
 
@@ -175,109 +269,210 @@ impl ClusterSettings {
     pub fn with_limit_side(rsm_size: u32, side: u32) -> Self {
         let top = rsm_size.ilog2();
         Self {
-            start_level: top.saturating_sub(3),
-            limit_level: top.saturating_sub(side.max(1).ilog2()),
-            depth_threshold: 0.05,
-            normal_threshold: 0.9,
+            limit_level: Some(top.saturating_sub(side.max(1).ilog2())),
             validity: Validity::Local,
-            flux_weighted: true,
+            ..Self::DEFAULT
         }
     }
 
     /// Every cluster a single VPL: the cut is the whole RSM.
-    pub fn every_vpl(rsm_size: u32) -> Self {
+    pub fn every_vpl() -> Self {
         Self {
-            limit_level: 0,
+            limit_level: Some(0),
             depth_threshold: 0.0,
-            ..Self::defaults(rsm_size)
+            ..Self::DEFAULT
         }
     }
 }
 
+impl Default for ClusterSettings {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// The size check `validate()` and `--size` share.
+fn check_size(size: &Size) -> Result<(), String> {
+    size.check(Settings::SIDE)
+}
+
+/// The RSM-size check `validate()` and `--rsm-size` share: a power of two within
+/// [`Settings::RSM_SIZE`].
+fn check_rsm_size(size: u32) -> Result<u32, String> {
+    if size.is_power_of_two() && Settings::RSM_SIZE.contains(size) {
+        Ok(size)
+    } else {
+        Err(format!(
+            "RSM size {size} must be a power of two in {}",
+            Settings::RSM_SIZE
+        ))
+    }
+}
+
+#[cfg(feature = "cli")]
+fn parse_rsm_size(text: &str) -> Result<u32, String> {
+    check_rsm_size(Settings::RSM_SIZE.parser()(text)?)
+}
+
 /// Sizes and the parameters of every method.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct Settings {
-    /// Picture width in pixels.
-    pub width: u32,
-    /// Picture height in pixels.
-    pub height: u32,
-    /// Side of the square RSM in texels (a power of two): how many VPLs the spot makes.
+    /// Picture size in pixels, WxH.
+    #[serde(flatten)]
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.size,
+        value_parser = quadray_core::settings::checked(check_size),
+    ))]
+    pub size: Size,
+    /// Side of the square reflective shadow map in texels (a power of two): how many VPLs the
+    /// spot makes.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.rsm_size,
+        value_parser = parse_rsm_size,
+    ))]
     pub rsm_size: u32,
     /// The quadtree's parameters, for the quadtree methods.
+    #[cfg_attr(feature = "cli", command(flatten))]
     pub cluster: ClusterSettings,
     /// RSM-sampling samples per pixel.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.samples,
+        value_parser = Settings::SAMPLES.parser(),
+    ))]
     pub samples: u32,
-    /// Sampling radius as a fraction of the RSM's diagonal.
+    /// RSM sampling's radius as a fraction of the RSM's diagonal.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.rsm_radius,
+        value_parser = Settings::RSM_RADIUS.parser(),
+    ))]
     pub rsm_radius: f32,
-    /// Indirect at one sample per `subsample`^2 pixels (1: full resolution), for the methods
-    /// that [`Method::subsamples`]: the low-resolution samples are upsampled where the
-    /// geometry agrees and the other pixels recomputed at full resolution.
+    /// Indirect at one sample per KxK pixels (1: full resolution), upsampled where the geometry
+    /// agrees and the other pixels recomputed at full resolution (quadtree, rsm: the methods
+    /// that [`Method::subsamples`]).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.subsample,
+        value_parser = Settings::SUBSAMPLE.parser(),
+    ))]
     pub subsample: u32,
-    /// Indirect shadows for the quadtree methods: points marched between each receiver and
-    /// cluster, tested against the camera's and the light's depth (0: none, as in the paper).
-    /// The per-tile cuts march from each tile's four corner receivers only, and a pixel weighs
-    /// each cluster by the corners' visibility interpolated (a pixel off the corners' surface,
-    /// across a depth edge, marches its own).
+    /// Indirect shadows (quadtree methods): march points between each receiver and cluster and
+    /// test them against the camera's and the light's depth (off in the paper). The per-tile
+    /// cuts march from each tile's four corner receivers only, and a pixel weighs each cluster
+    /// by the corners' visibility interpolated (a pixel off the corners' surface, across a
+    /// depth edge, marches its own).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub indirect_shadows: bool,
+    /// Points marched per receiver and cluster with --indirect-shadows.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.shadow_steps,
+        value_parser = Settings::SHADOW_STEPS.parser(),
+    ))]
     pub shadow_steps: u32,
-    /// How far behind a surface a depth map sees a marched point counts as inside an occluder,
-    /// as a fraction of the scene's extent.
+    /// Depth behind a seen surface that counts as inside an occluder (a fraction of the scene's
+    /// extent), with --indirect-shadows.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.shadow_thickness,
+        value_parser = Settings::SHADOW_THICKNESS.parser(),
+    ))]
     pub shadow_thickness: f32,
-    /// Weight of this frame's indirect light in a running average over frames (1: no filter),
-    /// for every method but the brute force. Damps the popping of the cut under a moving light
-    /// (see BENCHMARKS.md); the average is not reprojected, so it restarts whenever the camera,
-    /// the method or the cluster settings change.
+    /// Weight of each frame's indirect light in a running average over frames (1: off), every
+    /// method but the brute force: damps the cut's popping under a moving light (see
+    /// BENCHMARKS.md). Not reprojected: it restarts when the camera, the method or the cluster
+    /// settings change.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.temporal_weight,
+        value_parser = Settings::TEMPORAL_WEIGHT.parser(),
+    ))]
     pub temporal_weight: f32,
-    /// Per-tile cuts ([`Method::QuadtreeTiles`]): a node is split while an upper bound of its
-    /// irradiance at any pixel of the tile exceeds this fraction of the tile's estimated
-    /// irradiance (0: every VPL on its own), or while its estimated error does
-    /// ([`Settings::tile_criterion`]).
-    pub tile_error: f32,
-    /// Per-tile cuts: what is compared with [`Settings::tile_error`] of the tile's irradiance.
+    /// quadtree-tiles: split a cluster while a bound of its irradiance at any pixel of the tile
+    /// (or its estimated error, --tile-criterion) exceeds this fraction of the tile's estimated
+    /// irradiance (0: every VPL); default: [`TileCriterion::default_error`], 0.05 for the bound
+    /// and 0.002 for the estimate.
+    #[cfg_attr(feature = "cli", arg(long, value_parser = Settings::TILE_ERROR.parser()))]
+    pub tile_error: Option<f32>,
+    /// quadtree-tiles: what is compared with --tile-error: bound (an upper bound of the
+    /// cluster's irradiance at the tile) or estimate (the estimated error of keeping the
+    /// cluster rather than its children, the largest |E(node) - sum of E(children)| at a few of
+    /// the tile's pixels, where the bound is over the threshold).
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, default_value_t = Settings::DEFAULT.tile_criterion)
+    )]
     pub tile_criterion: TileCriterion,
-    /// Per-tile cuts: the most nodes a tile's cut may hold (1..=1024); past it refinement stops
-    /// (counted in [`crate::WorkCounts::refused_splits`]). The lists take 4 bytes a node and tile of
-    /// GPU memory, allocated by a [`crate::Gather`]'s first frame of [`Method::QuadtreeTiles`], at most
-    /// [`Self::MAX_TILE_LIST_BYTES`] ([`Self::tile_capacity_for`] keeps the default within
-    /// [`Self::DEFAULT_TILE_LIST_BYTES`]).
-    pub tile_capacity: u32,
-    /// Per-tile cuts: a node of a tile's cut farther from the tile's receivers than this times
-    /// their box's diagonal (and in front of the tile's corner receivers) is evaluated once at
-    /// each corner of the tile, as vector irradiance, and interpolated bilinearly to its pixels
-    /// (a receiver hierarchy, as in Multidimensional Lightcuts); pixels off the corners'
-    /// surface evaluate it themselves. 0: every pixel evaluates every node.
+    /// quadtree-tiles: the most clusters a tile's cut holds; past it refinement stops (counted
+    /// as [`crate::WorkCounts::refused_splits`]). The lists take 4 bytes a node and tile of GPU
+    /// memory, at most [`Self::MAX_TILE_LIST_BYTES`]; default: 1024, less where the picture's
+    /// lists would take over [`Self::DEFAULT_TILE_LIST_BYTES`] (256 at 1920x1080).
+    #[cfg_attr(feature = "cli", arg(long, value_parser = Settings::TILE_CAPACITY.parser()))]
+    pub tile_capacity: Option<u32>,
+    /// quadtree-tiles: gather a cluster farther from the tile's pixels than this times their
+    /// box's diagonal (and in front of the tile's corners) once at each corner of the tile, as
+    /// vector irradiance, and interpolate it (a receiver hierarchy, as in Multidimensional
+    /// Lightcuts; 0: every pixel evaluates every cluster).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.tile_share,
+        value_parser = Settings::TILE_SHARE.parser(),
+    ))]
     pub tile_share: f32,
 }
 
 impl Default for Settings {
     fn default() -> Self {
-        Self::sized(512, 512, 512)
+        Self::DEFAULT
     }
 }
 
 impl Settings {
-    /// The defaults for a `width` x `height` picture lit through an `rsm_size`^2 RSM (the cut's
-    /// limits follow the RSM's size).
-    pub fn sized(width: u32, height: u32, rsm_size: u32) -> Self {
-        Self {
-            width,
-            height,
-            rsm_size,
-            cluster: ClusterSettings::defaults(rsm_size),
-            samples: 256,
-            rsm_radius: 1.0,
-            subsample: 1,
-            shadow_steps: 0,
-            shadow_thickness: 0.1,
-            temporal_weight: 1.0,
-            tile_error: TileCriterion::Bound.default_error(),
-            tile_criterion: TileCriterion::Bound,
-            tile_capacity: Self::tile_capacity_for(width, height),
-            tile_share: 0.0,
-        }
-    }
+    /// Every parameter's default (the flags' defaults too).
+    pub const DEFAULT: Settings = Settings {
+        size: Size::new(512, 512),
+        rsm_size: 512,
+        cluster: ClusterSettings::DEFAULT,
+        samples: 256,
+        rsm_radius: 1.0,
+        subsample: 1,
+        indirect_shadows: false,
+        shadow_steps: 8,
+        shadow_thickness: 0.1,
+        temporal_weight: 1.0,
+        tile_error: None,
+        tile_criterion: TileCriterion::Bound,
+        tile_capacity: None,
+        tile_share: 0.0,
+    };
 
-    /// The largest [`Settings::tile_capacity`], what a tile's frontier holds in workgroup memory.
-    pub const MAX_TILE_CAPACITY: u32 = TILE_FRONTIER;
+    /// Either side of [`Settings::size`].
+    pub const SIDE: Limits<u32> = Limits::closed(1, 8192);
+    /// [`Settings::rsm_size`] (also a power of two): 1024^2 VPLs make a 67 MB quadtree, within
+    /// every adapter's storage-buffer limit.
+    pub const RSM_SIZE: Limits<u32> = Limits::closed(4, 1024);
+    /// [`Settings::samples`].
+    pub const SAMPLES: Limits<u32> = Limits::closed(1, 65536);
+    /// [`Settings::rsm_radius`].
+    pub const RSM_RADIUS: Limits<f32> = Limits::above(0.0, 1.0);
+    /// [`Settings::subsample`].
+    pub const SUBSAMPLE: Limits<u32> = Limits::closed(1, 64);
+    /// [`Settings::shadow_steps`].
+    pub const SHADOW_STEPS: Limits<u32> = Limits::closed(1, 64);
+    /// [`Settings::shadow_thickness`].
+    pub const SHADOW_THICKNESS: Limits<f32> = Limits::above(0.0, 1.0);
+    /// [`Settings::temporal_weight`].
+    pub const TEMPORAL_WEIGHT: Limits<f32> = Limits::above(0.0, 1.0);
+    /// [`Settings::tile_error`].
+    pub const TILE_ERROR: Limits<f32> = Limits::closed(0.0, f32::MAX);
+    /// [`Settings::tile_capacity`]: up to what a tile's frontier holds in workgroup memory.
+    pub const TILE_CAPACITY: Limits<u32> = Limits::closed(1, TILE_FRONTIER);
+    /// [`Settings::tile_share`].
+    pub const TILE_SHARE: Limits<f32> = Limits::closed(0.0, 1000.0);
 
     /// Bytes the per-tile cuts' lists may take, a storage buffer every adapter binds.
     pub const MAX_TILE_LIST_BYTES: u64 = 128 << 20;
@@ -286,47 +481,98 @@ impl Settings {
     /// less of the scene and need fewer clusters (BENCHMARKS.md, "Per-tile cuts").
     pub const DEFAULT_TILE_LIST_BYTES: u64 = 32 << 20;
 
-    /// The default [`Settings::tile_capacity`] of a `width` x `height` picture: the largest
-    /// power of two up to [`Self::MAX_TILE_CAPACITY`] whose lists fit
-    /// [`Self::DEFAULT_TILE_LIST_BYTES`] (1,024 up to 512x512, 256 at 1920x1080).
-    pub fn tile_capacity_for(width: u32, height: u32) -> u32 {
-        Self::tile_capacity_within(width, height, Self::DEFAULT_TILE_LIST_BYTES)
+    /// The defaults for a `width` x `height` picture lit through an `rsm_size`^2 RSM.
+    pub fn sized(width: u32, height: u32, rsm_size: u32) -> Self {
+        Self {
+            size: Size::new(width, height),
+            rsm_size,
+            ..Self::DEFAULT
+        }
     }
 
-    /// The largest power of two up to [`Self::MAX_TILE_CAPACITY`] whose lists for a `width` x
-    /// `height` picture fit `bytes` (at least 1).
-    fn tile_capacity_within(width: u32, height: u32, bytes: u64) -> u32 {
-        let tiles = u64::from(width.div_ceil(TILE)) * u64::from(height.div_ceil(TILE));
+    /// The levels the cut spans ([`ClusterSettings::levels`] on this RSM).
+    pub fn levels(&self) -> Levels {
+        self.cluster.levels(self.rsm_size)
+    }
+
+    /// The per-tile cuts' threshold: [`Settings::tile_error`], else its criterion's default.
+    pub fn tile_error_or_default(&self) -> f32 {
+        self.tile_error
+            .unwrap_or(self.tile_criterion.default_error())
+    }
+
+    /// The per-tile cuts' list capacity: [`Settings::tile_capacity`], else the largest power of
+    /// two up to [`Self::TILE_CAPACITY`]'s maximum whose lists fit
+    /// [`Self::DEFAULT_TILE_LIST_BYTES`] (1,024 up to 512x512, 256 at 1920x1080).
+    pub fn tile_capacity_or_default(&self) -> u32 {
+        self.tile_capacity
+            .unwrap_or_else(|| Self::tile_capacity_within(self.size, Self::DEFAULT_TILE_LIST_BYTES))
+    }
+
+    /// Points marched per receiver and cluster: [`Settings::shadow_steps`] with indirect
+    /// shadows, else 0.
+    pub fn march_steps(&self) -> u32 {
+        if self.indirect_shadows {
+            self.shadow_steps
+        } else {
+            0
+        }
+    }
+
+    /// These settings with every default that depends on another setting written out (the
+    /// levels, the tile threshold and capacity): what the stats record.
+    pub fn resolved(&self) -> Settings {
+        let levels = self.levels();
+        Settings {
+            cluster: ClusterSettings {
+                start_level: Some(levels.start),
+                limit_level: Some(levels.limit),
+                ..self.cluster
+            },
+            tile_error: Some(self.tile_error_or_default()),
+            tile_capacity: Some(self.tile_capacity_or_default()),
+            ..self.clone()
+        }
+    }
+
+    /// The largest power of two up to [`Self::TILE_CAPACITY`]'s maximum whose lists for a
+    /// picture of `size` fit `bytes` (at least 1).
+    fn tile_capacity_within(size: Size, bytes: u64) -> u32 {
+        let tiles = u64::from(size.width.div_ceil(TILE)) * u64::from(size.height.div_ceil(TILE));
         let fits = bytes / 4 / tiles.max(1);
-        let capacity = u64::from(Self::MAX_TILE_CAPACITY).min(fits).max(1);
+        let capacity = u64::from(Self::TILE_CAPACITY.max).min(fits).max(1);
         1 << capacity.ilog2()
     }
 
     /// The low-resolution samples across and down the picture (one per `subsample`^2 pixels).
     pub(crate) fn low_size(&self) -> (u32, u32) {
         (
-            self.width.div_ceil(self.subsample),
-            self.height.div_ceil(self.subsample),
+            self.size.width.div_ceil(self.subsample),
+            self.size.height.div_ceil(self.subsample),
         )
     }
 
     /// Tiles of [`TILE`]^2 pixels across and down the picture (per-tile cuts).
     pub(crate) fn tiles(&self) -> (u32, u32) {
-        (self.width.div_ceil(TILE), self.height.div_ceil(TILE))
+        (
+            self.size.width.div_ceil(TILE),
+            self.size.height.div_ceil(TILE),
+        )
     }
 
     /// Bytes the per-tile cuts' lists take ([`Settings::tile_capacity`] node indices a tile).
     pub(crate) fn tile_list_bytes(&self) -> u64 {
         let (tx, ty) = self.tiles();
-        u64::from(tx) * u64::from(ty) * u64::from(self.tile_capacity) * 4
+        u64::from(tx) * u64::from(ty) * u64::from(self.tile_capacity_or_default()) * 4
     }
 
     /// The level whose nodes make a tile's coarse estimate of its irradiance (per-tile cuts): the
     /// quadtree's start level, or a coarser one where its nodes would outnumber a tile's list.
     pub(crate) fn tile_start_level(&self) -> u32 {
         let top = self.rsm_size.ilog2();
-        (self.cluster.start_level..top)
-            .find(|&level| (self.rsm_size >> level).pow(2) <= self.tile_capacity)
+        let capacity = self.tile_capacity_or_default();
+        (self.levels().start..top)
+            .find(|&level| (self.rsm_size >> level).pow(2) <= capacity)
             .unwrap_or(top)
     }
 
@@ -339,88 +585,172 @@ impl Settings {
     /// Refuses sizes and parameters that would make no picture or an absurd amount of work.
     pub fn validate(&self) -> Result<(), String> {
         let s = self;
-        if !(1..=8192).contains(&s.width) || !(1..=8192).contains(&s.height) {
-            return Err(format!("size {}x{} is outside 1..8192", s.width, s.height));
-        }
-        // 1024^2 VPLs make a 67 MB quadtree, within every adapter's storage-buffer limit
-        if !s.rsm_size.is_power_of_two() || !(4..=1024).contains(&s.rsm_size) {
-            return Err(format!(
-                "RSM size {} must be a power of two in 4..1024",
-                s.rsm_size
-            ));
+        check_size(&s.size)?;
+        check_rsm_size(s.rsm_size)?;
+        let c = &s.cluster;
+        for (what, level) in [
+            ("start level", c.start_level),
+            ("limit level", c.limit_level),
+        ] {
+            if let Some(level) = level {
+                ClusterSettings::LEVEL.check(what, level)?;
+            }
         }
         let top = s.rsm_size.ilog2();
-        let c = &s.cluster;
-        if c.start_level > top || c.limit_level > c.start_level {
+        let levels = s.levels();
+        if levels.start > top || levels.limit > levels.start {
             return Err(format!(
                 "levels must satisfy limit ({}) <= start ({}) <= {top} (the 1x1 level of a {} RSM)",
-                c.limit_level, c.start_level, s.rsm_size
+                levels.limit, levels.start, s.rsm_size
             ));
         }
-        if !(c.depth_threshold.is_finite() && c.depth_threshold >= 0.0) {
-            return Err(format!(
-                "depth threshold {} must be >= 0",
-                c.depth_threshold
-            ));
+        ClusterSettings::DEPTH_THRESHOLD.check("depth threshold", c.depth_threshold)?;
+        ClusterSettings::NORMAL_THRESHOLD.check("normal threshold", c.normal_threshold)?;
+        Self::SAMPLES.check("samples", s.samples)?;
+        Self::RSM_RADIUS.check("RSM radius", s.rsm_radius)?;
+        Self::SUBSAMPLE.check("subsample", s.subsample)?;
+        Self::SHADOW_STEPS.check("shadow steps", s.shadow_steps)?;
+        Self::SHADOW_THICKNESS.check("shadow thickness", s.shadow_thickness)?;
+        Self::TEMPORAL_WEIGHT.check("temporal weight", s.temporal_weight)?;
+        if let Some(error) = s.tile_error {
+            Self::TILE_ERROR.check("tile error", error)?;
         }
-        if !(c.normal_threshold.is_finite() && (-1.0..=1.0).contains(&c.normal_threshold)) {
-            return Err(format!(
-                "normal threshold {} is outside [-1, 1]",
-                c.normal_threshold
-            ));
+        if let Some(capacity) = s.tile_capacity {
+            Self::TILE_CAPACITY.check("tile capacity", capacity)?;
         }
-        if !(1..=65536).contains(&s.samples) {
-            return Err(format!("{} samples is outside 1..65536", s.samples));
-        }
-        if !(s.rsm_radius.is_finite() && s.rsm_radius > 0.0 && s.rsm_radius <= 1.0) {
-            return Err(format!("RSM radius {} is outside (0, 1]", s.rsm_radius));
-        }
-        if !(1..=64).contains(&s.subsample) {
-            return Err(format!("subsample {} is outside 1..64", s.subsample));
-        }
-        if s.shadow_steps > 64 {
-            return Err(format!("{} shadow steps is over 64", s.shadow_steps));
-        }
-        if !(s.shadow_thickness.is_finite()
-            && s.shadow_thickness > 0.0
-            && s.shadow_thickness <= 1.0)
-        {
-            return Err(format!(
-                "shadow thickness {} is outside (0, 1]",
-                s.shadow_thickness
-            ));
-        }
-        if !(s.temporal_weight.is_finite() && s.temporal_weight > 0.0 && s.temporal_weight <= 1.0) {
-            return Err(format!(
-                "temporal weight {} is outside (0, 1]",
-                s.temporal_weight
-            ));
-        }
-        if !(s.tile_error.is_finite() && s.tile_error >= 0.0) {
-            return Err(format!("tile error {} must be >= 0", s.tile_error));
-        }
-        if !(s.tile_share.is_finite() && (0.0..=1000.0).contains(&s.tile_share)) {
-            return Err(format!("tile share {} must be in 0..1000", s.tile_share));
-        }
-        if !(1..=Self::MAX_TILE_CAPACITY).contains(&s.tile_capacity) {
-            return Err(format!(
-                "tile capacity {} is outside 1..{}",
-                s.tile_capacity,
-                Self::MAX_TILE_CAPACITY
-            ));
-        }
+        Self::TILE_SHARE.check("tile share", s.tile_share)?;
         let bytes = s.tile_list_bytes();
         if bytes > Self::MAX_TILE_LIST_BYTES {
             return Err(format!(
-                "per-tile cuts of {} nodes for a {}x{} picture take {} MiB, over {} MiB: lower the tile capacity to {} or less",
-                s.tile_capacity,
-                s.width,
-                s.height,
+                "per-tile cuts of {} nodes for a {} picture take {} MiB, over {} MiB: lower the tile capacity to {} or less",
+                s.tile_capacity_or_default(),
+                s.size,
                 bytes >> 20,
                 Self::MAX_TILE_LIST_BYTES >> 20,
-                Self::tile_capacity_within(s.width, s.height, Self::MAX_TILE_LIST_BYTES),
+                Self::tile_capacity_within(s.size, Self::MAX_TILE_LIST_BYTES),
             ));
         }
         Ok(())
+    }
+
+    /// The `quadray indirect` flags that render these settings (the viewer prints them beside
+    /// its screenshots; the CLI's tests parse them back). Defaults left to their rules stay
+    /// unwritten.
+    pub fn to_args(&self) -> Vec<String> {
+        let s = self;
+        let c = &s.cluster;
+        let mut args: Vec<(&str, String)> = vec![
+            ("--size", s.size.to_string()),
+            ("--rsm-size", s.rsm_size.to_string()),
+            ("--depth-threshold", c.depth_threshold.to_string()),
+            ("--normal-threshold", c.normal_threshold.to_string()),
+            ("--validity", c.validity.to_string()),
+            ("--samples", s.samples.to_string()),
+            ("--rsm-radius", s.rsm_radius.to_string()),
+            ("--subsample", s.subsample.to_string()),
+            ("--shadow-steps", s.shadow_steps.to_string()),
+            ("--shadow-thickness", s.shadow_thickness.to_string()),
+            ("--temporal-weight", s.temporal_weight.to_string()),
+            ("--tile-criterion", s.tile_criterion.to_string()),
+            ("--tile-share", s.tile_share.to_string()),
+        ];
+        let optional = [
+            ("--start-level", c.start_level.map(|l| l.to_string())),
+            ("--limit-level", c.limit_level.map(|l| l.to_string())),
+            ("--tile-error", s.tile_error.map(|e| e.to_string())),
+            ("--tile-capacity", s.tile_capacity.map(|n| n.to_string())),
+        ];
+        args.extend(optional.into_iter().filter_map(|(f, v)| Some((f, v?))));
+        let mut words: Vec<String> = args
+            .into_iter()
+            .flat_map(|(flag, value)| [flag.to_string(), value])
+            .collect();
+        for (on, flag) in [
+            (!c.flux_weighted, "--unweighted-means"),
+            (s.indirect_shadows, "--indirect-shadows"),
+        ] {
+            if on {
+                words.push(flag.into());
+            }
+        }
+        words
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_levels_follow_the_rsm_and_given_ones_are_kept() {
+        let c = ClusterSettings::DEFAULT;
+        assert_eq!(c.levels(512), Levels { start: 6, limit: 3 });
+        assert_eq!(c.levels(64), Levels { start: 3, limit: 0 });
+        let given = ClusterSettings {
+            start_level: Some(4),
+            ..c
+        };
+        assert_eq!(given.levels(512), Levels { start: 4, limit: 3 });
+    }
+
+    #[test]
+    fn resolved_settings_render_the_same_and_write_every_default_out() {
+        let s = Settings::sized(1920, 1080, 256);
+        let r = s.resolved();
+        assert_eq!(
+            (
+                r.levels(),
+                r.tile_error_or_default(),
+                r.tile_capacity_or_default()
+            ),
+            (s.levels(), 0.05, 256)
+        );
+        assert!(r.cluster.start_level.is_some() && r.tile_capacity.is_some());
+    }
+
+    #[test]
+    fn validate_uses_the_declared_limits() {
+        let ok = Settings::DEFAULT;
+        assert!(ok.validate().is_ok());
+        let bad = [
+            Settings {
+                rsm_size: 96,
+                ..ok.clone()
+            },
+            Settings {
+                size: Size::new(0, 4),
+                ..ok.clone()
+            },
+            Settings {
+                cluster: ClusterSettings {
+                    limit_level: Some(7),
+                    ..ClusterSettings::DEFAULT
+                },
+                ..ok.clone()
+            },
+            Settings {
+                cluster: ClusterSettings {
+                    normal_threshold: f32::NAN,
+                    ..ClusterSettings::DEFAULT
+                },
+                ..ok.clone()
+            },
+            Settings {
+                temporal_weight: 0.0,
+                ..ok.clone()
+            },
+            Settings {
+                tile_capacity: Some(2048),
+                ..ok.clone()
+            },
+            Settings {
+                size: Size::new(8192, 8192),
+                tile_capacity: Some(1024),
+                ..ok.clone()
+            },
+        ];
+        for s in bad {
+            assert!(s.validate().is_err(), "{s:?}");
+        }
     }
 }

@@ -8,19 +8,19 @@ use quadray_gpu::Gpu;
 use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
 use quadray_indirect::gpu::Receiver;
 use quadray_indirect::{
-    ClusterSettings, Method, Renderer, Scene, Settings, TileCriterion, Validity, WorkCounts,
+    ClusterSettings, Levels, Method, Renderer, Scene, Settings, Size, TileCriterion, Validity,
+    WorkCounts,
 };
 
 const RSM: u32 = 32;
 
 fn settings() -> Settings {
     Settings {
-        width: 40,
-        height: 32,
+        size: Size::new(40, 32),
         rsm_size: RSM,
         cluster: ClusterSettings {
             validity: Validity::Recursive,
-            ..ClusterSettings::defaults(RSM)
+            ..ClusterSettings::DEFAULT
         },
         samples: 48,
         ..Settings::default()
@@ -35,11 +35,11 @@ fn node_index(level: u32, x: u32, y: u32) -> usize {
 
 /// The top-down cut rule of `cut_rule.wgsl` over the nodes read back, with the node records it
 /// reads: (in the cut, reads).
-fn in_cut(nodes: &[[[f32; 4]; 3]], c: &ClusterSettings, level: u32, x: u32, y: u32) -> (bool, u64) {
+fn in_cut(nodes: &[[[f32; 4]; 3]], c: &Levels, level: u32, x: u32, y: u32) -> (bool, u64) {
     let index = node_index;
     let mut reads = 1;
     let mut accepted = |level: u32, x: u32, y: u32| {
-        if level == c.limit_level {
+        if level == c.limit {
             return true;
         }
         reads += 1;
@@ -47,7 +47,7 @@ fn in_cut(nodes: &[[[f32; 4]; 3]], c: &ClusterSettings, level: u32, x: u32, y: u
     };
     let used = nodes[index(level, x, y)][0][3] >= 0.5
         && accepted(level, x, y)
-        && (level + 1..=c.start_level).all(|a| !accepted(a, x >> (a - level), y >> (a - level)));
+        && (level + 1..=c.start).all(|a| !accepted(a, x >> (a - level), y >> (a - level)));
     (used, reads)
 }
 
@@ -68,7 +68,7 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     let nodes = r.read_nodes().unwrap();
     let vpls = r.read_vpls().unwrap().len() as u64;
     let receivers = r.read_receivers().unwrap();
-    let pixels = u64::from(s.width * s.height);
+    let pixels = u64::from(s.size.width * s.size.height);
     let shaded = receivers.iter().filter(|r| r.is_some()).count() as u64;
     assert!(
         shaded > pixels / 2 && shaded < pixels,
@@ -88,16 +88,16 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     assert_eq!(quadtree, expect(shaded * cut, 3 * pixels + shaded * cut));
 
     // the per-level passes: one dispatch per level; each node's cut test reads records
-    let c = s.cluster;
+    let c = s.levels();
     let mut level_reads = 0;
-    for level in c.limit_level..=c.start_level {
+    for level in c.limit..=c.start {
         let side = RSM >> level;
         for i in 0..side * side {
             let (used, reads) = in_cut(&nodes, &c, level, i % side, i / side);
             level_reads += reads + u64::from(used);
         }
     }
-    let levels = u64::from(c.start_level - c.limit_level + 1);
+    let levels = u64::from(c.start - c.limit + 1);
     let passes = counted(&mut r, Method::QuadtreePasses);
     assert_eq!(
         passes,
@@ -122,7 +122,7 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     // four children and evaluates itself and its non-empty ones at the sample pixels and the
     // receiver nearest it: every split node there, and some of the listed ones (the tile reports
     // how many, checked between the two)
-    let start = c.start_level;
+    let start = c.start;
     let root = RSM.ilog2();
     let lit = |level: u32, x: u32, y: u32| nodes[node_index(level, x, y)][0][3] > 0.5;
     let start_nodes = u64::from((RSM >> start).pow(2));
@@ -143,14 +143,16 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
         let cuts = r.read_tile_cuts().unwrap();
         let estimates = r.read_tile_estimates().unwrap();
         let (mut evaluations, mut fetches, mut bounds) = (0, 3 * pixels, 0);
-        let tiles_x = s.width.div_ceil(8);
+        let tiles_x = s.size.width.div_ceil(8);
         for ((tile, cut), &(estimated, estimate_evaluations)) in
             cuts.iter().enumerate().zip(&estimates)
         {
             let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
             let covered = |lx: u32, ly: u32| {
                 let (x, y) = (tx * 8 + lx, ty * 8 + ly);
-                x < s.width && y < s.height && receivers[(y * s.width + x) as usize].is_some()
+                x < s.size.width
+                    && y < s.size.height
+                    && receivers[(y * s.size.width + x) as usize].is_some()
             };
             let pixels_lit = (0..64).filter(|i| covered(i % 8, i / 8)).count() as u64;
             if pixels_lit == 0 {
@@ -294,11 +296,11 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     )
     .unwrap();
     let frame = sub.render_frame(Method::Quadtree).unwrap();
-    let low_receivers: Vec<&Receiver> = (0..s.height.div_ceil(k))
-        .flat_map(|y| (0..s.width.div_ceil(k)).map(move |x| (x, y)))
+    let low_receivers: Vec<&Receiver> = (0..s.size.height.div_ceil(k))
+        .flat_map(|y| (0..s.size.width.div_ceil(k)).map(move |x| (x, y)))
         .filter_map(|(x, y)| {
             let p = |v: u32, n: u32| (v * k + k / 2).min(n - 1);
-            receivers[(p(y, s.height) * s.width + p(x, s.width)) as usize].as_ref()
+            receivers[(p(y, s.size.height) * s.size.width + p(x, s.size.width)) as usize].as_ref()
         })
         .collect();
     let low_shaded = low_receivers.len() as u64;

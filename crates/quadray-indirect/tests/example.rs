@@ -13,7 +13,7 @@ use quadray_indirect::{Method, Renderer};
 fn gi_gbuffer_example_matches_quadrays_own_render() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     let s = example::settings();
-    let (w, h) = (s.width, s.height);
+    let (w, h) = (s.size.width, s.size.height);
     let radiance = example::render(&gpu.device, &gpu.queue).unwrap();
     let rgb: Vec<[f32; 3]> = radiance.iter().map(|p| [p[0], p[1], p[2]]).collect();
     let picture = tone_map(w, h, &rgb, 1.0);

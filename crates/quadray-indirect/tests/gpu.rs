@@ -6,7 +6,7 @@
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::{self, ImageError, compare};
 use quadray_indirect::{
-    ClusterSettings, CutNode, Method, Renderer, Scene, Settings, TileCriterion, Validity,
+    ClusterSettings, CutNode, Method, Renderer, Scene, Settings, Size, TileCriterion, Validity,
 };
 
 fn settings(rsm_size: u32) -> Settings {
@@ -78,8 +78,7 @@ fn gpu_brute_force_sums_every_vpl_of_the_largest_rsm() {
     let gpu = gpu();
     let scene = Scene::cornell();
     let s = Settings {
-        width: 8,
-        height: 8,
+        size: Size::new(8, 8),
         ..settings(1024)
     };
     let mut r = Renderer::new(&gpu, &scene, s).unwrap();
@@ -90,7 +89,7 @@ fn gpu_brute_force_sums_every_vpl_of_the_largest_rsm() {
     let e = logged_error("GPU vs CPU brute force, 1024^2 RSM", &gpu_image, &cpu_image);
     assert!(e.rel_l1 < 1e-4, "{e:?}");
     // every cluster a single VPL: a cut of a million clusters, and the per-level passes
-    r.set_cluster(ClusterSettings::every_vpl(1024)).unwrap();
+    r.set_cluster(ClusterSettings::every_vpl()).unwrap();
     for method in [Method::Quadtree, Method::QuadtreePasses] {
         let what = format!("{method:?} with every VPL a cluster vs brute force");
         let e = logged_error(&what, &render(&mut r, method), &gpu_image);
@@ -102,13 +101,13 @@ fn gpu_brute_force_sums_every_vpl_of_the_largest_rsm() {
 fn quadtree_with_every_cluster_one_vpl_equals_the_brute_force() {
     let gpu = gpu();
     let mut s = settings(32);
-    s.cluster = ClusterSettings::every_vpl(32);
+    s.cluster = ClusterSettings::every_vpl();
     let mut r = cornell(&gpu, s);
     let brute = render(&mut r, Method::Reference);
     for validity in [Validity::Local, Validity::Recursive] {
         r.set_cluster(ClusterSettings {
             validity,
-            ..ClusterSettings::every_vpl(32)
+            ..ClusterSettings::every_vpl()
         })
         .unwrap();
         let cut = render(&mut r, Method::Quadtree);
@@ -159,10 +158,10 @@ fn the_cut_covers_every_lit_rsm_texel_exactly_once() {
     r.render(Method::Quadtree, true, false).unwrap();
     let cut = r.read_cut().unwrap();
     assert_eq!(cut.len() as u32, r.clusters_in_cut().unwrap());
-    let c = r.settings().cluster;
+    let c = r.settings().levels();
     let mut cover = vec![0u32; (size * size) as usize];
     for &CutNode { level, x, y } in &cut {
-        assert!((c.limit_level..=c.start_level).contains(&level), "{level}");
+        assert!((c.limit..=c.start).contains(&level), "{level}");
         let side = 1 << level;
         for ty in y * side..(y + 1) * side {
             for tx in x * side..(x + 1) * side {
@@ -195,7 +194,7 @@ fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
     let brute = render(&mut r, Method::Reference);
     // the defaults meet the target; the paper's settings (local rule) are faster and coarser
     for (name, cluster, bound) in [
-        ("defaults", ClusterSettings::defaults(size), 0.05),
+        ("defaults", ClusterSettings::DEFAULT, 0.05),
         (
             "local, limit 64^2",
             ClusterSettings::with_limit_side(size, 64),
@@ -264,7 +263,7 @@ fn per_tile_cuts_converge_to_the_brute_force_as_their_error_bound_shrinks() {
             let mut r = cornell(
                 &gpu,
                 Settings {
-                    tile_error,
+                    tile_error: Some(tile_error),
                     tile_criterion,
                     ..settings(32)
                 },
@@ -297,8 +296,8 @@ fn a_full_tile_list_stops_refinement_and_keeps_every_vpl() {
     let mut r = cornell(
         &gpu,
         Settings {
-            tile_error: 0.0,
-            tile_capacity: capacity,
+            tile_error: Some(0.0),
+            tile_capacity: Some(capacity),
             ..settings(32)
         },
     );
@@ -334,7 +333,6 @@ fn per_tile_cuts_at_the_default_error_stay_within_their_measured_error() {
         let mut r = cornell(
             &gpu,
             Settings {
-                tile_error: tile_criterion.default_error(),
                 tile_criterion,
                 ..settings(size)
             },
@@ -343,7 +341,7 @@ fn per_tile_cuts_at_the_default_error_stay_within_their_measured_error() {
         let clusters = check_tile_cuts(&r);
         let what = format!(
             "{tile_criterion:?} {}: {clusters:.1} clusters a tile, {:.1} evaluations a pixel, {} splits refused",
-            r.settings().tile_error,
+            r.settings().tile_error_or_default(),
             frame.counts.vpl_evaluations_per_pixel(),
             frame.counts.refused_splits
         );
@@ -371,7 +369,6 @@ fn shared_far_clusters_are_exact_at_tile_corners_and_cut_evaluations() {
             &gpu,
             Settings {
                 tile_criterion: TileCriterion::Estimate,
-                tile_error: TileCriterion::Estimate.default_error(),
                 tile_share,
                 ..sized()
             },
@@ -475,21 +472,21 @@ fn absurd_settings_are_refused() {
         },
         Settings {
             cluster: ClusterSettings {
-                limit_level: 4,
-                start_level: 2,
-                ..ClusterSettings::defaults(32)
+                limit_level: Some(4),
+                start_level: Some(2),
+                ..ClusterSettings::DEFAULT
             },
             ..settings(32)
         },
         Settings {
             cluster: ClusterSettings {
                 depth_threshold: f32::NAN,
-                ..ClusterSettings::defaults(32)
+                ..ClusterSettings::DEFAULT
             },
             ..settings(32)
         },
         Settings {
-            width: 0,
+            size: Size::new(0, 32),
             ..settings(32)
         },
         Settings {
@@ -501,15 +498,15 @@ fn absurd_settings_are_refused() {
             ..settings(32)
         },
         Settings {
-            tile_error: -0.1,
+            tile_error: Some(-0.1),
             ..settings(32)
         },
         Settings {
-            tile_capacity: 2048,
+            tile_capacity: Some(2048),
             ..settings(32)
         },
         Settings {
-            tile_capacity: 1024,
+            tile_capacity: Some(1024),
             ..Settings::sized(4096, 4096, 32)
         },
     ] {
@@ -587,7 +584,7 @@ fn quadtree_nodes_match_a_cpu_rebuild() {
     for validity in [Validity::Local, Validity::Recursive] {
         let cluster = ClusterSettings {
             validity,
-            ..ClusterSettings::defaults(size)
+            ..ClusterSettings::DEFAULT
         };
         r.set_cluster(cluster).unwrap();
         r.render(Method::Quadtree, true, false).unwrap();

@@ -16,13 +16,13 @@ fn written(
     let s = renderer.settings();
     let (d, q) = (&gpu.device, &gpu.queue);
     let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
-    let texture = texture_2d(d, "output", (s.width, s.height), format, usage);
+    let texture = texture_2d(d, "output", (s.size.width, s.size.height), format, usage);
     let pass = OutputPass::new(d, format, OutputTerm::Combined).unwrap();
-    let bytes_per_row = s.width * texel_bytes;
+    let bytes_per_row = s.size.width * texel_bytes;
     assert_eq!(bytes_per_row % wgpu::COPY_BYTES_PER_ROW_ALIGNMENT, 0);
     let buffer = d.create_buffer(&wgpu::BufferDescriptor {
         label: None,
-        size: u64::from(bytes_per_row * s.height),
+        size: u64::from(bytes_per_row * s.size.height),
         usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });

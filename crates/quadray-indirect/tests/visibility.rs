@@ -67,7 +67,7 @@ fn without_and_with_shadows(
 
 fn shadowed(settings: &Settings) -> Settings {
     Settings {
-        shadow_steps: 8,
+        indirect_shadows: true,
         ..settings.clone()
     }
 }
@@ -112,7 +112,6 @@ fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
         // 0.187 -> 0.144)
         let tiled = Settings {
             tile_criterion: TileCriterion::Estimate,
-            tile_error: TileCriterion::Estimate.default_error(),
             tile_share: 2.0,
             ..Settings::sized(96, 96, 32)
         };

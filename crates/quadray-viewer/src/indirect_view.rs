@@ -11,9 +11,7 @@ use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, tone_map};
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
-use quadray_indirect::{
-    ClusterSettings, FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity,
-};
+use quadray_indirect::{FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity};
 use std::path::{Path, PathBuf};
 
 /// What the view shows.
@@ -164,8 +162,7 @@ impl IndirectView {
             renderer: None,
             settings: Settings {
                 rsm_size,
-                cluster: ClusterSettings::defaults(rsm_size),
-                ..Settings::default()
+                ..Settings::DEFAULT
             },
             method,
             show,
@@ -188,11 +185,8 @@ impl IndirectView {
         size: [u32; 2],
         dt: f32,
     ) -> Option<(egui::TextureId, [u32; 2])> {
-        self.settings.width = size[0].clamp(16, 4096);
-        self.settings.height = size[1].clamp(16, 4096);
-        // the per-tile cuts' lists grow with the picture: keep them within their buffer
-        self.settings.tile_capacity =
-            Settings::tile_capacity_for(self.settings.width, self.settings.height);
+        self.settings.size.width = size[0].clamp(16, 4096);
+        self.settings.size.height = size[1].clamp(16, 4096);
         if self.animate_light
             && let Some((_, _, pose)) = &mut self.loaded
         {
@@ -262,8 +256,8 @@ impl IndirectView {
         self.redraw = false;
         self.rebuild = false;
         let (w, h, rsm_size) = (
-            self.settings.width,
-            self.settings.height,
+            self.settings.size.width,
+            self.settings.size.height,
             self.settings.rsm_size,
         );
         let frame = renderer.read_frame()?;
@@ -295,56 +289,24 @@ impl IndirectView {
     pub fn command_line(&self, out: &Path) -> Option<String> {
         let (index, base, pose) = self.loaded.as_ref()?;
         let scene = pose.apply(base, self.animate_light);
-        let s = &self.settings;
-        let c = &s.cluster;
         let v = |p: [f32; 3]| format!("{},{},{}", p[0], p[1], p[2]);
-        let mut cmd = format!(
-            "quadray indirect --scene {} --method {} --rsm-size {} --limit-level {} \
-             --start-level {} --depth-threshold {} --normal-threshold {} --validity {} \
-             --samples {} --subsample {} --size {}x{} --exposure {} --camera-position {} \
-             --camera-target {} --light-position {} --light-direction {} --frames 1",
+        let words = [
+            "quadray indirect --scene".to_string(),
             shell_word(&self.scenes[*index]),
-            self.method.name(),
-            s.rsm_size,
-            c.limit_level,
-            c.start_level,
-            c.depth_threshold,
-            c.normal_threshold,
-            match c.validity {
-                Validity::Local => "local",
-                Validity::Recursive => "recursive",
-            },
-            s.samples,
-            s.subsample,
-            s.width,
-            s.height,
-            self.exposure,
-            v(scene.camera.position),
-            v(scene.camera.target),
-            v(scene.light.position),
-            v(scene.light.direction),
-        );
-        if !c.flux_weighted {
-            cmd += " --unweighted-means";
-        }
-        if self.method == Method::QuadtreeTiles {
-            cmd += &format!(
-                " --tile-criterion {} --tile-error {} --tile-share {}",
-                s.tile_criterion.name(),
-                s.tile_error,
-                s.tile_share
-            );
-        }
-        if s.shadow_steps > 0 {
-            cmd += &format!(
-                " --indirect-shadows --shadow-steps {} --shadow-thickness {}",
-                s.shadow_steps, s.shadow_thickness
-            );
-        }
-        if s.temporal_weight < 1.0 {
-            cmd += &format!(" --temporal-weight {}", s.temporal_weight);
-        }
-        Some(cmd + &format!(" --out {}", shell_word(out)))
+            format!("--method {}", self.method),
+        ]
+        .into_iter()
+        .chain(self.settings.to_args())
+        .chain([
+            format!("--exposure {}", self.exposure),
+            format!("--camera-position {}", v(scene.camera.position)),
+            format!("--camera-target {}", v(scene.camera.target)),
+            format!("--light-position {}", v(scene.light.position)),
+            format!("--light-direction {}", v(scene.light.direction)),
+            "--frames 1 --out".into(),
+            shell_word(out),
+        ]);
+        Some(words.collect::<Vec<_>>().join(" "))
     }
 
     /// Saves the picture shown as a PNG and the command line that reproduces it beside it
@@ -398,17 +360,18 @@ impl IndirectView {
         );
         if 1 << rsm_log != s.rsm_size {
             s.rsm_size = 1 << rsm_log;
-            s.cluster = ClusterSettings {
-                depth_threshold: s.cluster.depth_threshold,
-                normal_threshold: s.cluster.normal_threshold,
-                validity: s.cluster.validity,
-                ..ClusterSettings::defaults(s.rsm_size)
-            };
+            // levels chosen on the old RSM follow the new one's defaults again
+            s.cluster.start_level = None;
+            s.cluster.limit_level = None;
         }
+        let levels = s.levels();
+        let (mut start, mut limit) = (levels.start, levels.limit);
+        ui.add(egui::Slider::new(&mut start, 0..=rsm_log).text("start level"));
+        ui.add(egui::Slider::new(&mut limit, 0..=start).text("limit level"));
         let c = &mut s.cluster;
-        let top = rsm_log;
-        ui.add(egui::Slider::new(&mut c.start_level, 0..=top).text("start level"));
-        ui.add(egui::Slider::new(&mut c.limit_level, 0..=c.start_level).text("limit level"));
+        if (start, limit) != (levels.start, levels.limit) {
+            (c.start_level, c.limit_level) = (Some(start), Some(limit.min(start)));
+        }
         ui.add(
             egui::Slider::new(&mut c.depth_threshold, 0.0..=0.5)
                 .logarithmic(true)
@@ -439,22 +402,24 @@ impl IndirectView {
         );
         if s.tile_criterion != criterion {
             // the two criteria compare different things with the fraction
-            s.tile_error = s.tile_criterion.default_error();
+            s.tile_error = None;
         }
+        let mut tile_error = s.tile_error_or_default();
         ui.add(
-            egui::Slider::new(&mut s.tile_error, 0.0002..=1.0)
+            egui::Slider::new(&mut tile_error, 0.0002..=1.0)
                 .logarithmic(true)
                 .text("tile error (quadtree-tiles)"),
         );
+        if tile_error != s.tile_error_or_default() {
+            s.tile_error = Some(tile_error);
+        }
         ui.add(
             egui::Slider::new(&mut s.tile_share, 0.0..=8.0)
                 .text("shared beyond, tile extents (quadtree-tiles, 0: off)"),
         );
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
-        let mut shadows = s.shadow_steps > 0;
-        ui.checkbox(&mut shadows, "indirect shadows (quadtree)");
-        s.shadow_steps = if shadows { 8 } else { 0 };
+        ui.checkbox(&mut s.indirect_shadows, "indirect shadows (quadtree)");
         let mut temporal = s.temporal_weight < 1.0;
         ui.checkbox(&mut temporal, "temporal filter (moving light)");
         s.temporal_weight = if temporal {
@@ -464,7 +429,8 @@ impl IndirectView {
         };
         ui.checkbox(&mut self.animate_light, "animate light (L)");
         if self.method == Method::Reference {
-            let work = f64::from(s.width) * f64::from(s.height) * f64::from(s.rsm_size).powi(2);
+            let work =
+                f64::from(s.size.width) * f64::from(s.size.height) * f64::from(s.rsm_size).powi(2);
             ui.colored_label(
                 egui::Color32::YELLOW,
                 format!(

@@ -149,9 +149,6 @@ pub fn render_demo(
     Ok(files)
 }
 
-/// Marched points per receiver and cluster for the demo's indirect shadows (the CLI's default).
-const SHADOW_STEPS: u32 = 8;
-
 /// The leak scene's indirect light without and with indirect shadows, beside one bounce from
 /// every VPL with exact visibility (the ground truth on the CPU; a 32^2 RSM keeps it to seconds):
 /// the one cut marching from every pixel, then the per-tile cuts (estimate, far clusters shared)
@@ -161,7 +158,6 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
     let plain = Settings::sized(size, size, 32);
     let tiled = Settings {
         tile_criterion: TileCriterion::Estimate,
-        tile_error: TileCriterion::Estimate.default_error(),
         tile_share: 2.0,
         ..plain.clone()
     };
@@ -169,9 +165,9 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
     let mut r = Renderer::new(gpu, &scene, plain.clone())?;
     r.render_frame(Method::Quadtree)?;
     let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
-    let indirect = |settings: &Settings, method, shadow_steps| {
+    let indirect = |settings: &Settings, method, indirect_shadows| {
         let settings = Settings {
-            shadow_steps,
+            indirect_shadows,
             ..settings.clone()
         };
         Ok::<_, IndirectError>(
@@ -190,8 +186,8 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
     let mut pictures = Vec::new();
     for (name, settings, method) in rows {
         let (leaky, shadowed) = (
-            indirect(settings, method, 0)?,
-            indirect(settings, method, SHADOW_STEPS)?,
+            indirect(settings, method, false)?,
+            indirect(settings, method, true)?,
         );
         pictures.push((format!("{name}, L1 {:.2}", l1(&leaky)), tile(&leaky)));
         pictures.push((format!("shadows, L1 {:.2}", l1(&shadowed)), tile(&shadowed)));

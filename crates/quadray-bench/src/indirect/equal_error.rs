@@ -251,7 +251,7 @@ fn scene_result(
             },
         )?;
         for (label, cluster) in [
-            ("default", ClusterSettings::defaults(base.rsm_size)),
+            ("default", ClusterSettings::DEFAULT),
             ("paper", ClusterSettings::with_limit_side(base.rsm_size, 32)),
         ] {
             progress(&format!("{name}: quadtree {label}, subsample {subsample}"));
@@ -280,7 +280,7 @@ fn scene_result(
             gpu,
             scene,
             Settings {
-                tile_error,
+                tile_error: Some(tile_error),
                 tile_criterion,
                 tile_share,
                 ..base.clone()

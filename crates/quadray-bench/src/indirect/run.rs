@@ -81,14 +81,14 @@ pub struct TruthError {
 
 /// Refuses a ground truth that would trace more than [`reference::MAX_GROUND_TRUTH_RAYS`].
 pub fn check_ground_truth_size(settings: &Settings) -> Result<(), IndirectError> {
-    let rays = u64::from(settings.width)
-        * u64::from(settings.height)
+    let rays = u64::from(settings.size.width)
+        * u64::from(settings.size.height)
         * u64::from(settings.rsm_size).pow(2);
     if rays > reference::MAX_GROUND_TRUTH_RAYS {
         return Err(IndirectError::Settings(format!(
             "the ground truth traces a ray per pixel and VPL: {}x{} pixels x {}^2 VPLs is {rays:.3e} rays, over the limit of {:.3e}; use a smaller --size or --rsm-size",
-            settings.width,
-            settings.height,
+            settings.size.width,
+            settings.size.height,
             settings.rsm_size,
             reference::MAX_GROUND_TRUTH_RAYS as f64,
         )));
@@ -156,8 +156,8 @@ pub fn run(
     } else {
         None
     };
-    let s = renderer.settings().clone();
-    let (w, h) = (s.width, s.height);
+    let s = renderer.settings().resolved();
+    let (w, h) = (s.size.width, s.size.height);
     let combined = frame.combined();
     let error = reference
         .as_ref()

@@ -104,6 +104,6 @@ impl OutputPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &group, &[]);
         let s = gather.settings();
-        dispatch_2d(&mut pass, s.width, s.height);
+        dispatch_2d(&mut pass, s.size.width, s.size.height);
     }
 }

@@ -8,7 +8,7 @@ use super::contract::{
     storage_entry, tex, texture_entry, uniform_buffer, uniform_entry, whole,
 };
 use super::rsm::RsmViews;
-use crate::settings::{ClusterSettings, Validity};
+use crate::settings::{ClusterSettings, Levels, Validity};
 use crate::wgsl;
 use quadray_gpu::GpuTimer;
 
@@ -171,14 +171,15 @@ impl LightQuadtree {
 
     fn write_cluster(&self, queue: &wgpu::Queue) {
         let c = &self.cluster;
+        let levels = self.levels();
         queue.write_buffer(
             &self.params,
             0,
             bytemuck::bytes_of(&ClusterUniform {
                 rsm_size: self.rsm_size,
                 levels: self.rsm_size.ilog2() + 1,
-                start_level: c.start_level,
-                limit_level: c.limit_level,
+                start_level: levels.start,
+                limit_level: levels.limit,
                 recursive: u32::from(c.validity == Validity::Recursive),
                 flux_weighted: u32::from(c.flux_weighted),
                 depth_threshold: c.depth_threshold,
@@ -224,9 +225,9 @@ impl LightQuadtree {
     /// levels limit..start, atomic append.
     pub fn record_cut(&self, encoder: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         encoder.clear_buffer(&self.cut_count, 0, None);
-        let c = &self.cluster;
-        let nodes = level_offset(self.rsm_size, c.start_level + 1)
-            - level_offset(self.rsm_size, c.limit_level);
+        let levels = self.levels();
+        let nodes = level_offset(self.rsm_size, levels.start + 1)
+            - level_offset(self.rsm_size, levels.limit);
         let stamps = timer.and_then(|(t, slot)| t.compute_pass(slot));
         let mut pass = compute_pass(encoder, "cut", stamps);
         pass.set_pipeline(&self.select_cut);
@@ -243,6 +244,11 @@ impl LightQuadtree {
     /// The parameters the next cut is made with.
     pub fn cluster(&self) -> ClusterSettings {
         self.cluster
+    }
+
+    /// The levels the cut spans ([`ClusterSettings::levels`] on this quadtree's RSM).
+    pub fn levels(&self) -> Levels {
+        self.cluster.levels(self.rsm_size)
     }
 
     pub(crate) fn params(&self) -> &wgpu::Buffer {

@@ -39,7 +39,7 @@ impl<'g> Renderer<'g> {
             let rsm = RsmPass::new(d, settings.rsm_size);
             let quadtree =
                 LightQuadtree::new(d, q, settings.rsm_size, settings.cluster, rsm.views());
-            let gbuffer = GBufferPass::new(d, (settings.width, settings.height));
+            let gbuffer = GBufferPass::new(d, (settings.size.width, settings.size.height));
             let gather = Gather::new(d, &settings, &quadtree, rsm.views(), gbuffer.views())?;
             let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("vertices"),
@@ -75,7 +75,7 @@ impl<'g> Renderer<'g> {
         self.rsm.set_light(q, &spot);
         self.gather.set_light(q, &spot, scene.r_min);
         let s = self.settings();
-        let view_proj = scene.camera_view_proj(s.width as f32 / s.height as f32);
+        let view_proj = scene.camera_view_proj(s.size.width as f32 / s.size.height as f32);
         let eye = scene.camera.position.into();
         self.gbuffer.set_camera(q, view_proj, eye);
         self.gather.set_camera(q, view_proj, eye);
@@ -267,8 +267,8 @@ impl<'g> Renderer<'g> {
                 bound_evaluations: counts.iter().map(|c| u64::from(c[2])).sum(),
                 refused_splits: counts.iter().map(|c| u64::from(c[3])).sum(),
             },
-            width: s.width,
-            height: s.height,
+            width: s.size.width,
+            height: s.size.height,
             recomputed: indirect.iter().filter(|p| p[3] > 0.5).count() as u32,
             indirect: rgb(indirect),
             direct: rgb(direct),
@@ -298,7 +298,7 @@ impl<'g> Renderer<'g> {
     /// before the first such frame.
     pub fn read_tile_cuts(&self) -> Result<Vec<Vec<CutNode>>, IndirectError> {
         let s = self.settings();
-        let capacity = s.tile_capacity as usize;
+        let capacity = s.tile_capacity_or_default() as usize;
         let Some((sizes, lists)) = self.read_tile_lists()? else {
             return Ok(Vec::new());
         };

@@ -35,7 +35,7 @@ impl Cut {
     /// Dispatches the sum over `quadtree`'s cut takes: a cut partitions the RSM into nodes no
     /// finer than the limit level.
     pub fn slices(quadtree: &LightQuadtree) -> u32 {
-        let finest = quadtree.rsm_size() >> quadtree.cluster().limit_level;
+        let finest = quadtree.rsm_size() >> quadtree.levels().limit;
         slices(u64::from(finest).pow(2), SLICE)
     }
 

@@ -69,7 +69,7 @@ pub struct Gather {
 
 impl Gather {
     /// The gather of `settings` (sizes, samples, subsampling) reading `quadtree`, the RSM it was
-    /// built from and the caller's G-buffer (`settings.width` x `settings.height`).
+    /// built from and the caller's G-buffer (`settings.size`).
     pub fn new(
         device: &wgpu::Device,
         settings: &Settings,

@@ -33,8 +33,8 @@ impl Passes {
     /// Records one pass per level, coarsest first, each in level slices.
     pub fn record(&self, pass: &mut wgpu::ComputePass, res: &Resources, quadtree: &LightQuadtree) {
         pass.set_pipeline(&self.pipeline);
-        let c = quadtree.cluster();
-        for level in (c.limit_level..=c.start_level).rev() {
+        let levels = quadtree.levels();
+        for level in (levels.limit..=levels.start).rev() {
             let nodes = u64::from(quadtree.rsm_size() >> level).pow(2);
             res.sliced(pass, level, slices(nodes, LEVEL_SLICE), res.size());
         }

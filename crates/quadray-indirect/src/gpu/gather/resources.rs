@@ -44,10 +44,10 @@ fn shade_uniform(s: &Settings) -> ShadeUniform {
         low_width,
         low_height,
         normal_agreement: 0.9,
-        shadow_steps: s.shadow_steps,
+        shadow_steps: s.march_steps(),
         temporal_weight: s.temporal_weight,
-        tile_error: s.tile_error,
-        tile_capacity: s.tile_capacity,
+        tile_error: s.tile_error_or_default(),
+        tile_capacity: s.tile_capacity_or_default(),
         tile_start: s.tile_start_level(),
         tiles_x: s.tiles().0,
         tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
@@ -76,7 +76,7 @@ pub(crate) struct Outputs {
 
 impl Outputs {
     fn new(device: &wgpu::Device, s: &Settings) -> Self {
-        let pixels = u64::from(s.width) * u64::from(s.height);
+        let pixels = u64::from(s.size.width) * u64::from(s.size.height);
         let (lw, lh) = s.low_size();
         let samples = baselines::rsm_samples(
             s.samples,
@@ -96,7 +96,7 @@ impl Outputs {
                 contents: bytemuck::bytes_of(&camera_uniform(
                     glam::Mat4::IDENTITY,
                     glam::Vec3::ZERO,
-                    (s.width, s.height),
+                    (s.size.width, s.size.height),
                 )),
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             }),
@@ -276,7 +276,7 @@ impl Resources {
     /// Writes the camera the G-buffer is rendered from.
     pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
         let s = &self.settings;
-        let camera = camera_uniform(view_proj, eye, (s.width, s.height));
+        let camera = camera_uniform(view_proj, eye, (s.size.width, s.size.height));
         queue.write_buffer(&self.outputs.camera, 0, bytemuck::bytes_of(&camera));
     }
 
@@ -335,7 +335,7 @@ impl Resources {
 
     /// The picture's size in pixels.
     pub fn size(&self) -> (u32, u32) {
-        (self.settings.width, self.settings.height)
+        (self.settings.size.width, self.settings.size.height)
     }
 }
 
