@@ -88,7 +88,7 @@ impl State {
         args: &Args,
         start: (Vec<MapChoice>, usize, Settings),
     ) -> Result<Self> {
-        let (w, h) = args.view_size;
+        let (w, h) = (args.displace.size.width, args.displace.size.height);
         let attributes = Window::default_attributes()
             .with_title("quadray")
             .with_inner_size(winit::dpi::LogicalSize::new(
@@ -239,7 +239,7 @@ impl State {
                 let points = ui.available_size();
                 let ppp = ui.ctx().pixels_per_point();
                 let pixels = if scripted {
-                    [args.view_size.0, args.view_size.1]
+                    [args.displace.size.width, args.displace.size.height]
                 } else {
                     [(points.x * ppp) as u32, (points.y * ppp) as u32]
                 };

@@ -9,9 +9,9 @@ mod indirect_view;
 use anyhow::{Context, Result};
 use clap::Parser;
 use displace_view::MapChoice;
+use quadray_displace::Settings;
 use quadray_displace::heightmap::Convention;
 use quadray_displace::scene::SurfaceKind;
-use quadray_displace::{Method, Settings};
 use std::path::{Path, PathBuf};
 
 /// The path without `..`, so the screenshot's command line works from any directory.
@@ -51,17 +51,10 @@ pub struct Args {
     bundled: String,
     #[arg(long)]
     surface: Option<SurfaceKind>,
-    #[arg(long, default_value = "pyramid")]
-    method: Method,
-    /// Starting camera: view angle, azimuth (degrees) and zoom.
-    #[arg(long, default_value_t = 60.0)]
-    view_angle: f32,
-    #[arg(long, default_value_t = 30.0)]
-    azimuth: f32,
-    #[arg(long, default_value_t = 1.0)]
-    zoom: f32,
-    #[arg(long)]
-    shadows: bool,
+    /// Displacement: the starting settings, `quadray displace`'s flags (`--size` is the 3-D
+    /// view's size in a scripted run; the window's otherwise).
+    #[command(flatten)]
+    displace: Settings,
     /// An indirect-light scene file of your own (shown beside the bundled ones).
     #[arg(long)]
     scene: Option<PathBuf>,
@@ -83,9 +76,6 @@ pub struct Args {
     /// Where P (or a scripted run) saves the frame; the command line goes beside it (.txt).
     #[arg(long, default_value = "quadray-view.png")]
     screenshot: PathBuf,
-    /// Size of the 3-D view in a scripted run (the window fits it and the panel).
-    #[arg(long, default_value = "512x384", value_parser = quadray_core::parse_size)]
-    view_size: (u32, u32),
 }
 
 fn main() -> Result<()> {
@@ -108,14 +98,7 @@ fn main() -> Result<()> {
         });
         start = maps.len() - 1;
     }
-    let settings = Settings {
-        method: args.method,
-        view_angle_deg: args.view_angle,
-        azimuth_deg: args.azimuth,
-        zoom: args.zoom,
-        shadows: args.shadows,
-        ..Settings::default()
-    };
+    let settings = args.displace.clone();
     settings.validate().map_err(anyhow::Error::msg)?;
     app::run(args, maps, start, settings)
 }

@@ -167,12 +167,7 @@ fn screenshot_matches_replay(
     let _ = std::fs::remove_file(shot);
     let view_size = format!("{}x{}", size.0, size.1);
     let mut args: Vec<&str> = args.split_whitespace().collect();
-    args.extend([
-        "--view-size",
-        &view_size,
-        "--screenshot",
-        shot.to_str().unwrap(),
-    ]);
+    args.extend(["--size", &view_size, "--screenshot", shot.to_str().unwrap()]);
     run_on(&x.display, program, &args, Duration::from_secs(300));
     assert_screenshot(shot, size);
     let command = replay(&shot.with_extension("txt"));
