@@ -4,6 +4,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use quadray_bench::indirect::run::{RunOptions, run};
+use quadray_core::image_out::EXPOSURE;
 use quadray_core::write_json;
 use quadray_gpu::Gpu;
 use quadray_indirect::{Method, Scene, Settings};
@@ -37,8 +38,9 @@ pub struct IndirectArgs {
     /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio} to the stats.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     light_orbit: Option<f32>,
-    /// Radiance scale before tone mapping.
-    #[arg(long, default_value_t = 1.0)]
+    /// Radiance scale before tone mapping (a picture that comes out nearly black or white says
+    /// which exposure would show it).
+    #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser())]
     exposure: f32,
     /// Camera position X,Y,Z instead of the scene file's.
     #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
@@ -91,9 +93,6 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             anyhow::bail!("--light-orbit needs --frames 2 or more (a sequence)");
         }
     }
-    if !(args.exposure.is_finite() && args.exposure > 0.0) {
-        anyhow::bail!("--exposure {} must be positive", args.exposure);
-    }
     let gpu = Gpu::new()?;
     let outcome = run(
         &gpu,
@@ -109,6 +108,9 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         },
     )
     .context("rendering")?;
+    if let Some(advice) = &outcome.exposure_advice {
+        tracing::warn!("{}: {advice}", args.out.display());
+    }
     outcome.combined.save_png(&args.out)?;
     outcome.direct.save_png(&beside(&args.out, "direct"))?;
     outcome.indirect.save_png(&beside(&args.out, "indirect"))?;

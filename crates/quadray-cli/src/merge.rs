@@ -56,7 +56,7 @@ pub fn run(args: MergeArgs) -> anyhow::Result<()> {
         if exr {
             tiles::write_exr(&out, &picture, first.image, None)?;
         } else {
-            picture.to_rgba8().save_png(&out)?;
+            picture.to_rgba8(1.0).save_png(&out)?;
         }
         println!("{}", out.display());
     }

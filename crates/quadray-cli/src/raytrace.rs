@@ -3,6 +3,7 @@
 use crate::tiles::{self, Fingerprint, TileHeader, WorkItems};
 use anyhow::{Context, bail, ensure};
 use indicatif::{ProgressBar, ProgressStyle};
+use quadray_core::image_out::{EXPOSURE, check_exposure};
 use quadray_shadows::scene::{BUILTINS, Scene};
 use quadray_shadows::{Nth, Region, RunOptions, SchemeChoice, cost};
 use std::ops::Range;
@@ -37,6 +38,9 @@ pub struct RaytraceArgs {
     /// the work item's tile goes to (frameFFFF-tileTTTT.exr, its stats beside it).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Radiance scale before the PNG's clamp and gamma (an EXR keeps the radiance as is).
+    #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser())]
+    exposure: f32,
     /// Statistics JSON (times, sub-schemes, N_th, p, alpha, ...).
     #[arg(long)]
     stats: Option<PathBuf>,
@@ -114,6 +118,9 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         })?,
         _ => bail!("give --scene PATH or --builtin NAME"),
     };
+    if let Some(advice) = scene.lighting_advice() {
+        tracing::warn!("{}: {advice}", scene.name);
+    }
     let source = match &args.scene {
         Some(path) => path.display().to_string(),
         None => format!("builtin scene {:?}", scene.name),
@@ -182,7 +189,11 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         if is_exr(&out) {
             tiles::write_exr(&out, &radiance, (width, height), None)?;
         } else {
-            radiance.to_rgba8().save_png(&out)?;
+            radiance.to_rgba8(args.exposure).save_png(&out)?;
+            // the clamp shows radiance 1 as white
+            if let Some(advice) = check_exposure(&radiance.pixels, args.exposure, 1.0) {
+                tracing::warn!("{}: {advice}", out.display());
+            }
         }
         if let Some(path) = &args.stats {
             quadray_core::write_json(path, &report)?;

@@ -122,3 +122,77 @@ fn bad_scene_files_are_refused_naming_the_file() {
         quadray_refuses(&[&args[..], &[out.to_str().unwrap()]].concat(), needle);
     }
 }
+
+/// The exposure `quadray` suggests in `stderr`'s warning, if it gave one.
+fn suggested_exposure(stderr: &str) -> Option<String> {
+    let (_, rest) = stderr.split_once("try --exposure ")?;
+    Some(rest.split_whitespace().next()?.to_string())
+}
+
+/// A glTF spot of 6 cd (a desk lamp's, where the bundled scene's has 1366): `quadray indirect`
+/// renders it nearly black, says so and names an exposure that shows the picture; `quadray
+/// raytrace` says the ambient term drowns it (which no exposure changes). The bundled scene
+/// draws no warning.
+#[test]
+fn a_dim_gltf_light_is_reported_with_the_exposure_that_shows_it() {
+    let dir = scratch("scene-exposure");
+    let bundled = assets().join("scenes/cornell_spot.gltf");
+    let text = std::fs::read_to_string(&bundled).unwrap();
+    let dim = dir.join("dim.gltf");
+    assert!(text.contains("\"intensity\": 1366.0"));
+    std::fs::write(
+        &dim,
+        text.replace("\"intensity\": 1366.0", "\"intensity\": 6.0"),
+    )
+    .unwrap();
+    let out = dir.join("x.png");
+    let out = out.to_str().unwrap();
+    let indirect = |scene: &Path| {
+        let scene = scene.to_str().unwrap().to_string();
+        [
+            "indirect",
+            "--scene",
+            &scene,
+            "--size",
+            "32x32",
+            "--rsm-size",
+            "16",
+            "--frames",
+            "1",
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let run = |args: &[String], extra: &[&str]| {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        quadray_ok(&[&args[..], extra, &["--out", out]].concat())
+    };
+    assert!(!run(&indirect(&bundled), &[]).contains("WARN"));
+    let stderr = run(&indirect(&dim), &[]);
+    assert!(stderr.contains("nearly black"), "{stderr}");
+    let exposure = suggested_exposure(&stderr).expect("an exposure");
+    let stderr = run(&indirect(&dim), &["--exposure", &exposure]);
+    assert!(
+        suggested_exposure(&stderr).is_none(),
+        "{exposure}: {stderr}"
+    );
+    let lit = rgb(Path::new(out))
+        .as_raw()
+        .iter()
+        .filter(|&&v| v > 128)
+        .count();
+    assert!(lit > 32, "at --exposure {exposure}: {lit} bright values");
+
+    let raytrace = |scene: &Path| {
+        let scene = scene.to_str().unwrap().to_string();
+        ["raytrace", "--scene", &scene, "--size", "32x24"]
+            .map(String::from)
+            .to_vec()
+    };
+    assert!(!run(&raytrace(&bundled), &[]).contains("WARN"));
+    let stderr = run(&raytrace(&dim), &[]);
+    assert!(
+        stderr.contains("weak against the ambient light"),
+        "{stderr}"
+    );
+}

@@ -149,9 +149,94 @@ pub fn montage(tiles: &[(String, Rgba8Image)], columns: usize) -> Rgba8Image {
     out
 }
 
+/// The values an exposure (a radiance scale before tone mapping) may take.
+pub const EXPOSURE: crate::settings::Limits<f32> = crate::settings::Limits::above(0.0, 1e12);
+
+/// A linear picture that its exposure shows nearly black or nearly white, and the exposure that
+/// would show it: photometric lights (a glTF spot's candela) and a scene's scale make radiance
+/// differ by orders of magnitude between scenes, and a black picture alone says nothing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExposureAdvice {
+    /// What is wrong, in words.
+    pub problem: String,
+    /// The exposure that brings the picture's 99th-percentile luminance to 80% of white (none
+    /// where the picture is black everywhere: no exposure shows it).
+    pub suggested: Option<f32>,
+}
+
+impl std::fmt::Display for ExposureAdvice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.suggested {
+            Some(e) => write!(f, "{}: try --exposure {e}", self.problem),
+            None => f.write_str(&self.problem),
+        }
+    }
+}
+
+/// The picture of linear `radiance` at `exposure` judged by its 99th-percentile and median
+/// luminance: nearly black where 99% of the pixels are below 2% of `white` (the exposed value
+/// the tone map shows as white), nearly white where half of them are at or above `white`.
+pub fn check_exposure(radiance: &[[f32; 3]], exposure: f32, white: f32) -> Option<ExposureAdvice> {
+    let mut luminance: Vec<f32> = radiance
+        .iter()
+        .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+        .filter(|l| l.is_finite())
+        .map(|l| l.max(0.0))
+        .collect();
+    if luminance.is_empty() {
+        return None;
+    }
+    luminance.sort_by(f32::total_cmp);
+    let at = |q: f64| luminance[((luminance.len() - 1) as f64 * q).round() as usize];
+    let (p99, median) = (at(0.99), at(0.5));
+    if p99 <= 0.0 {
+        return Some(ExposureAdvice {
+            problem: "the picture is black: no light reaches what the camera sees".into(),
+            suggested: None,
+        });
+    }
+    let problem = if p99 * exposure < 0.02 * white {
+        "the picture is nearly black (99% of its pixels below 2% of white)"
+    } else if median * exposure >= white {
+        "the picture is nearly white (half of its pixels at white)"
+    } else {
+        return None;
+    };
+    let suggested = 0.8 * white / p99;
+    Some(ExposureAdvice {
+        problem: problem.into(),
+        suggested: Some(two_digits(suggested)),
+    })
+}
+
+/// `x` rounded to two significant digits (an exposure a person types).
+fn two_digits(x: f32) -> f32 {
+    format!("{x:.1e}").parse().unwrap_or(x)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn exposure_advice_names_an_exposure_that_shows_the_picture() {
+        // a ramp 0..1e-3: black at exposure 1, right at the suggested one
+        let dim: Vec<[f32; 3]> = (0..1000).map(|i| [i as f32 * 1e-6; 3]).collect();
+        let advice = check_exposure(&dim, 1.0, 1.0).unwrap();
+        assert!(advice.problem.contains("nearly black"), "{advice}");
+        let e = advice.suggested.unwrap();
+        assert_eq!(e, 810.0, "0.8 / 0.000989, two digits");
+        assert!(check_exposure(&dim, e, 1.0).is_none());
+        assert!(advice.to_string().ends_with("try --exposure 810"));
+        // half the pixels saturated
+        let bright: Vec<[f32; 3]> = (0..100).map(|i| [i as f32; 3]).collect();
+        let advice = check_exposure(&bright, 1.0, 2.3).unwrap();
+        assert!(advice.problem.contains("nearly white"), "{advice}");
+        assert!(check_exposure(&bright, advice.suggested.unwrap(), 2.3).is_none());
+        // nothing lit: no exposure helps; NaN pixels are ignored
+        let black = vec![[0.0; 3], [f32::NAN; 3]];
+        assert_eq!(check_exposure(&black, 1.0, 1.0).unwrap().suggested, None);
+    }
 
     #[test]
     fn heat_map_runs_black_to_white_and_marks_missing_data() {

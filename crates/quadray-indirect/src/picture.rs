@@ -4,6 +4,10 @@
 use crate::frame::CutNode;
 use quadray_core::image_out::Rgba8Image;
 
+/// The exposed radiance [`tone_map`] shows as 90% white (1 - e^-2.3): what
+/// [`quadray_core::image_out::check_exposure`] calls white for these pictures.
+pub const TONE_MAP_WHITE: f32 = 2.3;
+
 /// Exposure, then 1 - exp(-x) and the sRGB curve.
 pub fn tone_map(width: u32, height: u32, radiance: &[[f32; 3]], exposure: f32) -> Rgba8Image {
     let encode = |v: f32| {

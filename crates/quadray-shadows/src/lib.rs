@@ -306,7 +306,7 @@ pub fn render_prepared(
 ) -> (Rgba8Image, RunReport) {
     let full = Region::full(opts.width, opts.height);
     let (radiance, report) = render_prepared_region(prep, opts, costs, full, on_tile);
-    (radiance.to_rgba8(), report)
+    (radiance.to_rgba8(1.0), report)
 }
 
 /// [`render_prepared`] of one rectangle of the image, as radiance ([`trace::render_region`]):

@@ -365,6 +365,27 @@ impl Scene {
         Ok(())
     }
 
+    /// Says so where every light delivers less than half the ambient light at the scene's centre
+    /// (a light's intensity is what it delivers there): the picture then shows mostly the
+    /// ambient term, flat, whatever the exposure. A glTF light's intensity is in candela, so a desk
+    /// lamp's few candela in a room-sized scene comes out so.
+    pub fn lighting_advice(&self) -> Option<String> {
+        let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let ambient = luminance(self.ambient);
+        let strongest = self
+            .lights
+            .iter()
+            .map(|l| luminance(l.intensity))
+            .fold(0.0, f32::max);
+        (ambient > 0.0 && strongest < 0.5 * ambient).then(|| {
+            format!(
+                "the lights are weak against the ambient light ({strongest:.2e} at the scene's \
+                 centre against {ambient:.2e}): the picture shows mostly the flat ambient term; \
+                 brighten the lights (glTF intensities are candela) or lower `ambient`"
+            )
+        })
+    }
+
     /// Checks what the tracer relies on: a finite camera looking somewhere with a field of view
     /// in (0, 180) degrees, 1 to [`MAX_LIGHTS`] finite lights, finite materials with an index
     /// of refraction above 0, at least one face.

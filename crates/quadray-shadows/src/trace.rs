@@ -114,13 +114,14 @@ pub struct Radiance {
 }
 
 impl Radiance {
-    /// The displayed picture: clamped to [0, 1], gamma 2.2, rounded to 8 bits.
-    pub fn to_rgba8(&self) -> Rgba8Image {
+    /// The displayed picture: scaled by `exposure`, clamped to [0, 1], gamma 2.2, rounded to 8
+    /// bits.
+    pub fn to_rgba8(&self, exposure: f32) -> Rgba8Image {
         let pixels = self
             .pixels
             .iter()
             .map(|&p| {
-                let c = Vec3::from_array(p)
+                let c = (Vec3::from_array(p) * exposure)
                     .clamp(Vec3::ZERO, Vec3::ONE)
                     .powf(1.0 / 2.2)
                     * 255.0
@@ -146,7 +147,7 @@ pub fn render(
 ) -> (Rgba8Image, RenderStats) {
     let full = Region::full(settings.width, settings.height);
     let (radiance, stats) = render_region(prep, settings, full, on_tile);
-    (radiance.to_rgba8(), stats)
+    (radiance.to_rgba8(1.0), stats)
 }
 
 /// [`render`] of the pixels in `region` alone (inside the `settings.width` x `settings.height`

@@ -3,9 +3,9 @@
 //! the cut, error against the brute force).
 
 use super::temporal::{self, Temporal};
-use quadray_core::image_out::{Rgba8Image, heat_map};
+use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{cut_view, mean_flip, tone_map};
+use quadray_indirect::picture::{TONE_MAP_WHITE, cut_view, mean_flip, tone_map};
 use quadray_indirect::reference::{self, ImageError};
 use quadray_indirect::{
     Frame, FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts,
@@ -117,6 +117,8 @@ pub struct Outcome {
     pub cut_view: Option<Rgba8Image>,
     /// The ground truth's indirect light (with `ground_truth`).
     pub ground_truth: Option<Rgba8Image>,
+    /// The combined picture is nearly black or white at the exposure given: what would show it.
+    pub exposure_advice: Option<ExposureAdvice>,
 }
 
 /// Renders `options.method` on `scene`, times it and measures it.
@@ -166,6 +168,7 @@ pub fn run(
         .as_ref()
         .map(|r| heat_map(w, h, &reference::error_map(&frame.indirect, r), 0.5));
     let combined_image = tone_map(w, h, &combined, options.exposure);
+    let exposure_advice = check_exposure(&combined, options.exposure, TONE_MAP_WHITE);
     let flip = reference
         .as_ref()
         .map(|r| flip_against(&frame, r, &combined_image, options.exposure));
@@ -219,6 +222,7 @@ pub fn run(
         direct: tone_map(w, h, &frame.direct, options.exposure),
         indirect: tone_map(w, h, &frame.indirect, options.exposure),
         combined: combined_image,
+        exposure_advice,
         error_map,
         cut_view: cut,
         ground_truth: truth.map(|t| tone_map(w, h, &t, options.exposure)),

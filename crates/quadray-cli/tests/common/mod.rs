@@ -1,6 +1,4 @@
 //! Running the `quadray` binary from the CLI tests.
-// Each test binary uses its own part of this module.
-#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -18,14 +16,13 @@ fn quadray(args: &[&str]) -> Output {
         .expect("run quadray")
 }
 
-/// Runs `quadray` with `args` and checks that it succeeded.
-pub fn quadray_ok(args: &[&str]) {
+/// Runs `quadray` with `args`, checks that it succeeded and returns what it wrote to stderr
+/// (warnings).
+pub fn quadray_ok(args: &[&str]) -> String {
     let run = quadray(args);
-    assert!(
-        run.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert!(run.status.success(), "{args:?}: {stderr}");
+    stderr
 }
 
 /// Runs `quadray` with `args` and `--out out --stats stats` and checks that it succeeded: the
