@@ -6,6 +6,7 @@ mod common;
 mod deploy_files;
 mod displace_cli;
 mod fuzz_loaders;
+mod gpu_tables;
 mod headless_cli;
 mod indirect_cli;
 mod raytrace_cli;

@@ -1,0 +1,123 @@
+#!/usr/bin/env bash
+# Refreshes the GPU figures of BENCHMARKS.md on this machine's adapter, in one run sized for a
+# lent GPU's 10-minute call: the 1920x1080 displacement frame of every method at 0, 60 and 85
+# degrees (with the CPU ground truth's wrong-hit fraction), each indirect-light pass at 1920x1080
+# with a 512^2 RSM for every method, then, while the time budget lasts, the paper tables of
+# `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
+# name from the adapter, e.g. bench/nvidia-h100/) with every stats file and a summary.md of the
+# tables, and packs it into gpu-tables.tar.gz beside it (a device call returns few files).
+#
+#   scripts/gpu-tables.sh [--quick] [--bin PATH] [--out DIR] [--budget SECONDS]
+#
+# --quick: small frames, for trying the script on a software rasterizer (a minute on lavapipe).
+# --bin: the quadray binary (default target/release/quadray, built if missing).
+# --budget: seconds after which the optional paper tables are skipped (default 540).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+quick=0
+bin=target/release/quadray
+out_root=bench
+budget=540
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --quick) quick=1 ;;
+        --bin) bin=$2; shift ;;
+        --out) out_root=$2; shift ;;
+        --budget) budget=$2; shift ;;
+        *) echo "gpu-tables.sh: unknown option $1" >&2; exit 2 ;;
+    esac
+    shift
+done
+if [ ! -x "$bin" ]; then
+    cargo build --release --bin quadray
+fi
+start=$SECONDS
+left() { echo $((budget - (SECONDS - start))); }
+
+if [ $quick = 1 ]; then
+    size=96x54 rsm=32 frames=3 angles="0 60"
+else
+    size=1920x1080 rsm=512 frames=20 angles="0 60 85"
+fi
+
+# The adapter's name as a folder: "NVIDIA H100 80GB HBM3" -> nvidia-h100-80gb-hbm3.
+probe=$(mktemp -d)
+"$bin" indirect --size 16x16 --rsm-size 16 --frames 1 --out "$probe/p.png" --stats "$probe/p.json" >/dev/null
+adapter=$(sed -n 's/^ *"adapter": "\(.*\)",$/\1/p' "$probe/p.json" | head -1)
+device=$(echo "${adapter%% (*}" | tr '[:upper:]' '[:lower:]' | sed 's/[^a-z0-9]\+/-/g; s/^-//; s/-$//')
+[ $quick = 1 ] && device="$device-quick"
+out="$out_root/$device"
+mkdir -p "$out/displace-1080p" "$out/indirect-1080p"
+printf '%s\n%s\n' "$adapter" "$(date -u +%Y-%m-%dT%H:%MZ)" >"$out/adapter.txt"
+echo "$adapter -> $out"
+
+map=assets/heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png
+for m in pom pyramid pyramid-ascend pyramid-bilinear relief; do
+    for a in $angles; do
+        "$bin" displace --map $map --method $m --layers 1,16 --view-angle "$a" --size $size \
+            --reference --out "$probe/d.png" --stats "$out/displace-1080p/$m-$a.json" >/dev/null
+    done
+done
+"$bin" displace --map $map --method pyramid --lod auto --view-angle 60 --size $size --reference \
+    --out "$probe/d.png" --stats "$out/displace-1080p/pyramid-lodauto-60.json" >/dev/null
+
+for m in quadtree quadtree-passes quadtree-tiles rsm; do
+    "$bin" indirect --method $m --size $size --rsm-size $rsm --frames $frames \
+        --out "$probe/i.png" --stats "$out/indirect-1080p/$m.json" >/dev/null
+done
+"$bin" indirect --method quadtree --indirect-shadows --size $size --rsm-size $rsm \
+    --frames $frames --out "$probe/i.png" --stats "$out/indirect-1080p/quadtree-shadows.json" >/dev/null
+
+# The paper tables, each only if the budget still holds it.
+paper() {
+    local name=$1 need=$2
+    shift 2
+    if [ "$(left)" -gt "$need" ]; then
+        timeout "$(left)" "$bin" bench "$@" >"$out/$name.log" 2>&1 || echo "$name: stopped" >>"$out/skipped.txt"
+    else
+        echo "$name: skipped, $(left) s of the budget left" >>"$out/skipped.txt"
+    fi
+}
+if [ $quick = 1 ]; then
+    paper bench-indirect 30 indirect --quick --rsm-size 64 --out "$out/bench-indirect"
+else
+    paper bench-displace 240 displace --out "$out/bench-displace"
+    paper bench-indirect 120 indirect --rsm-size 512 --out "$out/bench-indirect"
+fi
+
+# (the summary needs python3; the stats files alone hold every figure)
+python3 - "$out" <<'EOF' || echo "no summary.md: python3 failed or is missing" >&2
+import json, pathlib, sys
+out = pathlib.Path(sys.argv[1])
+adapter, date = (out / "adapter.txt").read_text().split("\n")[:2]
+lines = [f"# GPU tables on {adapter}, {date}", ""]
+lines += ["## Displacement frame", "",
+          "| method | view angle | GPU ms | wrong-hit fraction | mean iterations | max iterations | cap hits |",
+          "|---|---|---|---|---|---|---|"]
+for f in sorted((out / "displace-1080p").glob("*.json")):
+    s = json.loads(f.read_text())
+    method = s["method"] + (" (lod auto)" if "lodauto" in f.name else "")
+    wrong = f"{s['wrong_hit_fraction']:.6f}" if "wrong_hit_fraction" in s else "-"
+    lines.append(f"| {method} | {s['view_angle_deg']:g} | {s['gpu_time_ms']:.3f} | {wrong} | "
+                 f"{s['mean_iterations']:.1f} | {s['max_iterations']} | {s['iteration_cap_hits']} |")
+lines += ["", "## Indirect light, per pass (GPU ms, median)", "",
+          "| run | G-buffer | direct | indirect | static frame | moving-light frame | VPL evaluations / pixel |",
+          "|---|---|---|---|---|---|---|"]
+for f in sorted((out / "indirect-1080p").glob("*.json")):
+    s = json.loads(f.read_text())
+    still, moving = s["gpu_time_ms_static"] or {}, s["gpu_time_ms_moving"] or {}
+    p = still.get("passes", {})
+    cell = lambda v: f"{v:.3f}" if isinstance(v, (int, float)) else "-"
+    lines.append(f"| {f.stem} | {cell(p.get('gbuffer'))} | {cell(p.get('direct'))} | "
+                 f"{cell(p.get('indirect'))} | {cell(still.get('total_ms'))} | "
+                 f"{cell(moving.get('total_ms'))} | {s['vpl_evaluations_per_pixel']:.1f} |")
+skipped = out / "skipped.txt"
+if skipped.exists():
+    lines += ["", "Skipped: " + "; ".join(skipped.read_text().split("\n")).strip("; ")]
+(out / "summary.md").write_text("\n".join(lines) + "\n")
+print("\n".join(lines))
+EOF
+tar -czf "$out_root/gpu-tables.tar.gz" -C "$out_root" "$device"
+rm -rf "$probe"
+echo "wrote $out and $out_root/gpu-tables.tar.gz in $((SECONDS - start)) s"
