@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::{quadray_ok, quadray_refuses, quadray_writes, read_json, scratch};
+use common::{assets, quadray_ok, quadray_refuses, quadray_writes, read_json, scratch};
 
 #[test]
 fn indirect_writes_pictures_stats_and_the_error_map() {
@@ -225,46 +225,56 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     assert_eq!((cut.width(), cut.height()), (512, 512));
 }
 
+/// The temporal filter's claim (README, BENCHMARKS.md "A moving light"): at 1 degree a frame the
+/// cut's popping makes the indirect image change 1.9-2.9x as much as the brute force's, and the
+/// filter at `MOVING_LIGHT_TEMPORAL_WEIGHT` brings that to about 1 for about a tenth more error.
+/// Measured at this size (lavapipe, 2026-11-26): 2.11 -> 1.03, mean rel_l1 0.0296 -> 0.0320
+/// (1.08x); the run at weight 1 in the filtered one's place (the flag not reaching the renderer)
+/// fails the 1.2 bound.
 #[test]
 fn a_turning_light_gives_the_temporal_figures() {
     let dir = scratch("indirect-orbit");
     let out = dir.join("orbit.png");
     let stats = dir.join("orbit.json");
+    let scene = assets().join("scenes/cornell.toml");
     let args = [
         "indirect",
+        "--scene",
+        scene.to_str().unwrap(),
         "--rsm-size",
-        "32",
+        "128",
         "--size",
-        "32x32",
+        "64x64",
         "--frames",
-        "3",
+        "10",
         "--light-orbit",
-        "2",
+        "1",
     ];
     quadray_writes(&args, &out, &stats);
     let t = &read_json(&stats)["temporal"];
-    assert_eq!(t["frames"], 3);
-    let changed = t["cut_changed_fraction"].as_f64().unwrap();
-    assert!((0.0..=2.0).contains(&changed), "{changed}");
-    // the light moves, so both images change; the ratio of their changes is near 1
-    let ratio = t["flicker_ratio"].as_f64().unwrap();
-    assert!(ratio > 0.2 && ratio < 5.0, "{ratio}");
-    assert!(t["reference_flicker"].as_f64().unwrap() > 0.0);
-    let error = t["mean_rel_l1"].as_f64().unwrap();
-    assert!(error > 0.0 && error <= t["max_rel_l1"].as_f64().unwrap());
-    // over two frame pairs a running average of weight w changes at most w(2 - w) as much
-    // (0.55 for w = 0.33): the flag reaches the renderer
-    let filtered = [&args[..], &["--temporal-weight", "0.33"]].concat();
+    assert_eq!(t["frames"], 10);
+    let figure = |t: &serde_json::Value, key: &str| t[key].as_f64().unwrap();
+    let changed = figure(t, "cut_changed_fraction");
+    assert!(
+        (0.1..=0.3).contains(&changed),
+        "{changed} of the cut changes a frame"
+    );
+    let popping = figure(t, "flicker_ratio");
+    assert!(popping > 1.5, "unfiltered flicker ratio {popping}");
+    assert!(figure(t, "reference_flicker") > 0.0);
+    let error = figure(t, "mean_rel_l1");
+    assert!(error > 0.0 && error <= figure(t, "max_rel_l1"));
+    let weight = quadray_indirect::Settings::MOVING_LIGHT_TEMPORAL_WEIGHT.to_string();
+    let filtered = [&args[..], &["--temporal-weight", &weight]].concat();
     quadray_writes(&filtered, &out, &stats);
     let damped = &read_json(&stats)["temporal"];
-    let (flicker, damped_flicker) = (
-        t["flicker"].as_f64().unwrap(),
-        damped["flicker"].as_f64().unwrap(),
-    );
+    let ratio = figure(damped, "flicker_ratio");
     assert!(
-        damped_flicker < 0.7 * flicker,
-        "{damped_flicker} vs {flicker}"
+        ratio <= 1.2,
+        "filtered flicker ratio {ratio} (unfiltered {popping})"
     );
+    let cost = figure(damped, "mean_rel_l1") / error;
+    assert!(cost <= 1.15, "the filter's lag costs {cost}x the error");
     assert_eq!(damped["reference_flicker"], t["reference_flicker"]);
     let out = out.to_str().unwrap();
     let zero_weight = ["indirect", "--out", out, "--temporal-weight", "0"];
