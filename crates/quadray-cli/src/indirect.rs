@@ -71,17 +71,15 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         Some(path) => Scene::load(path)?,
         None => Scene::cornell(),
     };
-    let overrides = [
-        (&mut scene.camera.position, args.camera_position),
-        (&mut scene.camera.target, args.camera_target),
-        (&mut scene.light.position, args.light_position),
-        (&mut scene.light.direction, args.light_direction),
-    ];
-    for (value, given) in overrides {
+    fn set<T: From<[f32; 3]>>(value: &mut T, given: Option<[f32; 3]>) {
         if let Some(v) = given {
-            *value = v;
+            *value = v.into();
         }
     }
+    set(&mut scene.camera.position, args.camera_position);
+    set(&mut scene.camera.target, args.camera_target);
+    set(&mut scene.light.position, args.light_position);
+    set(&mut scene.light.direction, args.light_direction);
     scene
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;

@@ -92,8 +92,8 @@ fn orbit(mut scene: Scene, degrees: f32) -> Scene {
     let centre = (lo + hi) * 0.5;
     let turn = glam::Quat::from_axis_angle(scene.camera.up.normalize(), degrees.to_radians());
     let cam = &mut scene.camera;
-    cam.eye = centre + turn * (cam.eye - centre);
-    cam.look_at = centre + turn * (cam.look_at - centre);
+    cam.position = centre + turn * (cam.position - centre);
+    cam.target = centre + turn * (cam.target - centre);
     scene
 }
 

@@ -292,20 +292,26 @@ fn stem(path: &Path) -> String {
 }
 
 /// Checks what holds for every scene, whatever file it came from.
-fn check_camera(c: &Camera) -> Result<(), String> {
-    if !(c.position.is_finite() && c.target.is_finite() && c.up.is_finite()) {
-        return Err("camera: a coordinate is not finite".into());
+impl Camera {
+    /// [`Camera::fov_y_deg`]: a picture needs some, a pinhole cannot reach 180.
+    pub const FOV_Y: crate::settings::Limits<f32> = crate::settings::Limits::above(0.0, 179.0);
+
+    /// The one check of a camera, whichever technique renders it: finite, looking somewhere,
+    /// its field of view within [`Camera::FOV_Y`].
+    pub fn validate(&self) -> Result<(), String> {
+        let c = self;
+        if !(c.position.is_finite() && c.target.is_finite() && c.up.is_finite()) {
+            return Err("camera: a coordinate is not finite".into());
+        }
+        if c.position.distance(c.target) < 1e-6 {
+            return Err("camera: position and target are the same point".into());
+        }
+        if c.up.cross(c.target - c.position) == Vec3::ZERO {
+            return Err("camera: up is zero or along the view".into());
+        }
+        Self::FOV_Y.check("camera: fov_y_deg", c.fov_y_deg)?;
+        Ok(())
     }
-    if c.position.distance(c.target) < 1e-6 {
-        return Err("camera: position and target are the same point".into());
-    }
-    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
-        return Err(format!(
-            "camera: fov_y_deg {} is not in (0, 180)",
-            c.fov_y_deg
-        ));
-    }
-    Ok(())
 }
 
 fn check_light(l: &Light) -> Result<(), String> {

@@ -101,10 +101,10 @@ pub fn scene() -> Scene {
     Scene {
         name: "gi_gbuffer".into(),
         camera: Camera {
-            position: [0.5, 0.5, 2.4],
-            target: [0.5, 0.5, 0.0],
-            up: [0.0, 1.0, 0.0],
-            fov_deg: 39.0,
+            position: Vec3::new(0.5, 0.5, 2.4),
+            target: Vec3::new(0.5, 0.5, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 39.0,
         },
         light: SpotLight {
             position: [0.5, 0.97, 0.85],

@@ -9,6 +9,7 @@ use builtin::{builtin_triangles, cuboid};
 use glam::{Mat4, Vec3};
 use quadray_core::FileError;
 use quadray_core::mesh::Model;
+pub use quadray_core::scene::Camera;
 use quadray_core::scene::{Object, SceneDescription, Shape};
 use std::path::{Path, PathBuf};
 
@@ -22,19 +23,6 @@ pub struct Vertex {
     pub normal: [f32; 3],
     /// Diffuse albedo in [0, 1] per channel.
     pub albedo: [f32; 3],
-}
-
-/// The pinhole camera pictures are rendered from.
-#[derive(Clone, Debug)]
-pub struct Camera {
-    /// Eye position (world).
-    pub position: [f32; 3],
-    /// The point looked at (world).
-    pub target: [f32; 3],
-    /// Up direction of the picture.
-    pub up: [f32; 3],
-    /// Vertical field of view.
-    pub fov_deg: f32,
 }
 
 /// A spot light: full intensity inside `cone_deg - falloff_deg` of its axis, fading smoothly to
@@ -114,15 +102,9 @@ impl Scene {
         for (i, object) in d.objects.iter().enumerate() {
             triangles.extend(object_triangles(object, d).map_err(|e| format!("object {i}: {e}"))?);
         }
-        let c = &d.camera;
         let scene = Self {
             name: d.name.clone(),
-            camera: Camera {
-                position: c.position.into(),
-                target: c.target.into(),
-                up: c.up.into(),
-                fov_deg: c.fov_y_deg,
-            },
+            camera: d.camera,
             light: SpotLight {
                 position: light.position.into(),
                 direction: spot.direction.into(),
@@ -145,17 +127,8 @@ impl Scene {
     /// Checks the camera, the light and `r_min` (after loading, or after changing them).
     pub fn validate(&self) -> Result<(), String> {
         let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
-        let c = &self.camera;
+        self.camera.validate()?;
         let l = &self.light;
-        if !finite(&c.position) || !finite(&c.target) || !finite(&c.up) {
-            return Err("camera has a non-finite coordinate".into());
-        }
-        if Vec3::from(c.position).distance(Vec3::from(c.target)) < 1e-6 {
-            return Err("camera position equals its target".into());
-        }
-        if !(c.fov_deg > 1.0 && c.fov_deg < 179.0) {
-            return Err(format!("camera fov_deg {} is outside (1, 179)", c.fov_deg));
-        }
         if !finite(&l.position) || !finite(&l.direction) || !finite(&l.intensity) {
             return Err("light has a non-finite value".into());
         }
@@ -239,14 +212,16 @@ impl Scene {
     /// World -> camera clip space for a picture of this aspect ratio (width / height).
     pub fn camera_view_proj(&self, aspect: f32) -> Mat4 {
         let c = &self.camera;
-        let far = Vec3::from(c.position).distance(self.bounds().0.midpoint(self.bounds().1))
+        let far = c
+            .position
+            .distance(self.bounds().0.midpoint(self.bounds().1))
             + self.extent();
         glam::camera::rh::proj::directx::perspective(
-            c.fov_deg.to_radians(),
+            c.fov_y_deg.to_radians(),
             aspect,
             far * 1e-3,
             far,
-        ) * glam::camera::rh::view::look_at_mat4(c.position.into(), c.target.into(), c.up.into())
+        ) * glam::camera::rh::view::look_at_mat4(c.position, c.target, c.up)
     }
 }
 
@@ -475,8 +450,8 @@ mod tests {
         let close = |a: [f32; 3], b: [f32; 3], tolerance: f32| {
             Vec3::from(a).abs_diff_eq(Vec3::from(b), tolerance)
         };
-        assert!(close(gltf.camera.position, toml.camera.position, 1e-6));
-        assert!((gltf.camera.fov_deg - toml.camera.fov_deg).abs() < 1e-4);
+        assert!(gltf.camera.position.abs_diff_eq(toml.camera.position, 1e-6));
+        assert!((gltf.camera.fov_y_deg - toml.camera.fov_y_deg).abs() < 1e-4);
         let direction = Vec3::from(toml.light.direction).normalize().to_array();
         assert!(close(gltf.light.direction, direction, 1e-5));
         assert_eq!(gltf.light.intensity, toml.light.intensity);

@@ -560,7 +560,7 @@ fn temporal_filter_is_the_running_average_of_the_unfiltered_frames() {
             average = Some(expected);
         }
         let mut moved = scene.light_turned(20.0);
-        moved.camera.position[0] += 0.1;
+        moved.camera.position.x += 0.1;
         plain.set_view(&moved);
         filtered.set_view(&moved);
         let e = compare(

@@ -21,8 +21,8 @@ pub const NTH: f32 = 8.0;
 /// The scene: materials, lights, then the objects.
 pub fn scene() -> Result<Scene, BuildError> {
     let camera = Camera {
-        eye: Vec3::new(0.5, 2.2, 5.0),
-        look_at: Vec3::new(0.0, 0.6, 0.0),
+        position: Vec3::new(0.5, 2.2, 5.0),
+        target: Vec3::new(0.0, 0.6, 0.0),
         up: Vec3::Y,
         fov_y_deg: 45.0,
     };

@@ -21,7 +21,7 @@
 //! use glam::Vec3;
 //! use quadray_shadows::{Camera, Light, Material, Nth, RunOptions, Scene, SchemeChoice};
 //!
-//! let camera = Camera { eye: Vec3::new(0.0, 2.0, 4.0), look_at: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
+//! let camera = Camera { position: Vec3::new(0.0, 2.0, 4.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
 //! let mut scene = Scene::new("doc", camera);
 //! let grey = scene.add_material(Material::matte(Vec3::splat(0.7)));
 //! scene.add_light(Light::white(Vec3::new(1.0, 4.0, 2.0), 0.8));

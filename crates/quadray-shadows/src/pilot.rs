@@ -168,7 +168,7 @@ fn mean_shadow_ray_cells(polygons: &[&ConvexPolygon], grid: &Grid, lights: &[Vec
 /// shadow volumes decide the mix of checks and tests. None without shadow polygons.
 fn shadow_entry_cost(prep: &Prepared) -> Option<f64> {
     let volumes = prep.volumes.as_ref()?;
-    let eye = prep.scene.camera.eye;
+    let eye = prep.scene.camera.position;
     let pinhole = Pinhole::new(&prep.scene.camera, 64, 48);
     let mut objects = Mailbox::new(prep.polygons.len());
     // (direction, length, occupied cells, lights with shadow polygons in them): HST counts

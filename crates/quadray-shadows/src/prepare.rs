@@ -85,7 +85,7 @@ impl Prepared {
         let bounds = polygons
             .iter()
             .fold(Aabb::EMPTY, |b, p| b.union(p.bounds()))
-            .grow(scene.camera.eye);
+            .grow(scene.camera.position);
         let grid = Grid::for_polygons(bounds, polygons.len());
         let cells = grid.register(polygons.par_iter().map(|p| p.vertices.as_slice()));
         let volumes_start = crate::process_cpu_s();

@@ -101,18 +101,7 @@ impl Light {
     }
 }
 
-/// A pinhole camera.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// Where the camera is.
-    pub eye: Vec3,
-    /// The point seen in the image's centre.
-    pub look_at: Vec3,
-    /// Up in the image (need not be perpendicular to the view).
-    pub up: Vec3,
-    /// Vertical field of view in degrees.
-    pub fov_y_deg: f32,
-}
+pub use quadray_core::scene::Camera;
 
 /// A convex planar face: indices into the scene's vertices (shared between faces of one mesh).
 #[derive(Clone, Debug, PartialEq)]
@@ -386,24 +375,12 @@ impl Scene {
         })
     }
 
-    /// Checks what the tracer relies on: a finite camera looking somewhere with a field of view
-    /// in (0, 180) degrees, 1 to [`MAX_LIGHTS`] finite lights, finite materials with an index
+    /// Checks what the tracer relies on: a valid camera ([`Camera::validate`], the one check both
+    /// techniques use), 1 to [`MAX_LIGHTS`] finite lights, finite materials with an index
     /// of refraction above 0, at least one face.
     pub fn validate(&self) -> Result<(), BuildError> {
         let bad = |why: String| Err(BuildError::Invalid(why));
-        let c = &self.camera;
-        if !(c.eye.is_finite() && c.look_at.is_finite() && c.up.is_finite())
-            || c.look_at == c.eye
-            || c.up.cross(c.look_at - c.eye) == Vec3::ZERO
-        {
-            return bad("camera: eye, look_at and up must be finite, eye and look_at distinct, up not along the view".into());
-        }
-        if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
-            return bad(format!(
-                "camera: fov_y_deg {} is not in (0, 180)",
-                c.fov_y_deg
-            ));
-        }
+        self.camera.validate().map_err(BuildError::Invalid)?;
         if self.lights.is_empty() || self.lights.len() > MAX_LIGHTS {
             return bad(format!("{} lights; 1 to {MAX_LIGHTS}", self.lights.len()));
         }

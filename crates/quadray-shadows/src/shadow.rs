@@ -110,7 +110,7 @@ impl ShadowVolumes {
     /// registers them in the grid and counts the eye's depth. Every step runs in parallel, and
     /// only silhouette edges (a few percent of a fine mesh's edges) get past the weight.
     pub fn build(scene: &Scene, polygons: &[ConvexPolygon], grid: &Grid) -> Self {
-        let eye = scene.camera.eye;
+        let eye = scene.camera.position;
         let edges = edge_faces(polygons, &scene.faces);
         let edges: Vec<&[EdgeFace]> = edges.chunk_by(|x, y| x.0 == y.0).collect();
         let (lights, outlines): (Vec<LightVolumes>, Vec<Vec<Outline>>) = scene

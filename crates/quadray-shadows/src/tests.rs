@@ -744,8 +744,8 @@ fn self_shadowed_points_carry_a_valid_count_on() {
 fn the_builder_refuses_bad_faces_and_scenes_with_clear_errors() {
     use crate::scene::{BuildError, Camera, Light, Material};
     let camera = Camera {
-        eye: Vec3::new(0.0, 1.0, 3.0),
-        look_at: Vec3::ZERO,
+        position: Vec3::new(0.0, 1.0, 3.0),
+        target: Vec3::ZERO,
         up: Vec3::Y,
         fov_y_deg: 40.0,
     };

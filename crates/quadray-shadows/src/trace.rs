@@ -50,7 +50,7 @@ pub struct Pinhole {
 impl Pinhole {
     /// The eye rays of `cam` for a `w` x `h` image.
     pub fn new(cam: &crate::scene::Camera, w: u32, h: u32) -> Self {
-        let forward = (cam.look_at - cam.eye).normalize();
+        let forward = (cam.target - cam.position).normalize();
         let right = forward.cross(cam.up).normalize();
         let half = (cam.fov_y_deg.to_radians() * 0.5).tan();
         Self {
@@ -289,7 +289,7 @@ impl<S: ShadowTest> Tracer<'_, S> {
                     let d = pinhole.dir(x as f32 + u, y as f32 + v);
                     sum += self.trace(
                         &mut scratch,
-                        cam.eye,
+                        cam.position,
                         d,
                         None,
                         self.settings.depth,

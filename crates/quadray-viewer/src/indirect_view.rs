@@ -79,8 +79,8 @@ struct Pose {
 
 impl Pose {
     fn of(scene: &Scene) -> Self {
-        let eye = Vec3::from(scene.camera.position);
-        let (yaw, pitch) = yaw_pitch(Vec3::from(scene.camera.target) - eye);
+        let eye = scene.camera.position;
+        let (yaw, pitch) = yaw_pitch(scene.camera.target - eye);
         let (light_yaw, light_pitch) = yaw_pitch(scene.light.direction.into());
         Self {
             eye,
@@ -95,8 +95,8 @@ impl Pose {
     /// The scene with this pose's camera and light.
     fn apply(&self, base: &Scene, animated: bool) -> Scene {
         let mut scene = base.clone();
-        scene.camera.position = self.eye.into();
-        scene.camera.target = (self.eye + direction(self.yaw, self.pitch)).into();
+        scene.camera.position = self.eye;
+        scene.camera.target = self.eye + direction(self.yaw, self.pitch);
         let mut light = direction(self.light_yaw, self.light_pitch);
         if animated {
             // circle 15 degrees around the dragged direction
@@ -299,8 +299,8 @@ impl IndirectView {
         .chain(self.settings.to_args())
         .chain([
             format!("--exposure {}", self.exposure),
-            format!("--camera-position {}", v(scene.camera.position)),
-            format!("--camera-target {}", v(scene.camera.target)),
+            format!("--camera-position {}", v(scene.camera.position.to_array())),
+            format!("--camera-target {}", v(scene.camera.target.to_array())),
             format!("--light-position {}", v(scene.light.position)),
             format!("--light-direction {}", v(scene.light.direction)),
             "--frames 1 --out".into(),

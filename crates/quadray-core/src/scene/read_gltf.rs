@@ -3,8 +3,7 @@
 //! panic on a file that mixes up its fields).
 
 use super::{
-    Camera, Intensity, Light, Object, SceneDescription, Shape, Spot, Transform, check_camera,
-    check_light, stem,
+    Camera, Intensity, Light, Object, SceneDescription, Shape, Spot, Transform, check_light, stem,
 };
 use crate::FileError;
 use crate::mesh::gltf::{document, walk_nodes};
@@ -92,7 +91,7 @@ fn node_camera(json: &gltf::json::Root, index: usize, world: Mat4) -> Result<Cam
         up: world.transform_vector3(Vec3::Y).normalize_or_zero(),
         fov_y_deg: perspective.yfov.to_degrees(),
     };
-    check_camera(&camera)?;
+    camera.validate()?;
     Ok(camera)
 }
 

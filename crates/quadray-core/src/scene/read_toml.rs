@@ -3,7 +3,7 @@
 
 use super::{
     Camera, Intensity, Light, Material, Object, SceneDescription, Shape, Spot, Transform,
-    check_camera, check_light, stem,
+    check_light, stem,
 };
 use crate::mesh::load_model;
 use glam::Vec3;
@@ -90,7 +90,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<SceneDescription, String>
         up: c.up,
         fov_y_deg: c.fov_y_deg,
     };
-    check_camera(&camera)?;
+    camera.validate()?;
     let lights = file
         .light
         .into_iter()

@@ -76,7 +76,7 @@ impl<'g> Renderer<'g> {
         self.gather.set_light(q, &spot, scene.r_min);
         let s = self.settings();
         let view_proj = scene.camera_view_proj(s.size.width as f32 / s.size.height as f32);
-        let eye = scene.camera.position.into();
+        let eye = scene.camera.position;
         self.gbuffer.set_camera(q, view_proj, eye);
         self.gather.set_camera(q, view_proj, eye);
     }

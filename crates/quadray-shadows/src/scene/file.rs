@@ -1,7 +1,7 @@
 //! The ray tracer's scene built from the shared scene description (`quadray_core::scene`): a
 //! TOML or glTF file, or a description made in code.
 
-use super::{Camera, Light, Material, Scene, SceneError, scene_error};
+use super::{Light, Material, Scene, SceneError, scene_error};
 use glam::Vec3;
 use quadray_core::FileError;
 use quadray_core::geom::ConvexPolygon;
@@ -39,16 +39,7 @@ impl Scene {
         if d.lights.is_empty() {
             return Err("no lights".into());
         }
-        let c = d.camera;
-        let mut s = Scene::new(
-            &d.name,
-            Camera {
-                eye: c.position,
-                look_at: c.target,
-                up: c.up,
-                fov_y_deg: c.fov_y_deg,
-            },
-        );
+        let mut s = Scene::new(&d.name, d.camera);
         s.ambient = d.ambient.unwrap_or(s.ambient);
         s.background = d.background.unwrap_or(s.background);
         for (_, m) in &d.materials {
@@ -198,7 +189,11 @@ mod tests {
             light.intensity.abs_diff_eq(Vec3::splat(expected), 1e-4),
             "{light:?}"
         );
-        assert!(s.camera.eye.abs_diff_eq(Vec3::new(0.5, 0.5, 2.4), 1e-6));
+        assert!(
+            s.camera
+                .position
+                .abs_diff_eq(Vec3::new(0.5, 0.5, 2.4), 1e-6)
+        );
         let red = s
             .materials
             .iter()

@@ -151,10 +151,10 @@ impl Scene {
     }
 }
 
-fn camera(eye: Vec3, look_at: Vec3, fov_y_deg: f32) -> Camera {
+fn camera(position: Vec3, target: Vec3, fov_y_deg: f32) -> Camera {
     Camera {
-        eye,
-        look_at,
+        position,
+        target,
         up: Vec3::Y,
         fov_y_deg,
     }
