@@ -1,7 +1,5 @@
 //! Maps the tests share: the bundled assets as stored (square powers of two and odd sizes), and
 //! procedural maps of any size.
-// Each test binary uses its own part of this module.
-#![allow(dead_code)]
 
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use std::path::PathBuf;
