@@ -79,7 +79,7 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     set(&mut scene.camera.position, args.camera_position);
     set(&mut scene.camera.target, args.camera_target);
     set(&mut scene.light.position, args.light_position);
-    set(&mut scene.light.direction, args.light_direction);
+    set(&mut scene.light.spot.direction, args.light_direction);
     scene
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;

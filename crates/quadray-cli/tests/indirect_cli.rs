@@ -152,7 +152,7 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         (vec!["--light-direction", "0,NaN,0"], "finite"),
         (
             vec!["--light-direction", "0,0,0"],
-            "light direction is zero",
+            "light: direction must be finite and not zero",
         ),
         (
             vec!["--tile-capacity", "0"],

@@ -314,6 +314,27 @@ impl Camera {
     }
 }
 
+impl Spot {
+    /// [`Spot::cone_deg`]: a cone, at most a half-space.
+    pub const CONE: crate::settings::Limits<f32> = crate::settings::Limits::above(0.0, 90.0);
+
+    /// The one check of a spot's cone, whichever technique renders it: a finite axis that is not
+    /// zero, the cone within [`Spot::CONE`], the falloff within the cone.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.direction.is_finite() && self.direction.length() > 1e-6) {
+            return Err("direction must be finite and not zero".into());
+        }
+        Self::CONE.check("cone_deg", self.cone_deg)?;
+        if !(self.falloff_deg >= 0.0 && self.falloff_deg <= self.cone_deg) {
+            return Err(format!(
+                "falloff_deg {} is not in [0, cone_deg]",
+                self.falloff_deg
+            ));
+        }
+        Ok(())
+    }
+}
+
 fn check_light(l: &Light) -> Result<(), String> {
     let (Intensity::Native(i) | Intensity::Candela(i)) = l.intensity;
     if !(l.position.is_finite() && i.is_finite()) {
@@ -323,24 +344,8 @@ fn check_light(l: &Light) -> Result<(), String> {
         return Err(format!("light at {}: intensity is negative", l.position));
     }
     if let Some(s) = l.spot {
-        if !(s.direction.is_finite() && s.direction.length() > 1e-6) {
-            return Err(format!(
-                "light at {}: direction must be finite and not zero",
-                l.position
-            ));
-        }
-        if !(s.cone_deg > 0.0 && s.cone_deg <= 90.0) {
-            return Err(format!(
-                "light at {}: cone_deg {} is not in (0, 90]",
-                l.position, s.cone_deg
-            ));
-        }
-        if !(s.falloff_deg >= 0.0 && s.falloff_deg <= s.cone_deg) {
-            return Err(format!(
-                "light at {}: falloff_deg {} is not in [0, cone_deg]",
-                l.position, s.falloff_deg
-            ));
-        }
+        s.validate()
+            .map_err(|e| format!("light at {}: {e}", l.position))?;
     }
     Ok(())
 }

@@ -107,11 +107,13 @@ pub fn scene() -> Scene {
             fov_y_deg: 39.0,
         },
         light: SpotLight {
-            position: [0.5, 0.97, 0.85],
-            direction: [0.25, -1.0, -0.55],
-            cone_deg: 55.0,
-            falloff_deg: 15.0,
-            intensity: [2.0; 3],
+            position: Vec3::new(0.5, 0.97, 0.85),
+            spot: quadray_indirect::scene::Spot {
+                direction: Vec3::new(0.25, -1.0, -0.55),
+                cone_deg: 55.0,
+                falloff_deg: 15.0,
+            },
+            intensity: Vec3::splat(2.0),
         },
         r_min: 0.05,
         triangles,

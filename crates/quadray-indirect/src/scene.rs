@@ -10,6 +10,7 @@ use glam::{Mat4, Vec3};
 use quadray_core::FileError;
 use quadray_core::mesh::Model;
 pub use quadray_core::scene::Camera;
+pub use quadray_core::scene::Spot;
 use quadray_core::scene::{Object, SceneDescription, Shape};
 use std::path::{Path, PathBuf};
 
@@ -25,20 +26,18 @@ pub struct Vertex {
     pub albedo: [f32; 3],
 }
 
-/// A spot light: full intensity inside `cone_deg - falloff_deg` of its axis, fading smoothly to
-/// zero at `cone_deg`.
-#[derive(Clone, Debug)]
+/// The spot light whose RSM makes the VPLs: the scene description's cone ([`Spot`]: full
+/// intensity inside `cone_deg - falloff_deg` of its axis, fading smoothly to zero at
+/// `cone_deg`, which is also half the RSM's field of view) at a position, with its intensity as
+/// radiant intensity.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpotLight {
     /// Apex of the cone (world).
-    pub position: [f32; 3],
-    /// Axis of the cone (any length but zero).
-    pub direction: [f32; 3],
-    /// Half-angle of the cone; also half the field of view of the RSM.
-    pub cone_deg: f32,
-    /// Width of the smooth edge inside the cone, degrees.
-    pub falloff_deg: f32,
+    pub position: Vec3,
+    /// The cone.
+    pub spot: Spot,
     /// Radiant intensity on the axis (W/sr per channel).
-    pub intensity: [f32; 3],
+    pub intensity: Vec3,
 }
 
 /// A loaded scene, checked and flattened.
@@ -57,6 +56,9 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The widest cone this renderer takes: its RSM's field of view is twice the cone.
+    pub const MAX_CONE_DEG: f32 = 89.0;
+
     /// Reads a scene file: TOML, or glTF 2.0 for `.gltf` and `.glb`.
     pub fn load(path: &Path) -> Result<Self, FileError> {
         let description = SceneDescription::load(path)?;
@@ -106,11 +108,9 @@ impl Scene {
             name: d.name.clone(),
             camera: d.camera,
             light: SpotLight {
-                position: light.position.into(),
-                direction: spot.direction.into(),
-                cone_deg: spot.cone_deg,
-                falloff_deg: spot.falloff_deg,
-                intensity: light.intensity.watts_per_sr().into(),
+                position: light.position,
+                spot,
+                intensity: light.intensity.watts_per_sr(),
             },
             r_min: d.r_min.unwrap_or(DEFAULT_R_MIN),
             triangles,
@@ -126,28 +126,21 @@ impl Scene {
 
     /// Checks the camera, the light and `r_min` (after loading, or after changing them).
     pub fn validate(&self) -> Result<(), String> {
-        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
         self.camera.validate()?;
         let l = &self.light;
-        if !finite(&l.position) || !finite(&l.direction) || !finite(&l.intensity) {
+        if !(l.position.is_finite() && l.intensity.is_finite()) {
             return Err("light has a non-finite value".into());
         }
-        if Vec3::from(l.direction).length() < 1e-6 {
-            return Err("light direction is zero".into());
-        }
-        if !(l.cone_deg > 0.5 && l.cone_deg < 89.0) {
+        l.spot.validate().map_err(|e| format!("light: {e}"))?;
+        // the RSM sees the whole cone: twice it must stay below a half-space
+        if l.spot.cone_deg > Self::MAX_CONE_DEG {
             return Err(format!(
-                "light cone_deg {} is outside (0.5, 89)",
-                l.cone_deg
+                "light: cone_deg {} is over {} (the RSM's field of view is twice the cone)",
+                l.spot.cone_deg,
+                Self::MAX_CONE_DEG
             ));
         }
-        if !(l.falloff_deg >= 0.0 && l.falloff_deg <= l.cone_deg) {
-            return Err(format!(
-                "light falloff_deg {} is outside [0, cone_deg]",
-                l.falloff_deg
-            ));
-        }
-        if l.intensity.iter().any(|&x| x < 0.0) {
+        if l.intensity.min_element() < 0.0 {
             return Err("light intensity is negative".into());
         }
         if !(self.r_min.is_finite() && self.r_min > 0.0) {
@@ -161,7 +154,7 @@ impl Scene {
     pub fn light_turned(&self, degrees: f32) -> Self {
         let turn = glam::Quat::from_rotation_y(degrees.to_radians());
         let mut out = self.clone();
-        out.light.direction = (turn * Vec3::from(self.light.direction)).into();
+        out.light.spot.direction = turn * self.light.spot.direction;
         out
     }
 
@@ -185,16 +178,16 @@ impl Scene {
 
     /// World -> light view.
     pub fn light_view(&self) -> Mat4 {
-        let dir = Vec3::from(self.light.direction).normalize();
+        let dir = self.light.spot.direction.normalize();
         let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-        glam::camera::rh::view::look_to_mat4(self.light.position.into(), dir, up)
+        glam::camera::rh::view::look_to_mat4(self.light.position, dir, up)
     }
 
     /// World -> light clip space (the RSM and shadow map projection).
     pub fn light_view_proj(&self) -> Mat4 {
         let far = self.light_far();
         glam::camera::rh::proj::directx::perspective(
-            (2.0 * self.light.cone_deg).to_radians(),
+            (2.0 * self.light.spot.cone_deg).to_radians(),
             1.0,
             far * 1e-3,
             far,
@@ -204,7 +197,7 @@ impl Scene {
     /// Far plane of the light: everything in the scene is closer.
     pub fn light_far(&self) -> f32 {
         let (lo, hi) = self.bounds();
-        let p = Vec3::from(self.light.position);
+        let p = self.light.position;
         let centre = (lo + hi) * 0.5;
         p.distance(centre) + self.extent()
     }
@@ -365,8 +358,8 @@ mod tests {
     #[test]
     fn the_light_turns_about_the_vertical_axis() {
         let scene = Scene::cornell();
-        let d = Vec3::from(scene.light.direction);
-        let t = Vec3::from(scene.light_turned(90.0).light.direction);
+        let d = scene.light.spot.direction;
+        let t = scene.light_turned(90.0).light.spot.direction;
         assert!((t.y - d.y).abs() < 1e-6, "{d} -> {t}");
         assert!(
             (t.x - d.z).abs() < 1e-5 && (t.z + d.x).abs() < 1e-5,
@@ -452,11 +445,11 @@ mod tests {
         };
         assert!(gltf.camera.position.abs_diff_eq(toml.camera.position, 1e-6));
         assert!((gltf.camera.fov_y_deg - toml.camera.fov_y_deg).abs() < 1e-4);
-        let direction = Vec3::from(toml.light.direction).normalize().to_array();
-        assert!(close(gltf.light.direction, direction, 1e-5));
+        let direction = toml.light.spot.direction.normalize();
+        assert!(gltf.light.spot.direction.abs_diff_eq(direction, 1e-5));
         assert_eq!(gltf.light.intensity, toml.light.intensity);
-        assert!((gltf.light.cone_deg - toml.light.cone_deg).abs() < 1e-4);
-        assert!((gltf.light.falloff_deg - toml.light.falloff_deg).abs() < 1e-4);
+        assert!((gltf.light.spot.cone_deg - toml.light.spot.cone_deg).abs() < 1e-4);
+        assert!((gltf.light.spot.falloff_deg - toml.light.spot.falloff_deg).abs() < 1e-4);
         assert_eq!(gltf.r_min, toml.r_min);
         let (lo, hi) = gltf.bounds();
         assert!(close(lo.to_array(), [0.0; 3], 1e-6) && close(hi.to_array(), [1.0; 3], 1e-6));
@@ -482,7 +475,7 @@ mod tests {
              intensity = [1, 1, 1]\n[[mesh]]",
         );
         let scene = Scene::parse(&two_spots, "two").unwrap();
-        assert_eq!(scene.light.intensity, [2.0; 3]);
+        assert_eq!(scene.light.intensity, Vec3::splat(2.0));
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes");
         let points = std::fs::read_to_string(dir.join("shadows-demo.toml")).unwrap();
         let err = Scene::parse_in(&points, "shadows-demo", &dir).unwrap_err();

@@ -81,7 +81,7 @@ impl Pose {
     fn of(scene: &Scene) -> Self {
         let eye = scene.camera.position;
         let (yaw, pitch) = yaw_pitch(scene.camera.target - eye);
-        let (light_yaw, light_pitch) = yaw_pitch(scene.light.direction.into());
+        let (light_yaw, light_pitch) = yaw_pitch(scene.light.spot.direction);
         Self {
             eye,
             yaw,
@@ -104,7 +104,7 @@ impl Pose {
                 Quat::from_axis_angle(light, self.light_phase) * light.any_orthonormal_vector();
             light = Quat::from_axis_angle(axis, 15f32.to_radians()) * light;
         }
-        scene.light.direction = light.into();
+        scene.light.spot.direction = light;
         scene
     }
 }
@@ -301,8 +301,11 @@ impl IndirectView {
             format!("--exposure {}", self.exposure),
             format!("--camera-position {}", v(scene.camera.position.to_array())),
             format!("--camera-target {}", v(scene.camera.target.to_array())),
-            format!("--light-position {}", v(scene.light.position)),
-            format!("--light-direction {}", v(scene.light.direction)),
+            format!("--light-position {}", v(scene.light.position.to_array())),
+            format!(
+                "--light-direction {}",
+                v(scene.light.spot.direction.to_array())
+            ),
             "--frames 1 --out".into(),
             shell_word(out),
         ]);

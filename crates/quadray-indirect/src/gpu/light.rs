@@ -34,11 +34,11 @@ impl Spot {
         let l = &scene.light;
         Self {
             view_proj: scene.light_view_proj(),
-            position: l.position.into(),
-            direction: Vec3::from(l.direction).normalize(),
-            cone_deg: l.cone_deg,
-            falloff_deg: l.falloff_deg,
-            intensity: l.intensity,
+            position: l.position,
+            direction: l.spot.direction.normalize(),
+            cone_deg: l.spot.cone_deg,
+            falloff_deg: l.spot.falloff_deg,
+            intensity: l.intensity.to_array(),
             extent: scene.extent(),
             far: scene.light_far(),
         }
