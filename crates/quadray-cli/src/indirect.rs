@@ -40,7 +40,7 @@ pub struct IndirectArgs {
     light_orbit: Option<f32>,
     /// Radiance scale before tone mapping (a picture that comes out nearly black or white says
     /// which exposure would show it).
-    #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser())]
+    #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser(), allow_negative_numbers = true)]
     exposure: f32,
     /// Camera position X,Y,Z instead of the scene file's.
     #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]

@@ -39,7 +39,7 @@ pub struct RaytraceArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Radiance scale before the PNG's clamp and gamma (an EXR keeps the radiance as is).
-    #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser())]
+    #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser(), allow_negative_numbers = true)]
     exposure: f32,
     /// Statistics JSON (times, sub-schemes, N_th, p, alpha, ...).
     #[arg(long)]
