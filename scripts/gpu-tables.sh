@@ -4,7 +4,7 @@
 # degrees (with the CPU ground truth's wrong-hit fraction), each indirect-light pass at 1920x1080
 # with a 512^2 RSM for every method, then, while the time budget lasts, the paper tables of
 # `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
-# name from the adapter, e.g. bench/nvidia-h100/) with every stats file and a summary.md of the
+# name from the adapter, e.g. bench/nvidia-h200/) with every stats file and a summary.md of the
 # tables, and packs it into gpu-tables.tar.gz beside it (a device call returns few files).
 #
 #   scripts/gpu-tables.sh [--quick] [--bin PATH] [--out DIR] [--budget SECONDS]
@@ -41,7 +41,7 @@ else
     size=1920x1080 rsm=512 frames=20 angles="0 60 85"
 fi
 
-# The adapter's name as a folder: "NVIDIA H100 80GB HBM3" -> nvidia-h100-80gb-hbm3.
+# The adapter's name as a folder: "NVIDIA H200 (Vulkan, NVIDIA 580.159.04)" -> nvidia-h200.
 probe=$(mktemp -d)
 "$bin" indirect --size 16x16 --rsm-size 16 --frames 1 --out "$probe/p.png" --stats "$probe/p.json" >/dev/null
 adapter=$(sed -n 's/^ *"adapter": "\(.*\)",$/\1/p' "$probe/p.json" | head -1)
