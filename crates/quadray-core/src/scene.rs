@@ -10,9 +10,13 @@
 //!
 //! ```toml
 //! name = "demo"                  # default: the file's stem
-//! r_min = 0.05                   # quadray indirect: clamp of the VPL kernel (default 0.05)
-//! ambient = [0.08, 0.08, 0.08]   # quadray raytrace: ambient light (default 0.08)
-//! background = [0.0, 0.0, 0.0]   # quadray raytrace: colour of rays that leave (default dark blue)
+//!
+//! [indirect]                     # quadray indirect's own settings
+//! r_min = 0.05                   # clamp of the VPL kernel (default 0.05)
+//!
+//! [raytrace]                     # quadray raytrace's own settings
+//! ambient = [0.08, 0.08, 0.08]   # ambient light (default 0.08)
+//! background = [0.0, 0.0, 0.0]   # colour of rays that leave (default dark blue)
 //!
 //! [camera]
 //! position = [0.5, 0.5, 2.4]
@@ -68,6 +72,7 @@ use crate::FileError;
 use crate::mesh::Model;
 use glam::{Mat4, Vec3};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// A scene as read from a file, before a technique builds its own geometry from it.
@@ -84,12 +89,10 @@ pub struct SceneDescription {
     pub materials: Vec<(String, Material)>,
     /// Everything that is drawn.
     pub objects: Vec<Object>,
-    /// quadray indirect's clamp of the VPL kernel's 1/r^4 (world units), when the file sets it.
-    pub r_min: Option<f32>,
-    /// quadray raytrace's ambient light, when the file sets it.
-    pub ambient: Option<Vec3>,
-    /// quadray raytrace's background colour, when the file sets it.
-    pub background: Option<Vec3>,
+    /// Each technique's own scene settings, by the technique's name: the file's table of that
+    /// name (`[indirect]`, `[raytrace]`), for the technique to read with
+    /// [`SceneDescription::technique_settings`]. Empty for glTF files.
+    pub techniques: BTreeMap<String, toml::Table>,
 }
 
 /// A pinhole camera.
@@ -275,6 +278,21 @@ impl SceneDescription {
         }
         let text = std::fs::read_to_string(path).map_err(|e| FileError::new(path, e))?;
         Self::from_toml(&text, path)
+    }
+
+    /// `technique`'s own settings from its table (its defaults where the file has none); a key
+    /// the technique does not know is an error that names the table.
+    pub fn technique_settings<T: serde::de::DeserializeOwned + Default>(
+        &self,
+        technique: &str,
+    ) -> Result<T, String> {
+        match self.techniques.get(technique) {
+            None => Ok(T::default()),
+            Some(table) => table
+                .clone()
+                .try_into()
+                .map_err(|e| format!("[{technique}]: {}", e.to_string().trim())),
+        }
     }
 
     /// Parses TOML scene text. `path` names the scene in errors, its directory is where mesh

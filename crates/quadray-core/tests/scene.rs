@@ -101,6 +101,51 @@ fn the_older_spellings_read_as_the_canonical_one() {
     assert_eq!(a.objects[0].transform, Transform::IDENTITY);
 }
 
+/// A technique's own settings: its table, or the older top-level keys, read the same; a key in
+/// both places, or one the technique does not know, is refused with the table named.
+#[test]
+fn technique_tables_and_their_older_top_level_keys_read_the_same() {
+    #[derive(serde::Deserialize, Default, Debug, PartialEq)]
+    #[serde(deny_unknown_fields)]
+    struct Raytrace {
+        ambient: Option<Vec3>,
+        background: Option<Vec3>,
+    }
+    let body = "[camera]\nposition = [0, 0, 2]\ntarget = [0, 0, 0]\nfov_y_deg = 40\n\
+                [[objects]]\nbox = { min = [0, 0, 0], max = [1, 1, 1] }\nalbedo = [0.5, 0.5, 0.5]\n";
+    let file = asset("scenes/new.toml");
+    let read = |head: &str| SceneDescription::from_toml(&format!("{head}\n{body}"), &file);
+    let table = read("[raytrace]\nambient = [0.1, 0.2, 0.3]").unwrap();
+    let older = read("ambient = [0.1, 0.2, 0.3]").unwrap();
+    let expected = Raytrace {
+        ambient: Some(Vec3::new(0.1, 0.2, 0.3)),
+        background: None,
+    };
+    for scene in [&table, &older] {
+        assert_eq!(
+            scene.technique_settings::<Raytrace>("raytrace"),
+            Ok(Raytrace { ..expected })
+        );
+    }
+    // none: the technique's defaults
+    assert_eq!(
+        read("").unwrap().technique_settings::<Raytrace>("raytrace"),
+        Ok(Raytrace::default())
+    );
+    let twice =
+        read("ambient = [0.1, 0.1, 0.1]\n[raytrace]\nambient = [0.2, 0.2, 0.2]").unwrap_err();
+    assert!(twice.to_string().contains("both"), "{twice}");
+    assert!(twice.to_string().contains("new.toml"), "{twice}");
+    let unknown = read("[raytrace]\nambiant = [0.1, 0.1, 0.1]").unwrap();
+    let err = unknown
+        .technique_settings::<Raytrace>("raytrace")
+        .unwrap_err();
+    assert!(
+        err.contains("[raytrace]") && err.contains("ambiant"),
+        "{err}"
+    );
+}
+
 #[test]
 fn the_bundled_gltf_scene_has_the_camera_and_spot_of_cornell_toml() {
     let gltf = SceneDescription::load(&asset("scenes/cornell_spot.gltf")).unwrap();

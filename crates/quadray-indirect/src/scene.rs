@@ -112,7 +112,7 @@ impl Scene {
                 spot,
                 intensity: light.intensity.watts_per_sr(),
             },
-            r_min: d.r_min.unwrap_or(DEFAULT_R_MIN),
+            r_min: d.technique_settings::<FileSettings>("indirect")?.r_min,
             triangles,
         };
         scene.validate()?;
@@ -239,6 +239,22 @@ pub fn scenes_dir() -> PathBuf {
 
 /// Clamp of the VPL kernel's 1/r^4 (world units) of a scene that does not set `r_min`.
 pub const DEFAULT_R_MIN: f32 = 0.05;
+
+/// A scene file's `[indirect]` table.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct FileSettings {
+    /// [`Scene::r_min`].
+    r_min: f32,
+}
+
+impl Default for FileSettings {
+    fn default() -> Self {
+        Self {
+            r_min: DEFAULT_R_MIN,
+        }
+    }
+}
 
 /// Triangles of a mesh file with per-vertex albedo: the material's base colour times its texture
 /// sampled at the vertex (the RSM and G-buffer carry albedo per vertex, not per texel).

@@ -72,9 +72,7 @@ pub(super) fn load(path: &Path) -> Result<SceneDescription, FileError> {
             transform: Transform::IDENTITY,
             material: None,
         }],
-        r_min: None,
-        ambient: None,
-        background: None,
+        techniques: Default::default(),
     })
 }
 

@@ -15,9 +15,12 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 struct SceneToml {
     name: Option<String>,
-    r_min: Option<f32>,
-    ambient: Option<Vec3>,
-    background: Option<Vec3>,
+    indirect: Option<::toml::Table>,
+    raytrace: Option<::toml::Table>,
+    /// Older spellings of `[indirect] r_min` and `[raytrace] ambient`, `background`.
+    r_min: Option<::toml::Value>,
+    ambient: Option<::toml::Value>,
+    background: Option<::toml::Value>,
     camera: CameraToml,
     /// quadray indirect's older spelling: one spot light.
     light: Option<LightToml>,
@@ -97,9 +100,24 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<SceneDescription, String>
         .chain(file.lights)
         .map(light)
         .collect::<Result<Vec<_>, _>>()?;
-    for (what, colour) in [("ambient", file.ambient), ("background", file.background)] {
-        if colour.is_some_and(|c| !c.is_finite()) {
-            return Err(format!("{what} is not finite"));
+    let mut techniques = BTreeMap::new();
+    let older = [
+        ("indirect", file.indirect, vec![("r_min", file.r_min)]),
+        (
+            "raytrace",
+            file.raytrace,
+            vec![("ambient", file.ambient), ("background", file.background)],
+        ),
+    ];
+    for (technique, table, top_level) in older {
+        let mut table = table.unwrap_or_default();
+        for (key, value) in top_level.into_iter().filter_map(|(k, v)| Some((k, v?))) {
+            if table.insert(key.to_string(), value).is_some() {
+                return Err(format!("{key} is set both at the top and in [{technique}]"));
+            }
+        }
+        if !table.is_empty() {
+            techniques.insert(technique.to_string(), table);
         }
     }
     for (name, m) in &file.materials {
@@ -128,9 +146,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<SceneDescription, String>
         lights,
         materials,
         objects,
-        r_min: file.r_min,
-        ambient: file.ambient,
-        background: file.background,
+        techniques,
     })
 }
 

@@ -40,8 +40,14 @@ impl Scene {
             return Err("no lights".into());
         }
         let mut s = Scene::new(&d.name, d.camera);
-        s.ambient = d.ambient.unwrap_or(s.ambient);
-        s.background = d.background.unwrap_or(s.background);
+        let own: FileSettings = d.technique_settings("raytrace")?;
+        for (what, colour) in [("ambient", own.ambient), ("background", own.background)] {
+            if colour.is_some_and(|c| !(c.is_finite() && c.min_element() >= 0.0)) {
+                return Err(format!("[raytrace] {what} must be finite and not negative"));
+            }
+        }
+        s.ambient = own.ambient.unwrap_or(s.ambient);
+        s.background = own.background.unwrap_or(s.background);
         for (_, m) in &d.materials {
             s.add_material(Material {
                 diffuse: m.diffuse,
@@ -211,4 +217,12 @@ mod tests {
             "{e}"
         );
     }
+}
+
+/// A scene file's `[raytrace]` table (unset: [`Scene::new`]'s ambient light and background).
+#[derive(serde::Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FileSettings {
+    ambient: Option<Vec3>,
+    background: Option<Vec3>,
 }
