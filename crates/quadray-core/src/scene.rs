@@ -91,7 +91,8 @@ pub struct SceneDescription {
     pub objects: Vec<Object>,
     /// Each technique's own scene settings, by the technique's name: the file's table of that
     /// name (`[indirect]`, `[raytrace]`), for the technique to read with
-    /// [`SceneDescription::technique_settings`]. Empty for glTF files.
+    /// [`SceneDescription::technique_settings`]; in glTF, the default scene's `extras` of that
+    /// name.
     pub techniques: BTreeMap<String, toml::Table>,
 }
 

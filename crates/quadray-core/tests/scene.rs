@@ -188,6 +188,36 @@ fn edited_gltf(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)
     path
 }
 
+/// A technique's settings in the glTF scene's `extras` read as its TOML table; other extras are
+/// left alone, and a technique's that is no table is refused with the file named.
+#[test]
+fn technique_settings_come_from_the_gltf_scenes_extras() {
+    #[derive(serde::Deserialize, Default, Debug, PartialEq)]
+    #[serde(deny_unknown_fields)]
+    struct Indirect {
+        r_min: Option<f32>,
+    }
+    let dir = scratch("gltf-extras");
+    let path = edited_gltf(&dir, "extras.gltf", |j| {
+        j["scenes"][0]["extras"] =
+            serde_json::json!({"indirect": {"r_min": 0.1}, "blender_prop": [1, 2]});
+    });
+    let scene = SceneDescription::load(&path).unwrap();
+    assert_eq!(
+        scene.technique_settings::<Indirect>("indirect"),
+        Ok(Indirect { r_min: Some(0.1) })
+    );
+    assert!(!scene.techniques.contains_key("raytrace"));
+    let bad = edited_gltf(&dir, "bad-extras.gltf", |j| {
+        j["scenes"][0]["extras"] = serde_json::json!({"raytrace": 3});
+    });
+    let err = refused(&bad);
+    assert!(
+        err.contains("bad-extras.gltf") && err.contains("raytrace"),
+        "{err}"
+    );
+}
+
 /// A change made to the bundled glTF scene's JSON.
 type Edit = fn(&mut serde_json::Value);
 

@@ -72,8 +72,32 @@ pub(super) fn load(path: &Path) -> Result<SceneDescription, FileError> {
             transform: Transform::IDENTITY,
             material: None,
         }],
-        techniques: Default::default(),
+        techniques: scene_extras(json).map_err(|why| FileError::new(path, why))?,
     })
+}
+
+/// Each technique's own settings from the default scene's `extras` (`{"indirect": {"r_min":
+/// 0.05}, "raytrace": {...}}`, as the TOML tables; Blender writes a scene's custom properties
+/// there). Other extras are left alone.
+fn scene_extras(
+    json: &gltf::json::Root,
+) -> Result<std::collections::BTreeMap<String, toml::Table>, String> {
+    let scene = json.scene.map_or(0, |s| s.value());
+    let Some(raw) = json.scenes.get(scene).and_then(|s| s.extras.as_ref()) else {
+        return Ok(Default::default());
+    };
+    let extras: serde_json::Value =
+        serde_json::from_str(raw.get()).map_err(|e| format!("scene {scene}: extras: {e}"))?;
+    let mut techniques = std::collections::BTreeMap::new();
+    for technique in ["indirect", "raytrace"] {
+        if let Some(settings) = extras.get(technique) {
+            let table = toml::Table::try_from(settings).map_err(|e| {
+                format!("scene {scene}: extras: {technique}: not a table of settings ({e})")
+            })?;
+            techniques.insert(technique.to_string(), table);
+        }
+    }
+    Ok(techniques)
 }
 
 /// A glTF camera looks down its node's -z with +y up.
