@@ -237,11 +237,7 @@ pub fn render(device: &wgpu::Device, queue: &wgpu::Queue, map: &HeightMap) -> im
     device
         .poll(wgpu::PollType::wait_indefinitely())
         .expect("GPU work finished");
-    let bytes = readback
-        .slice(..)
-        .get_mapped_range()
-        .expect("mapped")
-        .to_vec();
+    let bytes = readback.slice(..).get_mapped_range().to_vec();
     image::RgbaImage::from_raw(SIZE, SIZE, bytes).expect("SIZE x SIZE RGBA")
 }
 

@@ -17,9 +17,7 @@ pub(crate) fn map_buffer<T>(
     rx.recv()
         .map_err(|e| GpuError::Readback(e.to_string()))?
         .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let view = slice
-        .get_mapped_range()
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    let view = slice.get_mapped_range();
     let out = f(&view);
     drop(view);
     buffer.unmap();

@@ -167,11 +167,11 @@ pub fn render(
             module: &module,
             entry_point: Some("vs"),
             compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
+            buffers: &[wgpu::VertexBufferLayout {
                 array_stride: size_of::<Vertex>() as u64,
                 step_mode: wgpu::VertexStepMode::Vertex,
                 attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3],
-            })],
+            }],
         },
         primitive: Default::default(),
         depth_stencil: Some(nearest_depth(wgpu::TextureFormat::Depth32Float)),
@@ -281,7 +281,7 @@ pub fn render(
         .slice(..)
         .map_async(wgpu::MapMode::Read, |r| r.expect("map the readback"));
     device.poll(wgpu::PollType::wait_indefinitely())?;
-    let pixels = bytemuck::pod_collect_to_vec(&readback.slice(..).get_mapped_range()?);
+    let pixels = bytemuck::pod_collect_to_vec(&readback.slice(..).get_mapped_range());
     Ok(pixels)
 }
 

@@ -329,11 +329,9 @@ impl State {
             size_in_pixels: [self.config.width, self.config.height],
             pixels_per_point: ppp,
         };
-        for (id, deltas) in &textures.set {
-            for delta in deltas {
-                self.egui_renderer
-                    .update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
-            }
+        for (id, delta) in &textures.set {
+            self.egui_renderer
+                .update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         let extra = self.egui_renderer.update_buffers(
@@ -357,7 +355,7 @@ impl State {
             .queue
             .submit(extra.into_iter().chain([encoder.finish()]));
         self.window.pre_present_notify();
-        self.gpu.queue.present(frame);
+        frame.present();
         for id in &textures.free {
             self.egui_renderer.free_texture(id);
         }

@@ -272,11 +272,11 @@ impl SurfacePass {
                     constants: &constants,
                     ..Default::default()
                 };
-                let vertex_layouts = [Some(wgpu::VertexBufferLayout {
+                let vertex_layouts = [wgpu::VertexBufferLayout {
                     array_stride: std::mem::size_of::<crate::scene::Vertex>() as u64,
                     step_mode: wgpu::VertexStepMode::Vertex,
                     attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2],
-                })];
+                }];
                 device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some(method.name()),
                     layout: Some(layout),

@@ -85,11 +85,11 @@ pub(crate) fn raster_pipeline(
             module,
             entry_point: Some("vertex"),
             compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
+            buffers: &[wgpu::VertexBufferLayout {
                 array_stride: size_of::<Vertex>() as u64,
                 step_mode: wgpu::VertexStepMode::Vertex,
                 attributes: &VERTEX_ATTRIBUTES,
-            })],
+            }],
         },
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: Some(nearest_depth(DEPTH_FORMAT)),
