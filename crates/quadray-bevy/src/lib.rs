@@ -36,6 +36,7 @@
 
 #![warn(missing_docs)]
 
+pub mod gi;
 mod pyramid_image;
 
 pub use pyramid_image::{PyramidImageError, depth_map, pyramid_image};

@@ -40,6 +40,45 @@ pub struct SpotLight {
     pub intensity: Vec3,
 }
 
+impl SpotLight {
+    /// World -> light view.
+    pub fn view(&self) -> Mat4 {
+        let dir = self.spot.direction.normalize();
+        let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+        glam::camera::rh::view::look_to_mat4(self.position, dir, up)
+    }
+
+    /// Far plane of the light over geometry within `bounds` (min, max): everything is closer.
+    pub fn far(&self, bounds: (Vec3, Vec3)) -> f32 {
+        let (lo, hi) = bounds;
+        self.position.distance((lo + hi) * 0.5) + extent_of(bounds)
+    }
+
+    /// World -> light clip space (the RSM and shadow map projection) over geometry within
+    /// `bounds`: a square perspective of twice the cone.
+    pub fn view_proj(&self, bounds: (Vec3, Vec3)) -> Mat4 {
+        let far = self.far(bounds);
+        glam::camera::rh::proj::directx::perspective(
+            (2.0 * self.spot.cone_deg).to_radians(),
+            1.0,
+            far * 1e-3,
+            far,
+        ) * self.view()
+    }
+}
+
+/// Axis-aligned bounds (min, max) of `points`.
+pub fn bounds_of(points: impl IntoIterator<Item = Vec3>) -> (Vec3, Vec3) {
+    points
+        .into_iter()
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)))
+}
+
+/// Length of the diagonal of `bounds` (min, max), at least 1e-3.
+pub fn extent_of((lo, hi): (Vec3, Vec3)) -> f32 {
+    (hi - lo).length().max(1e-3)
+}
+
 /// A loaded scene, checked and flattened.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -160,46 +199,33 @@ impl Scene {
 
     /// Axis-aligned bounds of the geometry.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut lo = Vec3::splat(f32::MAX);
-        let mut hi = Vec3::splat(f32::MIN);
-        for v in self.triangles.iter().flatten() {
-            lo = lo.min(v.position.into());
-            hi = hi.max(v.position.into());
-        }
-        (lo, hi)
+        bounds_of(
+            self.triangles
+                .iter()
+                .flatten()
+                .map(|v| Vec3::from(v.position)),
+        )
     }
 
     /// Length of the bounds' diagonal: the unit of RSM depth (validity thresholds are fractions of
     /// it) and the far plane of every projection.
     pub fn extent(&self) -> f32 {
-        let (lo, hi) = self.bounds();
-        (hi - lo).length().max(1e-3)
+        extent_of(self.bounds())
     }
 
     /// World -> light view.
     pub fn light_view(&self) -> Mat4 {
-        let dir = self.light.spot.direction.normalize();
-        let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-        glam::camera::rh::view::look_to_mat4(self.light.position, dir, up)
+        self.light.view()
     }
 
     /// World -> light clip space (the RSM and shadow map projection).
     pub fn light_view_proj(&self) -> Mat4 {
-        let far = self.light_far();
-        glam::camera::rh::proj::directx::perspective(
-            (2.0 * self.light.spot.cone_deg).to_radians(),
-            1.0,
-            far * 1e-3,
-            far,
-        ) * self.light_view()
+        self.light.view_proj(self.bounds())
     }
 
     /// Far plane of the light: everything in the scene is closer.
     pub fn light_far(&self) -> f32 {
-        let (lo, hi) = self.bounds();
-        let p = self.light.position;
-        let centre = (lo + hi) * 0.5;
-        p.distance(centre) + self.extent()
+        self.light.far(self.bounds())
     }
 
     /// World -> camera clip space for a picture of this aspect ratio (width / height).

@@ -2,7 +2,7 @@
 //! the per-light uniforms made from them (the light itself, the gather's per-light terms).
 
 use super::contract::{LightTermsUniform, LightUniform};
-use crate::scene::Scene;
+use crate::scene::{Scene, SpotLight, extent_of};
 use crate::settings::Settings;
 use glam::{Mat4, Vec3};
 
@@ -31,16 +31,21 @@ pub struct Spot {
 impl Spot {
     /// The light of a quadray [`Scene`].
     pub fn of_scene(scene: &Scene) -> Self {
-        let l = &scene.light;
+        Self::new(&scene.light, scene.bounds())
+    }
+
+    /// `light` over geometry within `bounds` (min, max): for a renderer that keeps its own
+    /// scene (the RSM's projection and depth unit follow the bounds).
+    pub fn new(light: &SpotLight, bounds: (Vec3, Vec3)) -> Self {
         Self {
-            view_proj: scene.light_view_proj(),
-            position: l.position,
-            direction: l.spot.direction.normalize(),
-            cone_deg: l.spot.cone_deg,
-            falloff_deg: l.spot.falloff_deg,
-            intensity: l.intensity.to_array(),
-            extent: scene.extent(),
-            far: scene.light_far(),
+            view_proj: light.view_proj(bounds),
+            position: light.position,
+            direction: light.spot.direction.normalize(),
+            cone_deg: light.spot.cone_deg,
+            falloff_deg: light.spot.falloff_deg,
+            intensity: light.intensity.to_array(),
+            extent: extent_of(bounds),
+            far: light.far(bounds),
         }
     }
 

@@ -32,7 +32,7 @@ use passes::Passes;
 use quadray_gpu::GpuTimer;
 use resources::Resources;
 use rsm_sampling::RsmSampling;
-use std::cell::Cell;
+use std::sync::{Mutex, PoisonError};
 use temporal::Temporal;
 use tiles::Tiles;
 
@@ -64,7 +64,7 @@ pub struct Gather {
     direct: Direct,
     temporal: Temporal,
     /// The camera last set, to restart the (not reprojected) average when it moves.
-    camera: Cell<Option<(glam::Mat4, glam::Vec3)>>,
+    camera: Mutex<Option<(glam::Mat4, glam::Vec3)>>,
 }
 
 impl Gather {
@@ -87,7 +87,7 @@ impl Gather {
             brute_force: BruteForce::new(device, &res),
             direct: Direct::new(device, &res),
             temporal: Temporal::new(device, &res),
-            camera: Cell::new(None),
+            camera: Mutex::new(None),
             res,
         })
     }
@@ -114,7 +114,8 @@ impl Gather {
     /// position): indirect shadows read the G-buffer as a depth map. A camera that moves
     /// restarts the temporal filter's average.
     pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
-        if self.camera.replace(Some((view_proj, eye))) != Some((view_proj, eye)) {
+        let mut camera = self.camera.lock().unwrap_or_else(PoisonError::into_inner);
+        if camera.replace((view_proj, eye)) != Some((view_proj, eye)) {
             self.reset_history();
         }
         self.res.set_camera(queue, view_proj, eye);
@@ -199,8 +200,10 @@ impl Gather {
         self.res.settings()
     }
 
-    /// Indirect radiance per pixel, row-major: rgb, and w = 1 where the upsampler recomputed it.
-    pub(crate) fn indirect(&self) -> &wgpu::Buffer {
+    /// Indirect radiance per pixel, row-major, `[f32; 4]`: rgb, and w = 1 where the upsampler
+    /// recomputed it. Valid after [`Gather::record_indirect`]; a renderer composites it itself
+    /// or through an [`super::OutputPass`].
+    pub fn indirect(&self) -> &wgpu::Buffer {
         &self.res.outputs.indirect
     }
 
@@ -211,7 +214,7 @@ impl Gather {
 
     /// Per pixel, the last indirect passes' VPL evaluations, texel fetches, bound evaluations and
     /// refused splits (`[u32; 4]`).
-    pub(crate) fn counts(&self) -> &wgpu::Buffer {
+    pub fn counts(&self) -> &wgpu::Buffer {
         &self.res.outputs.counts
     }
 

@@ -4,7 +4,7 @@
 use super::resources::Resources;
 use crate::gpu::contract::dispatch_2d;
 use crate::settings::Method;
-use std::cell::Cell;
+use std::sync::{Mutex, PoisonError};
 
 /// The pass's own shader parts, after the shared ones.
 pub(crate) const WGSL: [&str; 1] = [include_str!("temporal.wgsl")];
@@ -13,7 +13,7 @@ pub(crate) struct Temporal {
     blend: wgpu::ComputePipeline,
     /// The method whose frames the history averages; `None` when it holds nothing to continue
     /// from.
-    history_of: Cell<Option<Method>>,
+    history_of: Mutex<Option<Method>>,
 }
 
 impl Temporal {
@@ -21,18 +21,25 @@ impl Temporal {
         let [blend] = res.pipelines(device, "gather temporal", &WGSL, ["temporal_blend"], &[]);
         Self {
             blend,
-            history_of: Cell::new(None),
+            history_of: Mutex::new(None),
         }
     }
 
     /// Forgets the average: the next frame starts it anew.
     pub fn reset(&self) {
-        self.history_of.set(None);
+        *self
+            .history_of
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = None;
     }
 
     /// Whether the history holds an average of `method`'s frames to blend this frame into.
     pub fn continues(&self, method: Method) -> bool {
-        self.history_of.get() == Some(method)
+        *self
+            .history_of
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            == Some(method)
     }
 
     /// Records the blend of this frame into the average, in a pass that has the groups bound.
@@ -51,6 +58,9 @@ impl Temporal {
     ) {
         let o = &res.outputs;
         encoder.copy_buffer_to_buffer(&o.indirect, 0, &o.history, 0, o.indirect.size());
-        self.history_of.set(Some(method));
+        *self
+            .history_of
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Some(method);
     }
 }

@@ -7,7 +7,7 @@ use super::resources::Resources;
 use crate::Method;
 use crate::gpu::contract::{bind_group, layout, storage_buffer, storage_entry, whole};
 use crate::wgsl;
-use std::cell::OnceCell;
+use std::sync::OnceLock;
 
 /// The pass's own shader parts, after the shared ones.
 pub(crate) const WGSL: [&str; 2] = [wgsl::BOUND, include_str!("tiles.wgsl")];
@@ -27,7 +27,7 @@ pub(crate) struct Tiles {
     lists_layout: wgpu::BindGroupLayout,
     /// Allocated by the first frame (up to [`crate::Settings::MAX_TILE_LIST_BYTES`]), so that
     /// the other methods pay nothing for them.
-    lists: OnceCell<TileLists>,
+    lists: OnceLock<TileLists>,
     /// To allocate the lists when first drawn.
     device: wgpu::Device,
 }
@@ -52,7 +52,7 @@ impl Tiles {
         Self {
             pipeline,
             lists_layout,
-            lists: OnceCell::new(),
+            lists: OnceLock::new(),
             device: device.clone(),
         }
     }

@@ -1,0 +1,253 @@
+//! One bounce of indirect light in a Bevy app: the bundled Cornell box glTF
+//! (`assets/scenes/cornell_spot.gltf`) loaded by Bevy's glTF loader, its spot light turning
+//! slowly, Bevy's direct light and shadows as they are, and quadray's light quadtree adding the
+//! bounce. G turns the bounce on and off; M cycles the method (the quadtree's cut, per-tile cuts,
+//! RSM sampling, every VPL); Space stops and restarts the light. The window's title says what is
+//! shown.
+//!
+//! `cargo run --release --bin quadray-bevy-gi` (`--bin`, not `-p`: Cargo then resolves features
+//! as for the whole workspace, and what the test build compiled is reused).
+//! Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
+//! [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the light still and
+//! saves the picture.
+
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::gltf::GltfAssetLabel;
+use bevy::pbr::DefaultOpaqueRendererMethod;
+use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
+use bevy::window::{ExitCondition, PrimaryWindow};
+use bevy::winit::WinitPlugin;
+use bevy::world_serialization::WorldAssetRoot;
+use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+use quadray_indirect::{Method, Settings};
+use std::time::Duration;
+
+const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+const SCENE: &str = "scenes/cornell_spot.gltf";
+/// The methods M cycles through.
+const METHODS: [Method; 4] = [
+    Method::Quadtree,
+    Method::QuadtreeTiles,
+    Method::Rsm,
+    Method::Reference,
+];
+/// The light's turn about the vertical (radians a second).
+const TURN: f32 = 0.25;
+
+/// The glTF file's camera, when it appears.
+type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
+
+/// What the first frame shows (`--no-gi`, `--method`).
+#[derive(Resource, Clone, Copy)]
+struct Shown {
+    gi: bool,
+    method: Method,
+    turning: bool,
+}
+
+#[derive(Resource)]
+struct Offscreen {
+    path: String,
+    target: Handle<Image>,
+    frames: u32,
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    let method = match value("--method").map(|m| m.parse::<Method>()) {
+        None => Method::Quadtree,
+        Some(Ok(m)) => m,
+        Some(Err(e)) => {
+            eprintln!("--method: {e}");
+            std::process::exit(2);
+        }
+    };
+    let offscreen = value("--screenshot");
+    let shown = Shown {
+        gi: !args.iter().any(|a| a == "--no-gi"),
+        method,
+        turning: offscreen.is_none(),
+    };
+    let mut app = App::new();
+    let assets = AssetPlugin {
+        file_path: ASSETS.into(),
+        ..default()
+    };
+    if let Some(path) = offscreen {
+        let window = WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            ..default()
+        };
+        app.add_plugins(
+            DefaultPlugins
+                .set(assets)
+                .set(window)
+                .disable::<WinitPlugin>(),
+        )
+        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(1)))
+        .insert_resource(Offscreen {
+            path,
+            target: Handle::default(),
+            frames: 0,
+        })
+        .add_systems(Update, save_when_ready);
+    } else {
+        app.add_plugins(DefaultPlugins.set(assets));
+    }
+    app.insert_resource(DefaultOpaqueRendererMethod::deferred())
+        .add_plugins(IndirectLightPlugin)
+        .insert_resource(shown)
+        .add_systems(Startup, setup)
+        .add_systems(Update, (configure, keys, turn_light, show_title).chain())
+        .run();
+}
+
+fn setup(
+    mut commands: Commands,
+    assets: Res<AssetServer>,
+    mut images: ResMut<Assets<Image>>,
+    offscreen: Option<ResMut<Offscreen>>,
+) {
+    commands.spawn(WorldAssetRoot(
+        assets.load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
+    ));
+    if let Some(mut offscreen) = offscreen {
+        offscreen.target = images.add(Image::new_target_texture(
+            256,
+            256,
+            TextureFormat::Rgba8UnormSrgb,
+            None,
+        ));
+    }
+}
+
+/// A camera where the file's is (that one turned off) gets the bounce (deferred, no MSAA, a
+/// 128^2 RSM: interactive on a CPU rasteriser too); the file's spot is marked as its source.
+fn configure(
+    mut commands: Commands,
+    cameras: Query<(Entity, &Transform, &Projection), FileCamera>,
+    lights: Query<Entity, (Added<SpotLight>, Without<IndirectLightSource>)>,
+    offscreen: Option<Res<Offscreen>>,
+    shown: Res<Shown>,
+) {
+    for light in &lights {
+        commands.entity(light).insert(IndirectLightSource);
+    }
+    for (file_camera, transform, projection) in &cameras {
+        commands.entity(file_camera).insert(Camera {
+            is_active: false,
+            ..default()
+        });
+        let mut camera = commands.spawn((
+            Camera3d::default(),
+            *transform,
+            projection.clone(),
+            Msaa::Off,
+            Tonemapping::AcesFitted,
+            IndirectLight {
+                settings: Settings {
+                    rsm_size: 128,
+                    ..Settings::DEFAULT
+                },
+                method: shown.method,
+                enabled: shown.gi,
+                ..default()
+            },
+        ));
+        if let Some(offscreen) = &offscreen {
+            camera.insert(RenderTarget::Image(offscreen.target.clone().into()));
+        }
+    }
+}
+
+fn keys(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut shown: ResMut<Shown>,
+    mut cameras: Query<&mut IndirectLight>,
+) {
+    if keys.just_pressed(KeyCode::KeyG) {
+        shown.gi = !shown.gi;
+    }
+    if keys.just_pressed(KeyCode::KeyM) {
+        let next = METHODS
+            .iter()
+            .position(|&m| m == shown.method)
+            .map_or(0, |i| i + 1);
+        shown.method = METHODS[next % METHODS.len()];
+    }
+    if keys.just_pressed(KeyCode::Space) {
+        shown.turning = !shown.turning;
+    }
+    for mut gi in &mut cameras {
+        if gi.enabled != shown.gi || gi.method != shown.method {
+            gi.enabled = shown.gi;
+            gi.method = shown.method;
+        }
+    }
+}
+
+fn turn_light(
+    time: Res<Time>,
+    shown: Res<Shown>,
+    mut lights: Query<&mut Transform, With<IndirectLightSource>>,
+) {
+    if shown.turning {
+        for mut t in &mut lights {
+            t.rotate_y(TURN * time.delta_secs());
+        }
+    }
+}
+
+fn show_title(shown: Res<Shown>, mut windows: Query<&mut Window, With<PrimaryWindow>>) {
+    let title = format!(
+        "quadray indirect light: {} ({}) - G: bounce on/off, M: method, Space: light {}",
+        if shown.gi { "on" } else { "off" },
+        shown.method.name(),
+        if shown.turning { "turning" } else { "still" },
+    );
+    // The title, not text in the picture: Bevy's UI and text stack would be most of the build.
+    for mut window in &mut windows {
+        if window.title != title {
+            window.title.clone_from(&title);
+        }
+    }
+}
+
+/// Off screen: save the target once the scene is loaded and the pipelines warm, then quit.
+/// (Each frame gathers anew on the CPU rasteriser: a few seconds a frame at this size.)
+fn save_when_ready(
+    mut commands: Commands,
+    mut offscreen: ResMut<Offscreen>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    offscreen.frames += 1;
+    match offscreen.frames {
+        // the scene loads in a few frames and the light is still: a few more for the pipelines
+        60 => {
+            let path = offscreen.path.clone();
+            commands
+                .spawn(Screenshot::image(offscreen.target.clone()))
+                .observe(save_to_disk(path))
+                .observe(
+                    |_: On<ScreenshotCaptured>, mut offscreen: ResMut<Offscreen>| {
+                        offscreen.frames = 10_000
+                    },
+                );
+        }
+        n if n > 10_000 => {
+            exit.write(AppExit::Success);
+        }
+        _ => {}
+    }
+}

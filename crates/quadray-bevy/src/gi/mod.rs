@@ -1,0 +1,292 @@
+//! One bounce of indirect light from a Bevy `SpotLight` through quadray's light quadtree
+//! (`quadray_indirect`): the light's reflective shadow map, the cluster pyramid and its cut, the
+//! gather over the camera's deferred G-buffer, added to the lit HDR picture before tone mapping.
+//! Bevy's own direct light, shadows, materials and exposure stay as they are.
+//!
+//! ```no_run
+//! use bevy::core_pipeline::prepass::DeferredPrepass;
+//! use bevy::pbr::DefaultOpaqueRendererMethod;
+//! use bevy::prelude::*;
+//! use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+//!
+//! fn setup(mut commands: Commands) {
+//!     commands.spawn((SpotLight::default(), IndirectLightSource, Transform::default()));
+//!     commands.spawn((Camera3d::default(), Msaa::Off, IndirectLight::default()));
+//! }
+//!
+//! App::new()
+//!     // the gather reads the deferred G-buffer: StandardMaterials render deferred
+//!     .insert_resource(DefaultOpaqueRendererMethod::deferred())
+//!     .add_plugins((DefaultPlugins, IndirectLightPlugin))
+//!     .add_systems(Startup, setup)
+//!     .run();
+//! ```
+//!
+//! The passes are `quadray_indirect`'s own, recorded into Bevy's command encoder on Bevy's
+//! device (quadray builds on the wgpu Bevy 0.19 uses); the plugin adds only the translation of
+//! Bevy's packed G-buffer (`gbuffer.wgsl`, with Bevy's unpacking functions) and the additive
+//! composite (`composite.wgsl`). The light's RSM is rasterised from the scene's triangles,
+//! gathered on the CPU from every visible `Mesh3d` with a `StandardMaterial` (its base colour;
+//! textures are not read) whenever a mesh, material or transform changes; a moving light rebuilds
+//! the RSM, the pyramid and the cut, a still light and a moving camera reuse them.
+//!
+//! Units: the light's intensity is Bevy's (luminous power, lumens; a spot's luminous intensity
+//! is that over 4 pi, as Bevy lights it), so the indirect light is in the same units as Bevy's
+//! direct light and is scaled by the camera's exposure as Bevy's is.
+
+mod render;
+
+use bevy::asset::{AssetEvent, uuid_handle};
+use bevy::camera::Hdr;
+use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
+use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
+use bevy::pbr::StandardMaterial;
+use bevy::prelude::*;
+use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
+use bevy::render::extract_resource::{ExtractResource, ExtractResourcePlugin};
+use bevy::render::storage::ShaderBuffer;
+use bevy::shader::Shader;
+use quadray_indirect::scene::{Spot, SpotLight as QuadraySpot, Vertex};
+use quadray_indirect::{Method, Settings};
+use std::sync::Arc;
+
+const GBUFFER_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d11");
+
+/// Adds [`IndirectLight`] to the cameras that carry it, from the spot light marked
+/// [`IndirectLightSource`]. Add it after `DefaultPlugins`; the cameras need deferred rendering
+/// (`DefaultOpaqueRendererMethod::deferred()` or deferred materials) and `Msaa::Off`.
+pub struct IndirectLightPlugin;
+
+impl Plugin for IndirectLightPlugin {
+    fn build(&self, app: &mut App) {
+        let _ = app.world_mut().resource_mut::<Assets<Shader>>().insert(
+            &GBUFFER_SHADER,
+            Shader::from_wgsl(include_str!("gbuffer.wgsl"), "quadray/gi_gbuffer.wgsl"),
+        );
+        app.add_plugins((
+            ExtractComponentPlugin::<IndirectLight>::default(),
+            ExtractResourcePlugin::<IndirectLightScene>::default(),
+        ))
+        .init_resource::<IndirectLightScene>()
+        .add_systems(
+            PostUpdate,
+            (collect_triangles, collect_light)
+                .after(bevy::transform::TransformSystems::Propagate)
+                .after(bevy::camera::visibility::VisibilitySystems::VisibilityPropagate),
+        );
+        render::build(app);
+    }
+}
+
+/// On a camera: add one bounce of indirect light from the [`IndirectLightSource`] spot (to the
+/// HDR picture, before tone mapping: the camera gets `Hdr` and Bevy's depth and deferred prepasses).
+#[derive(Component, Clone, Debug, ExtractComponent)]
+#[require(DepthPrepass, DeferredPrepass, Hdr)]
+pub struct IndirectLight {
+    /// quadray's light-quadtree settings (RSM size, cut levels, validity thresholds, per-tile
+    /// cuts, indirect shadows, temporal weight, ...); `size` is ignored: the gather runs at the
+    /// camera's size.
+    pub settings: Settings,
+    /// How the indirect light is gathered: the quadtree's cut (default), per-tile cuts, the
+    /// paper's per-level passes, RSM sampling, or every VPL (the brute force).
+    pub method: Method,
+    /// Clamp of the VPL kernel's distance (world units): 1/r^4 is taken at no less than this.
+    pub r_min: f32,
+    /// `false` keeps what is built but gathers and adds no light (to compare).
+    pub enabled: bool,
+    /// Debug output: each frame's indirect radiance (`[f32; 4]` a pixel, row-major, before the
+    /// exposure) copied into this buffer, when it has room.
+    pub debug_indirect: Option<Handle<ShaderBuffer>>,
+}
+
+impl Default for IndirectLight {
+    fn default() -> Self {
+        Self {
+            settings: Settings::DEFAULT,
+            method: Method::Quadtree,
+            r_min: quadray_indirect::scene::DEFAULT_R_MIN,
+            enabled: true,
+            debug_indirect: None,
+        }
+    }
+}
+
+/// On a `SpotLight`: the light whose first bounce [`IndirectLight`] cameras add (the first
+/// one marked, when several are).
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct IndirectLightSource;
+
+/// What the render world needs of the main world's scene: its triangles (rebuilt when a mesh,
+/// material or transform changes) and the marked spot light.
+#[derive(Resource, Clone, Default, ExtractResource)]
+struct IndirectLightScene {
+    triangles: Arc<Vec<[Vertex; 3]>>,
+    /// Counts the rebuilds of `triangles`.
+    generation: u64,
+    light: Option<QuadraySpot>,
+}
+
+/// Bevy's spot light as quadray's: luminous intensity (lumens over 4 pi, as Bevy lights a spot)
+/// on the axis, the outer angle as the cone, the fade from the inner angle as its falloff.
+pub fn quadray_spot(light: &SpotLight, transform: &GlobalTransform) -> QuadraySpot {
+    let colour = LinearRgba::from(light.color);
+    let candela = light.intensity / (4.0 * std::f32::consts::PI);
+    let cone_deg = light.outer_angle.to_degrees();
+    QuadraySpot {
+        position: glam::Vec3::from_array(transform.translation().to_array()),
+        spot: Spot {
+            direction: glam::Vec3::from_array(transform.forward().to_array()),
+            cone_deg,
+            falloff_deg: (light.outer_angle - light.inner_angle)
+                .to_degrees()
+                .clamp(0.0, cone_deg),
+        },
+        intensity: glam::Vec3::new(colour.red, colour.green, colour.blue) * candela,
+    }
+}
+
+fn collect_light(
+    lights: Query<(&SpotLight, &GlobalTransform), With<IndirectLightSource>>,
+    cameras: Query<(), With<IndirectLight>>,
+    mut scene: ResMut<IndirectLightScene>,
+    mut warned: Local<Option<String>>,
+) {
+    let mut warn = |message: String| {
+        if warned.as_ref() != Some(&message) {
+            warn!("{message}");
+            *warned = Some(message);
+        }
+    };
+    let light = lights.iter().next().map(|(l, t)| quadray_spot(l, t));
+    let light = match light {
+        None if !cameras.is_empty() => {
+            warn(
+                "quadray indirect light: no SpotLight has IndirectLightSource; add that component \
+                 to the spot light whose bounce the IndirectLight cameras should show"
+                    .into(),
+            );
+            None
+        }
+        Some(l) => match l.spot.validate().and_then(|()| {
+            let max = quadray_indirect::Scene::MAX_CONE_DEG;
+            if l.spot.cone_deg > max {
+                Err(format!(
+                    "its outer angle {:.1} degrees is over {max} (the RSM sees twice the cone)",
+                    l.spot.cone_deg
+                ))
+            } else if !(l.position.is_finite() && l.intensity.is_finite())
+                || l.intensity.min_element() < 0.0
+            {
+                Err("its position or intensity is not finite and positive".into())
+            } else {
+                Ok(())
+            }
+        }) {
+            Ok(()) => Some(l),
+            Err(e) => {
+                warn(format!(
+                    "quadray indirect light: the IndirectLightSource spot is skipped: {e}"
+                ));
+                None
+            }
+        },
+        None => None,
+    };
+    if scene.light != light {
+        scene.light = light;
+    }
+}
+
+/// The objects whose triangles make the RSM.
+type Objects<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Ref<'static, GlobalTransform>,
+        Ref<'static, Mesh3d>,
+        Option<Ref<'static, MeshMaterial3d<StandardMaterial>>>,
+        Ref<'static, InheritedVisibility>,
+    ),
+>;
+
+#[allow(clippy::too_many_arguments)]
+fn collect_triangles(
+    objects: Objects,
+    meshes: Res<Assets<Mesh>>,
+    materials: Res<Assets<StandardMaterial>>,
+    mut mesh_events: MessageReader<AssetEvent<Mesh>>,
+    mut material_events: MessageReader<AssetEvent<StandardMaterial>>,
+    mut removed: RemovedComponents<Mesh3d>,
+    mut scene: ResMut<IndirectLightScene>,
+    mut count: Local<usize>,
+) {
+    let events =
+        mesh_events.read().count() + material_events.read().count() + removed.read().count();
+    let changed = objects.iter().any(|(t, m, mat, v)| {
+        t.is_changed() || m.is_changed() || v.is_changed() || mat.is_some_and(|m| m.is_changed())
+    });
+    if events == 0 && !changed && objects.iter().len() == *count {
+        return;
+    }
+    *count = objects.iter().len();
+    let mut triangles = Vec::new();
+    for (transform, mesh, material, visible) in &objects {
+        let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) else {
+            continue;
+        };
+        let albedo = material
+            .and_then(|m| materials.get(&m.0))
+            .map_or(Vec3::splat(0.5), |m| {
+                let c = LinearRgba::from(m.base_color);
+                Vec3::new(c.red, c.green, c.blue) * (1.0 - m.metallic)
+            });
+        append_triangles(mesh, &transform, albedo.to_array(), &mut triangles);
+    }
+    scene.triangles = Arc::new(triangles);
+    scene.generation += 1;
+}
+
+/// Appends `mesh`'s triangles in world space (a triangle list with positions; face normals where
+/// it has none); other topologies add nothing.
+fn append_triangles(
+    mesh: &Mesh,
+    transform: &GlobalTransform,
+    albedo: [f32; 3],
+    out: &mut Vec<[Vertex; 3]>,
+) {
+    if mesh.primitive_topology() != PrimitiveTopology::TriangleList {
+        return;
+    }
+    let Some(VertexAttributeValues::Float32x3(positions)) =
+        mesh.attribute(Mesh::ATTRIBUTE_POSITION)
+    else {
+        return;
+    };
+    let normals = match mesh.attribute(Mesh::ATTRIBUTE_NORMAL) {
+        Some(VertexAttributeValues::Float32x3(n)) if n.len() == positions.len() => Some(n),
+        _ => None,
+    };
+    let affine = transform.affine();
+    let normal_matrix = Mat3::from(affine.matrix3).inverse().transpose();
+    let vertex = |i: usize, face: Vec3| Vertex {
+        position: affine.transform_point3(Vec3::from(positions[i])).into(),
+        normal: normals
+            .map_or(face, |n| {
+                (normal_matrix * Vec3::from(n[i])).normalize_or_zero()
+            })
+            .into(),
+        albedo,
+    };
+    let corners: Vec<usize> = match mesh.indices() {
+        Some(indices @ (Indices::U16(_) | Indices::U32(_))) => indices.iter().collect(),
+        None => (0..positions.len()).collect(),
+    };
+    for t in corners.chunks_exact(3) {
+        if t.iter().any(|&i| i >= positions.len()) {
+            continue;
+        }
+        let p = [t[0], t[1], t[2]].map(|i| affine.transform_point3(Vec3::from(positions[i])));
+        let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        out.push([vertex(t[0], face), vertex(t[1], face), vertex(t[2], face)]);
+    }
+}

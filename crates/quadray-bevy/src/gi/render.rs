@@ -1,0 +1,598 @@
+//! The render world's side: per light, quadray's RSM and light quadtree; per camera, the
+//! G-buffer translated from Bevy's, quadray's gather, and the additive composite into the view.
+
+use super::{GBUFFER_SHADER, IndirectLight, IndirectLightScene};
+use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
+use bevy::core_pipeline::prepass::ViewPrepassTextures;
+use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::render::camera::ExtractedCamera;
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::binding_types::{
+    texture_2d, texture_depth_2d, texture_storage_2d, uniform_buffer_sized,
+};
+use bevy::render::render_resource::{
+    BindGroupLayoutDescriptor, BindGroupLayoutEntries, CachedComputePipelineId,
+    ComputePipelineDescriptor, PipelineCache, ShaderStages, StorageTextureAccess, TextureFormat,
+    TextureSampleType,
+};
+use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
+use bevy::render::storage::GpuShaderBuffer;
+use bevy::render::view::{ExtractedView, ViewTarget};
+use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
+use quadray_indirect::scene::SpotLight as QuadraySpot;
+use quadray_indirect::{
+    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, RsmPass, Settings,
+};
+use quadray_indirect::{Spot, scene::bounds_of};
+use std::num::NonZero;
+use std::sync::{Mutex, PoisonError};
+
+const COMPOSITE_WGSL: &str = include_str!("composite.wgsl");
+/// The G-buffer translation's uniform: world_from_clip, the eye (xyz), the size (two u32).
+const VIEW_UNIFORM_BYTES: u64 = 64 + 16 + 16;
+
+pub(super) fn build(app: &mut App) {
+    let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+        return;
+    };
+    render_app
+        .init_resource::<LightState>()
+        .add_systems(RenderStartup, init_pipelines)
+        .add_systems(
+            Render,
+            (prepare_light, prepare_views)
+                .chain()
+                .in_set(RenderSystems::PrepareBindGroups),
+        )
+        .add_systems(
+            Core3d,
+            indirect_light_pass
+                .after(main_opaque_pass_3d)
+                .before(main_transparent_pass_3d)
+                .in_set(Core3dSystems::MainPass),
+        );
+}
+
+#[derive(Resource)]
+struct Pipelines {
+    gbuffer_layout: BindGroupLayoutDescriptor,
+    gbuffer: CachedComputePipelineId,
+    composite_layout: wgpu::BindGroupLayout,
+    composite_module: wgpu::ShaderModule,
+    /// By the view target's format.
+    composite: HashMap<TextureFormat, wgpu::RenderPipeline>,
+}
+
+fn init_pipelines(
+    mut commands: Commands,
+    device: Res<RenderDevice>,
+    pipeline_cache: Res<PipelineCache>,
+) {
+    let gbuffer_layout = BindGroupLayoutDescriptor::new(
+        "quadray gi gbuffer",
+        &BindGroupLayoutEntries::sequential(
+            ShaderStages::COMPUTE,
+            (
+                texture_2d(TextureSampleType::Uint),
+                texture_depth_2d(),
+                uniform_buffer_sized(false, NonZero::new(VIEW_UNIFORM_BYTES)),
+                texture_storage_2d(FLOAT_FORMAT, StorageTextureAccess::WriteOnly),
+                texture_storage_2d(FLOAT_FORMAT, StorageTextureAccess::WriteOnly),
+                texture_storage_2d(FLOAT_FORMAT, StorageTextureAccess::WriteOnly),
+            ),
+        ),
+    );
+    let gbuffer = pipeline_cache.queue_compute_pipeline(ComputePipelineDescriptor {
+        label: Some("quadray gi gbuffer".into()),
+        layout: vec![gbuffer_layout.clone()],
+        shader: GBUFFER_SHADER,
+        entry_point: Some("translate".into()),
+        ..default()
+    });
+    let device = device.wgpu_device();
+    let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("quadray gi composite"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ],
+    });
+    let composite_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("quadray gi composite"),
+        source: wgpu::ShaderSource::Wgsl(COMPOSITE_WGSL.into()),
+    });
+    commands.insert_resource(Pipelines {
+        gbuffer_layout,
+        gbuffer,
+        composite_layout,
+        composite_module,
+        composite: HashMap::default(),
+    });
+}
+
+/// The composite's additive pipeline into a target of `format`.
+fn composite_pipeline(
+    device: &wgpu::Device,
+    pipelines: &Pipelines,
+    format: TextureFormat,
+) -> wgpu::RenderPipeline {
+    let add = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    let keep = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::Zero,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("quadray gi composite"),
+        bind_group_layouts: &[Some(&pipelines.composite_layout)],
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("quadray gi composite"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &pipelines.composite_module,
+            entry_point: Some("fullscreen"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &pipelines.composite_module,
+            entry_point: Some("add_indirect"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: Some(wgpu::BlendState {
+                    color: add,
+                    alpha: keep,
+                }),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The light's side, shared by every camera: its RSM over the scene's triangles and the light
+/// quadtree built over it.
+#[derive(Resource, Default)]
+struct LightState(Option<LightPasses>);
+
+struct LightPasses {
+    rsm: RsmPass,
+    quadtree: LightQuadtree,
+    rsm_size: u32,
+    vertices: Option<(wgpu::Buffer, u32)>,
+    generation: u64,
+    light: Option<QuadraySpot>,
+    spot: Option<Spot>,
+    /// The RSM, pyramid and cut are to be recorded again (the light or the scene changed).
+    stale: bool,
+    /// Counts the changes that make `stale`: a camera's last gather names the one it saw.
+    epoch: u64,
+}
+
+fn prepare_light(
+    scene: Option<Res<IndirectLightScene>>,
+    cameras: Query<&IndirectLight>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    mut state: ResMut<LightState>,
+) {
+    let (Some(scene), Some(camera)) = (scene, cameras.iter().next()) else {
+        return;
+    };
+    let device = device.wgpu_device();
+    let settings = &camera.settings;
+    let cluster = settings.cluster;
+    let rebuild = state
+        .0
+        .as_ref()
+        .is_none_or(|l| l.rsm_size != settings.rsm_size);
+    if rebuild {
+        let rsm = RsmPass::new(device, settings.rsm_size);
+        let quadtree = LightQuadtree::new(device, &queue, settings.rsm_size, cluster, rsm.views());
+        state.0 = Some(LightPasses {
+            rsm,
+            quadtree,
+            rsm_size: settings.rsm_size,
+            vertices: None,
+            generation: u64::MAX,
+            light: None,
+            spot: None,
+            stale: true,
+            epoch: 0,
+        });
+    }
+    let Some(l) = state.0.as_mut() else { return };
+    if l.quadtree.cluster() != cluster {
+        l.quadtree.set_cluster(&queue, cluster);
+        l.stale = true;
+        l.epoch += 1;
+    }
+    if l.generation != scene.generation {
+        l.generation = scene.generation;
+        l.vertices = (!scene.triangles.is_empty()).then(|| {
+            use wgpu::util::DeviceExt;
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("quadray gi triangles"),
+                contents: bytemuck::cast_slice(scene.triangles.as_slice()),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            (buffer, scene.triangles.len() as u32 * 3)
+        });
+        l.light = None;
+    }
+    if l.light != scene.light {
+        l.light = scene.light;
+        l.spot = scene.light.map(|light| {
+            let bounds = bounds_of(
+                scene
+                    .triangles
+                    .iter()
+                    .flatten()
+                    .map(|v| glam::Vec3::from(v.position)),
+            );
+            Spot::new(&light, bounds)
+        });
+        if let Some(spot) = &l.spot {
+            l.rsm.set_light(&queue, spot);
+        }
+        l.stale = true;
+        l.epoch += 1;
+    }
+}
+
+/// A camera's side: quadray's G-buffer (translated from Bevy's), its gather and composite.
+#[derive(Component)]
+pub(super) struct ViewPasses {
+    settings: Settings,
+    format: TextureFormat,
+    /// Position, normal, albedo.
+    gbuffer: [wgpu::TextureView; 3],
+    view_uniform: wgpu::Buffer,
+    gather: Gather,
+    composite_uniform: wgpu::Buffer,
+    composite_group: wgpu::BindGroup,
+    composite: wgpu::RenderPipeline,
+    /// What this frame's gather would see (set when preparing).
+    inputs: Mutex<Option<GatherInputs>>,
+    /// What the last gather saw: a frame that sees the same (and has no temporal filter to
+    /// feed) composites the last radiance again.
+    last_gather: Mutex<Option<GatherInputs>>,
+}
+
+/// What a gather's result depends on besides the settings.
+#[derive(Clone, Copy, PartialEq)]
+struct GatherInputs {
+    clip_from_world: Mat4,
+    light_epoch: u64,
+    method: Method,
+}
+
+impl ViewPasses {
+    fn new(
+        device: &wgpu::Device,
+        settings: Settings,
+        light: &LightPasses,
+        composite: wgpu::RenderPipeline,
+        composite_layout: &wgpu::BindGroupLayout,
+        format: TextureFormat,
+    ) -> Result<Self, quadray_indirect::IndirectError> {
+        let size = wgpu::Extent3d {
+            width: settings.size.width,
+            height: settings.size.height,
+            depth_or_array_layers: 1,
+        };
+        let gbuffer = ["position", "normal", "albedo"].map(|label| {
+            device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size,
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: FLOAT_FORMAT,
+                    usage: wgpu::TextureUsages::STORAGE_BINDING
+                        | wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+                .create_view(&Default::default())
+        });
+        let views = GBufferViews {
+            position: &gbuffer[0],
+            normal: &gbuffer[1],
+            albedo: &gbuffer[2],
+        };
+        let gather = Gather::new(device, &settings, &light.quadtree, light.rsm.views(), views)?;
+        let uniform = |label, size| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let view_uniform = uniform("quadray gi view", VIEW_UNIFORM_BYTES);
+        let composite_uniform = uniform("quadray gi composite", 16);
+        let composite_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("quadray gi composite"),
+            layout: composite_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: gather.indirect().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: composite_uniform.as_entire_binding(),
+                },
+            ],
+        });
+        Ok(Self {
+            settings,
+            format,
+            gbuffer,
+            view_uniform,
+            gather,
+            composite_uniform,
+            composite_group,
+            composite,
+            inputs: Mutex::new(None),
+            last_gather: Mutex::new(None),
+        })
+    }
+}
+
+/// What [`prepare_views`] reads of each camera with [`IndirectLight`].
+type Views<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static IndirectLight,
+        &'static ExtractedView,
+        &'static ExtractedCamera,
+        &'static ViewTarget,
+        Option<&'static ViewPrepassTextures>,
+        Option<&'static ViewPasses>,
+    ),
+>;
+
+fn prepare_views(
+    mut commands: Commands,
+    views: Views,
+    light: Res<LightState>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    mut pipelines: ResMut<Pipelines>,
+    mut warned: Local<HashMap<Entity, String>>,
+) {
+    let Some(l) = light.0.as_ref() else { return };
+    let device = device.wgpu_device();
+    for (entity, gi, view, camera, target, prepass, passes) in &views {
+        let mut warn = |message: String| {
+            if warned.get(&entity) != Some(&message) {
+                warn!("quadray indirect light on camera {entity}: {message}");
+                warned.insert(entity, message);
+            }
+        };
+        let problem = if prepass.and_then(|p| p.deferred.as_ref()).is_none() {
+            Some(
+                "the camera has no deferred G-buffer: render its materials deferred \
+                 (insert the resource DefaultOpaqueRendererMethod::deferred())",
+            )
+        } else if !camera.hdr {
+            Some(
+                "the camera renders without Hdr, so Bevy tone-maps in its lighting shaders and the \
+                  bounce would be added after: keep the Hdr component IndirectLight brings",
+            )
+        } else if target.sampled_main_texture().is_some() {
+            Some(
+                "MSAA is on, and Bevy's deferred G-buffer needs it off: add Msaa::Off to the camera",
+            )
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
+            warn(format!("{problem}; no indirect light is added"));
+            commands.entity(entity).remove::<ViewPasses>();
+            continue;
+        }
+        let Some(size) = camera.physical_viewport_size.filter(|s| s.x > 0 && s.y > 0) else {
+            continue;
+        };
+        let mut settings = gi.settings.clone();
+        settings.size = quadray_indirect::Size {
+            width: size.x,
+            height: size.y,
+        };
+        let format = target.main_texture_format();
+        let Some(passes) = passes.filter(|p| p.settings == settings && p.format == format) else {
+            let composite = match pipelines.composite.get(&format) {
+                Some(p) => p.clone(),
+                None => {
+                    let p = composite_pipeline(device, &pipelines, format);
+                    pipelines.composite.insert(format, p.clone());
+                    p
+                }
+            };
+            let layout = &pipelines.composite_layout;
+            match ViewPasses::new(device, settings, l, composite, layout, format) {
+                Ok(p) => {
+                    commands.entity(entity).insert(p);
+                }
+                Err(e) => {
+                    warn(format!("{e}; no indirect light is added"));
+                    commands.entity(entity).remove::<ViewPasses>();
+                }
+            }
+            // the new passes start next frame
+            continue;
+        };
+        let Some(spot) = &l.spot else { continue };
+        let inputs = GatherInputs {
+            clip_from_world: view.clip_from_world.unwrap_or_else(|| {
+                view.clip_from_view * view.world_from_view.to_matrix().inverse()
+            }),
+            light_epoch: l.epoch,
+            method: gi.method,
+        };
+        *lock(&passes.inputs) = Some(inputs);
+        let clip_from_world = inputs.clip_from_world;
+        let eye = view.world_from_view.translation();
+        passes.gather.set_camera(
+            &queue,
+            glam::Mat4::from_cols_array(&clip_from_world.to_cols_array()),
+            glam::Vec3::from_array(eye.to_array()),
+        );
+        passes.gather.set_light(&queue, spot, gi.r_min);
+        let mut uniform: Vec<f32> = clip_from_world.inverse().to_cols_array().to_vec();
+        uniform.extend([eye.x, eye.y, eye.z, 1.0]);
+        uniform.extend([f32::from_bits(size.x), f32::from_bits(size.y), 0.0, 0.0]);
+        queue.write_buffer(&passes.view_uniform, 0, bytemuck::cast_slice(&uniform));
+        let composite = [size.x, camera.exposure.to_bits(), 0, 0];
+        queue.write_buffer(
+            &passes.composite_uniform,
+            0,
+            bytemuck::cast_slice(&composite),
+        );
+    }
+}
+
+/// Records, for one camera: the light's RSM, pyramid and cut when they are stale, the G-buffer
+/// translation, the gather, the debug copy and the composite into the view.
+fn indirect_light_pass(
+    view: ViewQuery<(
+        &ViewPasses,
+        &ViewTarget,
+        &ViewPrepassTextures,
+        &IndirectLight,
+    )>,
+    mut light: ResMut<LightState>,
+    pipelines: Res<Pipelines>,
+    pipeline_cache: Res<PipelineCache>,
+    buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    mut ctx: RenderContext,
+) {
+    let (passes, target, prepass, gi) = view.into_inner();
+    let Some(l) = light.0.as_mut().filter(|_| gi.enabled) else {
+        return;
+    };
+    let (Some((vertices, vertex_count)), Some(_)) = (&l.vertices, &l.spot) else {
+        return;
+    };
+    let Some(translate) = pipeline_cache.get_compute_pipeline(pipelines.gbuffer) else {
+        return;
+    };
+    let (Some(deferred), Some(depth)) = (prepass.deferred_view(), prepass.depth_view()) else {
+        return;
+    };
+    let layout = pipeline_cache.get_bind_group_layout(&pipelines.gbuffer_layout);
+    let resources = [
+        wgpu::BindingResource::TextureView(deferred),
+        wgpu::BindingResource::TextureView(depth),
+        passes.view_uniform.as_entire_binding(),
+        wgpu::BindingResource::TextureView(&passes.gbuffer[0]),
+        wgpu::BindingResource::TextureView(&passes.gbuffer[1]),
+        wgpu::BindingResource::TextureView(&passes.gbuffer[2]),
+    ];
+    let group = ctx
+        .render_device()
+        .wgpu_device()
+        .create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("quadray gi gbuffer"),
+            layout: &layout,
+            entries: &resources
+                .into_iter()
+                .enumerate()
+                .map(|(i, resource)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource,
+                })
+                .collect::<Vec<_>>(),
+        });
+    let encoder = ctx.command_encoder();
+    if l.stale {
+        l.rsm
+            .record(encoder, vertices.slice(..), *vertex_count, None);
+        l.quadtree.record_build(encoder, None);
+        l.quadtree.record_cut(encoder, None);
+        l.stale = false;
+    }
+    let inputs = *lock(&passes.inputs);
+    let mut last = lock(&passes.last_gather);
+    if *last != inputs || passes.settings.temporal_weight < 1.0 {
+        *last = inputs;
+        let size = passes.settings.size;
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("quadray gi gbuffer"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(translate);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(size.width.div_ceil(8), size.height.div_ceil(8), 1);
+        }
+        passes
+            .gather
+            .record_indirect(encoder, gi.method, &l.quadtree, None);
+    }
+    if let Some(debug) = gi.debug_indirect.as_ref().and_then(|h| buffers.get(h)) {
+        let indirect = passes.gather.indirect();
+        if debug.buffer.size() >= indirect.size() {
+            encoder.copy_buffer_to_buffer(indirect, 0, &debug.buffer, 0, indirect.size());
+        }
+    }
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("quadray gi composite"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target.main_texture_view(),
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
+        });
+        pass.set_pipeline(&passes.composite);
+        pass.set_bind_group(0, &passes.composite_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// The value behind `mutex`, also after a panic elsewhere (every value here is whole).
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}

@@ -1,0 +1,265 @@
+//! The indirect-light plugin in a real Bevy app, headless on lavapipe, on the bundled Cornell box
+//! glTF loaded by Bevy's glTF loader (its camera and spot light): the plugin's brute force
+//! against quadray's own renderer (`quadray indirect --method reference`) on the same file, the
+//! plugin's quadtree against its brute force, and GI on against off in the final picture.
+
+use bevy::app::PluginsState;
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::gltf::GltfAssetLabel;
+use bevy::pbr::DefaultOpaqueRendererMethod;
+use bevy::prelude::*;
+use bevy::render::gpu_readback::{Readback, ReadbackComplete};
+use bevy::render::render_resource::{BufferUsages, TextureFormat, TextureUsages};
+use bevy::render::storage::ShaderBuffer;
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use bevy::world_serialization::WorldAssetRoot;
+use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+use quadray_indirect::reference::compare;
+use quadray_indirect::{Method, Renderer, Scene, Settings};
+use std::sync::{Arc, Mutex};
+
+const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+const SCENE: &str = "scenes/cornell_spot.gltf";
+const SIZE: u32 = 64;
+const RSM: u32 = 64;
+/// Further back than the file's camera (z = 2.4), so that the background shows around the box.
+const EYE: [f32; 3] = [0.5, 0.5, 3.4];
+const TARGET: [f32; 3] = [0.5, 0.5, 0.0];
+
+/// What one camera records, read back each frame (the latest kept).
+#[derive(Clone)]
+struct Probe {
+    method: Method,
+    enabled: bool,
+    indirect: Handle<ShaderBuffer>,
+    picture: Handle<Image>,
+    read_indirect: Arc<Mutex<Option<Vec<u8>>>>,
+    read_picture: Arc<Mutex<Option<Vec<u8>>>>,
+}
+
+#[derive(Resource)]
+struct Probes(Vec<Probe>);
+
+const CASES: [(Method, bool); 3] = [
+    (Method::Reference, true),
+    (Method::Quadtree, true),
+    (Method::Quadtree, false),
+];
+
+fn setup(
+    mut commands: Commands,
+    assets: Res<AssetServer>,
+    mut images: ResMut<Assets<Image>>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+) {
+    commands.spawn(WorldAssetRoot(
+        assets.load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
+    ));
+    let probes = CASES
+        .map(|(method, enabled)| {
+            let mut indirect = ShaderBuffer::with_size((SIZE * SIZE * 16) as usize, default());
+            indirect.buffer_description.usage |= BufferUsages::COPY_SRC | BufferUsages::COPY_DST;
+            let mut target =
+                Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
+            target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+            Probe {
+                method,
+                enabled,
+                indirect: buffers.add(indirect),
+                picture: images.add(target),
+                read_indirect: Arc::default(),
+                read_picture: Arc::default(),
+            }
+        })
+        .to_vec();
+    commands.insert_resource(Probes(probes));
+}
+
+/// The glTF's camera, when it appears.
+type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
+
+/// Once the glTF's camera and light exist: one camera per case with the file's projection, and
+/// the file's spot marked as the bounce's source.
+fn configure(
+    mut commands: Commands,
+    cameras: Query<(Entity, &Projection), FileCamera>,
+    lights: Query<Entity, (With<SpotLight>, Without<IndirectLightSource>)>,
+    probes: Res<Probes>,
+) {
+    for light in &lights {
+        commands.entity(light).insert(IndirectLightSource);
+    }
+    for (entity, projection) in &cameras {
+        // the file's camera: replaced by the probes'
+        commands.entity(entity).insert(Camera {
+            is_active: false,
+            ..default()
+        });
+        for p in &probes.0 {
+            commands.spawn((
+                Camera3d::default(),
+                projection.clone(),
+                Transform::from_translation(EYE.into()).looking_at(TARGET.into(), Vec3::Y),
+                RenderTarget::Image(p.picture.clone().into()),
+                Tonemapping::None,
+                Msaa::Off,
+                IndirectLight {
+                    settings: Settings::sized(SIZE, SIZE, RSM),
+                    method: p.method,
+                    enabled: p.enabled,
+                    debug_indirect: Some(p.indirect.clone()),
+                    ..default()
+                },
+            ));
+        }
+    }
+}
+
+fn app() -> App {
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(AssetPlugin {
+                file_path: ASSETS.into(),
+                ..default()
+            })
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .disable::<WinitPlugin>(),
+    )
+    .insert_resource(DefaultOpaqueRendererMethod::deferred())
+    .add_plugins(IndirectLightPlugin)
+    .add_systems(Startup, setup)
+    .add_systems(Update, configure);
+    while app.plugins_state() == PluginsState::Adding {
+        bevy::tasks::tick_global_task_pools_on_main_thread();
+    }
+    app.finish();
+    app.cleanup();
+    app
+}
+
+fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
+    bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(bytes)
+        .into_iter()
+        .map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
+
+#[test]
+fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
+    let mut app = app();
+    app.update();
+    let probes = app.world().resource::<Probes>().0.clone();
+    for p in &probes {
+        let read = p.read_indirect.clone();
+        app.world_mut()
+            .spawn(Readback::buffer(p.indirect.clone()))
+            .observe(move |e: On<ReadbackComplete>| *read.lock().unwrap() = Some(e.data.clone()));
+        let read = p.read_picture.clone();
+        app.world_mut()
+            .spawn(Readback::texture(p.picture.clone()))
+            .observe(move |e: On<ReadbackComplete>| *read.lock().unwrap() = Some(e.data.clone()));
+    }
+    // the scene loads, the pipelines compile, then every camera gathers: wait for light in every
+    // probe's indirect term, then render a few frames more
+    let lit = |p: &Probe| {
+        let gathered = p
+            .read_indirect
+            .lock()
+            .unwrap()
+            .as_ref()
+            .is_some_and(|b| floats(b).iter().any(|v| v[0] > 0.0));
+        // a camera with the bounce off gathers nothing
+        (gathered || !p.enabled) && p.read_picture.lock().unwrap().is_some()
+    };
+    let mut frames = 0;
+    while !probes.iter().all(lit) {
+        assert!(frames < 500, "no indirect light after {frames} frames");
+        app.update();
+        frames += 1;
+    }
+    for _ in 0..5 {
+        app.update();
+    }
+    let indirect: Vec<Vec<[f32; 3]>> = probes
+        .iter()
+        .map(|p| floats(p.read_indirect.lock().unwrap().as_ref().unwrap()))
+        .collect();
+
+    // quadray's renderer on the same file, in its units (W/sr = cd / 683; the plugin's are Bevy's,
+    // candela)
+    let gpu = quadray_gpu::Gpu::new().expect("an adapter (scripts/setup.sh installs lavapipe)");
+    let mut scene = Scene::load(&std::path::Path::new(ASSETS).join(SCENE)).unwrap();
+    scene.camera.position = EYE.into();
+    scene.camera.target = TARGET.into();
+    let mut renderer = Renderer::new(&gpu, &scene, Settings::sized(SIZE, SIZE, RSM)).unwrap();
+    let cd = quadray_core::scene::LUMENS_PER_WATT;
+    let in_candela = |image: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
+        image.into_iter().map(|p| p.map(|c| c * cd)).collect()
+    };
+    let reference = in_candela(renderer.render_frame(Method::Reference).unwrap().indirect);
+    let quadtree = in_candela(renderer.render_frame(Method::Quadtree).unwrap().indirect);
+
+    // (a) the two renderers' brute force agree
+    let agreement = compare(&indirect[0], &reference);
+    println!("plugin brute force against quadray's: {agreement:?}");
+    assert!(agreement.rel_l1 <= 0.05, "{agreement:?}");
+    // (b) the plugin's quadtree is as close to its brute force as quadray's is to its own
+    let quadray_error = compare(&quadtree, &reference).rel_l1;
+    let plugin_error = compare(&indirect[1], &indirect[0]).rel_l1;
+    println!("quadtree against brute force: plugin {plugin_error:.4}, quadray {quadray_error:.4}");
+    assert!(
+        plugin_error <= 1.5 * quadray_error.max(1e-3),
+        "{plugin_error} vs {quadray_error}"
+    );
+
+    // (c) GI adds light where the scene is lit only indirectly, nothing on the background
+    let picture = |p: &Probe| p.read_picture.lock().unwrap().clone().unwrap();
+    let (on, off) = (picture(&probes[1]), picture(&probes[2]));
+    let (mut seen_pixels, mut brighter, mut background, mut changed_background) = (0, 0, 0, 0);
+    for (i, (a, b)) in on.chunks_exact(4).zip(off.chunks_exact(4)).enumerate() {
+        let seen = reference[i].iter().any(|&c| c > 0.0);
+        let differs = a[..3] != b[..3];
+        seen_pixels += usize::from(seen);
+        brighter += usize::from(seen && a[..3].iter().zip(&b[..3]).all(|(x, y)| x >= y) && differs);
+        if !seen && quadtree[i] == [0.0; 3] {
+            background += 1;
+            changed_background += usize::from(differs);
+        }
+    }
+    println!(
+        "GI on against off: {brighter} of {seen_pixels} pixels with geometry brighter, \
+         {changed_background} of {background} background pixels changed"
+    );
+    // every pixel the bounce reaches gains light (a few dim ones may round to the same 8 bits)
+    assert!(
+        seen_pixels > 0 && brighter * 100 >= seen_pixels * 95,
+        "{brighter}"
+    );
+    assert!(background > 0 && changed_background == 0);
+    // the ceiling's middle is lit only by the bounce
+    let clip = scene.camera_view_proj(1.0) * glam::Vec4::new(0.5, 0.99, 0.5, 1.0);
+    let ndc = clip.truncate() / clip.w;
+    let (x, y) = (
+        (ndc.x + 1.0) * 0.5 * SIZE as f32,
+        (1.0 - ndc.y) * 0.5 * SIZE as f32,
+    );
+    let ceiling = (y as u32 * SIZE + x as u32) as usize * 4;
+    println!(
+        "ceiling at ({x}, {y}): {:?} with GI, {:?} without",
+        &on[ceiling..ceiling + 3],
+        &off[ceiling..ceiling + 3]
+    );
+    assert!(
+        on[ceiling..ceiling + 3]
+            .iter()
+            .zip(&off[ceiling..ceiling + 3])
+            .all(|(a, b)| a > b)
+    );
+}
