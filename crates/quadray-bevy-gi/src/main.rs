@@ -9,7 +9,8 @@
 //! as for the whole workspace, and what the test build compiled is reused).
 //! Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
 //! [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the light still and
-//! saves the picture.
+//! saves the picture. `--frames N` (with `--screenshot`) times N frames with the light turning
+//! and prints their median (the benchmark of the bounce's cost in a Bevy frame).
 
 use bevy::app::ScheduleRunnerPlugin;
 use bevy::camera::RenderTarget;
@@ -54,6 +55,9 @@ struct Offscreen {
     path: String,
     target: Handle<Image>,
     frames: u32,
+    /// Frames to time (`--frames`), and the times so far.
+    timed: usize,
+    times: Vec<f64>,
 }
 
 fn main() {
@@ -73,10 +77,18 @@ fn main() {
         }
     };
     let offscreen = value("--screenshot");
+    let timed = match value("--frames").map(|n| n.parse::<usize>()) {
+        None => 0,
+        Some(Ok(n)) if n > 0 && offscreen.is_some() => n,
+        _ => {
+            eprintln!("--frames: expected a positive count, with --screenshot");
+            std::process::exit(2);
+        }
+    };
     let shown = Shown {
         gi: !args.iter().any(|a| a == "--no-gi"),
         method,
-        turning: offscreen.is_none(),
+        turning: offscreen.is_none() || timed > 0,
     };
     let mut app = App::new();
     let assets = AssetPlugin {
@@ -100,6 +112,8 @@ fn main() {
             path,
             target: Handle::default(),
             frames: 0,
+            timed,
+            times: Vec::new(),
         })
         .add_systems(Update, save_when_ready);
     } else {
@@ -230,8 +244,31 @@ fn save_when_ready(
     mut commands: Commands,
     mut offscreen: ResMut<Offscreen>,
     mut exit: MessageWriter<AppExit>,
+    time: Res<Time<Real>>,
+    shown: Res<Shown>,
 ) {
     offscreen.frames += 1;
+    // timing: every frame after the warm-up, until `timed` are taken
+    if offscreen.timed > 0 {
+        if offscreen.frames <= 60 {
+            return;
+        }
+        offscreen.times.push(time.delta_secs_f64() * 1e3);
+        if offscreen.times.len() < offscreen.timed {
+            return;
+        }
+        offscreen.times.sort_by(f64::total_cmp);
+        let median = offscreen.times[offscreen.times.len() / 2];
+        println!(
+            "median frame {median:.1} ms over {} frames (bounce {}, {})",
+            offscreen.times.len(),
+            if shown.gi { "on" } else { "off" },
+            shown.method.name()
+        );
+        offscreen.timed = 0;
+        offscreen.frames = 59;
+        return;
+    }
     match offscreen.frames {
         // the scene loads in a few frames and the light is still: a few more for the pipelines
         60 => {

@@ -263,3 +263,93 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
             .all(|(a, b)| a > b)
     );
 }
+
+/// What a Bevy user may get wrong (MSAA on, which Bevy turns off on a deferred camera; an RSM
+/// size that is not a power of two; no spot light marked as the source) is a warning in the log:
+/// the app keeps running and Bevy's own light still draws the picture.
+#[test]
+fn misconfigured_cameras_keep_bevy_s_picture() {
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(AssetPlugin {
+                file_path: ASSETS.into(),
+                ..default()
+            })
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .disable::<WinitPlugin>(),
+    )
+    .insert_resource(DefaultOpaqueRendererMethod::deferred())
+    .add_plugins(IndirectLightPlugin);
+    while app.plugins_state() == PluginsState::Adding {
+        bevy::tasks::tick_global_task_pools_on_main_thread();
+    }
+    app.finish();
+    app.cleanup();
+    let world = app.world_mut();
+    let target = || {
+        let mut image = Image::new_target_texture(32, 32, TextureFormat::Rgba8UnormSrgb, None);
+        image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        image
+    };
+    let pictures: Vec<Handle<Image>> = (0..2)
+        .map(|_| world.resource_mut::<Assets<Image>>().add(target()))
+        .collect();
+    world.spawn(WorldAssetRoot(
+        world
+            .resource::<AssetServer>()
+            .load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
+    ));
+    let view = Transform::from_translation(EYE.into()).looking_at(TARGET.into(), Vec3::Y);
+    // MSAA left on; and an RSM of 100 texels a side
+    world.spawn((
+        Camera3d::default(),
+        view,
+        Msaa::Sample4,
+        RenderTarget::Image(pictures[0].clone().into()),
+        IndirectLight::default(),
+    ));
+    world.spawn((
+        Camera3d::default(),
+        view,
+        Msaa::Off,
+        RenderTarget::Image(pictures[1].clone().into()),
+        IndirectLight {
+            settings: Settings {
+                rsm_size: 100,
+                ..Settings::DEFAULT
+            },
+            ..default()
+        },
+    ));
+    let reads: Vec<Arc<Mutex<Option<Vec<u8>>>>> = pictures
+        .iter()
+        .map(|picture| {
+            let read = Arc::new(Mutex::new(None));
+            let sink = read.clone();
+            app.world_mut()
+                .spawn(Readback::texture(picture.clone()))
+                .observe(move |e: On<ReadbackComplete>| {
+                    *sink.lock().unwrap() = Some(e.data.clone())
+                });
+            read
+        })
+        .collect();
+    // no spot is marked: the file's spot lights the scene as Bevy lights it, nothing more
+    let lit = |read: &Arc<Mutex<Option<Vec<u8>>>>| {
+        read.lock()
+            .unwrap()
+            .as_ref()
+            .is_some_and(|p| p.chunks_exact(4).any(|c| c[0] > 100))
+    };
+    let mut frames = 0;
+    while !reads.iter().all(lit) {
+        assert!(frames < 500, "no picture after {frames} frames");
+        app.update();
+        frames += 1;
+    }
+}

@@ -4,7 +4,6 @@
 //! Bevy's own direct light, shadows, materials and exposure stay as they are.
 //!
 //! ```no_run
-//! use bevy::core_pipeline::prepass::DeferredPrepass;
 //! use bevy::pbr::DefaultOpaqueRendererMethod;
 //! use bevy::prelude::*;
 //! use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};

@@ -206,12 +206,23 @@ fn prepare_light(
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     mut state: ResMut<LightState>,
+    mut warned: Local<Option<String>>,
 ) {
     let (Some(scene), Some(camera)) = (scene, cameras.iter().next()) else {
         return;
     };
     let device = device.wgpu_device();
     let settings = &camera.settings;
+    // the light's passes are sized by the settings: refuse what the gather would refuse
+    if let Err(e) = settings.validate() {
+        let message = format!("quadray indirect light: the settings are refused: {e}");
+        if warned.as_ref() != Some(&message) {
+            warn!("{message}");
+            *warned = Some(message);
+        }
+        state.0 = None;
+        return;
+    }
     let cluster = settings.cluster;
     let rebuild = state
         .0
