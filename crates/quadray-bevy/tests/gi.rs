@@ -3,7 +3,6 @@
 //! against quadray's own renderer (`quadray indirect --method reference`) on the same file, the
 //! plugin's quadtree against its brute force, and GI on against off in the final picture.
 
-use bevy::app::PluginsState;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::gltf::GltfAssetLabel;
@@ -12,15 +11,16 @@ use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{BufferUsages, TextureFormat, TextureUsages};
 use bevy::render::storage::ShaderBuffer;
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
 use bevy::world_serialization::WorldAssetRoot;
 use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{Method, Renderer, Scene, Settings};
 use std::sync::{Arc, Mutex};
 
-const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+mod common;
+
+use common::ASSETS;
+
 const SCENE: &str = "scenes/cornell_spot.gltf";
 const SIZE: u32 = 64;
 const RSM: u32 = 64;
@@ -118,30 +118,12 @@ fn configure(
 }
 
 fn app() -> App {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(AssetPlugin {
-                file_path: ASSETS.into(),
-                ..default()
-            })
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .disable::<WinitPlugin>(),
-    )
-    .insert_resource(DefaultOpaqueRendererMethod::deferred())
-    .add_plugins(IndirectLightPlugin)
-    .add_systems(Startup, setup)
-    .add_systems(Update, configure);
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
-    app
+    common::headless_app(|app| {
+        app.insert_resource(DefaultOpaqueRendererMethod::deferred())
+            .add_plugins(IndirectLightPlugin)
+            .add_systems(Startup, setup)
+            .add_systems(Update, configure);
+    })
 }
 
 fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
@@ -269,27 +251,10 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
 /// the app keeps running and Bevy's own light still draws the picture.
 #[test]
 fn misconfigured_cameras_keep_bevy_s_picture() {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(AssetPlugin {
-                file_path: ASSETS.into(),
-                ..default()
-            })
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .disable::<WinitPlugin>(),
-    )
-    .insert_resource(DefaultOpaqueRendererMethod::deferred())
-    .add_plugins(IndirectLightPlugin);
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+    let mut app = common::headless_app(|app| {
+        app.insert_resource(DefaultOpaqueRendererMethod::deferred())
+            .add_plugins(IndirectLightPlugin);
+    });
     let world = app.world_mut();
     let target = || {
         let mut image = Image::new_target_texture(32, 32, TextureFormat::Rgba8UnormSrgb, None);

@@ -2,7 +2,6 @@
 //! truth on the same rays: each pixel records its ray (p0, e) and its hit in a storage buffer, the
 //! CPU intersects the same rays with the same height field exactly.
 
-use bevy::app::PluginsState;
 use bevy::camera::RenderTarget;
 use bevy::camera::visibility::RenderLayers;
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -11,8 +10,6 @@ use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{BufferUsages, TextureFormat};
 use bevy::render::storage::ShaderBuffer;
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial, depth_map};
 use quadray_core::image_out::Rgba8Image;
 use quadray_displace::accuracy::Accuracy;
@@ -23,7 +20,9 @@ use quadray_displace::reference::Surface;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+mod common;
+
+use common::ASSETS;
 const SIZE: u32 = 64;
 const DEPTH_SCALE: f32 = 0.1;
 const ANGLES_DEG: [f32; 3] = [0.0, 60.0, 80.0];
@@ -113,29 +112,10 @@ fn setup(
 }
 
 fn app() -> App {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(AssetPlugin {
-                file_path: ASSETS.into(),
-                ..default()
-            })
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .disable::<WinitPlugin>(),
-    )
-    .add_plugins(PyramidDisplacementPlugin)
-    .add_systems(Startup, setup);
-    // What App::run's runners do first: wait for the renderer, then finish the plugins.
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
-    app
+    common::headless_app(|app| {
+        app.add_plugins(PyramidDisplacementPlugin)
+            .add_systems(Startup, setup);
+    })
 }
 
 #[test]

@@ -8,17 +8,13 @@
 //! Without a display: `... --bin quadray-bevy-parallax -- --screenshot out.png [--method pom|relief|pyramid]`
 //! renders a few frames off screen and saves the picture.
 
-use bevy::app::ScheduleRunnerPlugin;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::image::ImageLoaderSettings;
 use bevy::prelude::*;
-use bevy::render::render_resource::TextureFormat;
-use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
-use bevy::window::{ExitCondition, PrimaryWindow};
-use bevy::winit::WinitPlugin;
+use bevy::window::PrimaryWindow;
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
-use std::time::Duration;
+use quadray_bevy_programs::{Offscreen, add_default_plugins, flag_value, set_title};
 
 const ASSETS: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -49,21 +45,9 @@ struct Cube;
 #[derive(Resource)]
 struct FirstMethod(usize);
 
-#[derive(Resource)]
-struct Offscreen {
-    path: String,
-    target: Handle<Image>,
-    frames: u32,
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let value = |flag: &str| {
-        args.iter()
-            .position(|a| a == flag)
-            .and_then(|i| args.get(i + 1))
-            .cloned()
-    };
+    let value = |flag: &str| flag_value(&args, flag);
     let method = match value("--method").as_deref() {
         None | Some("pyramid") => 2,
         Some("pom") => 0,
@@ -78,28 +62,8 @@ fn main() {
         file_path: ASSETS.into(),
         ..default()
     };
-    if let Some(path) = value("--screenshot") {
-        let window = WindowPlugin {
-            primary_window: None,
-            exit_condition: ExitCondition::DontExit,
-            ..default()
-        };
-        app.add_plugins(
-            DefaultPlugins
-                .set(assets)
-                .set(window)
-                .disable::<WinitPlugin>(),
-        )
-        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(1)))
-        .insert_resource(Offscreen {
-            path,
-            target: Handle::default(),
-            frames: 0,
-        })
-        .add_systems(Update, save_when_ready);
-    } else {
-        app.add_plugins(DefaultPlugins.set(assets));
-    }
+    let offscreen = value("--screenshot").map(|path| Offscreen::new(path, 300, 0));
+    add_default_plugins(&mut app, assets, offscreen);
     app.add_plugins(PyramidDisplacementPlugin)
         .insert_resource(FirstMethod(method))
         .add_systems(Startup, setup)
@@ -160,12 +124,7 @@ fn setup(
         Transform::from_translation(CAMERAS[0]).looking_at(Vec3::ZERO, Vec3::Y),
     ));
     if let Some(mut offscreen) = offscreen {
-        offscreen.target = images.add(Image::new_target_texture(
-            960,
-            540,
-            TextureFormat::Rgba8UnormSrgb,
-            None,
-        ));
+        offscreen.make_target(&mut images, 960, 540);
         camera.insert(RenderTarget::Image(offscreen.target.clone().into()));
     }
     commands.spawn((
@@ -294,37 +253,5 @@ fn show_method(
         "{} (Space: next method, 1/2: depth scale {depth:.2}, click: view)",
         METHODS[materials.method]
     );
-    // The title, not a line of text in the picture: Bevy's UI and text stack would be most of
-    // this program's build.
-    for mut window in &mut windows {
-        if window.title != title {
-            window.title.clone_from(&title);
-        }
-    }
-}
-
-/// Off screen: save the target once the cube's maps are loaded and the pipelines warm, then quit.
-fn save_when_ready(
-    mut commands: Commands,
-    mut offscreen: ResMut<Offscreen>,
-    mut exit: MessageWriter<AppExit>,
-) {
-    offscreen.frames += 1;
-    match offscreen.frames {
-        300 => {
-            let path = offscreen.path.clone();
-            commands
-                .spawn(Screenshot::image(offscreen.target.clone()))
-                .observe(save_to_disk(path))
-                .observe(
-                    |_: On<ScreenshotCaptured>, mut offscreen: ResMut<Offscreen>| {
-                        offscreen.frames = 10_000
-                    },
-                );
-        }
-        n if n > 10_000 => {
-            exit.write(AppExit::Success);
-        }
-        _ => {}
-    }
+    set_title(&mut windows, &title);
 }

@@ -12,20 +12,16 @@
 //! saves the picture. `--frames N` (with `--screenshot`) times N frames with the light turning
 //! and prints their median (the benchmark of the bounce's cost in a Bevy frame).
 
-use bevy::app::ScheduleRunnerPlugin;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::gltf::GltfAssetLabel;
 use bevy::pbr::DefaultOpaqueRendererMethod;
 use bevy::prelude::*;
-use bevy::render::render_resource::TextureFormat;
-use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
-use bevy::window::{ExitCondition, PrimaryWindow};
-use bevy::winit::WinitPlugin;
+use bevy::window::PrimaryWindow;
 use bevy::world_serialization::WorldAssetRoot;
 use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+use quadray_bevy_programs::{Offscreen, add_default_plugins, flag_value, set_title};
 use quadray_indirect::{Method, Settings};
-use std::time::Duration;
 
 const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
 const SCENE: &str = "scenes/cornell_spot.gltf";
@@ -50,24 +46,9 @@ struct Shown {
     turning: bool,
 }
 
-#[derive(Resource)]
-struct Offscreen {
-    path: String,
-    target: Handle<Image>,
-    frames: u32,
-    /// Frames to time (`--frames`), and the times so far.
-    timed: usize,
-    times: Vec<f64>,
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let value = |flag: &str| {
-        args.iter()
-            .position(|a| a == flag)
-            .and_then(|i| args.get(i + 1))
-            .cloned()
-    };
+    let value = |flag: &str| flag_value(&args, flag);
     let method = match value("--method").map(|m| m.parse::<Method>()) {
         None => Method::Quadtree,
         Some(Ok(m)) => m,
@@ -95,30 +76,10 @@ fn main() {
         file_path: ASSETS.into(),
         ..default()
     };
-    if let Some(path) = offscreen {
-        let window = WindowPlugin {
-            primary_window: None,
-            exit_condition: ExitCondition::DontExit,
-            ..default()
-        };
-        app.add_plugins(
-            DefaultPlugins
-                .set(assets)
-                .set(window)
-                .disable::<WinitPlugin>(),
-        )
-        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(1)))
-        .insert_resource(Offscreen {
-            path,
-            target: Handle::default(),
-            frames: 0,
-            timed,
-            times: Vec::new(),
-        })
-        .add_systems(Update, save_when_ready);
-    } else {
-        app.add_plugins(DefaultPlugins.set(assets));
-    }
+    // the scene loads in a few frames; each frame gathers anew while the light turns (on the
+    // CPU rasteriser about a second a frame at this size)
+    let offscreen = offscreen.map(|path| Offscreen::new(path, 60, timed));
+    add_default_plugins(&mut app, assets, offscreen);
     app.insert_resource(DefaultOpaqueRendererMethod::deferred())
         .add_plugins(IndirectLightPlugin)
         .insert_resource(shown)
@@ -137,12 +98,7 @@ fn setup(
         assets.load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
     ));
     if let Some(mut offscreen) = offscreen {
-        offscreen.target = images.add(Image::new_target_texture(
-            256,
-            256,
-            TextureFormat::Rgba8UnormSrgb,
-            None,
-        ));
+        offscreen.make_target(&mut images, 256, 256);
     }
 }
 
@@ -230,61 +186,5 @@ fn show_title(shown: Res<Shown>, mut windows: Query<&mut Window, With<PrimaryWin
         shown.method.name(),
         if shown.turning { "turning" } else { "still" },
     );
-    // The title, not text in the picture: Bevy's UI and text stack would be most of the build.
-    for mut window in &mut windows {
-        if window.title != title {
-            window.title.clone_from(&title);
-        }
-    }
-}
-
-/// Off screen: save the target once the scene is loaded and the pipelines warm, then quit.
-/// (Each frame gathers anew on the CPU rasteriser: a few seconds a frame at this size.)
-fn save_when_ready(
-    mut commands: Commands,
-    mut offscreen: ResMut<Offscreen>,
-    mut exit: MessageWriter<AppExit>,
-    time: Res<Time<Real>>,
-    shown: Res<Shown>,
-) {
-    offscreen.frames += 1;
-    // timing: every frame after the warm-up, until `timed` are taken
-    if offscreen.timed > 0 {
-        if offscreen.frames <= 60 {
-            return;
-        }
-        offscreen.times.push(time.delta_secs_f64() * 1e3);
-        if offscreen.times.len() < offscreen.timed {
-            return;
-        }
-        offscreen.times.sort_by(f64::total_cmp);
-        let median = offscreen.times[offscreen.times.len() / 2];
-        println!(
-            "median frame {median:.1} ms over {} frames (bounce {}, {})",
-            offscreen.times.len(),
-            if shown.gi { "on" } else { "off" },
-            shown.method.name()
-        );
-        offscreen.timed = 0;
-        offscreen.frames = 59;
-        return;
-    }
-    match offscreen.frames {
-        // the scene loads in a few frames and the light is still: a few more for the pipelines
-        60 => {
-            let path = offscreen.path.clone();
-            commands
-                .spawn(Screenshot::image(offscreen.target.clone()))
-                .observe(save_to_disk(path))
-                .observe(
-                    |_: On<ScreenshotCaptured>, mut offscreen: ResMut<Offscreen>| {
-                        offscreen.frames = 10_000
-                    },
-                );
-        }
-        n if n > 10_000 => {
-            exit.write(AppExit::Success);
-        }
-        _ => {}
-    }
+    set_title(&mut windows, &title);
 }
