@@ -446,6 +446,17 @@ fn prepare_views(
             width: size.x,
             height: size.y,
         };
+        // one light quadtree serves every camera: it is sized by the first camera's settings
+        if settings.rsm_size != l.rsm_size || settings.cluster != l.quadtree.cluster() {
+            warn(
+                "its RSM size or cluster settings differ from the first IndirectLight camera's, \
+                 which the light's quadtree is built with: give every camera the same; no \
+                 indirect light is added"
+                    .into(),
+            );
+            commands.entity(entity).remove::<ViewPasses>();
+            continue;
+        }
         let format = target.main_texture_format();
         let Some(passes) = passes.filter(|p| p.settings == settings && p.format == format) else {
             let composite = match pipelines.composite.get(&format) {
