@@ -2,27 +2,32 @@
 # Refreshes the GPU figures of BENCHMARKS.md on this machine's adapter, in one run sized for a
 # lent GPU's 10-minute call: the 1920x1080 displacement frame of every method at 0, 60 and 85
 # degrees (with the CPU ground truth's wrong-hit fraction), each indirect-light pass at 1920x1080
-# with a 512^2 RSM for every method, then, while the time budget lasts, the paper tables of
-# `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
+# with a 512^2 RSM for every method, given --bevy-bin the Bevy frame with and without the bounce
+# (two paired rounds, Bevy's render diagnostics), then, while the time budget lasts, the paper
+# tables of `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
 # name from the adapter, e.g. bench/nvidia-h200/) with every stats file and a summary.md of the
 # tables, and packs it into gpu-tables.tar.gz beside it (a device call returns few files).
 #
-#   scripts/gpu-tables.sh [--quick] [--bin PATH] [--out DIR] [--budget SECONDS]
+#   scripts/gpu-tables.sh [--quick] [--bin PATH] [--bevy-bin PATH] [--out DIR] [--budget SECONDS]
 #
 # --quick: small frames, for trying the script on a software rasterizer (a minute on lavapipe).
 # --bin: the quadray binary (default target/release/quadray, built if missing).
+# --bevy-bin: the quadray-bevy-gi program (`cargo build --release --bin quadray-bevy-gi`); it
+#   reads the assets from the checkout it was built in.
 # --budget: seconds after which the optional paper tables are skipped (default 540).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 quick=0
 bin=target/release/quadray
+bevy_bin=
 out_root=bench
 budget=540
 while [ $# -gt 0 ]; do
     case "$1" in
         --quick) quick=1 ;;
         --bin) bin=$2; shift ;;
+        --bevy-bin) bevy_bin=$2; shift ;;
         --out) out_root=$2; shift ;;
         --budget) budget=$2; shift ;;
         *) echo "gpu-tables.sh: unknown option $1" >&2; exit 2 ;;
@@ -36,44 +41,74 @@ start=$SECONDS
 left() { echo $((budget - (SECONDS - start))); }
 
 if [ $quick = 1 ]; then
-    size=96x54 rsm=32 frames=3 angles="0 60"
+    size=96x54 rsm=32 frames=3 angles="0 60" bevy_frames=3
 else
-    size=1920x1080 rsm=512 frames=20 angles="0 60 85"
+    size=1920x1080 rsm=512 frames=20 angles="0 60 85" bevy_frames=60
 fi
 
 # The adapter's name as a folder: "NVIDIA H200 (Vulkan, NVIDIA 580.159.04)" -> nvidia-h200.
 probe=$(mktemp -d)
-"$bin" indirect --size 16x16 --rsm-size 16 --frames 1 --out "$probe/p.png" --stats "$probe/p.json" >/dev/null
+map=assets/heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png
+timeout 120 "$bin" displace --map $map --size 16x16 --out "$probe/p.png" --stats "$probe/p.json" >/dev/null
 adapter=$(sed -n 's/^ *"adapter": "\(.*\)",$/\1/p' "$probe/p.json" | head -1)
 device=$(echo "${adapter%% (*}" | tr '[:upper:]' '[:lower:]' | sed 's/[^a-z0-9]\+/-/g; s/^-//; s/-$//')
 [ $quick = 1 ] && device="$device-quick"
 out="$out_root/$device"
-mkdir -p "$out/displace-1080p" "$out/indirect-1080p"
+mkdir -p "$out/displace-1080p" "$out/indirect-1080p" "$out/logs"
 printf '%s\n%s\n' "$adapter" "$(date -u +%Y-%m-%dT%H:%MZ)" >"$out/adapter.txt"
 echo "$adapter -> $out"
 
-map=assets/heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png
+# One run: its output in logs/NAME.log; a failure or a run past 3 minutes is noted in
+# skipped.txt and the next run goes on (the tables that did run still come back).
+step() {
+    local name=$1
+    shift
+    echo "$((SECONDS - start)) s: $name"
+    timeout 180 "$@" >"$out/logs/$name.log" 2>&1 ||
+        echo "$name: failed or stopped after 180 s (logs/$name.log)" >>"$out/skipped.txt"
+}
+
 for m in pom pyramid pyramid-ascend pyramid-bilinear relief; do
     for a in $angles; do
-        "$bin" displace --map $map --method $m --layers 1,16 --view-angle "$a" --size $size \
-            --reference --out "$probe/d.png" --stats "$out/displace-1080p/$m-$a.json" >/dev/null
+        step "displace-$m-$a" "$bin" displace --map $map --method $m --layers 1,16 \
+            --view-angle "$a" --size $size --reference --out "$probe/d.png" \
+            --stats "$out/displace-1080p/$m-$a.json"
     done
 done
-"$bin" displace --map $map --method pyramid --lod auto --view-angle 60 --size $size --reference \
-    --out "$probe/d.png" --stats "$out/displace-1080p/pyramid-lodauto-60.json" >/dev/null
+step displace-pyramid-lodauto-60 "$bin" displace --map $map --method pyramid --lod auto \
+    --view-angle 60 --size $size --reference --out "$probe/d.png" \
+    --stats "$out/displace-1080p/pyramid-lodauto-60.json"
 
 for m in quadtree quadtree-passes quadtree-tiles rsm; do
-    "$bin" indirect --method $m --size $size --rsm-size $rsm --frames $frames \
-        --out "$probe/i.png" --stats "$out/indirect-1080p/$m.json" >/dev/null
+    step "indirect-$m" "$bin" indirect --method $m --size $size --rsm-size $rsm \
+        --frames $frames --out "$probe/i.png" --stats "$out/indirect-1080p/$m.json"
 done
-"$bin" indirect --method quadtree --indirect-shadows --size $size --rsm-size $rsm \
-    --frames $frames --out "$probe/i.png" --stats "$out/indirect-1080p/quadtree-shadows.json" >/dev/null
+step indirect-quadtree-shadows "$bin" indirect --method quadtree --indirect-shadows \
+    --size $size --rsm-size $rsm --frames $frames --out "$probe/i.png" \
+    --stats "$out/indirect-1080p/quadtree-shadows.json"
+
+# The Bevy frame, the light turning (every frame a new RSM, pyramid, cut and gather), with and
+# without the bounce, in two paired rounds.
+if [ -n "$bevy_bin" ]; then
+    mkdir -p "$out/bevy"
+    for round in 1 2; do
+        for gi in gi no-gi; do
+            flag=$([ $gi = no-gi ] && echo --no-gi || true)
+            # shellcheck disable=SC2086 # $flag is one word or none
+            step "bevy-$gi-$round" "$bevy_bin" --screenshot "$out/bevy/$gi.png" \
+                --frames $bevy_frames --size $size --rsm-size $rsm $flag
+            grep -a -E '^(median frame|render/)' "$out/logs/bevy-$gi-$round.log" \
+                >"$out/bevy/$gi-$round.log" || true
+        done
+    done
+fi
 
 # The paper tables, each only if the budget still holds it.
 paper() {
     local name=$1 need=$2
     shift 2
     if [ "$(left)" -gt "$need" ]; then
+        echo "$((SECONDS - start)) s: $name"
         timeout "$(left)" "$bin" bench "$@" >"$out/$name.log" 2>&1 || echo "$name: stopped" >>"$out/skipped.txt"
     else
         echo "$name: skipped, $(left) s of the budget left" >>"$out/skipped.txt"
@@ -112,6 +147,23 @@ for f in sorted((out / "indirect-1080p").glob("*.json")):
     lines.append(f"| {f.stem} | {cell(p.get('gbuffer'))} | {cell(p.get('direct'))} | "
                  f"{cell(p.get('indirect'))} | {cell(still.get('total_ms'))} | "
                  f"{cell(moving.get('total_ms'))} | {s['vpl_evaluations_per_pixel']:.1f} |")
+bevy = sorted((out / "bevy").glob("*.log")) if (out / "bevy").exists() else []
+if bevy:
+    lines += ["", "## The Bevy frame (quadray-bevy-gi, light turning; medians)", "",
+              "| run | frame ms | bounce GPU ms | light passes | gather | composite | clusters in cut | VPL evaluations / pixel |",
+              "|---|---|---|---|---|---|---|---|"]
+    for f in bevy:
+        values = {}
+        for line in f.read_text().splitlines():
+            if line.startswith("median frame"):
+                values["frame"] = float(line.split()[2])
+            elif ": median " in line:
+                path, rest = line.split(": median ")
+                values[path.removeprefix("render/quadray_gi").strip("/")] = float(rest.split()[0].rstrip("ms"))
+        cell = lambda k: f"{values[k]:.3f}" if k in values else "-"
+        lines.append(f"| {f.stem} | {cell('frame')} | {cell('elapsed_gpu')} | {cell('light/elapsed_gpu')} | "
+                     f"{cell('gather/elapsed_gpu')} | {cell('composite/elapsed_gpu')} | "
+                     f"{cell('cut_clusters')} | {cell('vpl_evaluations_per_pixel')} |")
 skipped = out / "skipped.txt"
 if skipped.exists():
     lines += ["", "Skipped: " + "; ".join(skipped.read_text().split("\n")).strip("; ")]

@@ -1,14 +1,32 @@
 //! What quadray's Bevy programs share: their flags' values, a window or off-screen rendering
 //! (`--screenshot PATH`: a few frames into an image, saved, then exit; `--frames N`: N frames
-//! timed first), and the window title that says what is shown.
+//! timed first, with the median of each of quadray's render diagnostics), and the window title
+//! that says what is shown.
 
 use bevy::app::ScheduleRunnerPlugin;
+use bevy::diagnostic::DiagnosticsStore;
 use bevy::prelude::*;
+use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
 use bevy::window::{ExitCondition, PrimaryWindow};
 use bevy::winit::WinitPlugin;
 use std::time::Duration;
+
+/// Bevy's asset plugin reading the repository's `assets/<folder>`: under `BEVY_ASSET_ROOT` when
+/// that is set (Bevy's own variable; for a binary run outside the checkout it was built in, as on
+/// a lent GPU), else in the checkout it was built in.
+pub fn repository_assets(folder: &str) -> AssetPlugin {
+    let root = match std::env::var_os("BEVY_ASSET_ROOT") {
+        // Bevy joins a relative path to BEVY_ASSET_ROOT itself
+        Some(_) => std::path::PathBuf::from("assets"),
+        None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets"),
+    };
+    AssetPlugin {
+        file_path: root.join(folder).to_string_lossy().into_owned(),
+        ..default()
+    }
+}
 
 /// The value after `flag` on the command line, if any.
 pub fn flag_value(args: &[String], flag: &str) -> Option<String> {
@@ -59,7 +77,8 @@ impl Offscreen {
 }
 
 /// Bevy's default plugins with `assets` as the asset folder: with a window, or, given
-/// `offscreen`, headless (no window, a loop of 1 ms) saving the picture when ready.
+/// `offscreen`, headless (no window) saving the picture when ready; timed frames follow each
+/// other at once and record Bevy's render diagnostics (GPU times where timestamps exist).
 pub fn add_default_plugins(app: &mut App, assets: AssetPlugin, offscreen: Option<Offscreen>) {
     let Some(offscreen) = offscreen else {
         app.add_plugins(DefaultPlugins.set(assets));
@@ -70,15 +89,21 @@ pub fn add_default_plugins(app: &mut App, assets: AssetPlugin, offscreen: Option
         exit_condition: ExitCondition::DontExit,
         ..default()
     };
+    let wait = Duration::from_millis(if offscreen.timed > 0 { 0 } else { 1 });
+    let timed = offscreen.timed > 0;
     app.add_plugins(
         DefaultPlugins
             .set(assets)
             .set(window)
             .disable::<WinitPlugin>(),
     )
-    .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(1)))
+    .add_plugins(ScheduleRunnerPlugin::run_loop(wait))
     .insert_resource(offscreen)
     .add_systems(Update, save_when_ready);
+    // after the render app exists, which it hands its recorder to
+    if timed {
+        app.add_plugins(RenderDiagnosticsPlugin);
+    }
 }
 
 /// Sets the primary window's title (when it changed).
@@ -91,16 +116,24 @@ pub fn set_title(windows: &mut Query<&mut Window, With<PrimaryWindow>>, title: &
     }
 }
 
-/// Off screen: after the warm-up, times the frames asked for (printing their median), then saves
-/// the target and quits.
+/// Off screen: after the warm-up, times the frames asked for (printing their median and the
+/// medians of quadray's render diagnostics over their last frames), then saves the target and
+/// quits.
 fn save_when_ready(
     mut commands: Commands,
     mut offscreen: ResMut<Offscreen>,
     mut exit: MessageWriter<AppExit>,
     time: Res<Time<Real>>,
+    mut diagnostics: ResMut<DiagnosticsStore>,
 ) {
     offscreen.frames += 1;
     let warm_up = offscreen.warm_up;
+    if offscreen.frames == warm_up + 1 {
+        // the medians are over the timed frames only
+        for d in diagnostics.iter_mut() {
+            d.clear_history();
+        }
+    }
     if offscreen.frames > warm_up && offscreen.times.len() < offscreen.timed {
         offscreen.times.push(time.delta_secs_f64() * 1e3);
         if offscreen.times.len() == offscreen.timed {
@@ -111,6 +144,7 @@ fn save_when_ready(
                 times[times.len() / 2],
                 times.len()
             );
+            print_quadray_diagnostics(&diagnostics);
         }
         return;
     }
@@ -126,5 +160,28 @@ fn save_when_ready(
             );
     } else if offscreen.frames > u32::MAX / 2 {
         exit.write(AppExit::Success);
+    }
+}
+
+/// Each of quadray's render diagnostics (`render/quadray*`): the median of its kept history.
+fn print_quadray_diagnostics(diagnostics: &DiagnosticsStore) {
+    let mut found: Vec<_> = diagnostics
+        .iter()
+        .filter(|d| d.path().as_str().starts_with("render/quadray"))
+        .collect();
+    found.sort_by_key(|d| d.path().as_str());
+    for d in found {
+        let mut values: Vec<f64> = d.values().copied().collect();
+        if values.is_empty() {
+            continue;
+        }
+        values.sort_by(f64::total_cmp);
+        println!(
+            "{}: median {:.4}{} over {} frames",
+            d.path(),
+            values[values.len() / 2],
+            d.suffix,
+            values.len()
+        );
     }
 }

@@ -1,13 +1,16 @@
 //! The indirect-light plugin in a real Bevy app, headless on lavapipe, on the bundled Cornell box
 //! glTF loaded by Bevy's glTF loader (its camera and spot light): the plugin's brute force
 //! against quadray's own renderer (`quadray indirect --method reference`) on the same file, the
-//! plugin's quadtree against its brute force, and GI on against off in the final picture.
+//! plugin's quadtree against its brute force, GI on against off in the final picture, and the
+//! counts the plugin reports to Bevy's diagnostics against quadray's own.
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::diagnostic::DiagnosticsStore;
 use bevy::gltf::GltfAssetLabel;
 use bevy::pbr::DefaultOpaqueRendererMethod;
 use bevy::prelude::*;
+use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{BufferUsages, TextureFormat, TextureUsages};
 use bevy::render::storage::ShaderBuffer;
@@ -120,7 +123,7 @@ fn configure(
 fn app() -> App {
     common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
-            .add_plugins(IndirectLightPlugin)
+            .add_plugins((IndirectLightPlugin, RenderDiagnosticsPlugin))
             .add_systems(Startup, setup)
             .add_systems(Update, configure);
     })
@@ -185,8 +188,41 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
     let in_candela = |image: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
         image.into_iter().map(|p| p.map(|c| c * cd)).collect()
     };
-    let reference = in_candela(renderer.render_frame(Method::Reference).unwrap().indirect);
-    let quadtree = in_candela(renderer.render_frame(Method::Quadtree).unwrap().indirect);
+    let reference_frame = renderer.render_frame(Method::Reference).unwrap();
+    let quadtree_frame = renderer.render_frame(Method::Quadtree).unwrap();
+    let clusters = renderer.clusters_in_cut().unwrap();
+    let reference = in_candela(reference_frame.indirect);
+    let quadtree = in_candela(quadtree_frame.indirect);
+
+    // the counts in Bevy's diagnostics are quadray's: the cut's clusters, and each camera's VPL
+    // evaluations per shaded pixel (every camera records under the same paths, so the history
+    // holds the brute force's and the quadtree's)
+    let store = app.world().resource::<DiagnosticsStore>();
+    let history = |name: &str| -> Vec<f64> {
+        let path = format!("render/quadray_gi/{name}");
+        store
+            .iter()
+            .find(|d| d.path().as_str() == path)
+            .map(|d| d.values().copied().collect())
+            .unwrap_or_default()
+    };
+    let cut = history("cut_clusters");
+    println!("clusters in the cut: plugin {cut:?}, quadray {clusters}");
+    assert!(!cut.is_empty() && cut.iter().all(|&c| c == f64::from(clusters)));
+    let evaluations = history("vpl_evaluations_per_pixel");
+    for (method, counts) in [
+        ("reference", reference_frame.counts),
+        ("quadtree", quadtree_frame.counts),
+    ] {
+        let expected = counts.vpl_evaluations_per_pixel();
+        println!("VPL evaluations per pixel, {method}: quadray {expected:.2}");
+        assert!(
+            evaluations
+                .iter()
+                .any(|&e| (e - expected).abs() <= 0.01 * expected),
+            "{method}: {expected} not among the plugin's {evaluations:?}"
+        );
+    }
 
     // (a) the two renderers' brute force agree
     let agreement = compare(&indirect[0], &reference);

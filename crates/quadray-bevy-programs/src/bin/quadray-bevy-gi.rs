@@ -10,7 +10,10 @@
 //! Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
 //! [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the light still and
 //! saves the picture. `--frames N` (with `--screenshot`) times N frames with the light turning
-//! and prints their median (the benchmark of the bounce's cost in a Bevy frame).
+//! and prints their median and Bevy's render diagnostics of the bounce (GPU time of the light's
+//! passes, the gather and the composite; clusters in the cut; VPL evaluations and texel fetches
+//! per shaded pixel): the benchmark of the bounce's cost in a Bevy frame. `--size WxH` (default
+//! 256x256) and `--rsm-size N` (default 128) size the off-screen picture and the RSM.
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -20,10 +23,11 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy::world_serialization::WorldAssetRoot;
 use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
-use quadray_bevy_programs::{Offscreen, add_default_plugins, flag_value, set_title};
+use quadray_bevy_programs::{
+    Offscreen, add_default_plugins, flag_value, repository_assets, set_title,
+};
 use quadray_indirect::{Method, Settings};
 
-const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
 const SCENE: &str = "scenes/cornell_spot.gltf";
 /// The methods M cycles through.
 const METHODS: [Method; 4] = [
@@ -38,12 +42,14 @@ const TURN: f32 = 0.25;
 /// The glTF file's camera, when it appears.
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
-/// What the first frame shows (`--no-gi`, `--method`).
+/// What the first frame shows (`--no-gi`, `--method`) and at what size (`--size`, `--rsm-size`).
 #[derive(Resource, Clone, Copy)]
 struct Shown {
     gi: bool,
     method: Method,
     turning: bool,
+    size: (u32, u32),
+    rsm_size: u32,
 }
 
 fn main() {
@@ -66,16 +72,31 @@ fn main() {
             std::process::exit(2);
         }
     };
+    let size = match value("--size").map(|s| parse_size(&s)) {
+        None => (256, 256),
+        Some(Some(size)) => size,
+        Some(None) => {
+            eprintln!("--size: expected WIDTHxHEIGHT, each 1..=8192");
+            std::process::exit(2);
+        }
+    };
+    let rsm_size = match value("--rsm-size").map(|n| n.parse::<u32>()) {
+        None => 128,
+        Some(Ok(n)) => n,
+        Some(Err(e)) => {
+            eprintln!("--rsm-size: {e}");
+            std::process::exit(2);
+        }
+    };
     let shown = Shown {
         gi: !args.iter().any(|a| a == "--no-gi"),
         method,
         turning: offscreen.is_none() || timed > 0,
+        size,
+        rsm_size,
     };
     let mut app = App::new();
-    let assets = AssetPlugin {
-        file_path: ASSETS.into(),
-        ..default()
-    };
+    let assets = repository_assets("");
     // the scene loads in a few frames; each frame gathers anew while the light turns (on the
     // CPU rasteriser about a second a frame at this size)
     let offscreen = offscreen.map(|path| Offscreen::new(path, 60, timed));
@@ -88,22 +109,32 @@ fn main() {
         .run();
 }
 
+/// `WIDTHxHEIGHT`, each side 1..=8192.
+fn parse_size(text: &str) -> Option<(u32, u32)> {
+    let (w, h) = text.split_once('x')?;
+    let side = |s: &str| s.parse::<u32>().ok().filter(|n| (1..=8192).contains(n));
+    Some((side(w)?, side(h)?))
+}
+
 fn setup(
     mut commands: Commands,
     assets: Res<AssetServer>,
     mut images: ResMut<Assets<Image>>,
     offscreen: Option<ResMut<Offscreen>>,
+    shown: Res<Shown>,
 ) {
     commands.spawn(WorldAssetRoot(
         assets.load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
     ));
     if let Some(mut offscreen) = offscreen {
-        offscreen.make_target(&mut images, 256, 256);
+        let (width, height) = shown.size;
+        offscreen.make_target(&mut images, width, height);
     }
 }
 
-/// A camera where the file's is (that one turned off) gets the bounce (deferred, no MSAA, a
-/// 128^2 RSM: interactive on a CPU rasteriser too); the file's spot is marked as its source.
+/// A camera where the file's is (that one turned off) gets the bounce (deferred, no MSAA, by
+/// default a 128^2 RSM: interactive on a CPU rasteriser too); the file's spot is marked as its
+/// source. A refused RSM size is Bevy's log's warning, as for any app.
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Transform, &Projection), FileCamera>,
@@ -127,7 +158,7 @@ fn configure(
             Tonemapping::AcesFitted,
             IndirectLight {
                 settings: Settings {
-                    rsm_size: 128,
+                    rsm_size: shown.rsm_size,
                     ..Settings::DEFAULT
                 },
                 method: shown.method,

@@ -14,12 +14,10 @@ use bevy::image::ImageLoaderSettings;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
-use quadray_bevy_programs::{Offscreen, add_default_plugins, flag_value, set_title};
+use quadray_bevy_programs::{
+    Offscreen, add_default_plugins, flag_value, repository_assets, set_title,
+};
 
-const ASSETS: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/heightmaps/bevy_parallax"
-);
 const METHODS: [&str; 3] = [
     "Bevy parallax occlusion mapping",
     "Bevy relief mapping",
@@ -58,10 +56,7 @@ fn main() {
         }
     };
     let mut app = App::new();
-    let assets = AssetPlugin {
-        file_path: ASSETS.into(),
-        ..default()
-    };
+    let assets = repository_assets("heightmaps/bevy_parallax");
     let offscreen = value("--screenshot").map(|path| Offscreen::new(path, 300, 0));
     add_default_plugins(&mut app, assets, offscreen);
     app.add_plugins(PyramidDisplacementPlugin)

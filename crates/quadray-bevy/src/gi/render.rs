@@ -8,6 +8,7 @@ use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
+use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
     texture_2d, texture_depth_2d, texture_storage_2d, uniform_buffer_sized,
@@ -30,6 +31,7 @@ use std::num::NonZero;
 use std::sync::{Mutex, PoisonError};
 
 const COMPOSITE_WGSL: &str = include_str!("composite.wgsl");
+const COUNTS_WGSL: &str = include_str!("counts.wgsl");
 /// The G-buffer translation's uniform: world_from_clip, the eye (xyz), the size (two u32).
 const VIEW_UNIFORM_BYTES: u64 = 64 + 16 + 16;
 
@@ -63,6 +65,8 @@ struct Pipelines {
     composite_module: wgpu::ShaderModule,
     /// By the view target's format.
     composite: HashMap<TextureFormat, wgpu::RenderPipeline>,
+    /// The work counts' means, for Bevy's diagnostics.
+    counts: wgpu::ComputePipeline,
 }
 
 fn init_pipelines(
@@ -121,12 +125,25 @@ fn init_pipelines(
         label: Some("quadray gi composite"),
         source: wgpu::ShaderSource::Wgsl(COMPOSITE_WGSL.into()),
     });
+    let counts_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("quadray gi counts"),
+        source: wgpu::ShaderSource::Wgsl(COUNTS_WGSL.into()),
+    });
+    let counts = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("quadray gi counts"),
+        layout: None,
+        module: &counts_module,
+        entry_point: Some("mean_counts"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
     commands.insert_resource(Pipelines {
         gbuffer_layout,
         gbuffer,
         composite_layout,
         composite_module,
         composite: HashMap::default(),
+        counts,
     });
 }
 
@@ -294,6 +311,9 @@ pub(super) struct ViewPasses {
     composite_uniform: wgpu::Buffer,
     composite_group: wgpu::BindGroup,
     composite: wgpu::RenderPipeline,
+    /// The gather's counts as means per shaded pixel: VPL evaluations, texel fetches.
+    means: wgpu::Buffer,
+    means_group: wgpu::BindGroup,
     /// What this frame's gather would see (set when preparing).
     inputs: Mutex<Option<GatherInputs>>,
     /// What the last gather saw: a frame that sees the same (and has no temporal filter to
@@ -316,6 +336,7 @@ impl ViewPasses {
         light: &LightPasses,
         composite: wgpu::RenderPipeline,
         composite_layout: &wgpu::BindGroupLayout,
+        counts: &wgpu::ComputePipeline,
         format: TextureFormat,
     ) -> Result<Self, quadray_indirect::IndirectError> {
         let size = wgpu::Extent3d {
@@ -368,6 +389,30 @@ impl ViewPasses {
                 },
             ],
         });
+        let means = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("quadray gi count means"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let means_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("quadray gi counts"),
+            layout: &counts.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: gather.counts().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&gbuffer[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: means.as_entire_binding(),
+                },
+            ],
+        });
         Ok(Self {
             settings,
             format,
@@ -377,6 +422,8 @@ impl ViewPasses {
             composite_uniform,
             composite_group,
             composite,
+            means,
+            means_group,
             inputs: Mutex::new(None),
             last_gather: Mutex::new(None),
         })
@@ -468,7 +515,8 @@ fn prepare_views(
                 }
             };
             let layout = &pipelines.composite_layout;
-            match ViewPasses::new(device, settings, l, composite, layout, format) {
+            let counts = &pipelines.counts;
+            match ViewPasses::new(device, settings, l, composite, layout, counts, format) {
                 Ok(p) => {
                     commands.entity(entity).insert(p);
                 }
@@ -562,18 +610,26 @@ fn indirect_light_pass(
                 })
                 .collect::<Vec<_>>(),
         });
+    // Bevy's diagnostics (with its RenderDiagnosticsPlugin): GPU time of the light's passes,
+    // the gather and the composite, the cut's size and the gather's work per shaded pixel
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
     let encoder = ctx.command_encoder();
+    let whole = diagnostics.time_span(encoder, "quadray_gi");
     if l.stale {
+        let span = diagnostics.time_span(encoder, "light");
         l.rsm
             .record(encoder, vertices.slice(..), *vertex_count, None);
         l.quadtree.record_build(encoder, None);
         l.quadtree.record_cut(encoder, None);
         l.stale = false;
+        span.end(encoder);
     }
     let inputs = *lock(&passes.inputs);
     let mut last = lock(&passes.last_gather);
     if *last != inputs || passes.settings.temporal_weight < 1.0 {
         *last = inputs;
+        let span = diagnostics.time_span(encoder, "gather");
         let size = passes.settings.size;
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -587,6 +643,16 @@ fn indirect_light_pass(
         passes
             .gather
             .record_indirect(encoder, gi.method, &l.quadtree, None);
+        span.end(encoder);
+        if diagnostics.is_some() {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("quadray gi counts"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipelines.counts);
+            pass.set_bind_group(0, &passes.means_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
     }
     if let Some(debug) = gi.debug_indirect.as_ref().and_then(|h| buffers.get(h)) {
         let indirect = passes.gather.indirect();
@@ -594,6 +660,7 @@ fn indirect_light_pass(
             encoder.copy_buffer_to_buffer(indirect, 0, &debug.buffer, 0, indirect.size());
         }
     }
+    let span = diagnostics.time_span(encoder, "composite");
     {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("quadray gi composite"),
@@ -611,6 +678,20 @@ fn indirect_light_pass(
         pass.set_pipeline(&passes.composite);
         pass.set_bind_group(0, &passes.composite_group, &[]);
         pass.draw(0..3, 0..1);
+    }
+    span.end(encoder);
+    whole.end(encoder);
+    if diagnostics.is_some() {
+        let cut = l.quadtree.cut_count().slice(0..4);
+        diagnostics.record_u32(encoder, &cut, "quadray_gi/cut_clusters");
+        let evaluations = passes.means.slice(0..4);
+        diagnostics.record_f32(
+            encoder,
+            &evaluations,
+            "quadray_gi/vpl_evaluations_per_pixel",
+        );
+        let fetches = passes.means.slice(4..8);
+        diagnostics.record_f32(encoder, &fetches, "quadray_gi/texel_fetches_per_pixel");
     }
 }
 

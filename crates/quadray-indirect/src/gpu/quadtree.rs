@@ -265,8 +265,9 @@ impl LightQuadtree {
         &self.cut
     }
 
-    /// How many clusters the cut holds (one `u32`).
-    pub(crate) fn cut_count(&self) -> &wgpu::Buffer {
+    /// How many clusters the last cut holds (one `u32`, copyable: for a read-back or a
+    /// profiler's counter).
+    pub fn cut_count(&self) -> &wgpu::Buffer {
         &self.cut_count
     }
 
