@@ -188,6 +188,41 @@ fn default_ior() -> f32 {
 }
 
 impl Material {
+    /// A dull surface of colour `diffuse` with a faint highlight (the ray tracer's builtin
+    /// scenes' walls and tables).
+    pub fn matte(diffuse: Vec3) -> Self {
+        Self {
+            diffuse,
+            specular: 0.1,
+            shininess: 16.0,
+            reflect: 0.0,
+            transmit: 0.0,
+            ior: 1.0,
+        }
+    }
+
+    /// A shiny surface that mirrors `reflect` of the light.
+    pub fn glossy(diffuse: Vec3, reflect: f32) -> Self {
+        Self {
+            specular: 0.6,
+            shininess: 64.0,
+            reflect,
+            ..Self::matte(diffuse)
+        }
+    }
+
+    /// Clear glass (index 1.5).
+    pub fn glass() -> Self {
+        Self {
+            diffuse: Vec3::splat(0.05),
+            specular: 0.8,
+            shininess: 128.0,
+            reflect: 0.1,
+            transmit: 0.85,
+            ior: 1.5,
+        }
+    }
+
     /// A plain diffuse surface (what `albedo = [...]` means).
     pub fn diffuse(diffuse: Vec3) -> Self {
         Self {

@@ -29,59 +29,6 @@ fn scene_error(path: &Path, reason: impl ToString) -> SceneError {
     }
 }
 
-/// Whitted's surface: local diffuse + Blinn-Phong specular, mirror reflection and refraction.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Material {
-    /// Diffuse colour (linear RGB).
-    pub diffuse: Vec3,
-    /// Weight of the Blinn-Phong highlight.
-    pub specular: f32,
-    /// Blinn-Phong exponent.
-    pub shininess: f32,
-    /// Weight of the mirror reflection.
-    pub reflect: f32,
-    /// Weight of the refracted ray (transparent when above 0).
-    pub transmit: f32,
-    /// Index of refraction.
-    pub ior: f32,
-}
-
-impl Material {
-    /// A dull surface of colour `diffuse`.
-    pub fn matte(diffuse: Vec3) -> Self {
-        Self {
-            diffuse,
-            specular: 0.1,
-            shininess: 16.0,
-            reflect: 0.0,
-            transmit: 0.0,
-            ior: 1.0,
-        }
-    }
-
-    /// A shiny surface that mirrors `reflect` of the light.
-    pub fn glossy(diffuse: Vec3, reflect: f32) -> Self {
-        Self {
-            specular: 0.6,
-            shininess: 64.0,
-            reflect,
-            ..Self::matte(diffuse)
-        }
-    }
-
-    /// Clear glass (index 1.5).
-    pub fn glass() -> Self {
-        Self {
-            diffuse: Vec3::splat(0.05),
-            specular: 0.8,
-            shininess: 128.0,
-            reflect: 0.1,
-            transmit: 0.85,
-            ior: 1.5,
-        }
-    }
-}
-
 /// A point light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
@@ -101,7 +48,7 @@ impl Light {
     }
 }
 
-pub use quadray_core::scene::Camera;
+pub use quadray_core::scene::{Camera, Material};
 
 /// A convex planar face: indices into the scene's vertices (shared between faces of one mesh).
 #[derive(Clone, Debug, PartialEq)]

@@ -49,14 +49,7 @@ impl Scene {
         s.ambient = own.ambient.unwrap_or(s.ambient);
         s.background = own.background.unwrap_or(s.background);
         for (_, m) in &d.materials {
-            s.add_material(Material {
-                diffuse: m.diffuse,
-                specular: m.specular,
-                shininess: m.shininess,
-                reflect: m.reflect,
-                transmit: m.transmit,
-                ior: m.ior,
-            });
+            s.add_material(*m);
         }
         // Vertices at the same position are one vertex, so faces find their neighbours.
         let mut welded: HashMap<[u32; 3], u32> = HashMap::new();
