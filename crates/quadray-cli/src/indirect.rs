@@ -31,13 +31,19 @@ pub struct IndirectArgs {
     /// small --size and --rsm-size (at most 2^30 rays).
     #[arg(long)]
     ground_truth: bool,
-    /// Frames timed per light mode (median); with --light-orbit also the frames of the sequence.
+    /// Frames timed per light mode (median); with --light-orbit or --camera-orbit also the
+    /// frames of the sequence.
     #[arg(long, default_value_t = 20)]
     frames: u32,
     /// Render a sequence of --frames frames with the spot turning DEG a frame about the
-    /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio} to the stats.
+    /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio, ...} to the stats.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     light_orbit: Option<f32>,
+    /// In that sequence (or alone), the camera moves DEG a frame along an orbit about its
+    /// target's vertical axis; adds temporal {disoccluded_fraction, disoccluded_rel_l1}: the
+    /// pixels showing what the last frame did not see, and the error there.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    camera_orbit: Option<f32>,
     /// Radiance scale before tone mapping (a picture that comes out nearly black or white says
     /// which exposure would show it).
     #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser(), allow_negative_numbers = true)]
@@ -83,12 +89,17 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     scene
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;
-    if let Some(degrees) = args.light_orbit {
-        if !(degrees.is_finite() && degrees.abs() <= 180.0) {
-            anyhow::bail!("--light-orbit {degrees} must be a finite angle within [-180, 180]");
-        }
-        if args.frames < 2 {
-            anyhow::bail!("--light-orbit needs --frames 2 or more (a sequence)");
+    for (flag, orbit) in [
+        ("--light-orbit", args.light_orbit),
+        ("--camera-orbit", args.camera_orbit),
+    ] {
+        if let Some(degrees) = orbit {
+            if !(degrees.is_finite() && degrees.abs() <= 180.0) {
+                anyhow::bail!("{flag} {degrees} must be a finite angle within [-180, 180]");
+            }
+            if args.frames < 2 {
+                anyhow::bail!("{flag} needs --frames 2 or more (a sequence)");
+            }
         }
     }
     let gpu = Gpu::new()?;
@@ -102,6 +113,7 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             reference: args.reference,
             ground_truth: args.ground_truth,
             light_orbit: args.light_orbit,
+            camera_orbit: args.camera_orbit,
             exposure: args.exposure,
         },
     )

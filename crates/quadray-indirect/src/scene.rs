@@ -197,6 +197,16 @@ impl Scene {
         out
     }
 
+    /// The scene with its camera moved `degrees` along an orbit about the vertical axis
+    /// through its target (still looking at the target).
+    pub fn camera_orbited(&self, degrees: f32) -> Self {
+        let turn = glam::Quat::from_rotation_y(degrees.to_radians());
+        let mut out = self.clone();
+        let c = &self.camera;
+        out.camera.position = c.target + turn * (c.position - c.target);
+        out
+    }
+
     /// Axis-aligned bounds of the geometry.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         bounds_of(

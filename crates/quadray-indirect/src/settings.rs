@@ -384,8 +384,8 @@ pub struct Settings {
     pub shadow_thickness: f32,
     /// Weight of each frame's indirect light in a running average over frames (1: off), every
     /// method but the brute force: damps the cut's popping under a moving light (see
-    /// BENCHMARKS.md). Not reprojected: it restarts when the camera, the method or the cluster
-    /// settings change.
+    /// BENCHMARKS.md). Reprojected through the camera's motion (points the last frame did not
+    /// see start anew); it restarts when the method or the cluster settings change.
     #[cfg_attr(feature = "cli", arg(
         long,
         default_value_t = Settings::DEFAULT.temporal_weight,
@@ -576,10 +576,10 @@ impl Settings {
             .unwrap_or(top)
     }
 
-    /// A [`Settings::temporal_weight`] for a light that moves under a still camera: on the
-    /// Cornell box and the atrium at 1 degree a frame it brings the image's frame-to-frame
-    /// change down to the brute force's, for a few percent more error against each frame's
-    /// brute force (BENCHMARKS.md, "A moving light").
+    /// A [`Settings::temporal_weight`] for a moving light: on the Cornell box and the atrium at
+    /// 1 degree a frame it brings the image's frame-to-frame change down to the brute force's,
+    /// for a few percent more error against each frame's brute force, also with the camera
+    /// moving (BENCHMARKS.md, "A moving light").
     pub const MOVING_LIGHT_TEMPORAL_WEIGHT: f32 = 0.33;
 
     /// Refuses sizes and parameters that would make no picture or an absurd amount of work.

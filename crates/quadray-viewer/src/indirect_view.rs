@@ -424,7 +424,7 @@ impl IndirectView {
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
         ui.checkbox(&mut s.indirect_shadows, "indirect shadows (quadtree)");
         let mut temporal = s.temporal_weight < 1.0;
-        ui.checkbox(&mut temporal, "temporal filter (moving light)");
+        ui.checkbox(&mut temporal, "temporal filter (reprojected)");
         s.temporal_weight = if temporal {
             Settings::MOVING_LIGHT_TEMPORAL_WEIGHT
         } else {

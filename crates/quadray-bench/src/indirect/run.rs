@@ -22,9 +22,11 @@ pub struct RunOptions {
     pub reference: bool,
     /// Also compute the CPU ground truth with visibility and measure the error against it.
     pub ground_truth: bool,
-    /// Also render a sequence with the light turning this many degrees a frame (`frames`
-    /// frames) and measure its stability.
+    /// Also render a sequence of `frames` frames with the light turning this many degrees a
+    /// frame and measure its stability.
     pub light_orbit: Option<f32>,
+    /// In that sequence (or alone), the camera orbits its target this many degrees a frame.
+    pub camera_orbit: Option<f32>,
     /// Radiance scale before tone mapping.
     pub exposure: f32,
 }
@@ -178,15 +180,18 @@ pub fn run(
     } else {
         None
     };
-    let temporal = match options.light_orbit {
-        Some(degrees) => Some(temporal::measure(
+    let temporal = match (options.light_orbit, options.camera_orbit) {
+        (None, None) => None,
+        (light, camera) => Some(temporal::measure(
             &mut renderer,
             scene,
             method,
-            degrees,
+            temporal::Orbit {
+                light_degrees: light.unwrap_or(0.0),
+                camera_degrees: camera.unwrap_or(0.0),
+            },
             options.frames,
         )?),
-        None => None,
     };
     let ground_truth = truth.as_ref().map(|truth| {
         let e = reference::compare(&frame.indirect, truth);

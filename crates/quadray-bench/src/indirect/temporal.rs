@@ -1,19 +1,31 @@
-//! Stability under a moving light (`quadray indirect --light-orbit DEG --frames N`): the spot
-//! turns DEG a frame about the vertical axis; every frame rebuilds the RSM, the quadtree and the
-//! cut. Popping shows as a cut that changes much from frame to frame and as an indirect image
-//! that changes more than the brute force's own does under the same motion. A damping that lags
-//! the light shows in the error against each frame's brute force.
+//! Stability under motion (`quadray indirect --light-orbit DEG [--camera-orbit DEG] --frames
+//! N`): the spot turns DEG a frame about the vertical axis, the camera orbits its target; every
+//! frame rebuilds the RSM, the quadtree and the cut. Popping shows as a cut that changes much
+//! from frame to frame and as an indirect image that changes more than the brute force's own does
+//! under the same motion. A damping that lags shows in the error against each frame's brute
+//! force, and a temporal filter that drags old light onto newly seen surfaces (ghosting) in the
+//! error on the pixels the last frame did not see.
 
-use quadray_indirect::reference;
-use quadray_indirect::{IndirectError, Method, Renderer, Scene};
+use quadray_indirect::{IndirectError, Method, Receiver, Renderer, Scene, reference};
 use serde::Serialize;
 use std::collections::HashSet;
+
+/// The motion per frame.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Orbit {
+    /// Degrees the spot turns a frame about the vertical axis.
+    pub light_degrees: f32,
+    /// Degrees the camera moves a frame along its orbit about the target's vertical axis.
+    pub camera_degrees: f32,
+}
 
 /// The sequence's figures (the stats' `temporal`).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Temporal {
     /// Degrees the light turns a frame.
     pub degrees_per_frame: f32,
+    /// Degrees the camera orbits a frame.
+    pub camera_degrees_per_frame: f32,
     /// Frames in the sequence.
     pub frames: u32,
     /// Mean over frame pairs of the clusters that enter or leave the cut over the cut's size
@@ -25,10 +37,19 @@ pub struct Temporal {
     pub flicker: f64,
     /// The same for the brute force over every VPL.
     pub reference_flicker: f64,
+    /// Mean frame-to-frame |change| of the error image (the method's light minus the brute
+    /// force's): popping that a moving camera's own change of the picture does not hide.
+    pub error_flicker: f64,
     /// Mean over the frames of the indirect light's rel_l1 against that frame's brute force.
     pub mean_rel_l1: f64,
     /// The largest of those.
     pub max_rel_l1: f64,
+    /// With the camera moving: the mean fraction of a frame's shaded pixels whose surface point
+    /// the last frame did not see (disoccluded or new in the view).
+    pub disoccluded_fraction: Option<f64>,
+    /// The mean over frames of the rel_l1 against the brute force on those pixels alone (a
+    /// filter that drags old light onto them shows here).
+    pub disoccluded_rel_l1: Option<f64>,
 }
 
 /// One frame of the sequence: our indirect light, the brute force's, and the cut (level, x, y).
@@ -44,22 +65,74 @@ fn mean_change(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
     sum / (a.len() * 3).max(1) as f64
 }
 
-/// Renders `frames` frames of `method` and of the brute force with the light turning
-/// `degrees` a frame (the temporal filter's average, if any, starting at the first), and leaves
-/// the renderer at `scene`'s own view.
+/// Per pixel and channel, `a - b`.
+fn difference(a: &[[f32; 3]], b: &[[f32; 3]]) -> Vec<[f32; 3]> {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| std::array::from_fn(|c| a[c] - b[c]))
+        .collect()
+}
+
+/// How far (relative to the distance from the last frame's eye) the point the last frame saw at
+/// a pixel may lie from this frame's point and still be the same.
+const SAME_POINT: f32 = 0.02;
+
+/// What a frame saw, for the next one's disocclusion: each pixel's point, the view and the eye.
+struct Seen {
+    receivers: Vec<Option<Receiver>>,
+    view_proj: glam::Mat4,
+    eye: glam::Vec3,
+}
+
+/// Per pixel of `now`: whether it shows a point `then` did not see.
+fn disoccluded(now: &[Option<Receiver>], then: &Seen, (width, height): (u32, u32)) -> Vec<bool> {
+    now.iter()
+        .map(|r| {
+            let Some(r) = r else { return false };
+            let p = glam::Vec3::from(r.position);
+            let clip = then.view_proj * p.extend(1.0);
+            if clip.w <= 0.0 {
+                return true;
+            }
+            let x = (clip.x / clip.w * 0.5 + 0.5) * width as f32;
+            let y = (0.5 - clip.y / clip.w * 0.5) * height as f32;
+            if !(0.0..width as f32).contains(&x) || !(0.0..height as f32).contains(&y) {
+                return true;
+            }
+            match &then.receivers[y as usize * width as usize + x as usize] {
+                Some(seen) => {
+                    let tolerance = SAME_POINT * p.distance(then.eye);
+                    glam::Vec3::from(seen.position).distance(p) > tolerance
+                }
+                None => true,
+            }
+        })
+        .collect()
+}
+
+/// Renders `frames` frames of `method` and of the brute force under `orbit` (the temporal
+/// filter's average, if any, starting at the first), and leaves the renderer at `scene`'s own
+/// view.
 pub fn measure(
     renderer: &mut Renderer,
     scene: &Scene,
     method: Method,
-    degrees: f32,
+    orbit: Orbit,
     frames: u32,
 ) -> Result<Temporal, IndirectError> {
     let mut previous: Option<Step> = None;
-    let (mut ours, mut theirs, mut changed) = (0.0, 0.0, 0.0);
+    let mut seen: Option<Seen> = None;
+    let (mut ours, mut theirs, mut changed, mut error_change) = (0.0, 0.0, 0.0, 0.0);
     let (mut error_sum, mut error_max) = (0.0, 0.0f64);
+    let (mut new_fraction, mut new_error, mut new_frames) = (0.0, 0.0, 0u32);
+    let size = renderer.settings().size;
+    let (width, height) = (size.width, size.height);
     renderer.gather().reset_history();
     for f in 0..frames {
-        renderer.set_view(&scene.light_turned(degrees * f as f32));
+        let view = scene
+            .light_turned(orbit.light_degrees * f as f32)
+            .camera_orbited(orbit.camera_degrees * f as f32);
+        renderer.set_view(&view);
         let image = renderer.render_frame(method)?.indirect;
         let cut: HashSet<(u32, u32, u32)> = if method.uses_quadtree() {
             // the per-level passes keep no cut: build it without shading
@@ -75,9 +148,39 @@ pub fn measure(
         let error = reference::compare(&image, &reference).rel_l1;
         error_sum += error;
         error_max = error_max.max(error);
+        if orbit.camera_degrees != 0.0 {
+            let receivers = renderer.read_receivers()?;
+            if let Some(then) = &seen {
+                let new = disoccluded(&receivers, then, (width, height));
+                let shaded = receivers.iter().filter(|r| r.is_some()).count().max(1);
+                let pick = |image: &[[f32; 3]]| -> Vec<[f32; 3]> {
+                    image
+                        .iter()
+                        .zip(&new)
+                        .filter(|(_, n)| **n)
+                        .map(|(p, _)| *p)
+                        .collect()
+                };
+                let count = new.iter().filter(|n| **n).count();
+                new_fraction += count as f64 / shaded as f64;
+                if count > 0 {
+                    new_error += reference::compare(&pick(&image), &pick(&reference)).rel_l1;
+                    new_frames += 1;
+                }
+            }
+            seen = Some(Seen {
+                receivers,
+                view_proj: view.camera_view_proj(width as f32 / height as f32),
+                eye: view.camera.position,
+            });
+        }
         if let Some((image0, reference0, cut0)) = &previous {
             ours += mean_change(&image, image0);
             theirs += mean_change(&reference, reference0);
+            error_change += mean_change(
+                &difference(&image, &reference),
+                &difference(image0, reference0),
+            );
             let moved = cut.symmetric_difference(cut0).count();
             changed += moved as f64 / cut.len().max(1) as f64;
         }
@@ -85,15 +188,21 @@ pub fn measure(
     }
     renderer.set_view(scene);
     let pairs = f64::from(frames.saturating_sub(1).max(1));
+    let camera_moves = orbit.camera_degrees != 0.0;
     Ok(Temporal {
-        degrees_per_frame: degrees,
+        degrees_per_frame: orbit.light_degrees,
+        camera_degrees_per_frame: orbit.camera_degrees,
         frames,
         cut_changed_fraction: method.uses_quadtree().then_some(changed / pairs),
         flicker_ratio: if theirs > 0.0 { ours / theirs } else { 0.0 },
         flicker: ours / pairs,
         reference_flicker: theirs / pairs,
+        error_flicker: error_change / pairs,
         mean_rel_l1: error_sum / f64::from(frames.max(1)),
         max_rel_l1: error_max,
+        disoccluded_fraction: camera_moves.then_some(new_fraction / pairs),
+        disoccluded_rel_l1: (camera_moves && new_frames > 0)
+            .then(|| new_error / f64::from(new_frames)),
     })
 }
 

@@ -32,7 +32,6 @@ use passes::Passes;
 use quadray_gpu::GpuTimer;
 use resources::Resources;
 use rsm_sampling::RsmSampling;
-use std::sync::{Mutex, PoisonError};
 use temporal::Temporal;
 use tiles::Tiles;
 
@@ -63,8 +62,6 @@ pub struct Gather {
     brute_force: BruteForce,
     direct: Direct,
     temporal: Temporal,
-    /// The camera last set, to restart the (not reprojected) average when it moves.
-    camera: Mutex<Option<(glam::Mat4, glam::Vec3)>>,
 }
 
 impl Gather {
@@ -87,7 +84,6 @@ impl Gather {
             brute_force: BruteForce::new(device, &res),
             direct: Direct::new(device, &res),
             temporal: Temporal::new(device, &res),
-            camera: Mutex::new(None),
             res,
         })
     }
@@ -111,13 +107,9 @@ impl Gather {
     }
 
     /// Sets the camera the G-buffer is rendered from (`view_proj`: world -> clip, `eye`: its
-    /// position): indirect shadows read the G-buffer as a depth map. A camera that moves
-    /// restarts the temporal filter's average.
+    /// position): indirect shadows read the G-buffer as a depth map, and the temporal filter
+    /// reprojects its average from the last filtered frame's camera to this one.
     pub fn set_camera(&self, queue: &wgpu::Queue, view_proj: glam::Mat4, eye: glam::Vec3) {
-        let mut camera = self.camera.lock().unwrap_or_else(PoisonError::into_inner);
-        if camera.replace((view_proj, eye)) != Some((view_proj, eye)) {
-            self.reset_history();
-        }
         self.res.set_camera(queue, view_proj, eye);
     }
 
@@ -148,7 +140,9 @@ impl Gather {
         }
         .filter(|_| method.subsamples() && s.subsample > 1);
         let filtered = s.temporal_weight < 1.0 && method != Method::Reference;
-        let blend = filtered && self.temporal.continues(method);
+        if filtered {
+            self.temporal.record_prepare(encoder, res, method);
+        }
         if method == Method::QuadtreePasses {
             self.passes.record_clear(encoder, res);
         }
@@ -165,7 +159,7 @@ impl Gather {
                 (Method::Rsm, None) => self.rsm_sampling.record(&mut pass, res),
                 (Method::Reference, None) => self.brute_force.record(&mut pass, res),
             }
-            if blend && upsampled.is_none() {
+            if filtered && upsampled.is_none() {
                 self.temporal.record_blend(&mut pass, res);
             }
         }
@@ -174,12 +168,12 @@ impl Gather {
             let mut pass = compute_pass(encoder, "upsample", stamps);
             res.bind_groups(&mut pass);
             upsampled.record_upsample(&mut pass, res, slices);
-            if blend {
+            if filtered {
                 self.temporal.record_blend(&mut pass, res);
             }
         }
-        if filtered && !blend {
-            self.temporal.record_start(encoder, res, method);
+        if filtered {
+            self.temporal.record_finish(encoder, res, method);
         }
     }
 

@@ -98,7 +98,10 @@ impl Outputs {
                     glam::Vec3::ZERO,
                     (s.size.width, s.size.height),
                 )),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                // copied from by the temporal filter, which keeps the view of its history
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
             }),
             indirect: storage_buffer(device, "indirect", pixels * 16),
             direct: storage_buffer(device, "direct", pixels * 16),
@@ -331,6 +334,11 @@ impl Resources {
             self.bind_dispatch(pass, level, slice);
             dispatch_2d(pass, width, height);
         }
+    }
+
+    /// The camera uniform (world -> clip first).
+    pub fn camera(&self) -> &wgpu::Buffer {
+        &self.outputs.camera
     }
 
     /// The picture's size in pixels.

@@ -1,16 +1,30 @@
-//! The temporal filter: a running average of the indirect light over frames of one method
-//! ([`crate::Settings::temporal_weight`]), not reprojected.
+//! The temporal filter ([`crate::Settings::temporal_weight`]): a running average of the indirect
+//! light over frames of one method, reprojected through the camera's motion with the G-buffer's
+//! positions and normals, points the last frame did not see starting anew. Its group 3: the
+//! average as the last filtered frame left it, that frame's view and normals, and this frame's
+//! normals.
 
 use super::resources::Resources;
-use crate::gpu::contract::dispatch_2d;
+use crate::gpu::contract::{bind_group, dispatch_2d, layout, storage_buffer, storage_entry, whole};
 use crate::settings::Method;
 use std::sync::{Mutex, PoisonError};
 
 /// The pass's own shader parts, after the shared ones.
 pub(crate) const WGSL: [&str; 1] = [include_str!("temporal.wgsl")];
 
+/// Bytes of a world -> clip matrix, the camera uniform's first field.
+const VIEW_PROJ_BYTES: u64 = 64;
+
 pub(crate) struct Temporal {
     blend: wgpu::ComputePipeline,
+    /// The average as the last filtered frame left it, read while this frame's is written.
+    previous: wgpu::Buffer,
+    /// That frame's world -> clip, copied on the GPU from the camera uniform after its blend.
+    previous_view_proj: wgpu::Buffer,
+    /// That frame's normals, and this frame's (written by the blend).
+    previous_normal: wgpu::Buffer,
+    normal: wgpu::Buffer,
+    group: wgpu::BindGroup,
     /// The method whose frames the history averages; `None` when it holds nothing to continue
     /// from.
     history_of: Mutex<Option<Method>>,
@@ -18,49 +32,97 @@ pub(crate) struct Temporal {
 
 impl Temporal {
     pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
-        let [blend] = res.pipelines(device, "gather temporal", &WGSL, ["temporal_blend"], &[]);
+        let own = layout(
+            device,
+            "gather temporal",
+            &[
+                storage_entry::<[f32; 4]>(0, true),
+                storage_entry::<[[f32; 4]; 4]>(1, true),
+                storage_entry::<[f32; 4]>(2, true),
+                storage_entry::<[f32; 4]>(3, false),
+            ],
+        );
+        let [blend] = res.pipelines(
+            device,
+            "gather temporal",
+            &WGSL,
+            ["temporal_blend"],
+            &[&own],
+        );
+        let bytes = res.outputs.history.size();
+        let previous = storage_buffer(device, "indirect history, last frame", bytes);
+        let previous_view_proj = storage_buffer(device, "view of the history", VIEW_PROJ_BYTES);
+        let previous_normal = storage_buffer(device, "normals of the history, last frame", bytes);
+        let normal = storage_buffer(device, "normals of the history", bytes);
+        let group = bind_group(
+            device,
+            "gather temporal",
+            &own,
+            vec![
+                whole(&previous),
+                whole(&previous_view_proj),
+                whole(&previous_normal),
+                whole(&normal),
+            ],
+        );
         Self {
             blend,
+            previous,
+            previous_view_proj,
+            previous_normal,
+            normal,
+            group,
             history_of: Mutex::new(None),
         }
     }
 
     /// Forgets the average: the next frame starts it anew.
     pub fn reset(&self) {
-        *self
-            .history_of
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner) = None;
+        *self.history_of() = None;
     }
 
-    /// Whether the history holds an average of `method`'s frames to blend this frame into.
-    pub fn continues(&self, method: Method) -> bool {
-        *self
-            .history_of
+    fn history_of(&self) -> std::sync::MutexGuard<'_, Option<Method>> {
+        self.history_of
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
-            == Some(method)
     }
 
-    /// Records the blend of this frame into the average, in a pass that has the groups bound.
-    pub fn record_blend(&self, pass: &mut wgpu::ComputePass, res: &Resources) {
-        pass.set_pipeline(&self.blend);
-        let (width, height) = res.size();
-        dispatch_2d(pass, width, height);
-    }
-
-    /// Records the start of an average of `method`'s frames from this frame.
-    pub fn record_start(
+    /// Records, before the pass that blends, the average this frame reads: the last one when
+    /// it holds `method`'s frames, else none (every pixel starts anew).
+    pub fn record_prepare(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         res: &Resources,
         method: Method,
     ) {
-        let o = &res.outputs;
-        encoder.copy_buffer_to_buffer(&o.indirect, 0, &o.history, 0, o.indirect.size());
-        *self
-            .history_of
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner) = Some(method);
+        let history = &res.outputs.history;
+        if *self.history_of() == Some(method) {
+            encoder.copy_buffer_to_buffer(history, 0, &self.previous, 0, history.size());
+            let normal = &self.normal;
+            encoder.copy_buffer_to_buffer(normal, 0, &self.previous_normal, 0, normal.size());
+        } else {
+            encoder.clear_buffer(&self.previous, 0, None);
+        }
+    }
+
+    /// Records the blend of this frame into the average, in a pass that has the groups bound.
+    pub fn record_blend(&self, pass: &mut wgpu::ComputePass, res: &Resources) {
+        pass.set_bind_group(3, &self.group, &[]);
+        pass.set_pipeline(&self.blend);
+        let (width, height) = res.size();
+        dispatch_2d(pass, width, height);
+    }
+
+    /// Records, after the blend, that the average now holds `method`'s frames up to this one,
+    /// seen through this frame's camera.
+    pub fn record_finish(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        res: &Resources,
+        method: Method,
+    ) {
+        let camera = res.camera();
+        encoder.copy_buffer_to_buffer(camera, 0, &self.previous_view_proj, 0, VIEW_PROJ_BYTES);
+        *self.history_of() = Some(method);
     }
 }
