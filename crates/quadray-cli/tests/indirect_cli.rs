@@ -225,6 +225,24 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     assert_eq!((cut.width(), cut.height()), (512, 512));
 }
 
+/// The temporal tests' sequence: `scene` 64x64 with a 128^2 RSM, 10 frames, the light turning
+/// 1 degree a frame.
+fn orbit_args(scene: &str) -> [&str; 11] {
+    [
+        "indirect",
+        "--scene",
+        scene,
+        "--rsm-size",
+        "128",
+        "--size",
+        "64x64",
+        "--frames",
+        "10",
+        "--light-orbit",
+        "1",
+    ]
+}
+
 /// The temporal filter with the camera moving too (BENCHMARKS.md, "Light and camera moving"):
 /// reprojected, it keeps the flicker ratio under 1.2, damps the frame-to-frame change of the
 /// error image, costs at most a fifth more error, and drags no old light onto the surfaces a
@@ -240,20 +258,10 @@ fn a_moving_camera_keeps_the_filtered_light_stable_without_ghosts() {
     let stats = dir.join("orbit.json");
     let scene = assets().join("scenes/cornell.toml");
     let args = [
-        "indirect",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--rsm-size",
-        "128",
-        "--size",
-        "64x64",
-        "--frames",
-        "10",
-        "--light-orbit",
-        "1",
-        "--camera-orbit",
-        "1",
-    ];
+        &orbit_args(scene.to_str().unwrap())[..],
+        &["--camera-orbit", "1"],
+    ]
+    .concat();
     let figure = |t: &serde_json::Value, key: &str| t[key].as_f64().unwrap();
     quadray_writes(&args, &out, &stats);
     let plain = read_json(&stats)["temporal"].clone();
@@ -296,19 +304,7 @@ fn a_turning_light_gives_the_temporal_figures() {
     let out = dir.join("orbit.png");
     let stats = dir.join("orbit.json");
     let scene = assets().join("scenes/cornell.toml");
-    let args = [
-        "indirect",
-        "--scene",
-        scene.to_str().unwrap(),
-        "--rsm-size",
-        "128",
-        "--size",
-        "64x64",
-        "--frames",
-        "10",
-        "--light-orbit",
-        "1",
-    ];
+    let args = orbit_args(scene.to_str().unwrap());
     quadray_writes(&args, &out, &stats);
     let t = &read_json(&stats)["temporal"];
     assert_eq!(t["frames"], 10);
