@@ -86,6 +86,12 @@ done
 step indirect-quadtree-shadows "$bin" indirect --method quadtree --indirect-shadows \
     --size $size --rsm-size $rsm --frames $frames --out "$probe/i.png" \
     --stats "$out/indirect-1080p/quadtree-shadows.json"
+# An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
+# each submit), to see where it stops.
+if grep -qs '^indirect-' "$out/skipped.txt"; then
+    RUST_LOG=wgpu_core=trace,quadray=debug step indirect-trace "$bin" indirect --size 16x16 \
+        --rsm-size 16 --frames 1 --out "$probe/t.png" --stats "$probe/t.json"
+fi
 
 # The Bevy frame, the light turning (every frame a new RSM, pyramid, cut and gather), with and
 # without the bounce, in two paired rounds.
