@@ -1,8 +1,9 @@
 //! The indirect-light plugin in a real Bevy app, headless on lavapipe, on the bundled Cornell box
 //! glTF loaded by Bevy's glTF loader (its camera and spot light): the plugin's brute force
 //! against quadray's own renderer (`quadray indirect --method reference`) on the same file, the
-//! plugin's quadtree against its brute force, GI on against off in the final picture, and the
-//! counts the plugin reports to Bevy's diagnostics against quadray's own.
+//! plugin's quadtree against its brute force, GI on against off in the final picture, the
+//! counts the plugin reports to Bevy's diagnostics against quadray's own, and the plugin's cut
+//! view against quadray's picture of the same cut.
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -36,6 +37,7 @@ const TARGET: [f32; 3] = [0.5, 0.5, 0.0];
 struct Probe {
     method: Method,
     enabled: bool,
+    cut_view: bool,
     indirect: Handle<ShaderBuffer>,
     picture: Handle<Image>,
     read_indirect: Arc<Mutex<Option<Vec<u8>>>>,
@@ -45,10 +47,12 @@ struct Probe {
 #[derive(Resource)]
 struct Probes(Vec<Probe>);
 
-const CASES: [(Method, bool); 3] = [
-    (Method::Reference, true),
-    (Method::Quadtree, true),
-    (Method::Quadtree, false),
+/// Method, bounce on, cut view on.
+const CASES: [(Method, bool, bool); 4] = [
+    (Method::Reference, true, false),
+    (Method::Quadtree, true, false),
+    (Method::Quadtree, false, false),
+    (Method::Quadtree, true, true),
 ];
 
 fn setup(
@@ -61,7 +65,7 @@ fn setup(
         assets.load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
     ));
     let probes = CASES
-        .map(|(method, enabled)| {
+        .map(|(method, enabled, cut_view)| {
             let mut indirect = ShaderBuffer::with_size((SIZE * SIZE * 16) as usize, default());
             indirect.buffer_description.usage |= BufferUsages::COPY_SRC | BufferUsages::COPY_DST;
             let mut target =
@@ -70,6 +74,7 @@ fn setup(
             Probe {
                 method,
                 enabled,
+                cut_view,
                 indirect: buffers.add(indirect),
                 picture: images.add(target),
                 read_indirect: Arc::default(),
@@ -112,6 +117,7 @@ fn configure(
                     settings: Settings::sized(SIZE, SIZE, RSM),
                     method: p.method,
                     enabled: p.enabled,
+                    cut_view: p.cut_view,
                     debug_indirect: Some(p.indirect.clone()),
                     ..default()
                 },
@@ -237,8 +243,39 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
         "{plugin_error} vs {quadray_error}"
     );
 
-    // (c) GI adds light where the scene is lit only indirectly, nothing on the background
+    // the cut view: quadray's picture of its own cut (the same cut, the counts say), at the
+    // plugin's magnification for this size (the RSM at up to half the picture: one pixel a texel)
     let picture = |p: &Probe| p.read_picture.lock().unwrap().clone().unwrap();
+    let cut = renderer.read_cut().unwrap();
+    let expected =
+        quadray_indirect::picture::cut_view(RSM, &renderer.read_nodes().unwrap(), &cut, 1);
+    // the clusters' top and left edges
+    let mut outline = vec![false; (RSM * RSM) as usize];
+    for node in &cut {
+        let side = 1 << node.level;
+        let corner = node.y * side * RSM + node.x * side;
+        for i in 0..side {
+            outline[(corner + i) as usize] = true;
+            outline[(corner + i * RSM) as usize] = true;
+        }
+    }
+    let drawn = picture(&probes[3]);
+    let (mut exact, mut outlines, mut outlines_drawn, mut worst) = (0, 0, 0, 0);
+    for ((a, b), &edge) in drawn.chunks_exact(4).zip(&expected.pixels).zip(&outline) {
+        let difference = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap();
+        worst = worst.max(difference);
+        exact += usize::from(difference == 0);
+        outlines += usize::from(edge);
+        outlines_drawn += usize::from(edge && difference == 0);
+    }
+    println!(
+        "cut view: {exact} of {} pixels as quadray draws them (worst channel difference \
+         {worst}), {outlines_drawn} of {outlines} outline pixels",
+        expected.pixels.len()
+    );
+    assert!(worst <= 1 && outlines > 0 && outlines_drawn == outlines);
+
+    // (c) GI adds light where the scene is lit only indirectly, nothing on the background
     let (on, off) = (picture(&probes[1]), picture(&probes[2]));
     let (mut seen_pixels, mut brighter, mut background, mut changed_background) = (0, 0, 0, 0);
     for (i, (a, b)) in on.chunks_exact(4).zip(off.chunks_exact(4)).enumerate() {

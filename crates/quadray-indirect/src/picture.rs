@@ -29,7 +29,8 @@ pub fn tone_map(width: u32, height: u32, radiance: &[[f32; 3]], exposure: f32) -
     }
 }
 
-/// Outline colours of the cut's clusters by level (0 = single VPLs).
+/// Outline colours of the cut's clusters by level (0 = single VPLs); `wgsl/cut_view.wgsl` has
+/// the same.
 const LEVEL_COLOURS: [[u8; 4]; 6] = [
     [255, 255, 255, 255],
     [255, 64, 64, 255],
@@ -39,20 +40,29 @@ const LEVEL_COLOURS: [[u8; 4]; 6] = [
     [230, 90, 255, 255],
 ];
 
-/// The selected clusters over the RSM that they cluster: the RSM's flux (exposed by its mean over
-/// lit texels), magnified to at least 512 pixels, with every cluster of the cut outlined in a
-/// colour by its level (white single VPLs, then red, yellow, green, blue, violet going up).
-pub fn cut_view(rsm_size: u32, flux: &[[f32; 3]], cut: &[CutNode]) -> Rgba8Image {
-    let zoom = (512 / rsm_size).max(1);
+/// The magnification at which [`cut_view`] shows an RSM of `rsm_size` texels a side at 512
+/// pixels or more.
+pub fn cut_view_zoom(rsm_size: u32) -> u32 {
+    (512 / rsm_size.max(1)).max(1)
+}
+
+/// The selected clusters over the RSM that they cluster: the RSM's flux (level 0 of `nodes`,
+/// the pyramid as [`crate::Renderer::read_nodes`] reads it), exposed by its mean over the texels
+/// that see geometry (the root's flux over its texel count), magnified `zoom` times, with every
+/// cluster of the cut outlined in a colour by its level (white single VPLs, then red, yellow,
+/// green, blue, violet going up). The GPU draws the same picture with
+/// [`crate::wgsl::CUT_VIEW`] (the Bevy plugin's debug view).
+pub fn cut_view(rsm_size: u32, nodes: &[[[f32; 4]; 3]], cut: &[CutNode], zoom: u32) -> Rgba8Image {
     let side = rsm_size * zoom;
-    let luminance = |p: &[f32; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-    let (sum, lit) = flux
+    let luminance = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let root = nodes.last().map_or([0.0; 4], |n| n[0]);
+    let sum = luminance(&root);
+    let exposure = if sum > 0.0 { root[3] / sum } else { 1.0 };
+    let flux: Vec<[f32; 3]> = nodes[..(rsm_size * rsm_size) as usize]
         .iter()
-        .map(luminance)
-        .filter(|&l| l > 0.0)
-        .fold((0.0, 0u32), |(s, n), l| (s + l, n + 1));
-    let exposure = if sum > 0.0 { lit as f32 / sum } else { 1.0 };
-    let rsm = tone_map(rsm_size, rsm_size, flux, exposure);
+        .map(|n| [n[0][0], n[0][1], n[0][2]])
+        .collect();
+    let rsm = tone_map(rsm_size, rsm_size, &flux, exposure);
     let mut image = Rgba8Image {
         width: side,
         height: side,

@@ -182,7 +182,8 @@ fn the_cut_covers_every_lit_rsm_texel_exactly_once() {
         assert!(n == 1 || !lit(i), "lit texel {i} is in no cluster");
     }
     // the picture of it: the RSM magnified to 512 pixels with the clusters outlined
-    let picture = quadray_indirect::picture::cut_view(size, &flux, &cut);
+    let zoom = quadray_indirect::picture::cut_view_zoom(size);
+    let picture = quadray_indirect::picture::cut_view(size, &r.read_nodes().unwrap(), &cut, zoom);
     assert_eq!((picture.width, picture.height), (512, 512));
 }
 

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{cut_view, tone_map};
+use quadray_indirect::picture::{cut_view, cut_view_zoom, tone_map};
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
 use quadray_indirect::{FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity};
 use std::path::{Path, PathBuf};
@@ -279,8 +279,9 @@ impl IndirectView {
             Show::Indirect => tone_map(w, h, &frame.indirect, self.exposure),
             Show::Cut => cut_view(
                 rsm_size,
-                &renderer.read_rsm_flux()?,
+                &renderer.read_nodes()?,
                 cut.as_deref().unwrap_or_default(),
+                cut_view_zoom(rsm_size),
             ),
         }))
     }

@@ -5,7 +5,7 @@
 
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{cut_view, tone_map};
+use quadray_indirect::picture::{cut_view, cut_view_zoom, tone_map};
 use quadray_indirect::reference::{compare, error_map, ground_truth};
 use quadray_indirect::scene::scenes_dir;
 use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings, TileCriterion};
@@ -63,7 +63,13 @@ pub fn render_demo(
         3,
     );
     files.push(save(&picture, &out.join("cornell.png"))?);
-    let cut = cut_view(r.settings().rsm_size, &r.read_rsm_flux()?, &r.read_cut()?);
+    let rsm_size = r.settings().rsm_size;
+    let cut = cut_view(
+        rsm_size,
+        &r.read_nodes()?,
+        &r.read_cut()?,
+        cut_view_zoom(rsm_size),
+    );
     let cut_picture = montage(
         &[(format!("the cut over the RSM: {clusters} clusters"), cut)],
         1,

@@ -5,7 +5,7 @@
 use super::temporal::{self, Temporal};
 use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{TONE_MAP_WHITE, cut_view, mean_flip, tone_map};
+use quadray_indirect::picture::{TONE_MAP_WHITE, cut_view, cut_view_zoom, mean_flip, tone_map};
 use quadray_indirect::reference::{self, ImageError};
 use quadray_indirect::{
     Frame, FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts,
@@ -145,7 +145,12 @@ pub fn run(
         renderer.render(Method::Quadtree, true, false)?;
         let cut = renderer.read_cut()?;
         let rsm_size = renderer.settings().rsm_size;
-        let picture = cut_view(rsm_size, &renderer.read_rsm_flux()?, &cut);
+        let picture = cut_view(
+            rsm_size,
+            &renderer.read_nodes()?,
+            &cut,
+            cut_view_zoom(rsm_size),
+        );
         (Some(cut.len() as u32), Some(picture))
     } else {
         (None, None)

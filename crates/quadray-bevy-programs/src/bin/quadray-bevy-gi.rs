@@ -2,12 +2,12 @@
 //! (`assets/scenes/cornell_spot.gltf`) loaded by Bevy's glTF loader, its spot light turning
 //! slowly, Bevy's direct light and shadows as they are, and quadray's light quadtree adding the
 //! bounce. G turns the bounce on and off; M cycles the method (the quadtree's cut, per-tile cuts,
-//! RSM sampling, every VPL); Space stops and restarts the light. The window's title says what is
-//! shown.
+//! RSM sampling, every VPL); C shows the light quadtree's cut over the RSM in the top-left corner;
+//! Space stops and restarts the light. The window's title says what is shown.
 //!
 //! `cargo run --release --bin quadray-bevy-gi` (`--bin`, not `-p`: Cargo then resolves features
 //! as for the whole workspace, and what the test build compiled is reused).
-//! Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
+//! Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi] [--cut-view]
 //! [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the light still and
 //! saves the picture. `--frames N` (with `--screenshot`) times N frames with the light turning
 //! and prints their median and Bevy's render diagnostics of the bounce (GPU time of the light's
@@ -42,11 +42,13 @@ const TURN: f32 = 0.25;
 /// The glTF file's camera, when it appears.
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
-/// What the first frame shows (`--no-gi`, `--method`) and at what size (`--size`, `--rsm-size`).
+/// What the first frame shows (`--no-gi`, `--method`, `--cut-view`) and at what size (`--size`,
+/// `--rsm-size`).
 #[derive(Resource, Clone, Copy)]
 struct Shown {
     gi: bool,
     method: Method,
+    cut_view: bool,
     turning: bool,
     size: (u32, u32),
     rsm_size: u32,
@@ -91,6 +93,7 @@ fn main() {
     let shown = Shown {
         gi: !args.iter().any(|a| a == "--no-gi"),
         method,
+        cut_view: args.iter().any(|a| a == "--cut-view"),
         turning: offscreen.is_none() || timed > 0,
         size,
         rsm_size,
@@ -163,6 +166,7 @@ fn configure(
                 },
                 method: shown.method,
                 enabled: shown.gi,
+                cut_view: shown.cut_view,
                 ..default()
             },
         ));
@@ -187,13 +191,17 @@ fn keys(
             .map_or(0, |i| i + 1);
         shown.method = METHODS[next % METHODS.len()];
     }
+    if keys.just_pressed(KeyCode::KeyC) {
+        shown.cut_view = !shown.cut_view;
+    }
     if keys.just_pressed(KeyCode::Space) {
         shown.turning = !shown.turning;
     }
     for mut gi in &mut cameras {
-        if gi.enabled != shown.gi || gi.method != shown.method {
+        if gi.enabled != shown.gi || gi.method != shown.method || gi.cut_view != shown.cut_view {
             gi.enabled = shown.gi;
             gi.method = shown.method;
+            gi.cut_view = shown.cut_view;
         }
     }
 }
@@ -212,7 +220,8 @@ fn turn_light(
 
 fn show_title(shown: Res<Shown>, mut windows: Query<&mut Window, With<PrimaryWindow>>) {
     let title = format!(
-        "quadray indirect light: {} ({}) - G: bounce on/off, M: method, Space: light {}",
+        "quadray indirect light: {} ({}) - G: bounce on/off, M: method, C: cut over the RSM, \
+         Space: light {}",
         if shown.gi { "on" } else { "off" },
         shown.method.name(),
         if shown.turning { "turning" } else { "still" },

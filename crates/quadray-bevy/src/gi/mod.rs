@@ -93,6 +93,11 @@ pub struct IndirectLight {
     pub r_min: f32,
     /// `false` keeps what is built but gathers and adds no light (to compare).
     pub enabled: bool,
+    /// Debug view: the light quadtree's cut over the RSM in the picture's top-left corner, after
+    /// tone mapping (the RSM's flux with every cluster outlined in its level's colour: white
+    /// single VPLs, then red, yellow, green, blue, violet going up), the picture `quadray
+    /// indirect` writes as `*.cut.png`. The per-tile cuts refine this cut tile by tile.
+    pub cut_view: bool,
     /// Debug output: each frame's indirect radiance (`[f32; 4]` a pixel, row-major, before the
     /// exposure) copied into this buffer, when it has room.
     pub debug_indirect: Option<Handle<ShaderBuffer>>,
@@ -105,6 +110,7 @@ impl Default for IndirectLight {
             method: Method::Quadtree,
             r_min: quadray_indirect::scene::DEFAULT_R_MIN,
             enabled: true,
+            cut_view: false,
             debug_indirect: None,
         }
     }

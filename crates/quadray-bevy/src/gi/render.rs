@@ -1,10 +1,12 @@
 //! The render world's side: per light, quadray's RSM and light quadtree; per camera, the
-//! G-buffer translated from Bevy's, quadray's gather, and the additive composite into the view.
+//! G-buffer translated from Bevy's, quadray's gather, the additive composite into the view and,
+//! on request, the cut over the RSM drawn into the tone-mapped picture.
 
 use super::{GBUFFER_SHADER, IndirectLight, IndirectLightScene};
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::core_pipeline::tonemapping::tonemapping;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
@@ -30,7 +32,6 @@ use quadray_indirect::{Spot, scene::bounds_of};
 use std::num::NonZero;
 use std::sync::{Mutex, PoisonError};
 
-const COMPOSITE_WGSL: &str = include_str!("composite.wgsl");
 const COUNTS_WGSL: &str = include_str!("counts.wgsl");
 /// The G-buffer translation's uniform: world_from_clip, the eye (xyz), the size (two u32).
 const VIEW_UNIFORM_BYTES: u64 = 64 + 16 + 16;
@@ -50,11 +51,31 @@ pub(super) fn build(app: &mut App) {
         )
         .add_systems(
             Core3d,
-            indirect_light_pass
-                .after(main_opaque_pass_3d)
-                .before(main_transparent_pass_3d)
-                .in_set(Core3dSystems::MainPass),
+            (
+                indirect_light_pass
+                    .after(main_opaque_pass_3d)
+                    .before(main_transparent_pass_3d)
+                    .in_set(Core3dSystems::MainPass),
+                cut_view_pass
+                    .after(tonemapping)
+                    .in_set(Core3dSystems::PostProcess),
+            ),
         );
+}
+
+/// The composite's and the cut view's shader: quadray's engine-neutral modules, then this
+/// plugin's bindings and entry points.
+fn composite_source() -> String {
+    use quadray_indirect::wgsl;
+    [
+        wgsl::prelude().as_str(),
+        wgsl::NODE,
+        wgsl::KERNEL,
+        wgsl::CUT_RULE,
+        wgsl::CUT_VIEW,
+        include_str!("composite.wgsl"),
+    ]
+    .concat()
 }
 
 #[derive(Resource)]
@@ -62,9 +83,11 @@ struct Pipelines {
     gbuffer_layout: BindGroupLayoutDescriptor,
     gbuffer: CachedComputePipelineId,
     composite_layout: wgpu::BindGroupLayout,
+    cut_view_layout: wgpu::BindGroupLayout,
     composite_module: wgpu::ShaderModule,
     /// By the view target's format.
     composite: HashMap<TextureFormat, wgpu::RenderPipeline>,
+    cut_view: HashMap<TextureFormat, wgpu::RenderPipeline>,
     /// The work counts' means, for Bevy's diagnostics.
     counts: wgpu::ComputePipeline,
 }
@@ -96,34 +119,33 @@ fn init_pipelines(
         ..default()
     });
     let device = device.wgpu_device();
+    let fragment_buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let storage = wgpu::BufferBindingType::Storage { read_only: true };
+    let uniform = wgpu::BufferBindingType::Uniform;
     let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("quadray gi composite"),
+        entries: &[fragment_buffer(0, storage), fragment_buffer(1, uniform)],
+    });
+    let cut_view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("quadray gi cut view"),
         entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
+            fragment_buffer(2, uniform),
+            fragment_buffer(3, storage),
+            fragment_buffer(4, uniform),
         ],
     });
     let composite_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("quadray gi composite"),
-        source: wgpu::ShaderSource::Wgsl(COMPOSITE_WGSL.into()),
+        source: wgpu::ShaderSource::Wgsl(composite_source().into()),
     });
     let counts_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("quadray gi counts"),
@@ -141,38 +163,71 @@ fn init_pipelines(
         gbuffer_layout,
         gbuffer,
         composite_layout,
+        cut_view_layout,
         composite_module,
         composite: HashMap::default(),
+        cut_view: HashMap::default(),
         counts,
     });
 }
 
-/// The composite's additive pipeline into a target of `format`.
+/// What a pipeline of the composite's shader draws.
+#[derive(Clone, Copy)]
+enum Draw {
+    /// The indirect light, added.
+    Composite,
+    /// The cut view, over what is there.
+    CutView,
+}
+
+/// The composite's shader's pipeline for `draw` into a target of `format` (made once a format).
 fn composite_pipeline(
     device: &wgpu::Device,
-    pipelines: &Pipelines,
+    pipelines: &mut Pipelines,
+    draw: Draw,
     format: TextureFormat,
 ) -> wgpu::RenderPipeline {
-    let add = wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
+    let Pipelines {
+        composite,
+        cut_view,
+        composite_layout,
+        cut_view_layout,
+        composite_module: module,
+        ..
+    } = pipelines;
+    let (cache, layout, entry_point, blend) = match draw {
+        Draw::Composite => {
+            let add = wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            };
+            let keep = wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::Zero,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            };
+            let blend = wgpu::BlendState {
+                color: add,
+                alpha: keep,
+            };
+            (composite, &*composite_layout, "add_indirect", Some(blend))
+        }
+        Draw::CutView => (cut_view, &*cut_view_layout, "draw_cut_view", None),
     };
-    let keep = wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::Zero,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    };
+    if let Some(pipeline) = cache.get(&format) {
+        return pipeline.clone();
+    }
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("quadray gi composite"),
-        bind_group_layouts: &[Some(&pipelines.composite_layout)],
+        label: Some(entry_point),
+        bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("quadray gi composite"),
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(entry_point),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
-            module: &pipelines.composite_module,
+            module,
             entry_point: Some("fullscreen"),
             compilation_options: Default::default(),
             buffers: &[],
@@ -181,21 +236,20 @@ fn composite_pipeline(
         depth_stencil: None,
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &pipelines.composite_module,
-            entry_point: Some("add_indirect"),
+            module,
+            entry_point: Some(entry_point),
             compilation_options: Default::default(),
             targets: &[Some(wgpu::ColorTargetState {
                 format,
-                blend: Some(wgpu::BlendState {
-                    color: add,
-                    alpha: keep,
-                }),
+                blend,
                 write_mask: wgpu::ColorWrites::ALL,
             })],
         }),
         multiview_mask: None,
         cache: None,
-    })
+    });
+    cache.insert(format, pipeline.clone());
+    pipeline
 }
 
 /// The light's side, shared by every camera: its RSM over the scene's triangles and the light
@@ -299,7 +353,8 @@ fn prepare_light(
     }
 }
 
-/// A camera's side: quadray's G-buffer (translated from Bevy's), its gather and composite.
+/// A camera's side: quadray's G-buffer (translated from Bevy's), its gather, composite and cut
+/// view.
 #[derive(Component)]
 pub(super) struct ViewPasses {
     settings: Settings,
@@ -311,6 +366,10 @@ pub(super) struct ViewPasses {
     composite_uniform: wgpu::Buffer,
     composite_group: wgpu::BindGroup,
     composite: wgpu::RenderPipeline,
+    /// The cut view's magnification (a `u32`).
+    cut_view_uniform: wgpu::Buffer,
+    cut_view_group: wgpu::BindGroup,
+    cut_view: wgpu::RenderPipeline,
     /// The gather's counts as means per shaded pixel: VPL evaluations, texel fetches.
     means: wgpu::Buffer,
     means_group: wgpu::BindGroup,
@@ -334,9 +393,7 @@ impl ViewPasses {
         device: &wgpu::Device,
         settings: Settings,
         light: &LightPasses,
-        composite: wgpu::RenderPipeline,
-        composite_layout: &wgpu::BindGroupLayout,
-        counts: &wgpu::ComputePipeline,
+        pipelines: &mut Pipelines,
         format: TextureFormat,
     ) -> Result<Self, quadray_indirect::IndirectError> {
         let size = wgpu::Extent3d {
@@ -375,9 +432,29 @@ impl ViewPasses {
         };
         let view_uniform = uniform("quadray gi view", VIEW_UNIFORM_BYTES);
         let composite_uniform = uniform("quadray gi composite", 16);
+        let cut_view_uniform = uniform("quadray gi cut view", 16);
+        let quadtree = &light.quadtree;
+        let cut_view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("quadray gi cut view"),
+            layout: &pipelines.cut_view_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: quadtree.params().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: quadtree.nodes().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: cut_view_uniform.as_entire_binding(),
+                },
+            ],
+        });
         let composite_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("quadray gi composite"),
-            layout: composite_layout,
+            layout: &pipelines.composite_layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -397,7 +474,7 @@ impl ViewPasses {
         });
         let means_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("quadray gi counts"),
-            layout: &counts.get_bind_group_layout(0),
+            layout: &pipelines.counts.get_bind_group_layout(0),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -421,7 +498,10 @@ impl ViewPasses {
             gather,
             composite_uniform,
             composite_group,
-            composite,
+            composite: composite_pipeline(device, pipelines, Draw::Composite, format),
+            cut_view_uniform,
+            cut_view_group,
+            cut_view: composite_pipeline(device, pipelines, Draw::CutView, format),
             means,
             means_group,
             inputs: Mutex::new(None),
@@ -506,17 +586,7 @@ fn prepare_views(
         }
         let format = target.main_texture_format();
         let Some(passes) = passes.filter(|p| p.settings == settings && p.format == format) else {
-            let composite = match pipelines.composite.get(&format) {
-                Some(p) => p.clone(),
-                None => {
-                    let p = composite_pipeline(device, &pipelines, format);
-                    pipelines.composite.insert(format, p.clone());
-                    p
-                }
-            };
-            let layout = &pipelines.composite_layout;
-            let counts = &pipelines.counts;
-            match ViewPasses::new(device, settings, l, composite, layout, counts, format) {
+            match ViewPasses::new(device, settings, l, &mut pipelines, format) {
                 Ok(p) => {
                     commands.entity(entity).insert(p);
                 }
@@ -555,7 +625,16 @@ fn prepare_views(
             0,
             bytemuck::cast_slice(&composite),
         );
+        let zoom = [cut_view_zoom(&passes.settings), 0, 0, 0];
+        queue.write_buffer(&passes.cut_view_uniform, 0, bytemuck::cast_slice(&zoom));
     }
+}
+
+/// The cut view's magnification: the RSM at up to half the picture's shorter side, at least
+/// one pixel a texel.
+fn cut_view_zoom(settings: &Settings) -> u32 {
+    let shorter = settings.size.width.min(settings.size.height);
+    (shorter / 2 / settings.rsm_size).max(1)
 }
 
 /// Records, for one camera: the light's RSM, pyramid and cut when they are stale, the G-buffer
@@ -698,4 +777,38 @@ fn indirect_light_pass(
 /// The value behind `mutex`, also after a panic elsewhere (every value here is whole).
 fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Draws the cut over the RSM into the tone-mapped picture's top-left corner, for a camera whose
+/// [`IndirectLight::cut_view`] is on (and whose bounce is: the cut is built with it).
+fn cut_view_pass(
+    view: ViewQuery<(&ViewPasses, &ViewTarget, &IndirectLight)>,
+    light: Res<LightState>,
+    mut ctx: RenderContext,
+) {
+    let (passes, target, gi) = view.into_inner();
+    if !(gi.cut_view && gi.enabled) || light.0.as_ref().is_none_or(|l| l.spot.is_none()) {
+        return;
+    }
+    let size = passes.settings.size;
+    let side = passes.settings.rsm_size * cut_view_zoom(&passes.settings);
+    let mut pass = ctx
+        .command_encoder()
+        .begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("quadray gi cut view"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target.main_texture_view(),
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
+        });
+    pass.set_scissor_rect(0, 0, side.min(size.width), side.min(size.height));
+    pass.set_pipeline(&passes.cut_view);
+    pass.set_bind_group(0, &passes.cut_view_group, &[]);
+    pass.draw(0..3, 0..1);
 }

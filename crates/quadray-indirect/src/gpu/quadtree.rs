@@ -251,12 +251,15 @@ impl LightQuadtree {
         self.cluster.levels(self.rsm_size)
     }
 
-    pub(crate) fn params(&self) -> &wgpu::Buffer {
+    /// The pyramid's parameters (a `ClusterParams` uniform of [`crate::wgsl::NODE`]): for an
+    /// engine's own passes over the quadtree, as the Bevy plugin's cut view.
+    pub fn params(&self) -> &wgpu::Buffer {
         &self.params
     }
 
-    /// Every node, finest level first: [`GpuNode`]s.
-    pub(crate) fn nodes(&self) -> &wgpu::Buffer {
+    /// Every node, finest level first: a `Node` array of [`crate::wgsl::NODE`] (for an engine's
+    /// own passes, as [`Self::params`]).
+    pub fn nodes(&self) -> &wgpu::Buffer {
         &self.nodes
     }
 

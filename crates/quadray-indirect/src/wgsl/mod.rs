@@ -63,6 +63,12 @@ pub const GATHER_LEVEL: &str = include_str!("gather_level.wgsl");
 /// `fn load_rsm_sample(i: u32) -> vec4<f32>` (the pattern of [`crate::baselines::rsm_samples`]).
 pub const GATHER_VPLS: &str = include_str!("gather_vpls.wgsl");
 
+/// The cut over the RSM as a picture (a debug view): `cut_view_exposure(params)` and
+/// `cut_view_pixel(params, zoom, pixel, exposure)`, the linear colour whose sRGB encoding is
+/// [`crate::picture::cut_view`]'s pixel (the Bevy plugin draws it in a corner of the picture).
+/// Needs [`NODE`], [`KERNEL`], [`CUT_RULE`]. Accessor: `load_node` (as [`CUT_RULE`]).
+pub const CUT_VIEW: &str = include_str!("cut_view.wgsl");
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,7 +91,7 @@ fn load_rsm_sample(i: u32) -> vec4<f32> { return vec4<f32>(0.0); }
 ";
 
     /// Each module after the modules it needs, then the stub accessors it calls.
-    fn modules() -> [(&'static str, Vec<&'static str>); 9] {
+    fn modules() -> [(&'static str, Vec<&'static str>); 10] {
         [
             ("node", vec![NODE]),
             ("kernel", vec![NODE, KERNEL]),
@@ -93,6 +99,10 @@ fn load_rsm_sample(i: u32) -> vec4<f32> { return vec4<f32>(0.0); }
             ("receiver", vec![RECEIVER]),
             ("cut rule", vec![NODE, CUT_RULE, NODE_ACCESSORS]),
             ("bound", vec![NODE, KERNEL, BOUND]),
+            (
+                "cut view",
+                vec![NODE, KERNEL, CUT_RULE, CUT_VIEW, NODE_ACCESSORS],
+            ),
             (
                 "gather cut",
                 vec![
@@ -135,6 +145,7 @@ fn load_rsm_sample(i: u32) -> vec4<f32> { return vec4<f32>(0.0); }
             GATHER_CUT,
             GATHER_LEVEL,
             GATHER_VPLS,
+            CUT_VIEW,
         ];
         for module in all {
             assert!(
