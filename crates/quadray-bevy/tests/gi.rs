@@ -171,7 +171,26 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
     };
     let mut frames = 0;
     while !probes.iter().all(lit) {
-        assert!(frames < 500, "no indirect light after {frames} frames");
+        if frames == 500 {
+            let states: Vec<String> = probes
+                .iter()
+                .map(|p| {
+                    let indirect = p.read_indirect.lock().unwrap();
+                    let lit = indirect.as_ref().map(|b| {
+                        let v = floats(b);
+                        v.iter().filter(|v| v[0] > 0.0).count()
+                    });
+                    format!(
+                        "{} (bounce {}, cut view {}): lit pixels {lit:?}, picture read {}",
+                        p.method.name(),
+                        p.enabled,
+                        p.cut_view,
+                        p.read_picture.lock().unwrap().is_some()
+                    )
+                })
+                .collect();
+            panic!("no indirect light after {frames} frames: {states:#?}");
+        }
         app.update();
         frames += 1;
     }

@@ -24,6 +24,7 @@ pub struct Ray {
 
 impl Ray {
     /// The segment of `origin + t dir` with `t` in `(t_min, t_max)`.
+    #[inline]
     pub fn new(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
         Self {
             origin,
@@ -35,12 +36,14 @@ impl Ray {
 
     /// The segment from `origin` to `origin + offset` with a unit direction (a shadow ray to a
     /// light), starting after `t_min`.
+    #[inline]
     pub fn segment(origin: Vec3, offset: Vec3, t_min: f32) -> Self {
         let dist = offset.length();
         Self::new(origin, offset / dist, t_min, dist)
     }
 
     /// The point at parameter `t`.
+    #[inline]
     pub fn at(&self, t: f32) -> Vec3 {
         self.origin + self.dir * t
     }

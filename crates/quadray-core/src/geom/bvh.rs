@@ -38,6 +38,8 @@ impl Bvh {
     }
 
     /// Is any polygon of `polygons` (those the BVH was built on) but `skip` hit on the ray?
+    // inlined: compiled in the tracing crate at its optimisation level (see Cargo.toml)
+    #[inline]
     pub fn occluded(&self, polygons: &[ConvexPolygon], ray: &Ray, skip: Option<u32>) -> bool {
         let (o, d, t_min, t_max) = (ray.origin, ray.dir, ray.t_min, ray.t_max);
         let inv_d = d.recip();
