@@ -740,24 +740,13 @@ fn indirect_light_pass(
         }
     }
     let span = diagnostics.time_span(encoder, "composite");
-    {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("quadray gi composite"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target.main_texture_view(),
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            ..Default::default()
-        });
-        pass.set_pipeline(&passes.composite);
-        pass.set_bind_group(0, &passes.composite_group, &[]);
-        pass.draw(0..3, 0..1);
-    }
+    draw_over(
+        encoder,
+        "quadray gi composite",
+        target.main_texture_view(),
+        (&passes.composite, &passes.composite_group),
+        None,
+    );
     span.end(encoder);
     whole.end(encoder);
     if diagnostics.is_some() {
@@ -792,23 +781,41 @@ fn cut_view_pass(
     }
     let size = passes.settings.size;
     let side = passes.settings.rsm_size * cut_view_zoom(&passes.settings);
-    let mut pass = ctx
-        .command_encoder()
-        .begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("quadray gi cut view"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target.main_texture_view(),
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            ..Default::default()
-        });
-    pass.set_scissor_rect(0, 0, side.min(size.width), side.min(size.height));
-    pass.set_pipeline(&passes.cut_view);
-    pass.set_bind_group(0, &passes.cut_view_group, &[]);
+    draw_over(
+        ctx.command_encoder(),
+        "quadray gi cut view",
+        target.main_texture_view(),
+        (&passes.cut_view, &passes.cut_view_group),
+        Some((side.min(size.width), side.min(size.height))),
+    );
+}
+
+/// Draws a full-screen triangle of the composite's shader over what `view` holds, within the
+/// top-left `scissor` (width, height) when one is given.
+fn draw_over(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    view: &wgpu::TextureView,
+    (pipeline, group): (&wgpu::RenderPipeline, &wgpu::BindGroup),
+    scissor: Option<(u32, u32)>,
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        ..Default::default()
+    });
+    if let Some((width, height)) = scissor {
+        pass.set_scissor_rect(0, 0, width, height);
+    }
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
     pass.draw(0..3, 0..1);
 }
