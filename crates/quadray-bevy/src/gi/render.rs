@@ -18,7 +18,7 @@ use bevy::render::render_resource::binding_types::{
 use bevy::render::render_resource::{
     BindGroupLayoutDescriptor, BindGroupLayoutEntries, CachedComputePipelineId,
     ComputePipelineDescriptor, PipelineCache, ShaderStages, StorageTextureAccess, TextureFormat,
-    TextureSampleType,
+    TextureSampleType, TextureViewId,
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::storage::GpuShaderBuffer;
@@ -373,6 +373,9 @@ pub(super) struct ViewPasses {
     /// The gather's counts as means per shaded pixel: VPL evaluations, texel fetches.
     means: wgpu::Buffer,
     means_group: wgpu::BindGroup,
+    /// The G-buffer translation's bind group, by the ids of Bevy's deferred and depth views it
+    /// reads.
+    gbuffer_group: Mutex<Option<([TextureViewId; 2], wgpu::BindGroup)>>,
     /// What this frame's gather would see (set when preparing).
     inputs: Mutex<Option<GatherInputs>>,
     /// What the last gather saw: a frame that sees the same (and has no temporal filter to
@@ -504,6 +507,7 @@ impl ViewPasses {
             cut_view: composite_pipeline(device, pipelines, Draw::CutView, format),
             means,
             means_group,
+            gbuffer_group: Mutex::new(None),
             inputs: Mutex::new(None),
             last_gather: Mutex::new(None),
         })
@@ -665,30 +669,41 @@ fn indirect_light_pass(
     let (Some(deferred), Some(depth)) = (prepass.deferred_view(), prepass.depth_view()) else {
         return;
     };
-    let layout = pipeline_cache.get_bind_group_layout(&pipelines.gbuffer_layout);
-    let resources = [
-        wgpu::BindingResource::TextureView(deferred),
-        wgpu::BindingResource::TextureView(depth),
-        passes.view_uniform.as_entire_binding(),
-        wgpu::BindingResource::TextureView(&passes.gbuffer[0]),
-        wgpu::BindingResource::TextureView(&passes.gbuffer[1]),
-        wgpu::BindingResource::TextureView(&passes.gbuffer[2]),
-    ];
-    let group = ctx
-        .render_device()
-        .wgpu_device()
-        .create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("quadray gi gbuffer"),
-            layout: &layout,
-            entries: &resources
-                .into_iter()
-                .enumerate()
-                .map(|(i, resource)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource,
-                })
-                .collect::<Vec<_>>(),
-        });
+    // made again only when Bevy's prepass textures are (a resize)
+    let key = [deferred.id(), depth.id()];
+    let mut cached = lock(&passes.gbuffer_group);
+    let group = match &*cached {
+        Some((k, group)) if *k == key => group.clone(),
+        _ => {
+            let layout = pipeline_cache.get_bind_group_layout(&pipelines.gbuffer_layout);
+            let resources = [
+                wgpu::BindingResource::TextureView(deferred),
+                wgpu::BindingResource::TextureView(depth),
+                passes.view_uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&passes.gbuffer[0]),
+                wgpu::BindingResource::TextureView(&passes.gbuffer[1]),
+                wgpu::BindingResource::TextureView(&passes.gbuffer[2]),
+            ];
+            let group =
+                ctx.render_device()
+                    .wgpu_device()
+                    .create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("quadray gi gbuffer"),
+                        layout: &layout,
+                        entries: &resources
+                            .into_iter()
+                            .enumerate()
+                            .map(|(i, resource)| wgpu::BindGroupEntry {
+                                binding: i as u32,
+                                resource,
+                            })
+                            .collect::<Vec<_>>(),
+                    });
+            *cached = Some((key, group.clone()));
+            group
+        }
+    };
+    drop(cached);
     // Bevy's diagnostics (with its RenderDiagnosticsPlugin): GPU time of the light's passes,
     // the gather and the composite, the cut's size and the gather's work per shaded pixel
     let diagnostics = ctx.diagnostic_recorder();
