@@ -21,13 +21,19 @@ pub(crate) struct Temporal {
     previous: wgpu::Buffer,
     /// That frame's world -> clip, copied on the GPU from the camera uniform after its blend.
     previous_view_proj: wgpu::Buffer,
-    /// That frame's normals, and this frame's (written by the blend).
-    previous_normal: wgpu::Buffer,
-    normal: wgpu::Buffer,
-    group: wgpu::BindGroup,
-    /// The method whose frames the history averages; `None` when it holds nothing to continue
-    /// from.
-    history_of: Mutex<Option<Method>>,
+    /// Group `k` reads the last frame's normals from normal buffer `k` and writes this frame's
+    /// into the other: the two take turns, no copy.
+    groups: [wgpu::BindGroup; 2],
+    /// What the history holds.
+    state: Mutex<History>,
+}
+
+#[derive(Clone, Copy)]
+struct History {
+    /// The method whose frames it averages; `None` when it holds nothing to continue from.
+    of: Option<Method>,
+    /// The group the next blend binds (the one reading the normals the last blend wrote).
+    group: usize,
 }
 
 impl Temporal {
@@ -52,39 +58,36 @@ impl Temporal {
         let bytes = res.outputs.history.size();
         let previous = storage_buffer(device, "indirect history, last frame", bytes);
         let previous_view_proj = storage_buffer(device, "view of the history", VIEW_PROJ_BYTES);
-        let previous_normal = storage_buffer(device, "normals of the history, last frame", bytes);
-        let normal = storage_buffer(device, "normals of the history", bytes);
-        let group = bind_group(
-            device,
-            "gather temporal",
-            &own,
-            vec![
-                whole(&previous),
-                whole(&previous_view_proj),
-                whole(&previous_normal),
-                whole(&normal),
-            ],
-        );
+        let normals = [0, 1].map(|_| storage_buffer(device, "normals of the history", bytes));
+        let groups = [0, 1].map(|k| {
+            bind_group(
+                device,
+                "gather temporal",
+                &own,
+                vec![
+                    whole(&previous),
+                    whole(&previous_view_proj),
+                    whole(&normals[k]),
+                    whole(&normals[1 - k]),
+                ],
+            )
+        });
         Self {
             blend,
             previous,
             previous_view_proj,
-            previous_normal,
-            normal,
-            group,
-            history_of: Mutex::new(None),
+            groups,
+            state: Mutex::new(History { of: None, group: 0 }),
         }
     }
 
     /// Forgets the average: the next frame starts it anew.
     pub fn reset(&self) {
-        *self.history_of() = None;
+        self.state().of = None;
     }
 
-    fn history_of(&self) -> std::sync::MutexGuard<'_, Option<Method>> {
-        self.history_of
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
+    fn state(&self) -> std::sync::MutexGuard<'_, History> {
+        self.state.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
     /// Records, before the pass that blends, the average this frame reads: the last one when
@@ -96,10 +99,9 @@ impl Temporal {
         method: Method,
     ) {
         let history = &res.outputs.history;
-        if *self.history_of() == Some(method) {
+        // (the average is copied: it is bound in the frame's group, which every pass shares)
+        if self.state().of == Some(method) {
             encoder.copy_buffer_to_buffer(history, 0, &self.previous, 0, history.size());
-            let normal = &self.normal;
-            encoder.copy_buffer_to_buffer(normal, 0, &self.previous_normal, 0, normal.size());
         } else {
             encoder.clear_buffer(&self.previous, 0, None);
         }
@@ -107,7 +109,7 @@ impl Temporal {
 
     /// Records the blend of this frame into the average, in a pass that has the groups bound.
     pub fn record_blend(&self, pass: &mut wgpu::ComputePass, res: &Resources) {
-        pass.set_bind_group(3, &self.group, &[]);
+        pass.set_bind_group(3, &self.groups[self.state().group], &[]);
         pass.set_pipeline(&self.blend);
         let (width, height) = res.size();
         dispatch_2d(pass, width, height);
@@ -123,6 +125,9 @@ impl Temporal {
     ) {
         let camera = res.camera();
         encoder.copy_buffer_to_buffer(camera, 0, &self.previous_view_proj, 0, VIEW_PROJ_BYTES);
-        *self.history_of() = Some(method);
+        let mut state = self.state();
+        state.of = Some(method);
+        // the next blend reads the normals this one wrote
+        state.group = 1 - state.group;
     }
 }
