@@ -1,7 +1,7 @@
 //! Pictures of a frame as `quadray indirect` and the viewer show them: tone mapping, the cut over
 //! the RSM, and the mean FLIP between two pictures.
 
-use crate::frame::CutNode;
+use crate::frame::{CutNode, Frame};
 use quadray_core::image_out::Rgba8Image;
 
 /// The exposed radiance [`tone_map`] shows as 90% white (1 - e^-2.3): what
@@ -98,4 +98,18 @@ pub fn mean_flip(reference: &Rgba8Image, test: &Rgba8Image) -> f32 {
         nv_flip::DEFAULT_PIXELS_PER_DEGREE,
     );
     nv_flip::FlipPool::from_image(&map).mean()
+}
+
+/// The mean FLIP of `frame`'s picture (direct plus indirect light, tone mapped at `exposure`)
+/// against the picture with the same direct light and `indirect` instead (a reference's).
+pub fn flip_against(frame: &Frame, indirect: &[[f32; 3]], exposure: f32) -> f32 {
+    let (w, h) = (frame.width, frame.height);
+    let reference = Frame {
+        indirect: indirect.to_vec(),
+        ..frame.clone()
+    };
+    mean_flip(
+        &tone_map(w, h, &reference.combined(), exposure),
+        &tone_map(w, h, &frame.combined(), exposure),
+    )
 }

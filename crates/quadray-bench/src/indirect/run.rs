@@ -5,11 +5,9 @@
 use super::temporal::{self, Temporal};
 use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{TONE_MAP_WHITE, cut_view, cut_view_zoom, mean_flip, tone_map};
+use quadray_indirect::picture::{TONE_MAP_WHITE, cut_view, cut_view_zoom, flip_against, tone_map};
 use quadray_indirect::reference::{self, ImageError};
-use quadray_indirect::{
-    Frame, FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts,
-};
+use quadray_indirect::{FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts};
 use serde::Serialize;
 
 /// What to do besides rendering.
@@ -98,16 +96,6 @@ pub fn check_ground_truth_size(settings: &Settings) -> Result<(), IndirectError>
     Ok(())
 }
 
-/// The mean FLIP of `frame`'s combined picture against the same direct light plus `indirect`.
-fn flip_against(frame: &Frame, indirect: &[[f32; 3]], picture: &Rgba8Image, exposure: f32) -> f32 {
-    let truth = Frame {
-        indirect: indirect.to_vec(),
-        ..frame.clone()
-    };
-    let (w, h) = (frame.width, frame.height);
-    mean_flip(&tone_map(w, h, &truth.combined(), exposure), picture)
-}
-
 pub struct Outcome {
     pub stats: Stats,
     pub direct: Rgba8Image,
@@ -178,7 +166,7 @@ pub fn run(
     let exposure_advice = check_exposure(&combined, options.exposure, TONE_MAP_WHITE);
     let flip = reference
         .as_ref()
-        .map(|r| flip_against(&frame, r, &combined_image, options.exposure));
+        .map(|r| flip_against(&frame, r, options.exposure));
     let truth = if options.ground_truth {
         let (vpls, receivers) = (renderer.read_vpls()?, renderer.read_receivers()?);
         Some(reference::ground_truth(&vpls, &receivers, scene))
@@ -203,7 +191,7 @@ pub fn run(
         TruthError {
             rel_l1: e.rel_l1,
             rmse: e.rmse,
-            flip: flip_against(&frame, truth, &combined_image, options.exposure),
+            flip: flip_against(&frame, truth, options.exposure),
         }
     });
     Ok(Outcome {
