@@ -131,10 +131,15 @@ const UNSEEN = 1u;
 const IN_LAYER = 2u;
 const THROUGH = 3u;
 
+// The march's depth bias (world units): a tenth of the layer.
+fn march_bias() -> f32 {
+    return 0.1 * terms.shadow_thickness;
+}
+
 // A marched point `behind` the surface its texel sees (world units): in front, in the layer, or
 // past it (UNSEEN, until `crossing_texel` says more).
 fn depth_state(behind: f32) -> u32 {
-    if (behind <= 0.1 * terms.shadow_thickness) {
+    if (behind <= march_bias()) {
         return IN_FRONT;
     }
     return select(UNSEEN, IN_LAYER, behind < terms.shadow_thickness);
@@ -146,7 +151,7 @@ fn depth_state(behind: f32) -> u32 {
 // a point of that plane in this texel (`on_plane`): so a wall thinner than the march's step
 // blocks, and a doorway beside it does not, as there the map sees past the wall's plane.
 fn crossing_texel(x: vec3<f32>, xp: vec3<f32>, seen: vec3<f32>, n: vec3<f32>, c: array<vec4<f32>, 2>, size: vec2<f32>) -> vec2<i32> {
-    let bias = 0.1 * terms.shadow_thickness;
+    let bias = march_bias();
     let a = dot(x - seen, n);
     let b = dot(xp - seen, n);
     if (min(a, b) >= -bias || max(a, b) <= bias) {
@@ -156,7 +161,7 @@ fn crossing_texel(x: vec3<f32>, xp: vec3<f32>, seen: vec3<f32>, n: vec3<f32>, c:
 }
 
 fn on_plane(there: vec3<f32>, seen: vec3<f32>, n: vec3<f32>) -> u32 {
-    return select(UNSEEN, THROUGH, abs(dot(there - seen, n)) < 0.1 * terms.shadow_thickness);
+    return select(UNSEEN, THROUGH, abs(dot(there - seen, n)) < march_bias());
 }
 
 // Marched point t of the segment x -> xp (ends `c` in the camera's clip space) against the
