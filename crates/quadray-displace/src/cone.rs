@@ -195,10 +195,11 @@ impl ConeMap {
                 if cancelled.load(Ordering::Relaxed) {
                     return Vec::new();
                 }
+                let mut search = Search::default();
                 let row: Vec<[f32; 2]> = (0..field.width)
                     .map(|x| {
                         let ds = field.depth(x, y);
-                        [ds, best_ratio(&field, &pyramid, &copies, (x, y), ds)]
+                        [ds, search.best_ratio(&field, &pyramid, &copies, (x, y), ds)]
                     })
                     .collect();
                 row_done();
@@ -289,66 +290,94 @@ impl Drop for ConeMapJob {
     }
 }
 
-/// Best-first branch and bound over the exit pyramid's nodes in every copy of the map.
-fn best_ratio(
-    field: &Field,
-    pyramid: &Pyramid,
-    copies: &[(i64, i64)],
-    (sx, sy): (i64, i64),
-    ds: f32,
-) -> f32 {
-    let top = pyramid.levels.len() - 1;
-    // From the centre s + 1/2 to the node's closed span [lo, hi] on one axis, in half texels.
-    let gap = |s: i64, lo: i64, hi: i64| (2 * lo - 2 * s - 1).max(2 * s + 1 - 2 * hi).max(0);
-    // A lower bound on the ratio any exit in node (level, nx, ny) of a copy can give: its nearest
-    // point over its shallowest exit. Positive floats order as their bits.
-    let bound = |level: usize, (nx, ny): (i64, i64), (ox, oy): (i64, i64)| -> Option<u32> {
-        let side = 1i64 << (level as u32);
-        let (level_width, level_height) = pyramid.level_size(level as u32);
-        if nx >= i64::from(level_width) || ny >= i64::from(level_height) {
-            // A child past an axis the padded pyramid has already reduced to one node.
-            return None;
-        }
-        let shallowest = pyramid.levels[level][(ny * i64::from(level_width) + nx) as usize];
-        if shallowest >= ds {
-            return None;
-        }
-        let (x0, y0) = (nx * side + ox, ny * side + oy);
-        let d = field.uv_distance(gap(sx, x0, x0 + side), gap(sy, y0, y0 + side));
-        Some((d / (ds - shallowest)).to_bits())
-    };
-    let mut best = UNBOUNDED_RATIO;
-    let mut heap = BinaryHeap::new();
-    for &copy in copies {
-        if let Some(b) = bound(top, (0, 0), copy) {
-            heap.push(Reverse((b, top, 0i64, 0i64, copy)));
-        }
-    }
-    while let Some(Reverse((b, level, nx, ny, copy))) = heap.pop() {
-        if f32::from_bits(b) >= best {
-            break;
-        }
-        if level == 0 {
-            // Leaves beyond the map (of a pyramid padded to a power of two) are no texel.
-            let in_map = nx < field.width && ny < field.height;
-            if let Some(r) = in_map
-                .then(|| field.texel_ratio((sx, sy), ds, (nx + copy.0, ny + copy.1)))
-                .flatten()
-            {
-                best = best.min(r);
+/// A pyramid node waiting to be searched: its bound (as bits), level, position and copy.
+type Node = Reverse<(u32, usize, i64, i64, (i64, i64))>;
+
+/// One row's search state, carried from texel to texel.
+#[derive(Default)]
+struct Search {
+    heap: BinaryHeap<Node>,
+    /// Where (in absolute texels, possibly in a neighbouring copy) the last texel's cone met
+    /// its exit. Neighbouring texels mostly share it: its ratio for the next texel is a real
+    /// exit's, an upper bound that prunes from the first node on, and the minimum stays the same.
+    last_exit: Option<(i64, i64)>,
+}
+
+impl Search {
+    /// Best-first branch and bound over the exit pyramid's nodes in every copy of the map.
+    fn best_ratio(
+        &mut self,
+        field: &Field,
+        pyramid: &Pyramid,
+        copies: &[(i64, i64)],
+        (sx, sy): (i64, i64),
+        ds: f32,
+    ) -> f32 {
+        let top = pyramid.levels.len() - 1;
+        // From the centre s + 1/2 to the node's closed span [lo, hi] on one axis, in half texels.
+        let gap = |s: i64, lo: i64, hi: i64| (2 * lo - 2 * s - 1).max(2 * s + 1 - 2 * hi).max(0);
+        // A lower bound on the ratio any exit in node (level, nx, ny) of a copy can give: its
+        // nearest point over its shallowest exit. Positive floats order as their bits.
+        let bound = |level: usize, (nx, ny): (i64, i64), (ox, oy): (i64, i64)| -> Option<u32> {
+            let side = 1i64 << (level as u32);
+            let (level_width, level_height) = pyramid.level_size(level as u32);
+            if nx >= i64::from(level_width) || ny >= i64::from(level_height) {
+                // A child past an axis the padded pyramid has already reduced to one node.
+                return None;
             }
-            continue;
+            let shallowest = pyramid.levels[level][(ny * i64::from(level_width) + nx) as usize];
+            if shallowest >= ds {
+                return None;
+            }
+            let (x0, y0) = (nx * side + ox, ny * side + oy);
+            let d = field.uv_distance(gap(sx, x0, x0 + side), gap(sy, y0, y0 + side));
+            Some((d / (ds - shallowest)).to_bits())
+        };
+        let mut best = UNBOUNDED_RATIO;
+        let mut best_exit = None;
+        if let Some(exit) = self.last_exit
+            && let Some(r) = field.texel_ratio((sx, sy), ds, exit)
+        {
+            (best, best_exit) = (r, Some(exit));
         }
-        for (cx, cy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-            let child = (2 * nx + cx, 2 * ny + cy);
-            if let Some(b) = bound(level - 1, child, copy)
+        let heap = &mut self.heap;
+        heap.clear();
+        for &copy in copies {
+            if let Some(b) = bound(top, (0, 0), copy)
                 && f32::from_bits(b) < best
             {
-                heap.push(Reverse((b, level - 1, child.0, child.1, copy)));
+                heap.push(Reverse((b, top, 0i64, 0i64, copy)));
             }
         }
+        while let Some(Reverse((b, level, nx, ny, copy))) = heap.pop() {
+            if f32::from_bits(b) >= best {
+                break;
+            }
+            if level == 0 {
+                // Leaves beyond the map (of a pyramid padded to a power of two) are no texel.
+                let exit = (nx + copy.0, ny + copy.1);
+                let in_map = nx < field.width && ny < field.height;
+                if let Some(r) = in_map
+                    .then(|| field.texel_ratio((sx, sy), ds, exit))
+                    .flatten()
+                    && r < best
+                {
+                    (best, best_exit) = (r, Some(exit));
+                }
+                continue;
+            }
+            for (cx, cy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let child = (2 * nx + cx, 2 * ny + cy);
+                if let Some(b) = bound(level - 1, child, copy)
+                    && f32::from_bits(b) < best
+                {
+                    heap.push(Reverse((b, level - 1, child.0, child.1, copy)));
+                }
+            }
+        }
+        self.last_exit = best_exit.or(self.last_exit);
+        best
     }
-    best
 }
 
 #[cfg(test)]

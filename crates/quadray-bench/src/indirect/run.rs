@@ -65,6 +65,9 @@ pub struct Stats {
     pub ground_truth: Option<TruthError>,
     /// Stability under a turning light (with `--light-orbit`).
     pub temporal: Option<Temporal>,
+    /// The same sequence without the temporal filter (with `--temporal-weight` below 1),
+    /// against the same brute-force frames: the filter's damping and its cost from one run.
+    pub temporal_unfiltered: Option<Temporal>,
 }
 
 /// Error of the indirect term against the ground truth with visibility, and the FLIP of the
@@ -176,6 +179,7 @@ pub fn run(
     let temporal = match (options.light_orbit, options.camera_orbit) {
         (None, None) => None,
         (light, camera) => Some(temporal::measure(
+            gpu,
             &mut renderer,
             scene,
             method,
@@ -214,7 +218,8 @@ pub fn run(
             error,
             flip,
             ground_truth,
-            temporal,
+            temporal: temporal.as_ref().map(|t| t.filtered),
+            temporal_unfiltered: temporal.and_then(|t| t.unfiltered),
             settings: s,
         },
         direct: tone_map(w, h, &frame.direct, options.exposure),

@@ -6,7 +6,8 @@
 //! force, and a temporal filter that drags old light onto newly seen surfaces (ghosting) in the
 //! error on the pixels the last frame did not see.
 
-use quadray_indirect::{IndirectError, Method, Receiver, Renderer, Scene, reference};
+use quadray_gpu::Gpu;
+use quadray_indirect::{IndirectError, Method, Receiver, Renderer, Scene, Settings, reference};
 use serde::Serialize;
 use std::collections::HashSet;
 
@@ -52,8 +53,76 @@ pub struct Temporal {
     pub disoccluded_rel_l1: Option<f64>,
 }
 
-/// One frame of the sequence: our indirect light, the brute force's, and the cut (level, x, y).
-type Step = (Vec<[f32; 3]>, Vec<[f32; 3]>, HashSet<(u32, u32, u32)>);
+/// A cut as the set of its clusters (level, x, y).
+type Cut = HashSet<(u32, u32, u32)>;
+
+/// A frame of a method: its indirect light, its error image against the brute force, its cut.
+struct Step {
+    image: Vec<[f32; 3]>,
+    error: Vec<[f32; 3]>,
+    cut: Cut,
+}
+
+/// A method's figures summed over the frames so far, and its last frame.
+#[derive(Default)]
+struct Sums {
+    previous: Option<Step>,
+    flicker: f64,
+    cut_changed: f64,
+    error_flicker: f64,
+    error: f64,
+    error_max: f64,
+    disoccluded_error: f64,
+}
+
+impl Sums {
+    /// Adds a frame: the method's light, its cut, that frame's brute force, and the pixels that
+    /// show what the last frame did not see (with the camera moving).
+    fn add(
+        &mut self,
+        image: Vec<[f32; 3]>,
+        cut: Cut,
+        reference: &[[f32; 3]],
+        new: Option<&[bool]>,
+    ) {
+        let error = reference::compare(&image, reference).rel_l1;
+        self.error += error;
+        self.error_max = self.error_max.max(error);
+        if let Some(new) = new.filter(|new| new.contains(&true)) {
+            let pick = |image: &[[f32; 3]]| -> Vec<[f32; 3]> {
+                image
+                    .iter()
+                    .zip(new)
+                    .filter(|(_, n)| **n)
+                    .map(|(p, _)| *p)
+                    .collect()
+            };
+            self.disoccluded_error += reference::compare(&pick(&image), &pick(reference)).rel_l1;
+        }
+        let step = Step {
+            error: difference(&image, reference),
+            image,
+            cut,
+        };
+        if let Some(last) = &self.previous {
+            self.flicker += mean_change(&step.image, &last.image);
+            self.error_flicker += mean_change(&step.error, &last.error);
+            let moved = step.cut.symmetric_difference(&last.cut).count();
+            self.cut_changed += moved as f64 / step.cut.len().max(1) as f64;
+        }
+        self.previous = Some(step);
+    }
+}
+
+/// What the frames have in common whatever the method: the brute force's change and the
+/// pixels newly seen.
+#[derive(Default)]
+struct Shared {
+    reference_flicker: f64,
+    disoccluded_fraction: f64,
+    /// Frames with newly seen pixels.
+    disoccluded_frames: u32,
+}
 
 fn mean_change(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
     let sum: f64 = a
@@ -110,63 +179,77 @@ fn disoccluded(now: &[Option<Receiver>], then: &Seen, (width, height): (u32, u32
         .collect()
 }
 
+/// The sequence's figures with the temporal filter `renderer`'s settings give and, where it
+/// filters, without it (the filter's damping and its cost in one run, against the same
+/// brute-force frames).
+pub struct Measured {
+    pub filtered: Temporal,
+    pub unfiltered: Option<Temporal>,
+}
+
+/// `method`'s frame on `renderer` and its cut (empty for methods without a quadtree).
+fn frame_and_cut(
+    renderer: &mut Renderer,
+    method: Method,
+) -> Result<(Vec<[f32; 3]>, Cut), IndirectError> {
+    let image = renderer.render_frame(method)?.indirect;
+    if !method.uses_quadtree() {
+        return Ok((image, HashSet::new()));
+    }
+    // the per-level passes keep no cut: build it without shading
+    if method != Method::Quadtree {
+        renderer.build_cut()?;
+    }
+    let cut = renderer.read_cut()?;
+    Ok((image, cut.iter().map(|c| (c.level, c.x, c.y)).collect()))
+}
+
 /// Renders `frames` frames of `method` and of the brute force under `orbit` (the temporal
-/// filter's average, if any, starting at the first), and leaves the renderer at `scene`'s own
-/// view.
+/// filter's average, if any, starting at the first; the same frames without it on a second
+/// renderer), and leaves the renderer at `scene`'s own view.
 pub fn measure(
+    gpu: &Gpu,
     renderer: &mut Renderer,
     scene: &Scene,
     method: Method,
     orbit: Orbit,
     frames: u32,
-) -> Result<Temporal, IndirectError> {
-    let mut previous: Option<Step> = None;
+) -> Result<Measured, IndirectError> {
+    let settings = renderer.settings().clone();
+    let filters = settings.temporal_weight < 1.0 && method != Method::Reference;
+    let mut plain = if filters {
+        let unfiltered = Settings {
+            temporal_weight: 1.0,
+            ..settings.clone()
+        };
+        Some(Renderer::new(gpu, scene, unfiltered)?)
+    } else {
+        None
+    };
+    let (width, height) = (settings.size.width, settings.size.height);
+    let camera_moves = orbit.camera_degrees != 0.0;
+    let mut shared = Shared::default();
+    let (mut sums, mut plain_sums) = (Sums::default(), Sums::default());
+    let mut previous_reference: Option<Vec<[f32; 3]>> = None;
     let mut seen: Option<Seen> = None;
-    let (mut ours, mut theirs, mut changed, mut error_change) = (0.0, 0.0, 0.0, 0.0);
-    let (mut error_sum, mut error_max) = (0.0, 0.0f64);
-    let (mut new_fraction, mut new_error, mut new_frames) = (0.0, 0.0, 0u32);
-    let size = renderer.settings().size;
-    let (width, height) = (size.width, size.height);
     renderer.gather().reset_history();
     for f in 0..frames {
         let view = scene
             .light_turned(orbit.light_degrees * f as f32)
             .camera_orbited(orbit.camera_degrees * f as f32);
         renderer.set_view(&view);
-        let image = renderer.render_frame(method)?.indirect;
-        let cut: HashSet<(u32, u32, u32)> = if method.uses_quadtree() {
-            // the per-level passes keep no cut: build it without shading
-            if method != Method::Quadtree {
-                renderer.build_cut()?;
-            }
-            let cut = renderer.read_cut()?;
-            cut.iter().map(|c| (c.level, c.x, c.y)).collect()
-        } else {
-            HashSet::new()
-        };
+        let (image, cut) = frame_and_cut(renderer, method)?;
         let reference = renderer.render_frame(Method::Reference)?.indirect;
-        let error = reference::compare(&image, &reference).rel_l1;
-        error_sum += error;
-        error_max = error_max.max(error);
-        if orbit.camera_degrees != 0.0 {
+        let mut new = None;
+        if camera_moves {
             let receivers = renderer.read_receivers()?;
             if let Some(then) = &seen {
-                let new = disoccluded(&receivers, then, (width, height));
+                let mask = disoccluded(&receivers, then, (width, height));
                 let shaded = receivers.iter().filter(|r| r.is_some()).count().max(1);
-                let pick = |image: &[[f32; 3]]| -> Vec<[f32; 3]> {
-                    image
-                        .iter()
-                        .zip(&new)
-                        .filter(|(_, n)| **n)
-                        .map(|(p, _)| *p)
-                        .collect()
-                };
-                let count = new.iter().filter(|n| **n).count();
-                new_fraction += count as f64 / shaded as f64;
-                if count > 0 {
-                    new_error += reference::compare(&pick(&image), &pick(&reference)).rel_l1;
-                    new_frames += 1;
-                }
+                let count = mask.iter().filter(|n| **n).count();
+                shared.disoccluded_fraction += count as f64 / shaded as f64;
+                shared.disoccluded_frames += u32::from(count > 0);
+                new = Some(mask);
             }
             seen = Some(Seen {
                 receivers,
@@ -174,35 +257,41 @@ pub fn measure(
                 eye: view.camera.position,
             });
         }
-        if let Some((image0, reference0, cut0)) = &previous {
-            ours += mean_change(&image, image0);
-            theirs += mean_change(&reference, reference0);
-            error_change += mean_change(
-                &difference(&image, &reference),
-                &difference(image0, reference0),
-            );
-            let moved = cut.symmetric_difference(cut0).count();
-            changed += moved as f64 / cut.len().max(1) as f64;
+        sums.add(image, cut, &reference, new.as_deref());
+        if let Some(plain) = plain.as_mut() {
+            plain.set_view(&view);
+            let (image, cut) = frame_and_cut(plain, method)?;
+            plain_sums.add(image, cut, &reference, new.as_deref());
         }
-        previous = Some((image, reference, cut));
+        if let Some(reference0) = &previous_reference {
+            shared.reference_flicker += mean_change(&reference, reference0);
+        }
+        previous_reference = Some(reference);
     }
     renderer.set_view(scene);
     let pairs = f64::from(frames.saturating_sub(1).max(1));
-    let camera_moves = orbit.camera_degrees != 0.0;
-    Ok(Temporal {
+    let figures = |sums: &Sums| Temporal {
         degrees_per_frame: orbit.light_degrees,
         camera_degrees_per_frame: orbit.camera_degrees,
         frames,
-        cut_changed_fraction: method.uses_quadtree().then_some(changed / pairs),
-        flicker_ratio: if theirs > 0.0 { ours / theirs } else { 0.0 },
-        flicker: ours / pairs,
-        reference_flicker: theirs / pairs,
-        error_flicker: error_change / pairs,
-        mean_rel_l1: error_sum / f64::from(frames.max(1)),
-        max_rel_l1: error_max,
-        disoccluded_fraction: camera_moves.then_some(new_fraction / pairs),
-        disoccluded_rel_l1: (camera_moves && new_frames > 0)
-            .then(|| new_error / f64::from(new_frames)),
+        cut_changed_fraction: method.uses_quadtree().then_some(sums.cut_changed / pairs),
+        flicker_ratio: if shared.reference_flicker > 0.0 {
+            sums.flicker / shared.reference_flicker
+        } else {
+            0.0
+        },
+        flicker: sums.flicker / pairs,
+        reference_flicker: shared.reference_flicker / pairs,
+        error_flicker: sums.error_flicker / pairs,
+        mean_rel_l1: sums.error / f64::from(frames.max(1)),
+        max_rel_l1: sums.error_max,
+        disoccluded_fraction: camera_moves.then_some(shared.disoccluded_fraction / pairs),
+        disoccluded_rel_l1: (camera_moves && shared.disoccluded_frames > 0)
+            .then(|| sums.disoccluded_error / f64::from(shared.disoccluded_frames)),
+    };
+    Ok(Measured {
+        filtered: figures(&sums),
+        unfiltered: plain.is_some().then(|| figures(&plain_sums)),
     })
 }
 
