@@ -41,7 +41,7 @@ start=$SECONDS
 left() { echo $((budget - (SECONDS - start))); }
 
 if [ $quick = 1 ]; then
-    size=96x54 rsm=32 frames=3 angles="0 60" bevy_frames=3
+    size=96x54 rsm=32 frames=3 angles=60 bevy_frames=3
 else
     size=1920x1080 rsm=512 frames=20 angles="0 60 85" bevy_frames=60
 fi

@@ -10,5 +10,5 @@ scripts/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --release -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --release
-cargo test --workspace --release --lib --bins --tests
+cargo test --workspace --release --tests
 cargo test --workspace --release --doc

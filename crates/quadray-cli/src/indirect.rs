@@ -36,7 +36,8 @@ pub struct IndirectArgs {
     #[arg(long, default_value_t = 20)]
     frames: u32,
     /// Render a sequence of --frames frames with the spot turning DEG a frame about the
-    /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio, ...} to the stats.
+    /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio, ...} to the stats, and
+    /// with --temporal-weight below 1 temporal_unfiltered: the same frames without the filter.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     light_orbit: Option<f32>,
     /// In that sequence (or alone), the camera moves DEG a frame along an orbit about its

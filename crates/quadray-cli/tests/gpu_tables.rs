@@ -46,8 +46,9 @@ fn the_gpu_tables_script_writes_every_row_and_packs_them() {
             })
             .count()
     };
-    // 5 methods x 2 angles and pyramid with lod auto; 4 methods and the cut with shadows
-    assert_eq!(rows("## Displacement frame"), 11, "{summary}");
+    // 5 methods at the quick mode's one angle and pyramid with lod auto; 4 methods and the cut
+    // with shadows
+    assert_eq!(rows("## Displacement frame"), 6, "{summary}");
     assert_eq!(rows("## Indirect light"), 5, "{summary}");
     assert!(
         summary.contains("Skipped: bench-indirect"),
