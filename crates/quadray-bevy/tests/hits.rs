@@ -215,10 +215,17 @@ fn bevy_hits_agree_with_the_cpu_ground_truth() {
             color: Rgba8Image::new(SIZE, SIZE, [0; 4]),
             hits,
             rays,
-            // Only the accuracy is measured here, not the cost.
+            // Only the accuracy is measured here, not the cost or the shadows.
             fetches: Vec::new(),
+            in_shadow: Vec::new(),
         };
-        let accuracy = Accuracy::measure(&frame, &maps[view.map], Addressing::Wrap, Surface::Point);
+        let accuracy = Accuracy::measure_rays(
+            &frame,
+            &frame.traced_rays(),
+            &maps[view.map],
+            Addressing::Wrap,
+            Surface::Point,
+        );
         let what = format!("{} at {} degrees", MAPS[view.map], view.angle_deg);
         println!(
             "{what}: {} covered, wrong-hit fraction {:.5}, mean error {:.4} texels",

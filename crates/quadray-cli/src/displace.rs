@@ -6,7 +6,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::maps::load_color;
-use quadray_displace::pyramid::Addressing;
 use quadray_displace::scene::SurfaceKind;
 use quadray_displace::{Method, Renderer, Settings};
 use quadray_gpu::Gpu;
@@ -104,12 +103,7 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
     let cost = Cost::of(&frame);
     let truth = settings.method.truth().filter(|_| args.reference);
     let (accuracy, error_map) = if let Some(truth) = truth {
-        let addressing = if args.surface.wraps() {
-            Addressing::Wrap
-        } else {
-            Addressing::Clamp
-        };
-        let acc = Accuracy::measure(&frame, &map, addressing, truth);
+        let acc = Accuracy::measure(&frame, &map, args.surface, settings, truth);
         let path = args.out.with_extension("error.png");
         acc.heat_map().save_png(&path)?;
         (Some(acc), Some(path))

@@ -1,13 +1,19 @@
-//! Measures a GPU frame against the CPU ground truth, pixel by pixel, on the very rays the GPU
-//! traced: a pixel is wrong when its hit is more than one texel (in uv) from the exact one, or
-//! when one of them hits and the other leaves the map.
+//! Measures a GPU frame against the CPU ground truth, pixel by pixel: the CPU builds each
+//! pixel's ray itself ([`camera_rays`]), traces it exactly, and a pixel is wrong when the GPU's hit
+//! is more than one texel (in uv) from the exact one, or when one of them shows the surface (or
+//! hits it) and the other does not. The GPU's own rays are compared with the CPU's separately
+//! ([`RayAgreement`]), and so are its self-shadows ([`ShadowAgreement`]).
 
+use crate::Settings;
 use crate::gpu::Frame;
 use crate::heightmap::HeightMap;
+use crate::primary_rays::{MIN_COSINE, PixelRay, camera_rays, ray_slope};
 use crate::pyramid::Addressing;
-use crate::reference::{Ray, Surface, intersect_all};
-use glam::DVec2;
+use crate::reference::{Hit, Ray, Surface, intersect, intersect_all};
+use crate::scene::{SurfaceKind, View};
+use glam::{DVec2, DVec3};
 use quadray_core::image_out::{Rgba8Image, heat_map};
+use rayon::prelude::*;
 
 /// Error given to a pixel whose hit/miss status differs from the truth, in texels.
 pub const STATUS_MISMATCH_TEXELS: f32 = 8.0;
@@ -15,7 +21,7 @@ pub const STATUS_MISMATCH_TEXELS: f32 = 8.0;
 #[derive(Clone, Debug, serde::Serialize)]
 /// A GPU frame measured against the ground truth.
 pub struct Accuracy {
-    /// Pixels that show the surface.
+    /// Pixels that show the surface (on the GPU, the CPU or both).
     pub covered: usize,
     /// Covered pixels more than a texel off (or of the wrong hit/miss status).
     pub wrong: usize,
@@ -25,6 +31,8 @@ pub struct Accuracy {
     pub mean_error_texels: f64,
     /// Largest distance to the true hit, in texels.
     pub max_error_texels: f64,
+    /// The GPU's rays against the CPU's (None where the rays came from elsewhere).
+    pub rays: Option<RayAgreement>,
     #[serde(skip)]
     /// Frame width in pixels.
     pub width: u32,
@@ -37,32 +45,50 @@ pub struct Accuracy {
 }
 
 impl Accuracy {
-    /// Traces every pixel's ray of `frame` on the CPU against `truth` and compares the hits.
-    pub fn measure(frame: &Frame, map: &HeightMap, addressing: Addressing, truth: Surface) -> Self {
-        let rays: Vec<Option<Ray>> = frame
-            .rays
-            .iter()
-            .zip(&frame.hits)
-            .map(|(r, h)| {
-                (h[2] != -2.0).then(|| Ray {
-                    p0: DVec2::new(r[0].into(), r[1].into()),
-                    e: DVec2::new(r[2].into(), r[3].into()),
-                })
-            })
-            .collect();
-        let truth_hits = intersect_all(map, addressing, truth, &rays);
+    /// Measures `frame`, drawn of `map` on `surface` with `s`, against the exact intersections
+    /// with `truth` of the rays the CPU builds itself from the camera and the surface.
+    pub fn measure(
+        frame: &Frame,
+        map: &HeightMap,
+        surface: SurfaceKind,
+        s: &Settings,
+        truth: Surface,
+    ) -> Self {
+        let rays = camera_rays(surface, s);
+        let traced: Vec<Option<Ray>> = rays.iter().map(|r| r.map(|p| p.ray)).collect();
+        let mut accuracy = Self::measure_rays(frame, &traced, map, surface.addressing(), truth);
+        accuracy.rays = Some(RayAgreement::of(frame, &traced, map, surface.wraps()));
+        accuracy
+    }
+
+    /// Measures `frame` against the exact intersections with `truth` of `rays` (one per pixel;
+    /// None where no surface should show).
+    pub fn measure_rays(
+        frame: &Frame,
+        rays: &[Option<Ray>],
+        map: &HeightMap,
+        addressing: Addressing,
+        truth: Surface,
+    ) -> Self {
+        let truth_hits = intersect_all(map, addressing, truth, rays);
         let texels_per_uv = map.texels_per_uv();
         let error_texels: Vec<f32> = rays
             .iter()
             .zip(&frame.hits)
             .zip(&truth_hits)
             .map(|((ray, gpu), truth)| {
-                if ray.is_none() {
+                let shown = gpu[2] != -2.0;
+                if ray.is_none() && !shown {
                     return f32::NAN;
+                }
+                if ray.is_none() == shown {
+                    return STATUS_MISMATCH_TEXELS;
                 }
                 let gpu_hit = (gpu[2] >= 0.0).then(|| DVec2::new(gpu[0].into(), gpu[1].into()));
                 match (gpu_hit, truth) {
-                    (Some(g), Some(t)) => ((g - t.uv) * texels_per_uv).length() as f32,
+                    (Some(g), Some(t)) => {
+                        (uv_offset(g - t.uv, addressing) * texels_per_uv).length() as f32
+                    }
                     (None, None) => 0.0,
                     _ => STATUS_MISMATCH_TEXELS,
                 }
@@ -77,6 +103,7 @@ impl Accuracy {
             wrong_hit_fraction: wrong as f64 / covered.max(1) as f64,
             mean_error_texels: errors.clone().map(f64::from).sum::<f64>() / covered.max(1) as f64,
             max_error_texels: errors.fold(0.0, f32::max).into(),
+            rays: None,
             width: frame.color.width,
             height: frame.color.height,
             error_texels,
@@ -86,6 +113,166 @@ impl Accuracy {
     /// Black: exact; white: 2+ texels off or wrong hit/miss status; grey: no surface.
     pub fn heat_map(&self) -> Rgba8Image {
         heat_map(self.width, self.height, &self.error_texels, 2.0)
+    }
+}
+
+/// A difference of two uv points as the surface sees it: on a wrapped map, whole repeats apart
+/// is the same point.
+fn uv_offset(d: DVec2, addressing: Addressing) -> DVec2 {
+    match addressing {
+        Addressing::Wrap => d - d.round(),
+        Addressing::Clamp => d,
+    }
+}
+
+/// The rays the GPU reports it traced against the CPU's own for the same pixels.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RayAgreement {
+    /// Pixels that show the surface on one side only.
+    pub coverage_mismatches: usize,
+    /// Pixels both trace.
+    pub compared: usize,
+    /// Largest distance between the rays' starting points, in texels.
+    pub max_start_texels: f64,
+    /// Largest angle between the rays' tangent-space directions, in degrees.
+    pub max_direction_deg: f64,
+    /// The pixel (x, y) of the largest difference of either kind.
+    pub worst_pixel: [u32; 2],
+}
+
+impl RayAgreement {
+    /// Compares `frame`'s rays with `rays` (the CPU's), on a map of `map`'s size.
+    pub fn of(frame: &Frame, rays: &[Option<Ray>], map: &HeightMap, wraps: bool) -> Self {
+        let addressing = if wraps {
+            Addressing::Wrap
+        } else {
+            Addressing::Clamp
+        };
+        let direction = |e: DVec2| DVec3::new(-e.x, -e.y, 1.0).normalize();
+        let mut agreement = Self {
+            coverage_mismatches: 0,
+            compared: 0,
+            max_start_texels: 0.0,
+            max_direction_deg: 0.0,
+            worst_pixel: [0, 0],
+        };
+        let mut worst = 0.0;
+        for (i, ((gpu, hit), cpu)) in frame.rays.iter().zip(&frame.hits).zip(rays).enumerate() {
+            match (hit[2] != -2.0, cpu) {
+                (true, Some(cpu)) => {
+                    agreement.compared += 1;
+                    let p0 = DVec2::new(gpu[0].into(), gpu[1].into());
+                    let e = DVec2::new(gpu[2].into(), gpu[3].into());
+                    let start = (uv_offset(p0 - cpu.p0, addressing) * map.texels_per_uv()).length();
+                    let angle = direction(e).angle_between(direction(cpu.e)).to_degrees();
+                    agreement.max_start_texels = agreement.max_start_texels.max(start);
+                    agreement.max_direction_deg = agreement.max_direction_deg.max(angle);
+                    // One texel off weighs as much as a degree.
+                    if start + angle > worst {
+                        worst = start + angle;
+                        agreement.worst_pixel = pixel(i, frame.color.width);
+                    }
+                }
+                (false, None) => {}
+                _ => agreement.coverage_mismatches += 1,
+            }
+        }
+        agreement
+    }
+}
+
+fn pixel(index: usize, width: u32) -> [u32; 2] {
+    [index as u32 % width, index as u32 / width]
+}
+
+/// Self-shadowing against the ground truth: the CPU follows the light's ray from each pixel's
+/// exact hit with the shader's rule (lit when the light's ray first meets the surface within 1.5
+/// texels along it, or within 0.002 in depth, of the hit; shadowed when the light is below the
+/// polygon), and the GPU's shadow flags are compared with it where the GPU's hit is right.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ShadowAgreement {
+    /// Pixels whose GPU hit is within a texel of the truth.
+    pub compared: usize,
+    /// Of those, the pixels the truth puts in shadow.
+    pub shadowed: usize,
+    /// Of those compared, the pixels whose shadow flag differs from the truth's.
+    pub disagree: usize,
+    /// `disagree` / `compared`.
+    pub disagree_fraction: f64,
+}
+
+impl ShadowAgreement {
+    /// Measures `frame` (drawn with `s.shadows`) of `map` on `surface` against the truth.
+    pub fn measure(
+        frame: &Frame,
+        map: &HeightMap,
+        surface: SurfaceKind,
+        s: &Settings,
+        truth: Surface,
+    ) -> Self {
+        let exact = ExactLight {
+            map,
+            addressing: surface.addressing(),
+            truth,
+            light: View::of(surface, s).light.as_dvec3(),
+            depth_scale: f64::from(s.depth_scale),
+            tile_world: f64::from(surface.tile_world()),
+        };
+        let texels = map.texels_per_uv();
+        // (truth shadowed, GPU shadowed) where the GPU's hit is right.
+        let flags: Vec<(bool, bool)> = camera_rays(surface, s)
+            .par_iter()
+            .zip(&frame.hits)
+            .zip(&frame.in_shadow)
+            .filter_map(|((ray, gpu), &gpu_shadowed)| {
+                let ray = ray.as_ref()?;
+                let hit = intersect(map, exact.addressing, truth, ray.ray)?;
+                let gpu_hit = DVec2::new(gpu[0].into(), gpu[1].into());
+                let off = (uv_offset(gpu_hit - hit.uv, exact.addressing) * texels).length();
+                (gpu[2] >= 0.0 && off <= 1.0).then(|| (!exact.reaches(ray, hit), gpu_shadowed))
+            })
+            .collect();
+        let compared = flags.len();
+        let disagree = flags.iter().filter(|(t, g)| t != g).count();
+        Self {
+            compared,
+            shadowed: flags.iter().filter(|(t, _)| *t).count(),
+            disagree,
+            disagree_fraction: disagree as f64 / compared.max(1) as f64,
+        }
+    }
+}
+
+/// The light's rays, traced exactly.
+struct ExactLight<'a> {
+    map: &'a HeightMap,
+    addressing: Addressing,
+    truth: Surface,
+    light: DVec3,
+    depth_scale: f64,
+    tile_world: f64,
+}
+
+impl ExactLight<'_> {
+    /// Whether the light reaches `hit` of `ray` by the rule of `shadow_lit` in `trace.wgsl`.
+    fn reaches(&self, ray: &PixelRay, hit: Hit) -> bool {
+        let world = ray.world_at(hit, self.depth_scale, self.tile_world);
+        let to_light = (self.light - world).normalize();
+        let [t, b, n] = ray.frame;
+        let l = DVec3::new(to_light.dot(t), to_light.dot(b), to_light.dot(n));
+        if l.z <= MIN_COSINE {
+            return false;
+        }
+        let el = ray_slope(l, self.depth_scale);
+        let from_light = Ray {
+            p0: hit.uv - el * hit.z,
+            e: el,
+        };
+        let Some(first) = intersect(self.map, self.addressing, self.truth, from_light) else {
+            return true;
+        };
+        let short_by = hit.z - first.z;
+        short_by * (el * self.map.texels_per_uv()).length() <= 1.5 || short_by <= 2.0e-3
     }
 }
 

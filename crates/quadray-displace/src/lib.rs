@@ -9,7 +9,8 @@
 //! same way.
 //!
 //! Data flows one way: [`heightmap`] (load) -> [`pyramid`] (build) -> [`gpu`] (trace and shade)
-//! -> [`accuracy`] (measure against [`reference`](mod@reference)).
+//! -> [`accuracy`] (measure against [`reference`](mod@reference) on the CPU's own
+//! [`primary_rays`]).
 
 #![warn(missing_docs)]
 
@@ -19,9 +20,11 @@ pub mod gpu;
 pub mod heightmap;
 pub mod maps;
 pub mod method;
+pub mod primary_rays;
 pub mod pyramid;
 pub mod reference;
 pub mod scene;
+pub mod search_cost;
 pub mod settings;
 
 /// Anything that can go wrong between a map file and a measured picture.

@@ -1,5 +1,6 @@
 //! Surfaces the height field is mapped onto, and the camera and light for a view angle.
 
+use crate::pyramid::Addressing;
 use glam::{Mat4, Vec3};
 
 /// What the map is displacing.
@@ -46,6 +47,15 @@ impl SurfaceKind {
     /// Whether rays wrap around the map (a tiled surface) rather than leave it.
     pub fn wraps(self) -> bool {
         matches!(self, SurfaceKind::Wall | SurfaceKind::Torus)
+    }
+
+    /// How rays address the map: wrapped on a tiled surface, clamped to one copy otherwise.
+    pub fn addressing(self) -> Addressing {
+        if self.wraps() {
+            Addressing::Wrap
+        } else {
+            Addressing::Clamp
+        }
     }
 
     /// Flat surfaces can also be drawn as a real displaced grid (the mesh baseline).

@@ -1,12 +1,11 @@
 //! Accuracy against the CPU ground truth: every method by view angle on every bundled map, and
 //! how many POM layers match the pyramid.
 
-use super::{AccuracyRow, Bench, Ratios, addressing, fixed_layers, ms, ratio, ratio_text, traced};
+use super::{AccuracyRow, Bench, Ratios, fixed_layers, ms, ratio, ratio_text, traced};
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::maps::{BUNDLED, resized};
-use quadray_displace::pyramid::Addressing;
 use quadray_displace::{DisplaceError, Method, Renderer, Settings, Size};
 use std::path::Path;
 
@@ -60,7 +59,7 @@ pub fn by_view_angle(
                     ..c.clone()
                 };
                 let frame = r.render(gpu, &s)?;
-                let acc = Accuracy::measure(&frame, &map, addressing(b), truth);
+                let acc = Accuracy::measure(&frame, &map, b.surface, &s, truth);
                 let cost = Cost::of(&frame);
                 row.push(format!("{:.4}", acc.wrong_hit_fraction));
                 fetch_row.push(format!("{:.1}", cost.texel_fetches_per_pixel));
@@ -120,7 +119,7 @@ pub fn pom_layers_to_match(
     let measure = |r: &mut Renderer, s: &Settings| -> Result<f64, DisplaceError> {
         let frame = r.render(gpu, s)?;
         let truth = s.method.truth().expect("a traced method");
-        Ok(Accuracy::measure(&frame, &map, Addressing::Wrap, truth).wrong_hit_fraction)
+        Ok(Accuracy::measure(&frame, &map, BUNDLED[0].surface, s, truth).wrong_hit_fraction)
     };
     let pyramid_settings = grazing(Method::Pyramid.timed());
     let pyramid_wrong = measure(&mut r, &pyramid_settings)?;

@@ -4,7 +4,6 @@
 use quadray_core::image_out::{Rgba8Image, montage};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::maps::BUNDLED;
-use quadray_displace::pyramid::Addressing;
 use quadray_displace::reference::Surface;
 use quadray_displace::scene::SurfaceKind;
 use quadray_displace::{DisplaceError, Lod, Method, Renderer, Settings, Size};
@@ -31,11 +30,6 @@ pub fn render_demo(
         let map = bundled.load()?;
         let color = bundled.load_color()?;
         let mut renderer = Renderer::new(gpu, &map, color.as_ref(), bundled.surface);
-        let addressing = if bundled.surface.wraps() {
-            Addressing::Wrap
-        } else {
-            Addressing::Clamp
-        };
         for angle in [35.0, 65.0, 80.0] {
             let methods = Method::ALL.map(|m| Settings {
                 view_angle_deg: angle,
@@ -47,7 +41,7 @@ pub fn render_demo(
             for s in &methods {
                 let frame = renderer.render(gpu, s)?;
                 if let Some(truth) = searched_truth(s.method) {
-                    let acc = Accuracy::measure(&frame, &map, addressing, truth);
+                    let acc = Accuracy::measure(&frame, &map, bundled.surface, s, truth);
                     heat.push((
                         format!("{} err {:.1}%", s.caption(), acc.wrong_hit_fraction * 100.0),
                         acc.heat_map(),
@@ -74,7 +68,7 @@ pub fn render_demo(
                 ..method.shown()
             };
             let frame = torus.render(gpu, &s)?;
-            let acc = Accuracy::measure(&frame, &map, Addressing::Wrap, truth);
+            let acc = Accuracy::measure(&frame, &map, SurfaceKind::Torus, &s, truth);
             let label = format!(
                 "torus {} err {:.1}%",
                 s.caption(),

@@ -10,8 +10,6 @@ pub mod timing;
 use crate::report::Table;
 use quadray_core::{write_json, write_text};
 use quadray_displace::heightmap::HeightMap;
-use quadray_displace::maps::BundledMap;
-use quadray_displace::pyramid::Addressing;
 use quadray_displace::{DisplaceError, Layers, Method, Renderer, Settings, Size};
 use quadray_gpu::Gpu;
 use serde::Serialize;
@@ -170,14 +168,6 @@ fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
 
 fn ratio_text(v: Option<f64>) -> String {
     v.map_or("n/a".into(), |v| format!("{v:.2}"))
-}
-
-fn addressing(b: &BundledMap) -> Addressing {
-    if b.surface.wraps() {
-        Addressing::Wrap
-    } else {
-        Addressing::Clamp
-    }
 }
 
 /// Runs every table and figure, writes results.json, results.md and the plots into `out`.

@@ -1,7 +1,7 @@
 //! The paper's timing tables and figures (tables 1 and 2, figures 20 and 21, the pyramid build),
 //! the cone map build and today's frame size, each as the rows it measured.
 
-use super::{Bench, Ratios, addressing, ms, ratio, ratio_text, traced};
+use super::{Bench, Ratios, ms, ratio, ratio_text, traced};
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_core::stats::{Summary, time_cpu};
 use quadray_displace::accuracy::Cost;
@@ -235,7 +235,7 @@ pub fn cone_build(bench: &Bench, tiles: &HeightMap) -> Result<Table, DisplaceErr
         ),
         &["map size", "seconds", "p10", "p90"],
     );
-    let addressing = addressing(&BUNDLED[0]);
+    let addressing = BUNDLED[0].surface.addressing();
     for size in [1024, 2048, 4096] {
         let map = resized(tiles, size);
         let mut seconds: Vec<f64> = (0..runs)

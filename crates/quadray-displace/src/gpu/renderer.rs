@@ -4,15 +4,17 @@
 use super::height_pyramid::{HeightPyramid, PyramidKind};
 use super::pyramid_build::PyramidBuilder;
 use super::surface_pass::{
-    COLOR_FORMAT, DEPTH_FORMAT, DebugTargets, FETCHES_FORMAT, FrameParams, Geometry, HIT_FORMAT,
-    MapParams, MapTextures, SurfacePass, Targets,
+    COLOR_FORMAT, DEPTH_FORMAT, DebugTargets, FrameParams, Geometry, HIT_FORMAT, MapParams,
+    MapTextures, SEARCH_FORMAT, SurfacePass, Targets,
 };
 use crate::cone::{ConeMap, ConeMapJob};
 use crate::heightmap::HeightMap;
 use crate::method::Method;
 use crate::pyramid::Addressing;
+use crate::reference::Ray;
 use crate::scene::{Plane, SurfaceKind, View};
 use crate::{DisplaceError, Settings};
+use glam::DVec2;
 use quadray_core::image_out::Rgba8Image;
 use quadray_core::stats::Summary;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32, read_texture_rgba8, texture_2d};
@@ -29,6 +31,24 @@ pub struct Frame {
     pub rays: Vec<[f32; 4]>,
     /// Per pixel: the texels the search read (every textureLoad of the trace).
     pub fetches: Vec<f32>,
+    /// Per pixel: whether the light's ray is blocked (self-shadowing on, a traced method).
+    pub in_shadow: Vec<bool>,
+}
+
+impl Frame {
+    /// The rays the GPU reports it traced, one per pixel (None where no surface shows).
+    pub fn traced_rays(&self) -> Vec<Option<Ray>> {
+        self.rays
+            .iter()
+            .zip(&self.hits)
+            .map(|(r, h)| {
+                (h[2] != -2.0).then(|| Ray {
+                    p0: DVec2::new(r[0].into(), r[1].into()),
+                    e: DVec2::new(r[2].into(), r[3].into()),
+                })
+            })
+            .collect()
+    }
 }
 
 /// One map on one surface, ready to render with any method.
@@ -59,11 +79,7 @@ impl Renderer {
         surface: SurfaceKind,
     ) -> Self {
         let (device, queue) = (&gpu.device, &gpu.queue);
-        let addressing = if surface.wraps() {
-            Addressing::Wrap
-        } else {
-            Addressing::Clamp
-        };
+        let addressing = surface.addressing();
         let builder = PyramidBuilder::new(device);
         let point = builder.build(device, queue, map, PyramidKind::Point);
         let conservative = builder.build(device, queue, map, PyramidKind::Conservative(addressing));
@@ -244,7 +260,7 @@ impl Renderer {
         if debug_outputs {
             t.push(make(HIT_FORMAT, "hits"));
             t.push(make(HIT_FORMAT, "rays"));
-            t.push(make(FETCHES_FORMAT, "fetches"));
+            t.push(make(SEARCH_FORMAT, "search"));
         }
         t
     }
@@ -334,12 +350,13 @@ impl Renderer {
                 Some(DebugTargets {
                     hits: &views[2],
                     rays: &views[3],
-                    fetches: &views[4],
+                    search: &views[4],
                 }),
                 None,
             )
         })?;
         gpu.queue.submit([encoder.finish()]);
+        let search = read_texture_f32(gpu, &targets[4], 0, 2)?;
         let pixels = |v: Vec<f32>| -> Vec<[f32; 4]> {
             v.chunks_exact(4)
                 .map(|c| [c[0], c[1], c[2], c[3]])
@@ -353,7 +370,8 @@ impl Renderer {
             ),
             hits: pixels(read_texture_f32(gpu, &targets[2], 0, 4)?),
             rays: pixels(read_texture_f32(gpu, &targets[3], 0, 4)?),
-            fetches: read_texture_f32(gpu, &targets[4], 0, 1)?,
+            fetches: search.iter().step_by(2).copied().collect(),
+            in_shadow: search.iter().skip(1).step_by(2).map(|&s| s > 0.5).collect(),
         })
     }
 

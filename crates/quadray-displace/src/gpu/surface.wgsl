@@ -66,8 +66,8 @@ struct FragmentOut {
     @location(1) hit: vec4f,
     // The ray itself, so the CPU ground truth traces exactly the same one.
     @location(2) ray: vec4f,
-    // Texels the search read (TraceHit.fetches).
-    @location(3) fetches: f32,
+    // Texels the search read (TraceHit.fetches); 1 where the light's ray is blocked, else 0.
+    @location(3) search: vec2f,
 }
 
 @vertex
@@ -254,7 +254,7 @@ fn fs_surface(in: VertexOut) -> FragmentOut {
     t.missed = t.missed || outside_map(info, hit_uv);
     // Iterations, negated when the cap stopped the search.
     out.hit = vec4f(hit_uv, select(t.z, -1.0, t.missed), select(f32(t.iterations), -f32(t.iterations), t.capped));
-    out.fetches = f32(t.fetches);
+    out.search.x = f32(t.fetches);
     if t.missed {
         out.color = SKY;
         return out;
@@ -266,6 +266,7 @@ fn fs_surface(in: VertexOut) -> FragmentOut {
     if frame.shadows == 1u && METHOD != METHOD_BUMP && METHOD != METHOD_PARALLAX {
         lit = light_reaches(hit_uv, t.z, world, t_axis, b_axis, n_axis, finest);
     }
+    out.search.y = select(1.0, 0.0, lit);
     out.color = vec4f(shade(hit_uv, world, t_axis, b_axis, n_axis, lit), 1.0);
     if frame.show_iterations == 1u {
         // Black through red and yellow to white at 64 iterations, as the CPU heat maps.

@@ -14,7 +14,7 @@ use wgpu::util::DeviceExt;
 pub(super) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub(super) const HIT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-pub(super) const FETCHES_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+pub(super) const SEARCH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 
 /// `surface.wgsl`'s `MapParams` (group 1).
 #[repr(C)]
@@ -106,11 +106,11 @@ pub struct Targets<'a> {
 }
 
 /// The per-pixel outputs beside the colour that tests and benchmarks read back: the hit
-/// (Rgba32Float), the ray (Rgba32Float) and the texels read (R32Float).
+/// (Rgba32Float), the ray (Rgba32Float), and the texels read and the shadow flag (Rg32Float).
 pub(super) struct DebugTargets<'a> {
     pub hits: &'a wgpu::TextureView,
     pub rays: &'a wgpu::TextureView,
-    pub fetches: &'a wgpu::TextureView,
+    pub search: &'a wgpu::TextureView,
 }
 
 /// The textures of one map, for [`SurfacePass::map_group`].
@@ -300,7 +300,7 @@ impl SurfacePass {
                             Some(COLOR_FORMAT.into()),
                             hit_target.clone(),
                             hit_target,
-                            debug_target(FETCHES_FORMAT),
+                            debug_target(SEARCH_FORMAT),
                         ],
                     }),
                     multiview_mask: None,
@@ -341,7 +341,7 @@ impl SurfacePass {
                 cleared_attachment(color, sky),
                 cleared_attachment(d.hits, no_surface),
                 cleared_attachment(d.rays, no_surface),
-                cleared_attachment(d.fetches, wgpu::Color::TRANSPARENT),
+                cleared_attachment(d.search, wgpu::Color::TRANSPARENT),
             ],
             None => [cleared_attachment(color, sky), None, None, None],
         };
