@@ -4,9 +4,10 @@
 //! wrong tangent frame or a wrong texture-space transform on the GPU shows up as wrong hits, and
 //! [`crate::accuracy::RayAgreement`] names the pixel whose GPU ray differs.
 
-use crate::Settings;
-use crate::reference::{Hit, Ray};
-use crate::scene::{Plane, SurfaceKind, Vertex, View};
+use crate::heightmap::HeightMap;
+use crate::reference::{Hit, Ray, bilinear_depth};
+use crate::scene::{Plane, SurfaceKind, Vertex, View, mesh_grid};
+use crate::{DisplaceError, Settings};
 use glam::{DMat4, DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 
@@ -43,67 +44,140 @@ pub fn ray_slope(towards: DVec3, depth_scale: f64) -> DVec2 {
 }
 
 /// Every pixel's ray for `kind` drawn with `s`, row by row from the top (None: the pixel shows
-/// no surface). The CPU rasterises the surface's triangles itself: each pixel's ray through its
-/// centre, the nearest triangle that faces the camera (as the depth test and the renderer's
-/// discard leave it), its attributes at the exact intersection (what perspective-correct
-/// interpolation gives).
+/// no surface): the nearest of the surface's triangles that faces the camera (as the depth test
+/// and the renderer's discard leave it), its attributes at the exact intersection (what
+/// perspective-correct interpolation gives).
 pub fn camera_rays(kind: SurfaceKind, s: &Settings) -> Vec<Option<PixelRay>> {
     let view = View::of(kind, s);
+    let eye = view.eye.as_dvec3();
+    let vertices = kind.vertices();
+    let triangles: Vec<[DVec3; 3]> = vertices
+        .chunks_exact(3)
+        .map(|t| [0, 1, 2].map(|k| DVec3::from(t[k].position.map(f64::from))))
+        .collect();
+    let plane = kind.is_planar().then(|| Plane::of(kind));
+    let depth_scale = f64::from(s.depth_scale);
+    rasterise(&triangles, &view, s, |i, world, weights| {
+        let (uv, frame) = match &plane {
+            Some(plane) => planar_attributes(plane, world),
+            None => interpolated_attributes(&vertices[i * 3..i * 3 + 3], weights),
+        };
+        let to_eye = (eye - world).normalize();
+        let v = DVec3::new(
+            to_eye.dot(frame[0]),
+            to_eye.dot(frame[1]),
+            to_eye.dot(frame[2]),
+        );
+        (v.z > MIN_COSINE).then(|| {
+            let p0 = if kind.wraps() { uv - uv.floor() } else { uv };
+            let ray = Ray {
+                p0,
+                e: ray_slope(v, depth_scale),
+            };
+            PixelRay { ray, world, frame }
+        })
+    })
+}
+
+/// The displaced-mesh baseline's exact hits: each pixel's ray against the same grid of
+/// triangles the mesh draws (one quad per texel of the map's longer side per repeat, vertices on
+/// the bilinear surface), the hit's uv and depth interpolated from the triangle's corners.
+/// Refused above [`MAX_MESH_TRIANGLES`] (a tiled wall of a 1024^2 map has 134 million).
+pub fn mesh_hits(
+    map: &HeightMap,
+    kind: SurfaceKind,
+    s: &Settings,
+) -> Result<Vec<Option<Hit>>, DisplaceError> {
+    let side = u64::from(mesh_grid(map.width, map.height)) * u64::from(kind.tiles());
+    if 2 * side * side > MAX_MESH_TRIANGLES {
+        return Err(DisplaceError::Settings(format!(
+            "the mesh ground truth would test {} triangles (at most {MAX_MESH_TRIANGLES})",
+            2 * side * side
+        )));
+    }
+    let view = View::of(kind, s);
+    let plane = Plane::of(kind);
+    let (origin, u, v) = (
+        plane.origin.as_dvec3(),
+        plane.u.as_dvec3(),
+        plane.v.as_dvec3(),
+    );
+    let down = -plane.normal().as_dvec3() * f64::from(s.depth_scale) * f64::from(kind.tile_world());
+    let grid = mesh_grid(map.width, map.height);
+    let addressing = kind.addressing();
+    let corner = |i: u32, j: u32| {
+        let uv = DVec2::new(f64::from(i), f64::from(j)) / f64::from(grid);
+        let depth = bilinear_depth(map, addressing, uv);
+        (uv, depth, origin + u * uv.x + v * uv.y + down * depth)
+    };
+    let side = grid * kind.tiles();
+    let corners: Vec<_> = (0..=side)
+        .flat_map(|j| (0..=side).map(move |i| (i, j)))
+        .map(|(i, j)| corner(i, j))
+        .collect();
+    let at = |i: u32, j: u32| corners[(j * (side + 1) + i) as usize];
+    let quads = (0..side).flat_map(|j| (0..side).map(move |i| (i, j)));
+    let mut triangles = Vec::new();
+    let mut attributes = Vec::new();
+    for (i, j) in quads {
+        let [a, b, c, d] = [at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)];
+        for t in [[a, b, c], [c, b, d]] {
+            triangles.push(t.map(|(_, _, world)| world));
+            attributes.push(t.map(|(uv, depth, _)| (uv, depth)));
+        }
+    }
+    Ok(rasterise(&triangles, &view, s, |i, _, weights| {
+        let (uv, z) = (0..3).fold((DVec2::ZERO, 0.0), |(uv, z), k| {
+            let (corner_uv, depth) = attributes[i][k];
+            (uv + corner_uv * weights[k], z + depth * weights[k])
+        });
+        Some(Hit { uv, z })
+    }))
+}
+
+/// The most triangles [`mesh_hits`] intersects.
+pub const MAX_MESH_TRIANGLES: u64 = 1 << 22;
+
+/// For each pixel of the frame `s` asks for, row by row from the top: the ray through its centre
+/// against `triangles` (world positions), `hit(triangle, point, barycentric weights)` of the
+/// nearest triangle it accepts. The CPU's own rasteriser: each triangle is tested only on the
+/// pixels its projection may cover.
+fn rasterise<T: Send>(
+    triangles: &[[DVec3; 3]],
+    view: &View,
+    s: &Settings,
+    hit: impl Fn(usize, DVec3, [f64; 3]) -> Option<T> + Sync,
+) -> Vec<Option<T>> {
     let (width, height) = (s.size.width, s.size.height);
     let view_proj = view.view_proj.as_dmat4();
     let inverse = view_proj.inverse();
-    let eye = view.eye.as_dvec3();
-    let triangles: Vec<[Vertex; 3]> = kind
-        .vertices()
-        .chunks_exact(3)
-        .map(|t| [t[0], t[1], t[2]])
-        .collect();
     let bounds: Vec<PixelBounds> = triangles
         .iter()
         .map(|t| PixelBounds::of(t, &view_proj, width, height))
         .collect();
-    let plane = kind.is_planar().then(|| Plane::of(kind));
-    let depth_scale = f64::from(s.depth_scale);
     (0..height)
         .into_par_iter()
         .flat_map_iter(|y| {
-            let (triangles, bounds, plane) = (&triangles, &bounds, &plane);
+            let (bounds, hit) = (&bounds, &hit);
             let row: Vec<usize> = (0..triangles.len())
                 .filter(|&i| bounds[i].rows.contains(&y))
                 .collect();
             (0..width).map(move |x| {
                 let (origin, direction) = pixel_ray(&inverse, [x, y], [width, height]);
-                let mut nearest: Option<(f64, PixelRay)> = None;
+                let mut nearest: Option<(f64, T)> = None;
                 for &i in row.iter().filter(|&&i| bounds[i].columns.contains(&x)) {
                     let Some((t, weights)) = intersect_triangle(origin, direction, &triangles[i])
                     else {
                         continue;
                     };
-                    if nearest.is_some_and(|(best, _)| best <= t) {
+                    if nearest.as_ref().is_some_and(|(best, _)| *best <= t) {
                         continue;
                     }
-                    let world = origin + direction * t;
-                    let (uv, frame) = match plane {
-                        Some(plane) => planar_attributes(plane, world),
-                        None => interpolated_attributes(&triangles[i], weights),
-                    };
-                    let to_eye = (eye - world).normalize();
-                    let v = DVec3::new(
-                        to_eye.dot(frame[0]),
-                        to_eye.dot(frame[1]),
-                        to_eye.dot(frame[2]),
-                    );
-                    if v.z <= MIN_COSINE {
-                        continue;
+                    if let Some(found) = hit(i, origin + direction * t, weights) {
+                        nearest = Some((t, found));
                     }
-                    let p0 = if kind.wraps() { uv - uv.floor() } else { uv };
-                    let ray = Ray {
-                        p0,
-                        e: ray_slope(v, depth_scale),
-                    };
-                    nearest = Some((t, PixelRay { ray, world, frame }));
                 }
-                nearest.map(|(_, ray)| ray)
+                nearest.map(|(_, found)| found)
             })
         })
         .collect()
@@ -129,9 +203,8 @@ struct PixelBounds {
 }
 
 impl PixelBounds {
-    fn of(triangle: &[Vertex; 3], view_proj: &DMat4, width: u32, height: u32) -> Self {
-        let clip =
-            triangle.map(|v| *view_proj * DVec3::from(v.position.map(f64::from)).extend(1.0));
+    fn of(triangle: &[DVec3; 3], view_proj: &DMat4, width: u32, height: u32) -> Self {
+        let clip = triangle.map(|p| *view_proj * p.extend(1.0));
         if clip.iter().any(|c| c.w <= 1e-9) {
             return Self {
                 rows: 0..=height - 1,
@@ -164,9 +237,8 @@ impl PixelBounds {
 fn intersect_triangle(
     origin: DVec3,
     direction: DVec3,
-    triangle: &[Vertex; 3],
+    &[a, b, c]: &[DVec3; 3],
 ) -> Option<(f64, [f64; 3])> {
-    let [a, b, c] = triangle.map(|v| DVec3::from(v.position.map(f64::from)));
     let (ab, ac) = (b - a, c - a);
     let p = direction.cross(ac);
     let det = ab.dot(p);
@@ -197,7 +269,7 @@ fn planar_attributes(plane: &Plane, world: DVec3) -> (DVec2, [DVec3; 3]) {
 
 /// A mesh's uv and frame at barycentric `weights`: its normals and (MikkTSpace) tangents
 /// interpolated, the bitangent of each vertex w * (N x T) as glTF defines it.
-fn interpolated_attributes(triangle: &[Vertex; 3], weights: [f64; 3]) -> (DVec2, [DVec3; 3]) {
+fn interpolated_attributes(triangle: &[Vertex], weights: [f64; 3]) -> (DVec2, [DVec3; 3]) {
     let mix = |f: &dyn Fn(&Vertex) -> DVec3| {
         (0..3).fold(DVec3::ZERO, |sum, i| sum + f(&triangle[i]) * weights[i])
     };

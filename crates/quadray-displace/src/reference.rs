@@ -221,6 +221,26 @@ fn first_root(c0: f64, c1: f64, c2: f64, lo: f64, hi: f64) -> Option<f64> {
     best.is_finite().then_some(best)
 }
 
+/// The depth of texel (i, j), wherever the ray is.
+fn texel_depth(map: &HeightMap, addressing: Addressing, i: i64, j: i64) -> f64 {
+    f64::from(map.at(
+        addressing.texel(i, map.width),
+        addressing.texel(j, map.height),
+    ))
+}
+
+/// The bilinear surface's depth at `p` (between texel centres at ((i + 0.5) / width, (j + 0.5)
+/// / height)).
+pub fn bilinear_depth(map: &HeightMap, addressing: Addressing, p: DVec2) -> f64 {
+    let q = p * map.texels_per_uv() - 0.5;
+    let (i, j) = (q.x.floor() as i64, q.y.floor() as i64);
+    let (fx, fy) = (q.x - i as f64, q.y - j as f64);
+    let d = |a: i64, b: i64| texel_depth(map, addressing, a, b);
+    let top = d(i, j) * (1.0 - fx) + d(i + 1, j) * fx;
+    let bottom = d(i, j + 1) * (1.0 - fx) + d(i + 1, j + 1) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -256,27 +276,9 @@ mod tests {
         z
     }
 
-    /// The depth of texel (i, j), wherever the ray is.
-    fn texel_depth(map: &HeightMap, addressing: Addressing, i: i64, j: i64) -> f64 {
-        f64::from(map.at(
-            addressing.texel(i, map.width),
-            addressing.texel(j, map.height),
-        ))
-    }
-
     fn point_depth(map: &HeightMap, addressing: Addressing, p: DVec2) -> f64 {
         let q = p * map.texels_per_uv();
         texel_depth(map, addressing, q.x.floor() as i64, q.y.floor() as i64)
-    }
-
-    fn bilinear_depth(map: &HeightMap, addressing: Addressing, p: DVec2) -> f64 {
-        let q = p * map.texels_per_uv() - 0.5;
-        let (i, j) = (q.x.floor() as i64, q.y.floor() as i64);
-        let (fx, fy) = (q.x - i as f64, q.y - j as f64);
-        let d = |a: i64, b: i64| texel_depth(map, addressing, a, b);
-        let top = d(i, j) * (1.0 - fx) + d(i + 1, j) * fx;
-        let bottom = d(i, j + 1) * (1.0 - fx) + d(i + 1, j + 1) * fx;
-        top * (1.0 - fy) + bottom * fy
     }
 
     /// Square, odd, one-texel-wide and one-texel-high maps.

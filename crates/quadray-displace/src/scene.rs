@@ -107,6 +107,11 @@ impl std::str::FromStr for SurfaceKind {
     }
 }
 
+/// The displaced-mesh baseline's quads per side per tile: one per texel of the map's longer side.
+pub fn mesh_grid(width: u32, height: u32) -> u32 {
+    width.max(height)
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 /// A surface vertex as the surface pass reads it.

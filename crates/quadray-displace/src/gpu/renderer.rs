@@ -12,7 +12,7 @@ use crate::heightmap::HeightMap;
 use crate::method::Method;
 use crate::pyramid::Addressing;
 use crate::reference::Ray;
-use crate::scene::{Plane, SurfaceKind, View};
+use crate::scene::{Plane, SurfaceKind, View, mesh_grid};
 use crate::{DisplaceError, Settings};
 use glam::DVec2;
 use quadray_core::image_out::Rgba8Image;
@@ -415,11 +415,6 @@ impl Renderer {
         }
         Ok(timer.summaries()[0])
     }
-}
-
-/// The displaced-mesh baseline's quads per side per tile: one per texel of the map's longer side.
-fn mesh_grid(width: u32, height: u32) -> u32 {
-    width.max(height)
 }
 
 /// The per-map bind group with `traced` (a pyramid or the cone map) in the pyramid's slot.
