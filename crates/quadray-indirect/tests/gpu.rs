@@ -194,31 +194,37 @@ fn the_cut_covers_every_lit_rsm_texel_exactly_once() {
     assert_eq!((picture.width, picture.height), (512, 512));
 }
 
+/// The cut's error against the brute force on the Cornell box (256^2 RSM) at the README's
+/// figures, within 10% of each: the defaults 3.7% (under the 5% target), the local rule with a
+/// 64^2 limit 5.1%, the paper's settings (local rule, 32^2) 7.4%, faster and coarser.
 #[test]
-fn default_thresholds_stay_within_five_percent_of_the_brute_force() {
+fn default_thresholds_give_the_readmes_error_against_the_brute_force() {
     let gpu = gpu();
     let size = 256;
     let mut r = cornell(&gpu, settings(size));
     let brute = render(&mut r, Method::Reference);
-    // the defaults meet the target; the paper's settings (local rule) are faster and coarser
-    for (name, cluster, bound) in [
-        ("defaults", ClusterSettings::DEFAULT, 0.05),
+    for (name, cluster, readme) in [
+        ("defaults", ClusterSettings::DEFAULT, 0.037),
         (
             "local, limit 64^2",
             ClusterSettings::with_limit_side(size, 64),
-            0.06,
+            0.051,
         ),
         (
             "paper: local, limit 32^2",
             ClusterSettings::with_limit_side(size, 32),
-            0.10,
+            0.074,
         ),
     ] {
         r.set_cluster(cluster).unwrap();
         let image = render(&mut r, Method::Quadtree);
         let what = format!("{name}, {} clusters", r.clusters_in_cut().unwrap());
         let e = logged_error(&what, &image, &brute);
-        assert!(e.rel_l1 < bound, "{name}: {e:?}");
+        assert!(
+            (e.rel_l1 - readme).abs() <= 0.1 * readme,
+            "{name}: rel. L1 {} where the README states {readme}: {e:?}",
+            e.rel_l1
+        );
     }
 }
 

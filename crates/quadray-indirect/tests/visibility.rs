@@ -40,7 +40,9 @@ fn the_leak_scene_leaks_without_visibility_and_the_ground_truth_stops_it() {
         "right room: {leaky} without visibility, {exact} with; left: {left_leaky}, {left_exact}"
     );
     assert!(exact > 0.0, "light comes through the doorway");
-    assert!(exact < 0.5 * leaky, "{exact} vs {leaky}");
+    // The README's 14x (measured 14.1x): within 15%.
+    let leak = leaky / exact;
+    assert!((12.0..=16.0).contains(&leak), "{leak}x the light without visibility");
     // the left room is a convex box: nothing in it hides a VPL (no ray hits its own surfaces)
     assert!((left_exact - left_leaky).abs() <= 1e-6 * left_leaky);
     let e = compare(&cpu, &truth);
