@@ -5,6 +5,7 @@
 mod common;
 mod deploy_files;
 mod displace_cli;
+mod examples;
 mod fuzz_loaders;
 mod gpu_tables;
 mod headless_cli;

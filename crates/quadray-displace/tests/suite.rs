@@ -1,8 +1,7 @@
 //! quadray-displace's integration tests, one module per file, linked as one binary: one test harness to
 //! build instead of one per file. One file's tests:
-//! `cargo test --release -p quadray-displace --test suite -- displaced_quad_example::`.
+//! `cargo test --release -p quadray-displace --test suite -- height_maps::`.
 
 mod common;
-mod displaced_quad_example;
 mod gpu_vs_reference;
 mod height_maps;

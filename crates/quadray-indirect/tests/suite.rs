@@ -3,9 +3,6 @@
 //! `cargo test --release -p quadray-indirect --test suite -- counts::`.
 
 mod counts;
-// Not `example`: the file declares its own `mod example` (the example's source).
-#[path = "example.rs"]
-mod gi_gbuffer_example;
 mod gpu;
 mod layers;
 mod output;

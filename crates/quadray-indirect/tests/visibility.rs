@@ -42,7 +42,10 @@ fn the_leak_scene_leaks_without_visibility_and_the_ground_truth_stops_it() {
     assert!(exact > 0.0, "light comes through the doorway");
     // The README's 14x (measured 14.1x): within 15%.
     let leak = leaky / exact;
-    assert!((12.0..=16.0).contains(&leak), "{leak}x the light without visibility");
+    assert!(
+        (12.0..=16.0).contains(&leak),
+        "{leak}x the light without visibility"
+    );
     // the left room is a convex box: nothing in it hides a VPL (no ray hits its own surfaces)
     assert!((left_exact - left_leaky).abs() <= 1e-6 * left_leaky);
     let e = compare(&cpu, &truth);
