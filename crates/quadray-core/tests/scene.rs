@@ -27,6 +27,7 @@ fn every_bundled_scene_file_loads() {
         ("cornell_bunny.toml", 1, 1, 2, 1),
         ("cornell_obj.toml", 1, 1, 1, 0),
         ("cornell_spot.gltf", 1, 1, 1, 0),
+        ("example-gi.toml", 1, 1, 10, 10),
         ("example-hst.toml", 2, 0, 5, 4),
         ("leak.toml", 1, 1, 9, 2),
         ("shadows-buddha.toml", 3, 0, 2, 1),
