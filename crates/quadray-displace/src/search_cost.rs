@@ -16,7 +16,8 @@ use glam::Vec2;
 enum Start {
     /// No coarser than the ray's footprint needs (the shader's choice).
     Footprint,
-    /// The root (the paper's).
+    /// The root (the paper's), which the shader no longer does: for the comparison.
+    #[cfg(test)]
     Root,
 }
 
@@ -64,6 +65,7 @@ impl SearchInput<'_> {
         let needed = footprint.max(1.0).log2().ceil() as i32 - 1;
         let mut level = match start {
             Start::Footprint => top.min(needed.max(0)),
+            #[cfg(test)]
             Start::Root => top,
         };
         let (mut z, mut reads) = (0.0f32, 0u32);
@@ -165,8 +167,9 @@ mod tests {
 
     /// Starting where the ray's footprint needs rather than at the root reads fewer texels for
     /// the same trace (the GPU's hits are the same from any level: `gpu_vs_reference.rs`): on the
-    /// tile map at 30-80 degrees, over a grid of rays. (On the GPU at 60 degrees, 64x64: 50,605
-    /// reads against 61,642 from the root.)
+    /// tile map at 30, 60 and 80 degrees over a grid of rays: measured 32,171, 52,809 and 88,018
+    /// reads against 52,563, 64,985 and 92,114 from the root (on the GPU at 60 degrees, 64x64:
+    /// 50,605 against 61,642).
     #[test]
     fn the_footprint_start_reads_fewer_texels_than_the_root() {
         let map = BUNDLED[0].load().unwrap();
@@ -187,8 +190,13 @@ mod tests {
                     root += u64::from(input.pyramid_reads(p0, e, false, Start::Root));
                 }
             }
-            println!("{angle} deg: {footprint} reads from the footprint's level, {root} from the root");
-            assert!(footprint < root, "{angle} deg: {footprint} vs {root} from the root");
+            println!(
+                "{angle} deg: {footprint} reads from the footprint's level, {root} from the root"
+            );
+            assert!(
+                footprint < root,
+                "{angle} deg: {footprint} vs {root} from the root"
+            );
         }
     }
 }
