@@ -12,7 +12,7 @@ use bevy::render::render_resource::{BufferUsages, TextureFormat};
 use bevy::render::storage::ShaderBuffer;
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial, depth_map};
 use quadray_core::image_out::Rgba8Image;
-use quadray_displace::accuracy::Accuracy;
+use quadray_displace::accuracy::GroundTruth;
 use quadray_displace::gpu::Frame;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::pyramid::Addressing;
@@ -219,13 +219,13 @@ fn bevy_hits_agree_with_the_cpu_ground_truth() {
             fetches: Vec::new(),
             in_shadow: Vec::new(),
         };
-        let accuracy = Accuracy::measure_rays(
-            &frame,
-            &frame.traced_rays(),
+        let accuracy = GroundTruth::of_rays(
             &maps[view.map],
             Addressing::Wrap,
             Surface::Point,
-        );
+            frame.traced_rays(),
+        )
+        .measure(&frame);
         let what = format!("{} at {} degrees", MAPS[view.map], view.angle_deg);
         println!(
             "{what}: {} covered, wrong-hit fraction {:.5}, mean error {:.4} texels",

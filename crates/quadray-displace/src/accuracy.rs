@@ -46,7 +46,8 @@ pub struct Accuracy {
 
 impl Accuracy {
     /// Measures `frame`, drawn of `map` on `surface` with `s`, against the exact intersections
-    /// with `truth` of the rays the CPU builds itself from the camera and the surface.
+    /// with `truth` of the rays the CPU builds itself from the camera and the surface. To measure
+    /// several frames of one view, trace a [`GroundTruth`] once.
     pub fn measure(
         frame: &Frame,
         map: &HeightMap,
@@ -54,28 +55,65 @@ impl Accuracy {
         s: &Settings,
         truth: Surface,
     ) -> Self {
-        let rays = camera_rays(surface, s);
-        let traced: Vec<Option<Ray>> = rays.iter().map(|r| r.map(|p| p.ray)).collect();
-        let mut accuracy = Self::measure_rays(frame, &traced, map, surface.addressing(), truth);
-        accuracy.rays = Some(RayAgreement::of(frame, &traced, map, surface.wraps()));
-        accuracy
+        GroundTruth::trace(map, surface, s, truth).measure(frame)
     }
 
-    /// Measures `frame` against the exact intersections with `truth` of `rays` (one per pixel;
-    /// None where no surface should show).
-    pub fn measure_rays(
-        frame: &Frame,
-        rays: &[Option<Ray>],
-        map: &HeightMap,
+    /// Black: exact; white: 2+ texels off or wrong hit/miss status; grey: no surface.
+    pub fn heat_map(&self) -> Rgba8Image {
+        heat_map(self.width, self.height, &self.error_texels, 2.0)
+    }
+}
+
+/// The exact hits of one view: each pixel's ray and its first intersection with the truth
+/// surface, traced once and measured against every frame drawn from that view (each method at
+/// one angle, as the benchmark and the tests compare them).
+pub struct GroundTruth<'a> {
+    map: &'a HeightMap,
+    addressing: Addressing,
+    rays: Vec<Option<Ray>>,
+    hits: Vec<Option<Hit>>,
+    /// The rays are the CPU's own (then each frame's rays are compared with them).
+    own_rays: bool,
+}
+
+impl<'a> GroundTruth<'a> {
+    /// The truth of the view `s` sets up on `surface`, on the CPU's own rays.
+    pub fn trace(map: &'a HeightMap, surface: SurfaceKind, s: &Settings, truth: Surface) -> Self {
+        let rays = camera_rays(surface, s)
+            .iter()
+            .map(|r| r.map(|p| p.ray))
+            .collect();
+        Self {
+            own_rays: true,
+            ..Self::of_rays(map, surface.addressing(), truth, rays)
+        }
+    }
+
+    /// The truth on `rays` (one per pixel; None where no surface should show) from elsewhere.
+    pub fn of_rays(
+        map: &'a HeightMap,
         addressing: Addressing,
         truth: Surface,
+        rays: Vec<Option<Ray>>,
     ) -> Self {
-        let truth_hits = intersect_all(map, addressing, truth, rays);
-        let texels_per_uv = map.texels_per_uv();
-        let error_texels: Vec<f32> = rays
+        let hits = intersect_all(map, addressing, truth, &rays);
+        Self {
+            map,
+            addressing,
+            rays,
+            hits,
+            own_rays: false,
+        }
+    }
+
+    /// Measures `frame` (of this view) against the truth.
+    pub fn measure(&self, frame: &Frame) -> Accuracy {
+        let (addressing, texels_per_uv) = (self.addressing, self.map.texels_per_uv());
+        let error_texels: Vec<f32> = self
+            .rays
             .iter()
             .zip(&frame.hits)
-            .zip(&truth_hits)
+            .zip(&self.hits)
             .map(|((ray, gpu), truth)| {
                 let shown = gpu[2] != -2.0;
                 if ray.is_none() && !shown {
@@ -97,22 +135,19 @@ impl Accuracy {
         let errors = error_texels.iter().copied().filter(|e| !e.is_nan());
         let covered = errors.clone().count();
         let wrong = errors.clone().filter(|&e| e > 1.0).count();
-        Self {
+        Accuracy {
             covered,
             wrong,
             wrong_hit_fraction: wrong as f64 / covered.max(1) as f64,
             mean_error_texels: errors.clone().map(f64::from).sum::<f64>() / covered.max(1) as f64,
             max_error_texels: errors.fold(0.0, f32::max).into(),
-            rays: None,
+            rays: self
+                .own_rays
+                .then(|| RayAgreement::of(frame, &self.rays, self.map, addressing)),
             width: frame.color.width,
             height: frame.color.height,
             error_texels,
         }
-    }
-
-    /// Black: exact; white: 2+ texels off or wrong hit/miss status; grey: no surface.
-    pub fn heat_map(&self) -> Rgba8Image {
-        heat_map(self.width, self.height, &self.error_texels, 2.0)
     }
 }
 
@@ -142,12 +177,12 @@ pub struct RayAgreement {
 
 impl RayAgreement {
     /// Compares `frame`'s rays with `rays` (the CPU's), on a map of `map`'s size.
-    pub fn of(frame: &Frame, rays: &[Option<Ray>], map: &HeightMap, wraps: bool) -> Self {
-        let addressing = if wraps {
-            Addressing::Wrap
-        } else {
-            Addressing::Clamp
-        };
+    pub fn of(
+        frame: &Frame,
+        rays: &[Option<Ray>],
+        map: &HeightMap,
+        addressing: Addressing,
+    ) -> Self {
         let direction = |e: DVec2| DVec3::new(-e.x, -e.y, 1.0).normalize();
         let mut agreement = Self {
             coverage_mismatches: 0,

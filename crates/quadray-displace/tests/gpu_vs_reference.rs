@@ -6,7 +6,7 @@
 use crate::common;
 
 use glam::DVec2;
-use quadray_displace::accuracy::{Accuracy, Cost, ShadowAgreement};
+use quadray_displace::accuracy::{Accuracy, Cost, GroundTruth, ShadowAgreement};
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::primary_rays::{camera_rays, mesh_hits};
 use quadray_displace::pyramid::{Addressing, Pyramid};
@@ -36,17 +36,11 @@ fn wrong_hit_fraction(
     (name, map): (&str, &HeightMap),
     method: Method,
     angle: f32,
+    truths: &Truths,
 ) -> f64 {
     let surface = renderer.surface();
-    let s = settings(method, angle);
-    let frame = renderer.render(gpu, &s).unwrap();
-    let acc = Accuracy::measure(
-        &frame,
-        map,
-        surface,
-        &s,
-        method.truth().expect("a traced method"),
-    );
+    let frame = renderer.render(gpu, &settings(method, angle)).unwrap();
+    let acc = truths.of(method).measure(&frame);
     let cost = Cost::of(&frame);
     let at = format!("{name} {surface:?} {method} {angle} deg");
     assert_rays_agree(&acc, &at);
@@ -61,6 +55,23 @@ fn wrong_hit_fraction(
         map.width, map.height, acc.wrong_hit_fraction, acc.covered
     );
     acc.wrong_hit_fraction
+}
+
+/// The point-sampled and the bilinear truth of one view, each traced once for every method.
+struct Truths<'a>([GroundTruth<'a>; 2]);
+
+impl<'a> Truths<'a> {
+    fn trace(map: &'a HeightMap, surface: SurfaceKind, angle: f32) -> Self {
+        let s = settings(Method::Pyramid, angle);
+        Self([Surface::Point, Surface::Bilinear].map(|t| GroundTruth::trace(map, surface, &s, t)))
+    }
+
+    fn of(&self, method: Method) -> &GroundTruth<'a> {
+        match method.truth().expect("a traced method") {
+            Surface::Point => &self.0[0],
+            Surface::Bilinear => &self.0[1],
+        }
+    }
 }
 
 /// The GPU traced the CPU's rays: the same pixels show the surface (but for one in 500, where a
@@ -135,14 +146,21 @@ fn pyramid_methods_match_the_ground_truth_at_every_angle_on_every_map() {
         let surfaces = [SurfaceKind::Wall, SurfaceKind::Terrain, SurfaceKind::Torus];
         for surface in surfaces.into_iter().chain(photo) {
             let mut renderer = Renderer::new(&gpu, &map, None, surface);
-            for method in [
-                Method::Pyramid,
-                Method::PyramidAscend,
-                Method::PyramidBilinear,
-            ] {
-                for angle in ANGLES {
-                    let wrong =
-                        wrong_hit_fraction(&gpu, &mut renderer, (name, &map), method, angle);
+            for angle in ANGLES {
+                let truths = Truths::trace(&map, surface, angle);
+                for method in [
+                    Method::Pyramid,
+                    Method::PyramidAscend,
+                    Method::PyramidBilinear,
+                ] {
+                    let wrong = wrong_hit_fraction(
+                        &gpu,
+                        &mut renderer,
+                        (name, &map),
+                        method,
+                        angle,
+                        &truths,
+                    );
                     assert!(
                         wrong <= 0.001,
                         "{name} {surface:?} {method} {angle} deg: wrong_hit_fraction {wrong} > 0.001"
@@ -171,14 +189,6 @@ fn cone_stepping_converges_to_the_ground_truth_and_its_budget_error_is_bounded()
         for surface in [SurfaceKind::Wall, SurfaceKind::Terrain] {
             let mut renderer = Renderer::new(&gpu, &map, None, surface);
             for angle in ANGLES {
-                let measure = |renderer: &mut Renderer, s: Settings| {
-                    let frame = renderer.render(&gpu, &s).unwrap();
-                    let cost = Cost::of(&frame);
-                    assert!(
-                        cost.texel_fetches_per_pixel <= f64::from(s.layers.max + s.binary_steps)
-                    );
-                    Accuracy::measure(&frame, &map, surface, &s, Surface::Point)
-                };
                 let budget = Settings {
                     view_angle_deg: angle,
                     size: Size::new(64, 64),
@@ -189,6 +199,18 @@ fn cone_stepping_converges_to_the_ground_truth_and_its_budget_error_is_bounded()
                     ..budget.clone()
                 };
                 let at = format!("{name} {surface:?} {angle} deg");
+                // One truth for both budgets: the same view.
+                let truth = GroundTruth::trace(&map, surface, &budget, Surface::Point);
+                let measure = |renderer: &mut Renderer, s: Settings| {
+                    let frame = renderer.render(&gpu, &s).unwrap();
+                    let cost = Cost::of(&frame);
+                    assert!(
+                        cost.texel_fetches_per_pixel <= f64::from(s.layers.max + s.binary_steps)
+                    );
+                    let accuracy = truth.measure(&frame);
+                    assert_rays_agree(&accuracy, &at);
+                    accuracy
+                };
                 let fixed = measure(&mut renderer, budget).wrong_hit_fraction;
                 let converged = measure(&mut renderer, spare);
                 println!(
@@ -296,9 +318,17 @@ fn maps_of_any_size_are_traced_exactly_without_resampling() {
     for (name, map) in &maps {
         for surface in [SurfaceKind::Wall, SurfaceKind::Terrain] {
             let mut renderer = Renderer::new(&gpu, map, None, surface);
-            for method in [Method::Pyramid, Method::PyramidBilinear] {
-                for angle in [0.0, 30.0, 60.0, 80.0, 85.0] {
-                    let wrong = wrong_hit_fraction(&gpu, &mut renderer, (name, map), method, angle);
+            for angle in [0.0, 30.0, 60.0, 80.0, 85.0] {
+                let truths = Truths::trace(map, surface, angle);
+                for method in [Method::Pyramid, Method::PyramidBilinear] {
+                    let wrong = wrong_hit_fraction(
+                        &gpu,
+                        &mut renderer,
+                        (name, map),
+                        method,
+                        angle,
+                        &truths,
+                    );
                     if wrong > 0.001 {
                         let size = format!("{}x{}", map.width, map.height);
                         failures.push(format!("{size} {surface:?} {method} {angle}: {wrong}"));
@@ -347,17 +377,29 @@ fn engine_default_searches_have_the_measured_error_at_every_angle() {
     let gpu = Gpu::new().expect("a GPU adapter");
     let (_, map, _) = common::bundled_maps().remove(0); // tiles105: sharp grout
     let mut renderer = Renderer::new(&gpu, &map, None, SurfaceKind::Wall);
-    for (method, measured) in MEASURED {
-        let wrong = ANGLES.map(|angle| {
-            let s = Settings {
-                view_angle_deg: angle,
-                size: Size::new(256, 256),
-                ..method.shown()
-            };
-            let frame = renderer.render(&gpu, &s).unwrap();
-            let truth = method.truth().expect("a traced method");
-            Accuracy::measure(&frame, &map, SurfaceKind::Wall, &s, truth).wrong_hit_fraction
-        });
+    let shown = |method: Method, angle| Settings {
+        view_angle_deg: angle,
+        size: Size::new(256, 256),
+        ..method.shown()
+    };
+    // Every one of these methods is measured against the bilinear surface: one truth an angle.
+    let mut wrong = [[0.0; 9]; 4];
+    for (a, angle) in ANGLES.into_iter().enumerate() {
+        let truth = GroundTruth::trace(
+            &map,
+            SurfaceKind::Wall,
+            &shown(Method::Pom, angle),
+            Surface::Bilinear,
+        );
+        for (m, (method, _)) in MEASURED.iter().enumerate() {
+            assert_eq!(method.truth(), Some(Surface::Bilinear), "{method}");
+            let frame = renderer.render(&gpu, &shown(*method, angle)).unwrap();
+            let accuracy = truth.measure(&frame);
+            assert_rays_agree(&accuracy, &format!("{method} at {angle} deg"));
+            wrong[m][a] = accuracy.wrong_hit_fraction;
+        }
+    }
+    for ((method, measured), wrong) in MEASURED.into_iter().zip(wrong) {
         println!("{method}: {wrong:.4?}");
         for ((angle, wrong), measured) in ANGLES.iter().zip(wrong).zip(measured) {
             assert!(
