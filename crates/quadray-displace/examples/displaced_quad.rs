@@ -81,8 +81,8 @@ pub fn tile_map() -> HeightMap {
 /// Draws the displaced quad on `device` and reads the picture back.
 pub fn render(device: &wgpu::Device, queue: &wgpu::Queue, map: &HeightMap) -> image::RgbaImage {
     let pyramid = HeightPyramid::build_gpu(device, queue, map, PyramidKind::Point);
-    let view = glam::camera::rh::view::look_at_mat4(EYE, Vec3::ZERO, Vec3::Y);
-    let proj = glam::camera::rh::proj::directx::perspective(50f32.to_radians(), 1.0, 0.01, 100.0);
+    let view = glam::Mat4::look_at_rh(EYE, Vec3::ZERO, Vec3::Y);
+    let proj = glam::Mat4::perspective_rh(50f32.to_radians(), 1.0, 0.01, 100.0);
     let uniforms = Uniforms {
         view_proj: (proj * view).to_cols_array_2d(),
         eye: EYE.extend(0.0).to_array(),

@@ -286,9 +286,8 @@ impl View {
         let eye = centre + (n * theta.cos() + away * theta.sin()) * kind.distance() * zoom;
         let forward = (centre - eye).normalize();
         let up = forward.cross(right);
-        let view = glam::camera::rh::view::look_at_mat4(eye, centre, up);
-        let proj =
-            glam::camera::rh::proj::directx::perspective(50f32.to_radians(), aspect, 0.01, 100.0);
+        let view = glam::Mat4::look_at_rh(eye, centre, up);
+        let proj = glam::Mat4::perspective_rh(50f32.to_radians(), aspect, 0.01, 100.0);
         // A light to the side and above, low enough to cast visible self-shadows.
         let reach = if kind.is_planar() { 1.0 } else { 3.0 };
         let light_azimuth = light_azimuth_deg.to_radians();

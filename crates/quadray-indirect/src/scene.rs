@@ -45,7 +45,7 @@ impl SpotLight {
     pub fn view(&self) -> Mat4 {
         let dir = self.spot.direction.normalize();
         let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-        glam::camera::rh::view::look_to_mat4(self.position, dir, up)
+        glam::Mat4::look_to_rh(self.position, dir, up)
     }
 
     /// Far plane of the light over geometry within `bounds` (min, max): everything is closer.
@@ -58,7 +58,7 @@ impl SpotLight {
     /// `bounds`: a square perspective of twice the cone.
     pub fn view_proj(&self, bounds: (Vec3, Vec3)) -> Mat4 {
         let far = self.far(bounds);
-        glam::camera::rh::proj::directx::perspective(
+        glam::Mat4::perspective_rh(
             (2.0 * self.spot.cone_deg).to_radians(),
             1.0,
             far * 1e-3,
@@ -245,12 +245,8 @@ impl Scene {
             .position
             .distance(self.bounds().0.midpoint(self.bounds().1))
             + self.extent();
-        glam::camera::rh::proj::directx::perspective(
-            c.fov_y_deg.to_radians(),
-            aspect,
-            far * 1e-3,
-            far,
-        ) * glam::camera::rh::view::look_at_mat4(c.position, c.target, c.up)
+        glam::Mat4::perspective_rh(c.fov_y_deg.to_radians(), aspect, far * 1e-3, far)
+            * glam::Mat4::look_at_rh(c.position, c.target, c.up)
     }
 }
 
