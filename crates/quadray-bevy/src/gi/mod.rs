@@ -138,15 +138,15 @@ pub fn quadray_spot(light: &SpotLight, transform: &GlobalTransform) -> QuadraySp
     let candela = light.intensity / (4.0 * std::f32::consts::PI);
     let cone_deg = light.outer_angle.to_degrees();
     QuadraySpot {
-        position: glam::Vec3::from_array(transform.translation().to_array()),
+        position: transform.translation(),
         spot: Spot {
-            direction: glam::Vec3::from_array(transform.forward().to_array()),
+            direction: transform.forward().as_vec3(),
             cone_deg,
             falloff_deg: (light.outer_angle - light.inner_angle)
                 .to_degrees()
                 .clamp(0.0, cone_deg),
         },
-        intensity: glam::Vec3::new(colour.red, colour.green, colour.blue) * candela,
+        intensity: Vec3::new(colour.red, colour.green, colour.blue) * candela,
     }
 }
 

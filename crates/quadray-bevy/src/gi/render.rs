@@ -613,11 +613,7 @@ fn prepare_views(
         *lock(&passes.inputs) = Some(inputs);
         let clip_from_world = inputs.clip_from_world;
         let eye = view.world_from_view.translation();
-        passes.gather.set_camera(
-            &queue,
-            glam::Mat4::from_cols_array(&clip_from_world.to_cols_array()),
-            glam::Vec3::from_array(eye.to_array()),
-        );
+        passes.gather.set_camera(&queue, clip_from_world, eye);
         passes.gather.set_light(&queue, spot, gi.r_min);
         let mut uniform: Vec<f32> = clip_from_world.inverse().to_cols_array().to_vec();
         uniform.extend([eye.x, eye.y, eye.z, 1.0]);
