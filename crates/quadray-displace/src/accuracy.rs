@@ -7,7 +7,7 @@
 use crate::Settings;
 use crate::gpu::Frame;
 use crate::heightmap::HeightMap;
-use crate::primary_rays::{MIN_COSINE, PixelRay, camera_rays, ray_slope};
+use crate::primary_rays::{MIN_COSINE, PixelRay, camera_rays, camera_rays_as, ray_slope};
 use crate::pyramid::Addressing;
 use crate::reference::{Hit, Ray, Surface, intersect, intersect_all};
 use crate::scene::{SurfaceKind, View};
@@ -79,10 +79,7 @@ pub struct GroundTruth<'a> {
 impl<'a> GroundTruth<'a> {
     /// The truth of the view `s` sets up on `surface`, on the CPU's own rays.
     pub fn trace(map: &'a HeightMap, surface: SurfaceKind, s: &Settings, truth: Surface) -> Self {
-        let rays = camera_rays(surface, s)
-            .iter()
-            .map(|r| r.map(|p| p.ray))
-            .collect();
+        let rays = camera_rays_as(surface, s, |pixel| pixel.ray);
         Self {
             own_rays: true,
             ..Self::of_rays(map, surface.addressing(), truth, rays)

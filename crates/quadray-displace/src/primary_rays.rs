@@ -48,6 +48,16 @@ pub fn ray_slope(towards: DVec3, depth_scale: f64) -> DVec2 {
 /// and the renderer's discard leave it), its attributes at the exact intersection (what
 /// perspective-correct interpolation gives).
 pub fn camera_rays(kind: SurfaceKind, s: &Settings) -> Vec<Option<PixelRay>> {
+    camera_rays_as(kind, s, |ray| ray)
+}
+
+/// [`camera_rays`], keeping of each only what `keep` takes from it (the ground truth keeps the
+/// tangent-space ray alone: a third of the memory on a large frame).
+pub fn camera_rays_as<T: Send>(
+    kind: SurfaceKind,
+    s: &Settings,
+    keep: impl Fn(PixelRay) -> T + Sync,
+) -> Vec<Option<T>> {
     let view = View::of(kind, s);
     let eye = view.eye.as_dvec3();
     let vertices = kind.vertices();
@@ -74,7 +84,7 @@ pub fn camera_rays(kind: SurfaceKind, s: &Settings) -> Vec<Option<PixelRay>> {
                 p0,
                 e: ray_slope(v, depth_scale),
             };
-            PixelRay { ray, world, frame }
+            keep(PixelRay { ray, world, frame })
         })
     })
 }
