@@ -3,9 +3,10 @@
 //! against quadray's own renderer (`quadray indirect --method reference`) on the same file, the
 //! plugin's quadtree against its brute force, GI on against off in the final picture, the
 //! counts the plugin reports to Bevy's diagnostics against quadray's own, and the plugin's cut
-//! view against quadray's picture of the same cut.
+//! view against quadray's picture of the same cut; and a still camera whose G-buffer fills later.
 
 use bevy::camera::RenderTarget;
+use bevy::camera::visibility::RenderLayers;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::gltf::GltfAssetLabel;
@@ -409,4 +410,108 @@ fn misconfigured_cameras_keep_bevy_s_picture() {
         app.update();
         frames += 1;
     }
+}
+
+/// A camera and a light that stand still while Bevy's G-buffer changes under them (here the
+/// camera's render layers; in an app, a mesh uploaded or a pipeline compiled frames after the
+/// scene's triangles arrived): the bounce follows what Bevy draws, it is not the first frame's.
+#[test]
+fn a_still_camera_gathers_what_bevy_draws_later() {
+    let mut app = common::headless_app(|app| {
+        app.insert_resource(DefaultOpaqueRendererMethod::deferred())
+            .add_plugins((IndirectLightPlugin, RenderDiagnosticsPlugin))
+            .add_systems(
+                Update,
+                |mut commands: Commands, lights: Query<Entity, Added<SpotLight>>| {
+                    for light in &lights {
+                        commands.entity(light).insert(IndirectLightSource);
+                    }
+                },
+            );
+    });
+    let world = app.world_mut();
+    world.spawn(WorldAssetRoot(
+        world
+            .resource::<AssetServer>()
+            .load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
+    ));
+    const SIDE: u32 = 32;
+    let mut picture = Image::new_target_texture(SIDE, SIDE, TextureFormat::Rgba8UnormSrgb, None);
+    picture.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+    let picture = world.resource_mut::<Assets<Image>>().add(picture);
+    let mut indirect = ShaderBuffer::with_size((SIDE * SIDE * 16) as usize, default());
+    indirect.buffer_description.usage |= BufferUsages::COPY_SRC | BufferUsages::COPY_DST;
+    let indirect = world.resource_mut::<Assets<ShaderBuffer>>().add(indirect);
+    // the camera draws nothing of the scene (its meshes are on layer 0) until it is switched
+    let camera = world
+        .spawn((
+            Camera3d::default(),
+            Transform::from_translation(EYE.into()).looking_at(TARGET.into(), Vec3::Y),
+            RenderTarget::Image(picture.into()),
+            Msaa::Off,
+            RenderLayers::layer(1),
+            IndirectLight {
+                settings: Settings::sized(SIDE, SIDE, SIDE),
+                debug_indirect: Some(indirect.clone()),
+                ..default()
+            },
+        ))
+        .id();
+    let read = Arc::new(Mutex::new(None));
+    let sink = read.clone();
+    world
+        .spawn(Readback::buffer(indirect))
+        .observe(move |e: On<ReadbackComplete>| *sink.lock().unwrap() = Some(e.data.clone()));
+    let lit_pixels = || {
+        read.lock()
+            .unwrap()
+            .as_ref()
+            .map(|b: &Vec<u8>| floats(b).iter().filter(|v| v[0] > 0.0).count())
+    };
+    // until the plugin has gathered (its diagnostics hold the cut) over the empty G-buffer
+    let gathered = |app: &App| {
+        app.world()
+            .resource::<DiagnosticsStore>()
+            .iter()
+            .any(|d| d.path().as_str() == "render/quadray_gi/cut_clusters" && d.value().is_some())
+    };
+    let mut frames = 0;
+    while !gathered(&app) {
+        assert!(
+            frames < 500,
+            "the plugin gathered nothing in {frames} frames"
+        );
+        app.update();
+        frames += 1;
+    }
+    for _ in 0..3 {
+        app.update();
+        frames += 1;
+    }
+    assert_eq!(
+        lit_pixels(),
+        Some(0),
+        "the camera sees none of the scene yet"
+    );
+    app.world_mut()
+        .entity_mut(camera)
+        .insert(RenderLayers::layer(0));
+    // Bevy compiles the meshes' pipelines for this camera now: the G-buffer fills frames later
+    let switched = frames;
+    while lit_pixels().unwrap() * 4 < (SIDE * SIDE) as usize {
+        assert!(
+            frames < switched + 500,
+            "{:?} pixels lit {} frames after the camera sees the scene",
+            lit_pixels(),
+            frames - switched
+        );
+        app.update();
+        frames += 1;
+    }
+    println!(
+        "{:?} of {} pixels lit by the bounce {} frames after the camera sees the scene",
+        lit_pixels(),
+        SIDE * SIDE,
+        frames - switched
+    );
 }

@@ -27,7 +27,9 @@
 //! composite (`composite.wgsl`). The light's RSM is rasterised from the scene's triangles,
 //! gathered on the CPU from every visible `Mesh3d` with a `StandardMaterial` (its base colour;
 //! textures are not read) whenever a mesh, material or transform changes; a moving light rebuilds
-//! the RSM, the pyramid and the cut, a still light and a moving camera reuse them.
+//! the RSM, the pyramid and the cut, a still light and a moving camera reuse them. Each camera
+//! gathers every frame: Bevy's G-buffer changes without the camera moving (a mesh's pipeline
+//! compiled frames after it loaded, render layers switched).
 //!
 //! Units: the light's intensity is Bevy's (luminous power, lumens; a spot's luminous intensity
 //! is that over 4 pi, as Bevy lights it), so the indirect light is in the same units as Bevy's

@@ -25,9 +25,7 @@ use bevy::render::storage::GpuShaderBuffer;
 use bevy::render::view::{ExtractedView, ViewTarget};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 use quadray_indirect::scene::SpotLight as QuadraySpot;
-use quadray_indirect::{
-    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, RsmPass, Settings,
-};
+use quadray_indirect::{FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, RsmPass, Settings};
 use quadray_indirect::{Spot, scene::bounds_of};
 use std::num::NonZero;
 use std::sync::{Mutex, PoisonError};
@@ -267,8 +265,6 @@ struct LightPasses {
     spot: Option<Spot>,
     /// The RSM, pyramid and cut are to be recorded again (the light or the scene changed).
     stale: bool,
-    /// Counts the changes that make `stale`: a camera's last gather names the one it saw.
-    epoch: u64,
 }
 
 fn prepare_light(
@@ -311,14 +307,12 @@ fn prepare_light(
             light: None,
             spot: None,
             stale: true,
-            epoch: 0,
         });
     }
     let Some(l) = state.0.as_mut() else { return };
     if l.quadtree.cluster() != cluster {
         l.quadtree.set_cluster(&queue, cluster);
         l.stale = true;
-        l.epoch += 1;
     }
     if l.generation != scene.generation {
         l.generation = scene.generation;
@@ -349,7 +343,6 @@ fn prepare_light(
             l.rsm.set_light(&queue, spot);
         }
         l.stale = true;
-        l.epoch += 1;
     }
 }
 
@@ -376,19 +369,6 @@ pub(super) struct ViewPasses {
     /// The G-buffer translation's bind group, by the ids of Bevy's deferred and depth views it
     /// reads.
     gbuffer_group: Mutex<Option<([TextureViewId; 2], wgpu::BindGroup)>>,
-    /// What this frame's gather would see (set when preparing).
-    inputs: Mutex<Option<GatherInputs>>,
-    /// What the last gather saw: a frame that sees the same (and has no temporal filter to
-    /// feed) composites the last radiance again.
-    last_gather: Mutex<Option<GatherInputs>>,
-}
-
-/// What a gather's result depends on besides the settings.
-#[derive(Clone, Copy, PartialEq)]
-struct GatherInputs {
-    clip_from_world: Mat4,
-    light_epoch: u64,
-    method: Method,
 }
 
 impl ViewPasses {
@@ -508,8 +488,6 @@ impl ViewPasses {
             means,
             means_group,
             gbuffer_group: Mutex::new(None),
-            inputs: Mutex::new(None),
-            last_gather: Mutex::new(None),
         })
     }
 }
@@ -603,15 +581,9 @@ fn prepare_views(
             continue;
         };
         let Some(spot) = &l.spot else { continue };
-        let inputs = GatherInputs {
-            clip_from_world: view.clip_from_world.unwrap_or_else(|| {
-                view.clip_from_view * view.world_from_view.to_matrix().inverse()
-            }),
-            light_epoch: l.epoch,
-            method: gi.method,
-        };
-        *lock(&passes.inputs) = Some(inputs);
-        let clip_from_world = inputs.clip_from_world;
+        let clip_from_world = view
+            .clip_from_world
+            .unwrap_or_else(|| view.clip_from_view * view.world_from_view.to_matrix().inverse());
         let eye = view.world_from_view.translation();
         passes.gather.set_camera(&queue, clip_from_world, eye);
         passes.gather.set_light(&queue, spot, gi.r_min);
@@ -715,34 +687,31 @@ fn indirect_light_pass(
         l.stale = false;
         span.end(encoder);
     }
-    let inputs = *lock(&passes.inputs);
-    let mut last = lock(&passes.last_gather);
-    if *last != inputs || passes.settings.temporal_weight < 1.0 {
-        *last = inputs;
-        let span = diagnostics.time_span(encoder, "gather");
-        let size = passes.settings.size;
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("quadray gi gbuffer"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(translate);
-            pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(size.width.div_ceil(8), size.height.div_ceil(8), 1);
-        }
-        passes
-            .gather
-            .record_indirect(encoder, gi.method, &l.quadtree, None);
-        span.end(encoder);
-        if diagnostics.is_some() {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("quadray gi counts"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipelines.counts);
-            pass.set_bind_group(0, &passes.means_group, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
-        }
+    // gathered every frame: Bevy's G-buffer can change while the camera and the light stand still
+    // (a mesh uploaded or a pipeline compiled frames after the scene's triangles arrived)
+    let span = diagnostics.time_span(encoder, "gather");
+    let size = passes.settings.size;
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("quadray gi gbuffer"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(translate);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(size.width.div_ceil(8), size.height.div_ceil(8), 1);
+    }
+    passes
+        .gather
+        .record_indirect(encoder, gi.method, &l.quadtree, None);
+    span.end(encoder);
+    if diagnostics.is_some() {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("quadray gi counts"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&pipelines.counts);
+        pass.set_bind_group(0, &passes.means_group, &[]);
+        pass.dispatch_workgroups(1, 1, 1);
     }
     if let Some(debug) = gi.debug_indirect.as_ref().and_then(|h| buffers.get(h)) {
         let indirect = passes.gather.indirect();
