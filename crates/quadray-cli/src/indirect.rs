@@ -15,10 +15,11 @@ pub struct IndirectArgs {
     /// Scene file: TOML, or glTF 2.0 (.gltf, .glb); default: the bundled Cornell box.
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// quadtree (compacted cut), quadtree-passes (the paper's per-level passes), quadtree-tiles
-    /// (a cut per 8x8 tile, refined where a cluster's bound exceeds --tile-error of the
-    /// tile's light), rsm (RSM sampling) or reference (every VPL).
-    #[arg(long, default_value_t = Method::Quadtree)]
+    /// quadtree-tiles (a cut per 8x8 tile, refined where a cluster's estimated error exceeds
+    /// --tile-error of the tile's light), quadtree (the paper's cut, compacted once),
+    /// quadtree-passes (the paper's per-level passes), rsm (RSM sampling) or reference (every
+    /// VPL).
+    #[arg(long, default_value_t = Method::DEFAULT)]
     method: Method,
     #[command(flatten)]
     settings: Settings,
@@ -295,7 +296,7 @@ mod tests {
     fn the_flags_defaults_are_the_settings_defaults() {
         let cli = Cli::try_parse_from(["indirect", "--out=o.png"]).unwrap();
         assert_eq!(cli.args.settings, Settings::DEFAULT);
-        assert_eq!(cli.args.method, Method::Quadtree);
+        assert_eq!(cli.args.method, Method::DEFAULT);
     }
 
     /// The flags refuse what `validate()` refuses, with the same limits.

@@ -123,7 +123,7 @@ fn gi_gbuffer_draws_what_quadray_indirect_draws() {
             "1",
         ],
         &dir,
-        "quadtree",
+        "default-method",
     );
     let flip = mean_flip(&cli, &example);
     let close = cli
@@ -144,7 +144,7 @@ fn gi_gbuffer_draws_what_quadray_indirect_draws() {
         w * h
     );
     // The direct light alone, which the command writes beside its picture.
-    let direct = load_png(&dir.join("quadtree.direct.png"));
+    let direct = load_png(&dir.join("default-method.direct.png"));
     let without_bounce = mean_flip(&direct, &example);
     assert!(
         without_bounce > 0.02,

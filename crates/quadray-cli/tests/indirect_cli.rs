@@ -79,6 +79,10 @@ fn per_tile_cuts_report_their_bounds_and_clusters() {
             "indirect",
             "--method",
             "quadtree-tiles",
+            "--tile-criterion",
+            "bound",
+            "--tile-share",
+            "0",
             "--tile-error",
             "0.1",
             "--rsm-size",
@@ -107,16 +111,10 @@ fn per_tile_cuts_report_their_bounds_and_clusters() {
     let rel_l1 = json["error"]["rel_l1"].as_f64().unwrap();
     assert!(rel_l1 > 0.0 && rel_l1 < 0.05, "{rel_l1}");
 
-    // the estimate criterion, at its own default error, with receiver sharing
+    // the default method: the estimate criterion at its own default error, with receiver sharing
     quadray_writes(
         &[
             "indirect",
-            "--method",
-            "quadtree-tiles",
-            "--tile-criterion",
-            "estimate",
-            "--tile-share",
-            "2",
             "--rsm-size",
             "32",
             "--size",
@@ -129,6 +127,7 @@ fn per_tile_cuts_report_their_bounds_and_clusters() {
         &stats,
     );
     let json = read_json(&stats);
+    assert_eq!(json["method"], "quadtree-tiles");
     assert_eq!(json["settings"]["tile_criterion"], "estimate");
     assert_eq!(json["settings"]["tile_share"].as_f64(), Some(2.0));
     let tile_error = json["settings"]["tile_error"].as_f64().unwrap();
@@ -190,8 +189,11 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     let dir = scratch("indirect-view");
     let render = |name: &str, extra: &[&str]| {
         let out = dir.join(name);
+        // the one cut: the method with a cut to draw
         let mut args = vec![
             "indirect",
+            "--method",
+            "quadtree",
             "--rsm-size",
             "32",
             "--size",
@@ -225,11 +227,13 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     assert_eq!((cut.width(), cut.height()), (512, 512));
 }
 
-/// The temporal tests' sequence: `scene` 64x64 with a 128^2 RSM, 10 frames, the light turning
-/// 1 degree a frame.
-fn orbit_args(scene: &str) -> [&str; 11] {
+/// The temporal tests' sequence: the one cut (whose popping the filter is for) on `scene` 64x64
+/// with a 128^2 RSM, 10 frames, the light turning 1 degree a frame.
+fn orbit_args(scene: &str) -> [&str; 13] {
     [
         "indirect",
+        "--method",
+        "quadtree",
         "--scene",
         scene,
         "--rsm-size",

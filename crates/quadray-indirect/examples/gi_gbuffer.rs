@@ -248,7 +248,7 @@ pub fn render(
     rsm.record(&mut encoder, vertices.slice(..), vertex_count, None);
     quadtree.record_build(&mut encoder, None);
     quadtree.record_cut(&mut encoder, None);
-    gather.record_indirect(&mut encoder, Method::Quadtree, &quadtree, None);
+    gather.record_indirect(&mut encoder, Method::DEFAULT, &quadtree, None);
     gather.record_direct(&mut encoder, None);
     output_pass.record(
         device,

@@ -23,6 +23,9 @@ fn settings() -> Settings {
             ..ClusterSettings::DEFAULT
         },
         samples: 48,
+        // the per-tile cuts' refinement and gather as the CPU recounts them: every pixel
+        // evaluates its tile's list (no far clusters shared at the corners)
+        tile_share: 0.0,
         ..Settings::default()
     }
 }

@@ -58,8 +58,8 @@ pub struct Args {
     /// An indirect-light scene file of your own (shown beside the bundled ones).
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// Indirect light: quadtree, quadtree-passes, quadtree-tiles, rsm or reference.
-    #[arg(long, default_value = "quadtree")]
+    /// Indirect light: quadtree-tiles, quadtree, quadtree-passes, rsm or reference.
+    #[arg(long, default_value_t = quadray_indirect::Method::DEFAULT)]
     indirect_method: quadray_indirect::Method,
     /// Indirect light: what the view shows.
     #[arg(long, value_enum, default_value = "combined")]

@@ -1,7 +1,7 @@
 //! One bounce of indirect light in a Bevy app: the bundled Cornell box glTF
 //! (`assets/scenes/cornell_spot.gltf`) loaded by Bevy's glTF loader, its spot light turning
 //! slowly, Bevy's direct light and shadows as they are, and quadray's light quadtree adding the
-//! bounce. G turns the bounce on and off; M cycles the method (the quadtree's cut, per-tile cuts,
+//! bounce. G turns the bounce on and off; M cycles the method (per-tile cuts, the quadtree's one cut,
 //! RSM sampling, every VPL); C shows the light quadtree's cut over the RSM in the top-left corner;
 //! Space stops and restarts the light. The window's title says what is shown.
 //!
@@ -31,8 +31,8 @@ use quadray_indirect::{Method, Settings};
 const SCENE: &str = "scenes/cornell_spot.gltf";
 /// The methods M cycles through.
 const METHODS: [Method; 4] = [
-    Method::Quadtree,
     Method::QuadtreeTiles,
+    Method::Quadtree,
     Method::Rsm,
     Method::Reference,
 ];
@@ -58,7 +58,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let value = |flag: &str| flag_value(&args, flag);
     let method = match value("--method").map(|m| m.parse::<Method>()) {
-        None => Method::Quadtree,
+        None => Method::DEFAULT,
         Some(Ok(m)) => m,
         Some(Err(e)) => {
             eprintln!("--method: {e}");

@@ -88,8 +88,8 @@ pub struct IndirectLight {
     /// cuts, indirect shadows, temporal weight, ...); `size` is ignored: the gather runs at the
     /// camera's size.
     pub settings: Settings,
-    /// How the indirect light is gathered: the quadtree's cut (default), per-tile cuts, the
-    /// paper's per-level passes, RSM sampling, or every VPL (the brute force).
+    /// How the indirect light is gathered: per-tile cuts ([`Method::DEFAULT`]), the quadtree's
+    /// one cut, the paper's per-level passes, RSM sampling, or every VPL (the brute force).
     pub method: Method,
     /// Clamp of the VPL kernel's distance (world units): 1/r^4 is taken at no less than this.
     pub r_min: f32,
@@ -109,7 +109,7 @@ impl Default for IndirectLight {
     fn default() -> Self {
         Self {
             settings: Settings::DEFAULT,
-            method: Method::Quadtree,
+            method: Method::DEFAULT,
             r_min: quadray_indirect::scene::DEFAULT_R_MIN,
             enabled: true,
             cut_view: false,

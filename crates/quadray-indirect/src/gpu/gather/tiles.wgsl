@@ -254,7 +254,10 @@ fn indirect_tiles(
     }
     let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
     if (workgroupUniformLoad(&reduce_n[0]).w == 0.0) {
-        // nothing to light
+        // nothing to light: no light either (the last frame's may be there)
+        if (inside) {
+            add_indirect(pixel_index(id.xy), vec4<f32>(0.0));
+        }
         if (local == 0u) {
             tile_sizes[tile] = vec4<u32>(0u);
         }
