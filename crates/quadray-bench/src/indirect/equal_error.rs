@@ -39,6 +39,17 @@ const ESTIMATE_ERRORS: [f32; 6] = [0.01, 0.002, 0.0005, 0.0002, 0.0001, 0.00005]
 /// Receiver sharing of the per-tile cuts split by the estimated error (`Settings::tile_share`,
 /// 0: off): clusters farther than this many tile extents are gathered at the tile's corners.
 const TILE_SHARES: [f32; 3] = [0.0, 2.0, 3.0];
+/// The label of the one cut at its default thresholds (the paper's method, quadray's default
+/// until the per-tile cuts won at equal error).
+const ONE_CUT: &str = "one-cut";
+
+/// The label of [`Method::DEFAULT`] at [`Settings::DEFAULT`] among the per-tile cuts' rows (the
+/// sweep holds its criterion, error and sharing).
+fn default_label() -> String {
+    let s = Settings::DEFAULT;
+    let family = tile_family(s.tile_criterion, s.tile_share);
+    format!("{family} {}", s.tile_error_or_default())
+}
 /// RSM sample counts swept, up to where sampling reaches the quadtree's error.
 const SAMPLES: [u32; 10] = [16, 64, 216, 512, 1024, 2040, 4096, 8192, 16384, 32768];
 
@@ -74,7 +85,7 @@ impl EqualErrorOptions {
 /// One method at one setting: its error and its cost.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
-    /// The method's setting ("default", "paper", "tiles E", "estimate E", "estimate+shareF E",
+    /// The method's setting ("one-cut", "paper", "tiles E", "estimate E", "estimate+shareF E",
     /// "N samples").
     pub label: String,
     /// One gather per `subsample`^2 pixels (1: full resolution).
@@ -251,7 +262,7 @@ fn scene_result(
             },
         )?;
         for (label, cluster) in [
-            ("default", ClusterSettings::DEFAULT),
+            (ONE_CUT, ClusterSettings::DEFAULT),
             ("paper", ClusterSettings::with_limit_side(base.rsm_size, 32)),
         ] {
             progress(&format!("{name}: quadtree {label}, subsample {subsample}"));
@@ -373,6 +384,46 @@ fn fixed(v: Option<f64>, digits: usize) -> String {
 }
 
 fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), IndirectError> {
+    // what a user gets without choosing, and the paper's one cut, against RSM sampling
+    let default = default_label();
+    let mut defaults = Table::new(
+        format!(
+            "The default method ({}, {default}) and the one cut against RSM sampling at equal \
+             error, full resolution",
+            Method::DEFAULT
+        ),
+        &[
+            "scene",
+            "RSM",
+            "method",
+            "rel L1",
+            "evals/px",
+            "RSM samples at that error",
+            "evals ratio",
+            "time ratio",
+        ],
+    );
+    for s in &results.scenes {
+        for (name, label) in [("default", default.as_str()), (ONE_CUT, ONE_CUT)] {
+            let found = s
+                .comparisons
+                .iter()
+                .find(|c| c.quadtree.label == label && c.quadtree.subsample == 1);
+            if let Some(c) = found {
+                let (q, full) = (&c.quadtree, &c.full_resolution);
+                defaults.row(vec![
+                    s.scene.clone(),
+                    format!("{}^2", s.rsm_size),
+                    name.into(),
+                    format!("{:.4}", q.rel_l1),
+                    format!("{:.1}", q.vpl_evaluations_per_pixel),
+                    fixed(full.rsm_samples, 0),
+                    fixed(full.evaluation_ratio, 2),
+                    fixed(full.time_ratio, 2),
+                ]);
+            }
+        }
+    }
     let mut table = Table::new(
         format!(
             "Quadtree vs RSM sampling at equal error, {0}x{0} image ({1}, {2} frames per median)",
@@ -450,7 +501,12 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             ]);
         }
     }
-    let md = format!("{}\n{}", table.to_markdown(), sweep.to_markdown());
+    let md = format!(
+        "{}\n{}\n{}",
+        defaults.to_markdown(),
+        table.to_markdown(),
+        sweep.to_markdown()
+    );
     write_text(&out.join("equal_error.md"), &md)?;
     write_json(&out.join("equal_error.json"), results)?;
     let mut series = Vec::new();
@@ -473,7 +529,7 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
                         .iter()
                         .map(|c| &c.quadtree)
                         .filter(at)
-                        // the one cut ("default", "paper"); the per-tile cuts follow
+                        // the one cut (`ONE_CUT`, "paper"); the per-tile cuts follow
                         .filter(|p| !p.label.contains(' ')),
                 ),
             });
@@ -521,7 +577,17 @@ fn tile_family(criterion: TileCriterion, share: f32) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::at_error;
+    use super::*;
+
+    #[test]
+    fn the_sweep_measures_the_default_method() {
+        let s = Settings::DEFAULT;
+        assert_eq!(Method::DEFAULT, Method::QuadtreeTiles);
+        assert_eq!(s.tile_criterion, TileCriterion::Estimate);
+        assert!(TILE_SHARES.contains(&s.tile_share));
+        assert!(ESTIMATE_ERRORS.contains(&s.tile_error_or_default()));
+        assert_eq!(default_label(), "estimate+share2 0.002");
+    }
 
     #[test]
     fn a_value_at_an_error_is_interpolated_log_log_between_the_bracketing_points() {
