@@ -91,6 +91,15 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     scene
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;
+    // a flag that would change nothing is a mistake to report, not to ignore
+    if args.settings.subsample > 1 && !args.method.subsamples() {
+        anyhow::bail!(
+            "--subsample {} applies to --method quadtree and rsm (the methods that gather at low \
+             resolution), not {}",
+            args.settings.subsample,
+            args.method
+        );
+    }
     for (flag, orbit) in [
         ("--light-orbit", args.light_orbit),
         ("--camera-orbit", args.camera_orbit),

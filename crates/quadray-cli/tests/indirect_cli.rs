@@ -142,7 +142,7 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
     let out = dir.join("x.png");
     let scene = dir.join("bad.toml");
     std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();
-    let cases: [(Vec<&str>, &str); 12] = [
+    let cases: [(Vec<&str>, &str); 13] = [
         (vec!["--scene", scene.to_str().unwrap()], "bad.toml"),
         (vec!["--scene", "/nonexistent/scene.toml"], "scene.toml"),
         (vec!["--rsm-size", "100"], "power of two"),
@@ -163,6 +163,11 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         (
             vec!["--tile-share=-2"],
             "--tile-share <TILE_SHARE>': -2 is outside",
+        ),
+        // the default method (per-tile cuts) gathers every pixel
+        (
+            vec!["--subsample", "2"],
+            "--subsample 2 applies to --method quadtree and rsm",
         ),
     ];
     for (extra, needle) in cases {

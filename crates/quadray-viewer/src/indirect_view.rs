@@ -286,6 +286,20 @@ impl IndirectView {
         }))
     }
 
+    /// The settings the picture is drawn with: sub-sampling only where the method sub-samples
+    /// (the slider keeps its value for the methods that do; `quadray indirect` refuses it for
+    /// the others).
+    fn shown_settings(&self) -> Settings {
+        Settings {
+            subsample: if self.method.subsamples() {
+                self.settings.subsample
+            } else {
+                1
+            },
+            ..self.settings.clone()
+        }
+    }
+
     /// The `quadray indirect` command that renders this view headless.
     pub fn command_line(&self, out: &Path) -> Option<String> {
         let (index, base, pose) = self.loaded.as_ref()?;
@@ -297,7 +311,7 @@ impl IndirectView {
             format!("--method {}", self.method),
         ]
         .into_iter()
-        .chain(self.settings.to_args())
+        .chain(self.shown_settings().to_args())
         .chain([
             format!("--exposure {}", self.exposure),
             format!("--camera-position {}", v(scene.camera.position.to_array())),
@@ -395,7 +409,10 @@ impl IndirectView {
                 .logarithmic(true)
                 .text("RSM samples"),
         );
-        ui.add(egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling"));
+        ui.add_enabled(
+            self.method.subsamples(),
+            egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling (quadtree, rsm)"),
+        );
         let criterion = s.tile_criterion;
         choice_box(
             ui,
