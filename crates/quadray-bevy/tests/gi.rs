@@ -49,11 +49,12 @@ struct Probe {
 struct Probes(Vec<Probe>);
 
 /// Method, bounce on, cut view on.
-const CASES: [(Method, bool, bool); 4] = [
+const CASES: [(Method, bool, bool); 5] = [
     (Method::Reference, true, false),
     (Method::Quadtree, true, false),
     (Method::Quadtree, false, false),
     (Method::Quadtree, true, true),
+    (Method::DEFAULT, true, false),
 ];
 
 fn setup(
@@ -216,6 +217,7 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
     };
     let reference_frame = renderer.render_frame(Method::Reference).unwrap();
     let quadtree_frame = renderer.render_frame(Method::Quadtree).unwrap();
+    let default_frame = renderer.render_frame(Method::DEFAULT).unwrap();
     let clusters = renderer.clusters_in_cut().unwrap();
     let reference = in_candela(reference_frame.indirect);
     let quadtree = in_candela(quadtree_frame.indirect);
@@ -258,6 +260,17 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
     let quadray_error = compare(&quadtree, &reference).rel_l1;
     let plugin_error = compare(&indirect[1], &indirect[0]).rel_l1;
     println!("quadtree against brute force: plugin {plugin_error:.4}, quadray {quadray_error:.4}");
+    assert!(
+        plugin_error <= 1.5 * quadray_error.max(1e-3),
+        "{plugin_error} vs {quadray_error}"
+    );
+    // the same for the default method (the per-tile cuts), which each camera refines over its
+    // own G-buffer
+    let quadray_error = compare(&in_candela(default_frame.indirect), &reference).rel_l1;
+    let plugin_error = compare(&indirect[4], &indirect[0]).rel_l1;
+    println!(
+        "default method against brute force: plugin {plugin_error:.4}, quadray {quadray_error:.4}"
+    );
     assert!(
         plugin_error <= 1.5 * quadray_error.max(1e-3),
         "{plugin_error} vs {quadray_error}"
