@@ -8,7 +8,7 @@ use quadray_gpu::Gpu;
 use quadray_indirect::picture::{cut_view, cut_view_zoom, tone_map};
 use quadray_indirect::reference::{compare, error_map, ground_truth};
 use quadray_indirect::scene::scenes_dir;
-use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings, TileCriterion};
+use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
 use std::path::{Path, PathBuf};
 
 const EXPOSURE: f32 = 1.0;
@@ -161,17 +161,13 @@ pub fn render_demo(
 /// marching from the tiles' corners, with the latter's error against the ground truth.
 fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join("leak.toml"))?;
-    let plain = Settings::sized(size, size, 32);
-    let tiled = Settings {
-        tile_criterion: TileCriterion::Estimate,
-        tile_share: 2.0,
-        ..plain.clone()
-    };
+    // the defaults: the per-tile cuts with the estimate and far clusters shared
+    let settings = Settings::sized(size, size, 32);
     // (a frame first: it renders the RSM and the G-buffer the ground truth reads)
-    let mut r = Renderer::new(gpu, &scene, plain.clone())?;
+    let mut r = Renderer::new(gpu, &scene, settings.clone())?;
     r.render_frame(Method::Quadtree)?;
     let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
-    let indirect = |settings: &Settings, method, indirect_shadows| {
+    let indirect = |method, indirect_shadows| {
         let settings = Settings {
             indirect_shadows,
             ..settings.clone()
@@ -184,17 +180,14 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
     };
     // (short captions: the demo's smallest pictures are 128 pixels wide)
     let rows = [
-        ("one cut", &plain, Method::Quadtree),
-        ("tiles", &tiled, Method::QuadtreeTiles),
+        ("one cut", Method::Quadtree),
+        ("tiles", Method::QuadtreeTiles),
     ];
     let tile = |v: &[[f32; 3]]| tone_map(size, size, v, EXPOSURE);
     let l1 = |v: &[[f32; 3]]| compare(v, &truth).rel_l1;
     let mut pictures = Vec::new();
-    for (name, settings, method) in rows {
-        let (leaky, shadowed) = (
-            indirect(settings, method, false)?,
-            indirect(settings, method, true)?,
-        );
+    for (name, method) in rows {
+        let (leaky, shadowed) = (indirect(method, false)?, indirect(method, true)?);
         pictures.push((format!("{name}, L1 {:.2}", l1(&leaky)), tile(&leaky)));
         pictures.push((format!("shadows, L1 {:.2}", l1(&shadowed)), tile(&shadowed)));
         if method == Method::Quadtree {
