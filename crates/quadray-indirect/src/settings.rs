@@ -70,6 +70,19 @@ impl Method {
         matches!(self, Method::Quadtree | Method::Rsm)
     }
 
+    /// A [`Settings::temporal_weight`] for the method's frames under a moving light and camera:
+    /// on the Cornell box and the atrium at 1 degree a frame it brings the image's frame-to-frame
+    /// change to the brute force's or below, for at most 15% more error against each frame's
+    /// brute force (BENCHMARKS.md, "A moving light", "Light and camera moving"). The per-tile
+    /// cuts pop less, so a lighter average does (0.5: error 1.00-1.09x); the one cut needs 0.33
+    /// (at 0.5 its flicker ratio stays at 1.3-1.5).
+    pub fn moving_light_temporal_weight(self) -> f32 {
+        match self {
+            Method::QuadtreeTiles => 0.5,
+            _ => 0.33,
+        }
+    }
+
     /// Whether the method uses the one cut of the light quadtree (so a cluster count means
     /// something for it).
     pub fn uses_quadtree(self) -> bool {
@@ -583,12 +596,6 @@ impl Settings {
             .find(|&level| (self.rsm_size >> level).pow(2) <= capacity)
             .unwrap_or(top)
     }
-
-    /// A [`Settings::temporal_weight`] for a moving light: on the Cornell box and the atrium at
-    /// 1 degree a frame it brings the image's frame-to-frame change down to the brute force's,
-    /// for a few percent more error against each frame's brute force, also with the camera
-    /// moving (BENCHMARKS.md, "A moving light").
-    pub const MOVING_LIGHT_TEMPORAL_WEIGHT: f32 = 0.33;
 
     /// Refuses sizes and parameters that would make no picture or an absurd amount of work.
     pub fn validate(&self) -> Result<(), String> {

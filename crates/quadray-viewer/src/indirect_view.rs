@@ -444,7 +444,7 @@ impl IndirectView {
         let mut temporal = s.temporal_weight < 1.0;
         ui.checkbox(&mut temporal, "temporal filter (reprojected)");
         s.temporal_weight = if temporal {
-            Settings::MOVING_LIGHT_TEMPORAL_WEIGHT
+            self.method.moving_light_temporal_weight()
         } else {
             1.0
         };
