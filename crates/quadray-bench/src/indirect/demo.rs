@@ -1,5 +1,5 @@
-//! The pictures of `quadray demo`: direct, indirect and combined light on the Cornell box with the
-//! brute force and the error heat map beside them; the paper's figure 9 (quadtree against RSM
+//! The pictures of `quadray demo`: direct, indirect (the default method) and combined light on the
+//! Cornell box with the brute force, the error heat map and the paper's one cut beside them; the paper's figure 9 (quadtree against RSM
 //! sampling at equal time and at 2040 samples, and the per-tile cuts); the atrium; the leak scene with and without
 //! indirect shadows beside the ground truth with visibility.
 
@@ -43,21 +43,27 @@ pub fn render_demo(
     let quadtree_ms = r.time(Method::Quadtree, false, FRAMES)?.map(|t| t.total_ms);
     let frame = r.render_frame(Method::Quadtree)?;
     let clusters = r.clusters_in_cut()?;
-    let combined = frame.combined();
     let e = compare(&frame.indirect, &brute);
+    // what a user gets: the default method, beside the paper's one cut
+    let default_frame = r.render_frame(Method::DEFAULT)?;
+    let default_error = compare(&default_frame.indirect, &brute);
     let tile = |v: &[[f32; 3]]| tone_map(size, size, v, EXPOSURE);
     let picture = montage(
         &[
-            ("direct".into(), tile(&frame.direct)),
+            ("direct".into(), tile(&default_frame.direct)),
             (
-                format!("indirect, {clusters} clusters"),
-                tile(&frame.indirect),
+                format!("indirect, {}", Method::DEFAULT),
+                tile(&default_frame.indirect),
             ),
-            ("combined".into(), tile(&combined)),
+            ("combined".into(), tile(&default_frame.combined())),
             ("brute force indirect".into(), tile(&brute)),
             (
-                format!("error (white 50%), L1 {:.3}", e.rel_l1),
-                heat_map(size, size, &error_map(&frame.indirect, &brute), 0.5),
+                format!("error (white 50%), L1 {:.3}", default_error.rel_l1),
+                heat_map(size, size, &error_map(&default_frame.indirect, &brute), 0.5),
+            ),
+            (
+                format!("one cut, {clusters} clusters, L1 {:.3}", e.rel_l1),
+                tile(&frame.indirect),
             ),
         ],
         3,
@@ -136,7 +142,7 @@ pub fn render_demo(
     let atrium = Scene::load(&scenes_dir().join("atrium.toml"))?;
     let (w, h) = (size * 16 / 9, size);
     let mut r = Renderer::new(gpu, &atrium, settings(gpu, w, h, 256))?;
-    let frame = r.render_frame(Method::Quadtree)?;
+    let frame = r.render_frame(Method::DEFAULT)?;
     let combined = frame.combined();
     let pictures = montage(
         &[
