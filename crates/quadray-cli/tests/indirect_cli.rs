@@ -230,6 +230,25 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     assert_ne!(base, moved);
     let cut = image::open(dir.join("base.cut.png")).unwrap();
     assert_eq!((cut.width(), cut.height()), (512, 512));
+    // the default method, the per-tile cuts: the list of the tile at the picture's centre, as
+    // the library draws it for the same frame (and not the one cut)
+    let tiles = dir.join("tiles.png");
+    let size = ["--rsm-size", "32", "--size", "48x48", "--frames", "1"];
+    quadray_ok(&[&["indirect", "--out", tiles.to_str().unwrap()], &size[..]].concat());
+    let drawn = image::open(dir.join("tiles.cut.png")).unwrap().to_rgba8();
+    let gpu = quadray_gpu::Gpu::new().expect("a GPU adapter");
+    let settings = quadray_indirect::Settings::sized(48, 48, 32);
+    let mut r =
+        quadray_indirect::Renderer::new(&gpu, &quadray_indirect::Scene::cornell(), settings)
+            .unwrap();
+    r.render_frame(quadray_indirect::Method::DEFAULT).unwrap();
+    let centre = r.read_tile_cut_at(24, 24).unwrap();
+    assert!(!centre.is_empty());
+    let expected = quadray_indirect::picture::renderer_cut_view(&r, &centre).unwrap();
+    let pixels: Vec<u8> = expected.pixels.concat();
+    assert!(drawn.as_raw() == &pixels, "the centre tile's cut differs");
+    assert_ne!(drawn.as_raw(), &cut.to_rgba8().into_raw());
+    assert!(r.read_tile_cut_at(48, 0).is_err());
 }
 
 /// The temporal tests' sequence: the one cut (whose popping the filter is for) on `scene` 64x64

@@ -207,8 +207,8 @@ impl State {
                     } else {
                         ui.label(format!("GPU n/a  frame {frame_ms:.1} ms"));
                     }
-                    if let Some(n) = view.clusters {
-                        ui.label(format!("{n} clusters in the cut"));
+                    if let Some(summary) = &view.cut_summary {
+                        ui.label(summary);
                     }
                     if let Some(e) = &view.error {
                         ui.colored_label(egui::Color32::LIGHT_RED, e);

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{cut_view, cut_view_zoom, tone_map};
+use quadray_indirect::picture::{renderer_cut_view, tone_map};
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
 use quadray_indirect::{FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity};
 use std::path::{Path, PathBuf};
@@ -128,7 +128,7 @@ pub struct IndirectView {
     picture: Option<Rgba8Image>,
     texture: Option<egui::TextureHandle>,
     pub timing: Option<FrameTiming>,
-    pub clusters: Option<u32>,
+    pub cut_summary: Option<String>,
     pub error: Option<String>,
 }
 
@@ -173,7 +173,7 @@ impl IndirectView {
             picture: None,
             texture: None,
             timing: None,
-            clusters: None,
+            cut_summary: None,
             error: None,
         }
     }
@@ -255,20 +255,21 @@ impl IndirectView {
         self.timing = renderer.time(self.method, self.rebuild, 1)?;
         self.redraw = false;
         self.rebuild = false;
-        let (w, h, rsm_size) = (
-            self.settings.size.width,
-            self.settings.size.height,
-            self.settings.rsm_size,
-        );
+        let (w, h) = (self.settings.size.width, self.settings.size.height);
         let frame = renderer.read_frame()?;
-        self.clusters = None;
-        let cut = if self.method == Method::Quadtree || self.show == Show::Cut {
+        self.cut_summary = None;
+        let cut = if self.show == Show::Cut && self.method == Method::QuadtreeTiles {
+            // the per-tile cuts: the list of the tile at the centre of the view
+            let cut = renderer.read_tile_cut_at(w / 2, h / 2)?;
+            self.cut_summary = Some(format!("{} clusters in the centre tile's cut", cut.len()));
+            Some(cut)
+        } else if self.method == Method::Quadtree || self.show == Show::Cut {
             // the other methods do not store the cut (the per-level passes select the same set)
             if self.method != Method::Quadtree {
                 renderer.build_cut()?;
             }
             let cut = renderer.read_cut()?;
-            self.clusters = Some(cut.len() as u32);
+            self.cut_summary = Some(format!("{} clusters in the cut", cut.len()));
             Some(cut)
         } else {
             None
@@ -277,12 +278,7 @@ impl IndirectView {
             Show::Combined => tone_map(w, h, &frame.combined(), self.exposure),
             Show::Direct => tone_map(w, h, &frame.direct, self.exposure),
             Show::Indirect => tone_map(w, h, &frame.indirect, self.exposure),
-            Show::Cut => cut_view(
-                rsm_size,
-                &renderer.read_nodes()?,
-                cut.as_deref().unwrap_or_default(),
-                cut_view_zoom(rsm_size),
-            ),
+            Show::Cut => renderer_cut_view(renderer, cut.as_deref().unwrap_or_default())?,
         }))
     }
 

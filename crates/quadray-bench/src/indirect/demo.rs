@@ -1,11 +1,12 @@
 //! The pictures of `quadray demo`: direct, indirect (the default method) and combined light on the
-//! Cornell box with the brute force, the error heat map and the paper's one cut beside them; the paper's figure 9 (quadtree against RSM
+//! Cornell box with the brute force, the error heat map and the paper's one cut beside them; the
+//! one cut and the centre tile's per-tile cut over the RSM; the paper's figure 9 (quadtree against RSM
 //! sampling at equal time and at 2040 samples, and the per-tile cuts); the atrium; the leak scene with and without
 //! indirect shadows beside the ground truth with visibility.
 
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{cut_view, cut_view_zoom, tone_map};
+use quadray_indirect::picture::{renderer_cut_view, tone_map};
 use quadray_indirect::reference::{compare, error_map, ground_truth};
 use quadray_indirect::scene::scenes_dir;
 use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
@@ -43,6 +44,7 @@ pub fn render_demo(
     let quadtree_ms = r.time(Method::Quadtree, false, FRAMES)?.map(|t| t.total_ms);
     let frame = r.render_frame(Method::Quadtree)?;
     let clusters = r.clusters_in_cut()?;
+    let one_cut = renderer_cut_view(&r, &r.read_cut()?)?;
     let e = compare(&frame.indirect, &brute);
     // what a user gets: the default method, beside the paper's one cut
     let default_frame = r.render_frame(Method::DEFAULT)?;
@@ -69,25 +71,27 @@ pub fn render_demo(
         3,
     );
     files.push(save(&picture, &out.join("cornell.png"))?);
-    let rsm_size = r.settings().rsm_size;
-    let cut = cut_view(
-        rsm_size,
-        &r.read_nodes()?,
-        &r.read_cut()?,
-        cut_view_zoom(rsm_size),
-    );
-    let cut_picture = montage(
-        &[(format!("the cut over the RSM: {clusters} clusters"), cut)],
-        1,
-    );
-    files.push(save(&cut_picture, &out.join("cornell_cut.png"))?);
-
     progress("figure 9: RSM sampling at equal time, and per-tile cuts");
     r.render(Method::QuadtreeTiles, true, false)?;
     let per_tile_ms = r
         .time(Method::QuadtreeTiles, false, FRAMES)?
         .map(|t| t.total_ms);
     let per_tile = r.read_frame()?.indirect;
+    let centre = r.read_tile_cut_at(size / 2, size / 2)?;
+    let cut_picture = montage(
+        &[
+            (
+                format!("the one cut over the RSM: {clusters} clusters"),
+                one_cut,
+            ),
+            (
+                format!("per-tile cuts, centre tile: {} clusters", centre.len()),
+                renderer_cut_view(&r, &centre)?,
+            ),
+        ],
+        2,
+    );
+    files.push(save(&cut_picture, &out.join("cornell_cut.png"))?);
     let mut tiles: Vec<(String, Rgba8Image)> = vec![
         (
             format!("quadtree{} L1 {:.3}", caption_ms(quadtree_ms), e.rel_l1),

@@ -5,7 +5,7 @@
 use super::temporal::{self, Temporal};
 use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{TONE_MAP_WHITE, cut_view, cut_view_zoom, flip_against, tone_map};
+use quadray_indirect::picture::{TONE_MAP_WHITE, flip_against, renderer_cut_view, tone_map};
 use quadray_indirect::reference::{self, ImageError};
 use quadray_indirect::{FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts};
 use serde::Serialize;
@@ -106,7 +106,8 @@ pub struct Outcome {
     pub combined: Rgba8Image,
     /// Per-pixel |error| / mean reference radiance, black 0 to white 0.5.
     pub error_map: Option<Rgba8Image>,
-    /// The cut over the RSM (quadtree methods), see [`cut_view`].
+    /// The cut over the RSM (see [`quadray_indirect::picture::cut_view`]): the one cut's
+    /// (quadtree methods), or the per-tile cuts' list of the tile at the picture's centre.
     pub cut_view: Option<Rgba8Image>,
     /// The ground truth's indirect light (with `ground_truth`).
     pub ground_truth: Option<Rgba8Image>,
@@ -132,17 +133,13 @@ pub fn run(
         None
     };
     // The compacted cut's size is the size of the set both quadtree methods use.
-    let (clusters_in_cut, cut) = if method.uses_quadtree() {
+    let (clusters_in_cut, mut cut) = if method.uses_quadtree() {
         renderer.render(Method::Quadtree, true, false)?;
         let cut = renderer.read_cut()?;
-        let rsm_size = renderer.settings().rsm_size;
-        let picture = cut_view(
-            rsm_size,
-            &renderer.read_nodes()?,
-            &cut,
-            cut_view_zoom(rsm_size),
-        );
-        (Some(cut.len() as u32), Some(picture))
+        (
+            Some(cut.len() as u32),
+            Some(renderer_cut_view(&renderer, &cut)?),
+        )
     } else {
         (None, None)
     };
@@ -152,6 +149,10 @@ pub fn run(
     let clusters_per_tile = if method == Method::QuadtreeTiles {
         let cuts = renderer.read_tile_cuts()?;
         let lit: Vec<usize> = cuts.iter().map(Vec::len).filter(|&n| n > 0).collect();
+        // the per-tile cuts' view: the list of the tile at the picture's centre
+        let size = renderer.settings().size;
+        let centre = renderer.read_tile_cut_at(size.width / 2, size.height / 2)?;
+        cut = Some(renderer_cut_view(&renderer, &centre)?);
         Some(lit.iter().sum::<usize>() as f64 / lit.len().max(1) as f64)
     } else {
         None

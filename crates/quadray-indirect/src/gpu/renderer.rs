@@ -10,7 +10,7 @@ use super::rsm::RsmPass;
 use crate::IndirectError;
 use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
 use crate::scene::Scene;
-use crate::settings::{ClusterSettings, Method, Settings};
+use crate::settings::{ClusterSettings, Method, Settings, TILE};
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use std::collections::BTreeMap;
 use wgpu::util::DeviceExt;
@@ -310,6 +310,25 @@ impl<'g> Renderer<'g> {
                 list.iter().map(|&i| CutNode::at(s.rsm_size, i)).collect()
             })
             .collect())
+    }
+
+    /// The cut of the tile that lights pixel `(x, y)` in the last [`Method::QuadtreeTiles`]
+    /// frame (empty before such a frame or where the tile sees no geometry): what
+    /// [`crate::picture::cut_view`] draws for the per-tile cuts.
+    pub fn read_tile_cut_at(&self, x: u32, y: u32) -> Result<Vec<CutNode>, IndirectError> {
+        let size = self.settings().size;
+        if x >= size.width || y >= size.height {
+            return Err(IndirectError::Settings(format!(
+                "pixel ({x}, {y}) is outside the {}x{} picture",
+                size.width, size.height
+            )));
+        }
+        let tile = (y / TILE * size.width.div_ceil(TILE) + x / TILE) as usize;
+        Ok(self
+            .read_tile_cuts()?
+            .into_iter()
+            .nth(tile)
+            .unwrap_or_default())
     }
 
     /// Per tile of the last [`Method::QuadtreeTiles`] frame (as [`Self::read_tile_cuts`]), the
