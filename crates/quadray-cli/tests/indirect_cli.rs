@@ -244,7 +244,7 @@ fn camera_and_light_options_move_them_and_the_cut_is_drawn() {
     r.render_frame(quadray_indirect::Method::DEFAULT).unwrap();
     let centre = r.read_tile_cut_at(24, 24).unwrap();
     assert!(!centre.is_empty());
-    let expected = quadray_indirect::picture::renderer_cut_view(&r, &centre).unwrap();
+    let expected = r.cut_view(&centre).unwrap();
     let pixels: Vec<u8> = expected.pixels.concat();
     assert!(drawn.as_raw() == &pixels, "the centre tile's cut differs");
     assert_ne!(drawn.as_raw(), &cut.to_rgba8().into_raw());

@@ -2,7 +2,6 @@
 //! the RSM, and the mean FLIP between two pictures.
 
 use crate::frame::{CutNode, Frame};
-use crate::{IndirectError, Renderer};
 use quadray_core::image_out::Rgba8Image;
 
 /// The exposed radiance [`tone_map`] shows as 90% white (1 - e^-2.3): what
@@ -84,21 +83,6 @@ pub fn cut_view(rsm_size: u32, nodes: &[[[f32; 4]; 3]], cut: &[CutNode], zoom: u
         }
     }
     image
-}
-
-/// [`cut_view`] of `cut` over `renderer`'s RSM at [`cut_view_zoom`]: the one cut
-/// ([`Renderer::read_cut`]) or a tile's ([`Renderer::read_tile_cut_at`]).
-pub fn renderer_cut_view(
-    renderer: &Renderer,
-    cut: &[CutNode],
-) -> Result<Rgba8Image, IndirectError> {
-    let rsm_size = renderer.settings().rsm_size;
-    Ok(cut_view(
-        rsm_size,
-        &renderer.read_nodes()?,
-        cut,
-        cut_view_zoom(rsm_size),
-    ))
 }
 
 /// Mean FLIP (NVIDIA's perceptual difference, 0 = identical) of `test` against `reference`.

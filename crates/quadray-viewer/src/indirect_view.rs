@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{renderer_cut_view, tone_map};
+use quadray_indirect::picture::tone_map;
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
 use quadray_indirect::{FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity};
 use std::path::{Path, PathBuf};
@@ -278,7 +278,7 @@ impl IndirectView {
             Show::Combined => tone_map(w, h, &frame.combined(), self.exposure),
             Show::Direct => tone_map(w, h, &frame.direct, self.exposure),
             Show::Indirect => tone_map(w, h, &frame.indirect, self.exposure),
-            Show::Cut => renderer_cut_view(renderer, cut.as_deref().unwrap_or_default())?,
+            Show::Cut => renderer.cut_view(cut.as_deref().unwrap_or_default())?,
         }))
     }
 

@@ -6,7 +6,7 @@
 
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{renderer_cut_view, tone_map};
+use quadray_indirect::picture::tone_map;
 use quadray_indirect::reference::{compare, error_map, ground_truth};
 use quadray_indirect::scene::scenes_dir;
 use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
@@ -44,7 +44,7 @@ pub fn render_demo(
     let quadtree_ms = r.time(Method::Quadtree, false, FRAMES)?.map(|t| t.total_ms);
     let frame = r.render_frame(Method::Quadtree)?;
     let clusters = r.clusters_in_cut()?;
-    let one_cut = renderer_cut_view(&r, &r.read_cut()?)?;
+    let one_cut = r.cut_view(&r.read_cut()?)?;
     let e = compare(&frame.indirect, &brute);
     // what a user gets: the default method, beside the paper's one cut
     let default_frame = r.render_frame(Method::DEFAULT)?;
@@ -86,7 +86,7 @@ pub fn render_demo(
             ),
             (
                 format!("per-tile cuts, centre tile: {} clusters", centre.len()),
-                renderer_cut_view(&r, &centre)?,
+                r.cut_view(&centre)?,
             ),
         ],
         2,

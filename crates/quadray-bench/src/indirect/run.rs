@@ -5,7 +5,7 @@
 use super::temporal::{self, Temporal};
 use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::{TONE_MAP_WHITE, flip_against, renderer_cut_view, tone_map};
+use quadray_indirect::picture::{TONE_MAP_WHITE, flip_against, tone_map};
 use quadray_indirect::reference::{self, ImageError};
 use quadray_indirect::{FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts};
 use serde::Serialize;
@@ -136,10 +136,7 @@ pub fn run(
     let (clusters_in_cut, mut cut) = if method.uses_quadtree() {
         renderer.render(Method::Quadtree, true, false)?;
         let cut = renderer.read_cut()?;
-        (
-            Some(cut.len() as u32),
-            Some(renderer_cut_view(&renderer, &cut)?),
-        )
+        (Some(cut.len() as u32), Some(renderer.cut_view(&cut)?))
     } else {
         (None, None)
     };
@@ -152,7 +149,7 @@ pub fn run(
         // the per-tile cuts' view: the list of the tile at the picture's centre
         let size = renderer.settings().size;
         let centre = renderer.read_tile_cut_at(size.width / 2, size.height / 2)?;
-        cut = Some(renderer_cut_view(&renderer, &centre)?);
+        cut = Some(renderer.cut_view(&centre)?);
         Some(lit.iter().sum::<usize>() as f64 / lit.len().max(1) as f64)
     } else {
         None

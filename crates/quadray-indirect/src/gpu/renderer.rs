@@ -9,8 +9,10 @@ use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
 use crate::IndirectError;
 use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
+use crate::picture::{cut_view, cut_view_zoom};
 use crate::scene::Scene;
 use crate::settings::{ClusterSettings, Method, Settings, TILE};
+use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use std::collections::BTreeMap;
 use wgpu::util::DeviceExt;
@@ -310,6 +312,19 @@ impl<'g> Renderer<'g> {
                 list.iter().map(|&i| CutNode::at(s.rsm_size, i)).collect()
             })
             .collect())
+    }
+
+    /// [`crate::picture::cut_view`] of `cut` over this renderer's RSM at
+    /// [`crate::picture::cut_view_zoom`]: the one cut ([`Self::read_cut`]) or a tile's
+    /// ([`Self::read_tile_cut_at`]).
+    pub fn cut_view(&self, cut: &[CutNode]) -> Result<Rgba8Image, IndirectError> {
+        let rsm_size = self.settings().rsm_size;
+        Ok(cut_view(
+            rsm_size,
+            &self.read_nodes()?,
+            cut,
+            cut_view_zoom(rsm_size),
+        ))
     }
 
     /// The cut of the tile that lights pixel `(x, y)` in the last [`Method::QuadtreeTiles`]
