@@ -93,16 +93,11 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;
     // a flag that would change nothing is a mistake to report, not to ignore
     if args.settings.subsample > 1 && !args.method.subsamples() {
-        let methods: Vec<&str> = Method::ALL
-            .into_iter()
-            .filter(|m| m.subsamples())
-            .map(Method::name)
-            .collect();
         anyhow::bail!(
             "--subsample {} applies to --method {} (the methods that gather at low resolution), \
              not {}",
             args.settings.subsample,
-            methods.join(" and "),
+            Method::subsampling_names().join(" and "),
             args.method
         );
     }

@@ -83,6 +83,15 @@ impl Method {
         }
     }
 
+    /// The names of the methods that [`Method::subsamples`] (for messages and labels).
+    pub fn subsampling_names() -> Vec<&'static str> {
+        Method::ALL
+            .into_iter()
+            .filter(|m| m.subsamples())
+            .map(Method::name)
+            .collect()
+    }
+
     /// Whether the method uses the one cut of the light quadtree (so a cluster count means
     /// something for it).
     pub fn uses_quadtree(self) -> bool {

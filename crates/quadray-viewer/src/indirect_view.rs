@@ -407,7 +407,10 @@ impl IndirectView {
         );
         ui.add_enabled(
             self.method.subsamples(),
-            egui::Slider::new(&mut s.subsample, 1..=8).text("sub-sampling (quadtree, rsm)"),
+            egui::Slider::new(&mut s.subsample, 1..=8).text(format!(
+                "sub-sampling ({})",
+                Method::subsampling_names().join(", ")
+            )),
         );
         let criterion = s.tile_criterion;
         choice_box(
