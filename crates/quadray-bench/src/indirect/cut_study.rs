@@ -4,8 +4,9 @@
 //! does (the coarse estimate from the start level's nodes at the first covered pixel of each
 //! quadrant, every node down to the start level split (the shader splits
 //! those by its bound, which is far above the threshold there), below it a node split while its error at
-//! those pixels and at the tile's receiver nearest it exceeds `tau` of the estimate; no bound,
-//! no list capacity), with three ways to know a node's error:
+//! those pixels and at the tile's receiver nearest it exceeds `tau` of the estimate, or while it
+//! holds the kernel's near field for the tile, where the shader's bound splits it; no bound, no
+//! list capacity), with three ways to know a node's error:
 //! - children: |E(node) - sum E(children)|, the shader's estimate;
 //! - grandchildren: |E(node) - sum E(grandchildren)|, two levels down;
 //! - oracle: |E(node) - the sum over the node's VPLs|, the error itself (its kernels are not
@@ -32,6 +33,9 @@ use std::path::Path;
 const TAUS: [f64; 5] = [0.01, 0.002, 0.0005, 0.0002, 0.00005];
 /// The tile's side in pixels (the shader's `TILE`).
 const TILE: usize = 8;
+/// The shader's `NEAR_FIELD_SIZE`: a node more than this many `r_min` across with a receiver of
+/// the tile within `r_min` of its box is split without an estimate.
+const NEAR_FIELD_SIZE: f64 = 4.0;
 /// Pixel and VPL pairs the CPU brute force (and the oracle, as much again) may sum: the
 /// default 128x128 picture over a 256^2 RSM is 2^30, about 20 s a scene on two cores.
 const MAX_PAIRS: u64 = 1 << 32;
@@ -96,6 +100,9 @@ struct Cluster {
     normal_sum: DVec3,
     covariance: [f64; 6],
     lit: bool,
+    /// The box of its VPLs' positions.
+    lo: DVec3,
+    hi: DVec3,
 }
 
 impl Cluster {
@@ -128,6 +135,11 @@ impl Cluster {
             normal_sum: lit.iter().map(|c| c.normal_sum).sum(),
             covariance,
             lit: true,
+            lo: lit.iter().map(|c| c.lo).fold(DVec3::INFINITY, DVec3::min),
+            hi: lit
+                .iter()
+                .map(|c| c.hi)
+                .fold(DVec3::NEG_INFINITY, DVec3::max),
         }
     }
 
@@ -265,7 +277,16 @@ fn tile_cut(
         if !node.lit {
             continue;
         }
+        // (the shader's bound splits a node in its near field: the study has no bound)
+        let near_field = || {
+            (node.hi - node.lo).length() > NEAR_FIELD_SIZE * r_min
+                && receivers.iter().any(|r| {
+                    let gap = (node.lo - r.0).max(r.0 - node.hi).max(DVec3::ZERO);
+                    gap.length() < r_min
+                })
+        };
         let split = at.0 >= start
+            || (at.0 > 0 && criterion != Criterion::Oracle && near_field())
             || (at.0 > 0 && {
                 let nearest = receivers
                     .iter()
@@ -350,6 +371,8 @@ fn study_scene(
                 covariance: [0.0; 6],
                 // (flux.w: the texel count, 1 where the texel sees geometry)
                 lit: covered,
+                lo: position,
+                hi: position,
             }
         })
         .collect();
@@ -559,6 +582,8 @@ mod tests {
                 normal_sum: up,
                 covariance: [0.0; 6],
                 lit: true,
+                lo: DVec3::ZERO,
+                hi: DVec3::ZERO,
             })
             .collect();
         let quads: Vec<Cluster> = vpls
