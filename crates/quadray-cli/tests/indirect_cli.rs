@@ -318,10 +318,10 @@ fn a_moving_camera_keeps_the_filtered_light_stable_without_ghosts() {
         "{ghosting}x the error on newly seen pixels"
     );
     // the default method (per-tile cuts) unfiltered: under 1.2 with an error image that changes
-    // less than the one cut's and less error (measured 1.05, 4.1e-4 against 6.3e-4, 0.0240
+    // less than the one cut's and less error (measured 1.04, 3.4e-4 against 6.3e-4, 0.0219
     // against 0.0291); fails with the one cut as the default. Filtered at its own weight: still
-    // under 1.2, for 1.065x the error of its unfiltered frames (0.985; at the one cut's weight
-    // of 0.33 the lag costs 1.149x and fails)
+    // under 1.2, for 1.030x the error of its unfiltered frames (1.003; at the one cut's weight
+    // of 0.33 the lag costs 1.177x and fails)
     let default_weight = quadray_indirect::Method::DEFAULT
         .moving_light_temporal_weight()
         .to_string();

@@ -74,11 +74,12 @@ impl Method {
     /// on the Cornell box and the atrium at 1 degree a frame it brings the image's frame-to-frame
     /// change to the brute force's or below, for at most 15% more error against each frame's
     /// brute force (BENCHMARKS.md, "A moving light", "Light and camera moving"). The per-tile
-    /// cuts pop less, so a lighter average does (0.5: error 1.00-1.09x); the one cut needs 0.33
-    /// (at 0.5 its flicker ratio stays at 1.3-1.5).
+    /// cuts pop less, so a lighter average does (0.67: flicker ratio 0.87-1.03 at 1.01-1.06x the
+    /// error; at 0.5 the lag cost the atrium 1.15x); the one cut needs 0.33 (at 0.5 its flicker
+    /// ratio stays at 1.3-1.5).
     pub fn moving_light_temporal_weight(self) -> f32 {
         match self {
-            Method::QuadtreeTiles => 0.5,
+            Method::QuadtreeTiles => 0.67,
             _ => 0.33,
         }
     }
