@@ -48,4 +48,6 @@ pub use gpu::{
 };
 pub use quadray_core::settings::Size;
 pub use scene::Scene;
-pub use settings::{ClusterSettings, Levels, Method, Settings, TileCriterion, Validity};
+pub use settings::{
+    ClusterSettings, Levels, Method, NEAR_FIELD_SIZE, Settings, TileCriterion, Validity,
+};

@@ -8,8 +8,8 @@ use quadray_gpu::Gpu;
 use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
 use quadray_indirect::gpu::Receiver;
 use quadray_indirect::{
-    ClusterSettings, Levels, Method, Renderer, Scene, Settings, Size, TileCriterion, Validity,
-    WorkCounts,
+    ClusterSettings, Levels, Method, NEAR_FIELD_SIZE, Renderer, Scene, Settings, Size,
+    TileCriterion, Validity, WorkCounts,
 };
 
 const RSM: u32 = 32;
@@ -125,7 +125,8 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     // four children and evaluates itself and its non-empty ones at the sample pixels and the
     // receiver nearest it: every split node there, and some of the listed ones (the tile reports
     // how many, checked between the two), except in a node's near field (`near_field` in
-    // tiles.wgsl: a receiver of the tile within r_min of a node's box more than 4 r_min across),
+    // tiles.wgsl: a receiver of the tile within r_min of a node's box more than NEAR_FIELD_SIZE
+    // r_min across),
     // where the bound alone decides
     let start = c.start;
     let node_bounds = r.read_node_bounds().unwrap();
@@ -134,7 +135,7 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     let near_field = |(level, x, y): (u32, u32, u32), tile: &[Vec3], margin: f32| {
         let [lo, hi] = node_bounds[node_index(level, x, y)].map(|v| Vec4::from(v).truncate());
         let r2 = r_min * r_min;
-        (hi - lo).length_squared() > 16.0 * r2 * (1.0 - margin)
+        (hi - lo).length_squared() > NEAR_FIELD_SIZE.powi(2) * r2 * (1.0 - margin)
             && tile.iter().any(|&p| {
                 let gap = (lo - p).max(p - hi).max(Vec3::ZERO);
                 gap.length_squared() < r2 * (1.0 + margin)

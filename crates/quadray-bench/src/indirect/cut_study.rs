@@ -23,7 +23,7 @@ use glam::DVec3;
 use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::{brute_force, compare, vpl_kernel};
-use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
+use quadray_indirect::{IndirectError, Method, NEAR_FIELD_SIZE, Renderer, Scene, Settings};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -33,9 +33,6 @@ use std::path::Path;
 const TAUS: [f64; 5] = [0.01, 0.002, 0.0005, 0.0002, 0.00005];
 /// The tile's side in pixels (the shader's `TILE`).
 const TILE: usize = 8;
-/// The shader's `NEAR_FIELD_SIZE`: a node more than this many `r_min` across with a receiver of
-/// the tile within `r_min` of its box is split without an estimate.
-const NEAR_FIELD_SIZE: f64 = 4.0;
 /// Pixel and VPL pairs the CPU brute force (and the oracle, as much again) may sum: the
 /// default 128x128 picture over a 256^2 RSM is 2^30, about 20 s a scene on two cores.
 const MAX_PAIRS: u64 = 1 << 32;
@@ -279,7 +276,7 @@ fn tile_cut(
         }
         // (the shader's bound splits a node in its near field: the study has no bound)
         let near_field = || {
-            (node.hi - node.lo).length() > NEAR_FIELD_SIZE * r_min
+            (node.hi - node.lo).length() > f64::from(NEAR_FIELD_SIZE) * r_min
                 && receivers.iter().any(|r| {
                     let gap = (node.lo - r.0).max(r.0 - node.hi).max(DVec3::ZERO);
                     gap.length() < r_min

@@ -4,7 +4,7 @@
 //! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
 //! shared struct's size and field offsets against these.
 
-pub(crate) use crate::settings::{TILE, TILE_FRONTIER};
+pub(crate) use crate::settings::{NEAR_FIELD_SIZE, TILE, TILE_FRONTIER};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -42,6 +42,7 @@ pub(crate) fn prelude() -> String {
          const MAX_LEVELS: u32 = {MAX_LEVELS}u;\n\
          const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;\n\
          const TILE: u32 = {TILE}u;\n\
+         const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};\n\
          const PI: f32 = {:?};\n\
          const OUTPUT_INDIRECT: u32 = {}u;\n\
          const OUTPUT_DIRECT: u32 = {}u;\n\
@@ -404,6 +405,7 @@ mod tests {
             format!("const MAX_LEVELS: u32 = {MAX_LEVELS}u;"),
             format!("const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;"),
             format!("const TILE: u32 = {TILE}u;"),
+            format!("const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};"),
         ] {
             assert!(prelude.contains(&line), "{line}");
         }

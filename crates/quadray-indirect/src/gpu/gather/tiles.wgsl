@@ -93,11 +93,11 @@ fn estimated_error(node: Node, at: u32, size: u32, level: u32) -> f32 {
 }
 
 // Whether a node holds its kernel's near field for this tile: a receiver of the tile lies within
-// `r_min` of the node's box and the box is more than NEAR_FIELD_SIZE times `r_min` across. There
-// the kernel's clamp falls inside the node, and its children's sum can agree with it however far
-// both are from its VPLs' (columns standing on a lit floor: with the estimate alone the atrium's
-// error stays at 0.046 rel. L1 whatever the tile error; CPU cut study), so the bound decides.
-const NEAR_FIELD_SIZE: f32 = 4.0;
+// `r_min` of the node's box and the box is more than NEAR_FIELD_SIZE (from the prelude) times
+// `r_min` across. There the kernel's clamp falls inside the node, and its children's sum can
+// agree with it however far both are from its VPLs' (columns standing on a lit floor: with the
+// estimate alone the atrium's error stays at 0.046 rel. L1 whatever the tile error; CPU cut
+// study), so the bound decides.
 fn near_field(b: NodeBounds, r_min: f32) -> bool {
     let side = b.hi.xyz - b.lo.xyz;
     if (dot(side, side) <= NEAR_FIELD_SIZE * NEAR_FIELD_SIZE * r_min * r_min) {
