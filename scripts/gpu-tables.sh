@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Refreshes the GPU figures of BENCHMARKS.md on this machine's adapter, in one run sized for a
-# lent GPU's 10-minute call: the 1920x1080 displacement frame of every method at 0, 60 and 85
+# Refreshes the GPU figures of BENCHMARKS.md on this machine's adapter, in one run of about 10
+# minutes. First the smoke stage: every GPU pass of every technique alone at 16x16 (`quadray
+# smoke`), each case in its own process under its own timeout, with the Khronos validation layer
+# and its synchronization validation where the machine has the layer (crates/quadray-gpu/vk_layer_settings.txt),
+# one line a pass, so that a pass that hangs or faults costs seconds and is named. Then the 1920x1080 displacement frame of every method at 0, 60 and 85
 # degrees (with the CPU ground truth's wrong-hit fraction), each indirect-light pass at 1920x1080
 # with a 512^2 RSM for every method, given --bevy-bin the Bevy frame with and without the bounce
 # (two paired rounds, Bevy's render diagnostics), then, while the time budget lasts, the paper
@@ -8,8 +11,11 @@
 # name from the adapter, e.g. bench/nvidia-h200/) with every stats file and a summary.md of the
 # tables, and packs it into gpu-tables.tar.gz beside it (a device call returns few files).
 #
-#   scripts/gpu-tables.sh [--quick] [--bin PATH] [--bevy-bin PATH] [--out DIR] [--budget SECONDS]
+#   scripts/gpu-tables.sh [--quick] [--smoke-only] [--smoke REGEX] [--bin PATH] [--bevy-bin PATH]
+#                         [--out DIR] [--budget SECONDS]
 #
+# --smoke-only: the smoke stage alone.
+# --smoke: only the smoke cases whose names match (grep -E; `quadray smoke --list` names them).
 # --quick: small frames, for trying the script on a software rasterizer (a minute on lavapipe).
 # --bin: the quadray binary (default target/release/quadray, built if missing).
 # --bevy-bin: the quadray-bevy-gi program (`cargo build --release --bin quadray-bevy-gi`); it
@@ -19,6 +25,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 quick=0
+smoke_only=0
+smoke_cases=.
 bin=target/release/quadray
 bevy_bin=
 out_root=bench
@@ -26,6 +34,8 @@ budget=540
 while [ $# -gt 0 ]; do
     case "$1" in
         --quick) quick=1 ;;
+        --smoke-only) smoke_only=1 ;;
+        --smoke) smoke_cases=$2; shift ;;
         --bin) bin=$2; shift ;;
         --bevy-bin) bevy_bin=$2; shift ;;
         --out) out_root=$2; shift ;;
@@ -49,14 +59,52 @@ fi
 # The adapter's name as a folder: "NVIDIA H200 (Vulkan, NVIDIA 580.159.04)" -> nvidia-h200.
 probe=$(mktemp -d)
 map=assets/heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png
-timeout 120 "$bin" displace --map $map --size 16x16 --out "$probe/p.png" --stats "$probe/p.json" >/dev/null
-adapter=$(sed -n 's/^ *"adapter": "\(.*\)",$/\1/p' "$probe/p.json" | head -1)
+adapter=$(timeout 60 "$bin" adapter)
 device=$(echo "${adapter%% (*}" | tr '[:upper:]' '[:lower:]' | sed 's/[^a-z0-9]\+/-/g; s/^-//; s/-$//')
 [ $quick = 1 ] && device="$device-quick"
 out="$out_root/$device"
-mkdir -p "$out/displace-1080p" "$out/indirect-1080p" "$out/logs"
+mkdir -p "$out/displace-1080p" "$out/indirect-1080p" "$out/logs" "$out/smoke"
 printf '%s\n%s\n' "$adapter" "$(date -u +%Y-%m-%dT%H:%MZ)" >"$out/adapter.txt"
 echo "$adapter -> $out"
+
+# The smoke stage. The layer is used where the Vulkan loader finds it (its manifest in a standard
+# folder, or in VK_ADD_LAYER_PATH / VK_LAYER_PATH); every message it prints is counted.
+layer_env=()
+layer="not found"
+for dir in $(echo "${VK_ADD_LAYER_PATH:-}:${VK_LAYER_PATH:-}" | tr : " ") /usr/share/vulkan/explicit_layer.d \
+    /usr/local/share/vulkan/explicit_layer.d /etc/vulkan/explicit_layer.d; do
+    if [ -f "$dir/VkLayer_khronos_validation.json" ]; then
+        layer_env=(VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation
+            "VK_LAYER_SETTINGS_PATH=$PWD/crates/quadray-gpu/vk_layer_settings.txt")
+        layer="on ($dir)"
+        break
+    fi
+done
+echo "smoke stage: validation layer $layer"
+smoke_failed=0
+for case in $("$bin" smoke --list | grep -E "$smoke_cases"); do
+    log="$out/smoke/$case.log"
+    status=0
+    env "${layer_env[@]}" QUADRAY_GPU_WAIT_S=15 timeout 45 "$bin" smoke --case "$case" >"$log" 2>&1 ||
+        status=$?
+    grep -a -E ': (done in|stopped after) ' "$log" || true
+    messages=$(grep -a -c -E 'Validation (Error|Warning)' "$log" || true)
+    if [ "$messages" != 0 ]; then
+        echo "$case: $messages validation messages (smoke/$case.log)"
+        smoke_failed=1
+    fi
+    if [ $status = 124 ]; then
+        echo "$case: killed after 45 s, after the last pass above (smoke/$case.log)"
+    fi
+    if [ $status != 0 ]; then
+        echo "$case: failed (exit $status)" >>"$out/skipped.txt"
+        smoke_failed=1
+    fi
+done
+if [ $smoke_only = 1 ]; then
+    tar -czf "$out_root/gpu-tables.tar.gz" -C "$out_root" "$device"
+    exit $smoke_failed
+fi
 
 # One run: its output in logs/NAME.log; a failure or a run past 3 minutes is noted in
 # skipped.txt and the next run goes on (the tables that did run still come back).

@@ -10,7 +10,7 @@
 # `embree` feature of the shadow benchmarks.
 set -euo pipefail
 pkgs=(libvulkan1 mesa-vulkan-drivers xvfb libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
-  slurm-wlm munge python3-venv)
+  vulkan-validationlayers slurm-wlm munge python3-venv)
 [[ "${1:-}" == "--embree" ]] && pkgs+=(libembree-dev)
 sudo=""
 [[ $(id -u) -ne 0 ]] && sudo="sudo"

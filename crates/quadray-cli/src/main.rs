@@ -5,6 +5,7 @@ mod displace;
 mod indirect;
 mod merge;
 mod raytrace;
+mod smoke;
 mod tiles;
 
 use anyhow::{Context, Result};
@@ -37,6 +38,9 @@ enum Command {
     Tiles(merge::TilesArgs),
     /// One-bounce indirect light from a light quadtree, its baselines and reference.
     Indirect(indirect::IndirectArgs),
+    /// Every GPU pass of every technique at a tiny size, one at a time, each waited for within
+    /// the bound: one line a pass, or the error naming where it stopped (a new GPU's first check).
+    Smoke(smoke::SmokeArgs),
     /// Open the interactive viewer: runs the `quadray-view` program installed beside this one
     /// (its own crate, so quadray builds without windowing); every argument is passed on.
     View {
@@ -145,6 +149,7 @@ fn main() -> Result<()> {
             what: Bench::Shadows { quick, out },
         } => raytrace::bench(quick, &out)?,
         Command::Indirect(args) => indirect::run_indirect(args)?,
+        Command::Smoke(args) => smoke::run(args)?,
         Command::Demo { out, size } => {
             if !(16..=4096).contains(&size) {
                 anyhow::bail!("--size {size} is outside 16..4096");

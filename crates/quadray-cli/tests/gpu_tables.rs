@@ -13,6 +13,8 @@ fn the_gpu_tables_script_writes_every_row_and_packs_them() {
     let run = Command::new(root.join("scripts/gpu-tables.sh"))
         .args([
             "--quick",
+            "--smoke",
+            "^indirect-quadtree-tiles$",
             "--budget",
             "0",
             "--bin",
@@ -29,6 +31,14 @@ fn the_gpu_tables_script_writes_every_row_and_packs_them() {
         "{stdout}{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    // the smoke stage, narrowed to one case: a line a pass, the frame as timed last
+    for pass in [
+        "setup", "rsm", "pyramid", "gbuffer", "indirect", "direct", "timed",
+    ] {
+        let line = format!("indirect-quadtree-tiles/{pass}: done in ");
+        assert!(stdout.contains(&line), "no `{line}` in {stdout}");
+    }
+    assert!(!stdout.contains("displace-pyramid/"), "{stdout}");
     let folder = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().path())

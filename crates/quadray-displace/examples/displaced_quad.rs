@@ -230,13 +230,18 @@ pub fn render(device: &wgpu::Device, queue: &wgpu::Queue, map: &HeightMap) -> im
         },
         extent,
     );
-    queue.submit([encoder.finish()]);
+    let frame = queue.submit([encoder.finish()]);
     readback
         .slice(..)
         .map_async(wgpu::MapMode::Read, |r| r.expect("map the readback"));
+    // Bounded: a frame that never ends (a driver fault, a shader that loops) is an error here,
+    // not a program that never returns.
     device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .expect("GPU work finished");
+        .poll(wgpu::PollType::Wait {
+            submission_index: Some(frame),
+            timeout: Some(std::time::Duration::from_secs(60)),
+        })
+        .expect("the frame finished within 60 s");
     let bytes = readback.slice(..).get_mapped_range().to_vec();
     image::RgbaImage::from_raw(SIZE, SIZE, bytes).expect("SIZE x SIZE RGBA")
 }

@@ -8,12 +8,18 @@
 mod readback;
 mod target;
 mod timer;
+pub mod validation;
 
 pub use readback::{read_buffer, read_texture_f32, read_texture_rgba8};
 pub use target::{cleared_attachment, nearest_depth, texture_2d, texture_2d_with_data};
 pub use timer::{GpuTimer, TimingSummary};
 
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
 use thiserror::Error;
+
+/// The environment variable that sets the bound on every wait for the GPU, in seconds.
+pub const WAIT_BOUND_ENV: &str = "QUADRAY_GPU_WAIT_S";
 
 #[derive(Debug, Error)]
 pub enum GpuError {
@@ -25,8 +31,28 @@ pub enum GpuError {
     NoDevice { adapter: String, reason: String },
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    #[error(
+        "the GPU `{adapter}` did not finish {work} within {bound_s} s (waited for: {waited_for}); a \
+         pass that never ends or a fault in it: run `scripts/gpu-tables.sh --smoke-only` to find \
+         the pass, or raise the bound with {env}=SECONDS",
+        env = WAIT_BOUND_ENV
+    )]
+    Timeout {
+        adapter: String,
+        work: String,
+        waited_for: String,
+        bound_s: u64,
+    },
+    #[error("the GPU `{adapter}` was lost during {work}: {reason}")]
+    DeviceLost {
+        adapter: String,
+        work: String,
+        reason: String,
+    },
     #[error("GPU validation failed: {0}")]
     Validation(String),
+    #[error("{0}")]
+    Setting(String),
 }
 
 /// Keeps Mesa's Vulkan device-selection layer from probing Wayland and X11 when a program that
@@ -53,6 +79,15 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// Timestamp queries are optional in WebGPU; timing degrades to `None` without them.
     pub has_timestamps: bool,
+    /// How long a wait for the GPU may take before it is an error ([`Gpu::wait`]).
+    wait_bound: Duration,
+    /// What was submitted last, for the error of a wait that ran out or a lost device.
+    last_work: Mutex<String>,
+    /// Why the device was lost, once it was.
+    lost: Arc<Mutex<Option<String>>>,
+    /// Set when a wait ran out: the device may still be running that work, so it is not
+    /// destroyed (see `Drop`).
+    stalled: std::sync::atomic::AtomicBool,
 }
 
 impl Gpu {
@@ -63,9 +98,9 @@ impl Gpu {
     }
 
     /// The instance every quadray program uses (backends from `WGPU_BACKEND`, else the primary
-    /// ones).
+    /// ones; wgpu's own validation with `WGPU_VALIDATION=1`).
     pub fn instance() -> wgpu::Instance {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
         wgpu::Instance::new(desc)
     }
@@ -98,13 +133,41 @@ impl Gpu {
             reason: e.to_string(),
         })?;
         let has_timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        tracing::info!(adapter = %adapter.get_info().name, backend = ?adapter.get_info().backend, has_timestamps, "GPU opened");
+        let wait_bound = wait_bound(adapter.get_info().device_type)?;
+        tracing::info!(adapter = %adapter.get_info().name, backend = ?adapter.get_info().backend, has_timestamps, ?wait_bound, "GPU opened");
+        let lost = Arc::new(Mutex::new(None));
+        let lost_reason = Arc::clone(&lost);
+        device.set_device_lost_callback(move |why, message| {
+            // Dropping the device reports a loss too; that one is not an error.
+            if why != wgpu::DeviceLostReason::Destroyed {
+                *lost_reason.lock().unwrap_or_else(|e| e.into_inner()) =
+                    Some(format!("{why:?}: {message}"));
+            }
+        });
         Ok(Self {
             adapter,
             device,
             queue,
             has_timestamps,
+            wait_bound,
+            last_work: Mutex::new("nothing yet".into()),
+            lost,
+            stalled: false.into(),
         })
+    }
+
+    /// Submits `commands`, remembering `work` (what they do, e.g. "indirect frame 64x64: rsm,
+    /// gather") so that a wait that runs out or a lost device names it.
+    pub fn submit(&self, work: impl Into<String>, commands: wgpu::CommandBuffer) {
+        *self.last_work.lock().unwrap_or_else(|e| e.into_inner()) = work.into();
+        self.queue.submit([commands]);
+    }
+
+    /// The bound on every wait: `QUADRAY_GPU_WAIT_S` seconds, else 60 s on a hardware adapter and
+    /// 1,800 s on a software one (lavapipe runs a 1920x1080 brute-force frame for minutes). Real
+    /// work ends far inside it; only a pass that never ends reaches it.
+    pub fn wait_bound(&self) -> Duration {
+        self.wait_bound
     }
 
     /// "NVIDIA H100 (Vulkan, driver 550.x)" — what benchmarks print beside their figures.
@@ -121,12 +184,47 @@ impl Gpu {
         self.adapter.get_info().device_type == wgpu::DeviceType::Cpu
     }
 
-    /// Blocks until all submitted work is done.
-    pub fn wait(&self) -> Result<(), GpuError> {
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.to_string()))
+    /// Blocks until all submitted work is done, at most [`Self::wait_bound`]; `waited_for` says
+    /// why the caller waits (a readback, a pass), for the error.
+    pub fn wait(&self, waited_for: &str) -> Result<(), GpuError> {
+        let polled = self.device.poll(wgpu::PollType::Wait {
+            submission_index: None,
+            timeout: Some(self.wait_bound),
+        });
+        self.check_lost()?;
+        match polled {
+            Ok(_) => Ok(()),
+            Err(wgpu::PollError::Timeout) => {
+                self.stalled
+                    .store(true, std::sync::atomic::Ordering::Relaxed);
+                Err(GpuError::Timeout {
+                    adapter: self.describe(),
+                    work: self.last_work(),
+                    waited_for: waited_for.into(),
+                    bound_s: self.wait_bound.as_secs(),
+                })
+            }
+            Err(e) => Err(GpuError::Readback(format!("{waited_for}: {e}"))),
+        }
+    }
+
+    /// An error naming the adapter and the last work if the device was lost.
+    fn check_lost(&self) -> Result<(), GpuError> {
+        match self.lost.lock().unwrap_or_else(|e| e.into_inner()).clone() {
+            Some(reason) => Err(GpuError::DeviceLost {
+                adapter: self.describe(),
+                work: self.last_work(),
+                reason,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn last_work(&self) -> String {
+        self.last_work
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
     }
 
     /// Runs `f` and turns any wgpu validation error it raised into a `GpuError` instead of a
@@ -139,4 +237,35 @@ impl Gpu {
             None => Ok(out),
         }
     }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        // After a wait ran out the device may still run that work, and destroying it would block
+        // on it (or fault): keep it alive, so that the program can report and exit.
+        if self.stalled.load(std::sync::atomic::Ordering::Relaxed) {
+            std::mem::forget(self.device.clone());
+            std::mem::forget(self.queue.clone());
+        }
+    }
+}
+
+/// [`Gpu::wait_bound`] for an adapter of `device_type`.
+fn wait_bound(device_type: wgpu::DeviceType) -> Result<Duration, GpuError> {
+    if let Some(value) = std::env::var_os(WAIT_BOUND_ENV) {
+        let value = value.to_string_lossy();
+        return match value.trim().parse::<f64>() {
+            Ok(s) if (0.1..=86_400.0).contains(&s) => Ok(Duration::from_secs_f64(s)),
+            _ => Err(GpuError::Setting(format!(
+                "{WAIT_BOUND_ENV}={value}: the bound on a wait for the GPU is seconds in 0.1..86400"
+            ))),
+        };
+    }
+    Ok(Duration::from_secs(
+        if device_type == wgpu::DeviceType::Cpu {
+            1800
+        } else {
+            60
+        },
+    ))
 }

@@ -2,10 +2,11 @@
 
 use crate::{Gpu, GpuError};
 
-/// Maps `buffer` for reading, waits, hands the bytes to `f`, and unmaps.
+/// Maps `buffer` for reading, waits (bounded), hands the bytes to `f`, and unmaps.
 pub(crate) fn map_buffer<T>(
     gpu: &Gpu,
     buffer: &wgpu::Buffer,
+    what: &str,
     f: impl FnOnce(&[u8]) -> T,
 ) -> Result<T, GpuError> {
     let slice = buffer.slice(..);
@@ -13,7 +14,7 @@ pub(crate) fn map_buffer<T>(
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    gpu.wait()?;
+    gpu.wait(what)?;
     rx.recv()
         .map_err(|e| GpuError::Readback(e.to_string()))?
         .map_err(|e| GpuError::Readback(e.to_string()))?;
@@ -65,7 +66,11 @@ fn read_texture_bytes(
         },
     );
     gpu.queue.submit([encoder.finish()]);
-    map_buffer(gpu, &buffer, |bytes| {
+    let what = format!(
+        "the readback of mip {level} of a {}x{} texture",
+        size.width, size.height
+    );
+    map_buffer(gpu, &buffer, &what, |bytes| {
         bytes
             .chunks(padded as usize)
             .flat_map(|r| &r[..row as usize])
@@ -101,5 +106,6 @@ pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
     gpu.queue.submit([encoder.finish()]);
-    map_buffer(gpu, &staging, <[u8]>::to_vec)
+    let what = format!("the readback of a {}-byte buffer", buffer.size());
+    map_buffer(gpu, &staging, &what, <[u8]>::to_vec)
 }

@@ -3,8 +3,12 @@
 //! medians back. CPU wall time never stands in for GPU time.
 
 use crate::{Gpu, GpuError};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use quadray_core::stats::Summary as TimingSummary;
+
+/// Bytes between two passes' timestamps in the resolve buffer (`QUERY_RESOLVE_BUFFER_ALIGNMENT`).
+const RESOLVE_STRIDE: u64 = wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT;
 
 /// A query set with room for `passes` begin/end pairs, resolved once per frame.
 pub struct GpuTimer {
@@ -12,13 +16,25 @@ pub struct GpuTimer {
     resolve: Option<wgpu::Buffer>,
     readback: Option<wgpu::Buffer>,
     passes: u32,
+    /// One bit a pass: the passes given timestamp writes since the last resolve. Only these are
+    /// resolved: resolving a query no pass wrote waits for it forever on some drivers (wgpu's
+    /// Vulkan backend copies query results with `VK_QUERY_RESULT_WAIT_BIT`; NVIDIA's driver
+    /// then never finishes the submission, lavapipe returns at once).
+    written: AtomicU64,
+    /// The passes the last resolve copied, which [`Self::collect`] reads.
+    resolved: AtomicU64,
     period_ns: f64,
     /// Per pass, the durations of every frame recorded so far (ms).
     samples: Vec<Vec<f64>>,
 }
 
 impl GpuTimer {
+    /// A timer for `passes` passes (at most 64).
     pub fn new(gpu: &Gpu, passes: u32) -> Self {
+        assert!(
+            passes <= 64,
+            "a GpuTimer times at most 64 passes, not {passes}"
+        );
         let count = passes * 2;
         let (query_set, resolve, readback) = if gpu.has_timestamps {
             let size = u64::from(count) * 8;
@@ -30,7 +46,7 @@ impl GpuTimer {
                 })),
                 Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("timestamp resolve"),
-                    size,
+                    size: u64::from(passes) * RESOLVE_STRIDE,
                     usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                     mapped_at_creation: false,
                 })),
@@ -49,6 +65,8 @@ impl GpuTimer {
             resolve,
             readback,
             passes,
+            written: AtomicU64::new(0),
+            resolved: AtomicU64::new(0),
             period_ns: f64::from(gpu.queue.get_timestamp_period()),
             samples: vec![Vec::new(); passes as usize],
         }
@@ -58,7 +76,10 @@ impl GpuTimer {
         self.query_set.is_some()
     }
 
+    /// The timestamp writes of pass `pass`; the pass must be recorded with them (its queries are
+    /// resolved at the next [`Self::resolve`]).
     pub fn render_pass(&self, pass: u32) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.mark(pass);
         self.query_set
             .as_ref()
             .map(|query_set| wgpu::RenderPassTimestampWrites {
@@ -68,7 +89,9 @@ impl GpuTimer {
             })
     }
 
+    /// The timestamp writes of pass `pass`, as [`Self::render_pass`].
     pub fn compute_pass(&self, pass: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.mark(pass);
         self.query_set
             .as_ref()
             .map(|query_set| wgpu::ComputePassTimestampWrites {
@@ -78,14 +101,40 @@ impl GpuTimer {
             })
     }
 
-    /// Records the resolve of this frame's timestamps; call after the timed passes, before finish.
+    fn mark(&self, pass: u32) {
+        assert!(
+            pass < self.passes,
+            "pass {pass} of a timer for {}",
+            self.passes
+        );
+        self.written.fetch_or(1 << pass, Ordering::Relaxed);
+    }
+
+    /// Records the resolve of this frame's timestamps, those of the passes given writes since the
+    /// last resolve; call after the timed passes, before finish.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        let written = self.written.swap(0, Ordering::Relaxed);
+        self.resolved.store(written, Ordering::Relaxed);
         if let (Some(q), Some(resolve), Some(readback)) =
             (&self.query_set, &self.resolve, &self.readback)
         {
-            encoder.resolve_query_set(q, 0..self.passes * 2, resolve, 0);
-            encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, resolve.size());
+            for pass in self.passes_in(written) {
+                // a resolve's destination offset must be 256-aligned: one slot a pass
+                let slot = u64::from(pass) * RESOLVE_STRIDE;
+                encoder.resolve_query_set(q, pass * 2..pass * 2 + 2, resolve, slot);
+                encoder.copy_buffer_to_buffer(resolve, slot, readback, u64::from(pass) * 16, 16);
+            }
         }
+    }
+
+    /// The passes the next [`Self::resolve`] resolves: those given timestamp writes since the
+    /// last one.
+    pub fn passes_to_resolve(&self) -> Vec<u32> {
+        self.passes_in(self.written.load(Ordering::Relaxed))
+    }
+
+    fn passes_in(&self, mask: u64) -> Vec<u32> {
+        (0..self.passes).filter(|p| mask & (1 << p) != 0).collect()
     }
 
     /// Reads this frame's timestamps (after the encoder with [`Self::resolve`] was submitted) and
@@ -94,11 +143,13 @@ impl GpuTimer {
         let Some(readback) = &self.readback else {
             return Ok(());
         };
-        let ticks: Vec<u64> = crate::readback::map_buffer(gpu, readback, |bytes| {
-            bytemuck::cast_slice(bytes).to_vec()
-        })?;
+        let resolved = self.resolved.load(Ordering::Relaxed);
+        let ticks: Vec<u64> =
+            crate::readback::map_buffer(gpu, readback, "the pass timestamps", |bytes| {
+                bytemuck::cast_slice(bytes).to_vec()
+            })?;
         for (pass, pair) in ticks.chunks_exact(2).enumerate() {
-            if pair[1] > pair[0] {
+            if resolved & (1 << pass) != 0 && pair[1] > pair[0] {
                 let ms = (pair[1] - pair[0]) as f64 * self.period_ns * 1e-6;
                 self.samples[pass].push(ms);
             }

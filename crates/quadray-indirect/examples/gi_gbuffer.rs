@@ -276,11 +276,16 @@ pub fn render(
         },
         output.size(),
     );
-    queue.submit([encoder.finish()]);
+    let frame = queue.submit([encoder.finish()]);
     readback
         .slice(..)
         .map_async(wgpu::MapMode::Read, |r| r.expect("map the readback"));
-    device.poll(wgpu::PollType::wait_indefinitely())?;
+    // Bounded: a frame that never ends (a driver fault, a shader that loops) is an error here,
+    // not a program that never returns.
+    device.poll(wgpu::PollType::Wait {
+        submission_index: Some(frame),
+        timeout: Some(std::time::Duration::from_secs(60)),
+    })?;
     let pixels = bytemuck::pod_collect_to_vec(&readback.slice(..).get_mapped_range());
     Ok(pixels)
 }

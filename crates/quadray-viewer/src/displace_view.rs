@@ -197,7 +197,7 @@ impl DisplaceView {
                 Some(&self.timer),
             )?;
             self.timer.resolve(&mut encoder);
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit("the viewer's displacement frame", encoder.finish());
             self.timer.collect(gpu)?;
             self.gpu_ms = self.timer.summaries()[0].map(|s| s.median_ms);
             self.timer.clear();

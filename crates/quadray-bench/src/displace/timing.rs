@@ -211,7 +211,10 @@ pub fn pyramid_build(bench: &Bench, tiles: &HeightMap) -> Result<Table, Displace
             let writes = timer.compute_pass(0);
             builder.record(&gpu.device, &gpu.queue, &mut encoder, &map, kind, writes);
             timer.resolve(&mut encoder);
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit(
+                format!("the pyramid build of a {size}^2 map"),
+                encoder.finish(),
+            );
             timer.collect(gpu)?;
         }
         let gpu_ms = timer.summaries()[0].map(|t| t.median_ms);

@@ -146,17 +146,39 @@ impl PyramidBuilder {
         let groups: Vec<_> = (1..=levels)
             .map(|k| bind(&level_view(&texture, k - 1), &level_view(&texture, k)))
             .collect();
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("pyramid reduce"),
-            timestamp_writes,
-        });
-        pass.set_pipeline(&self.reduce);
+        // One compute pass per level: with every level's dispatch in one pass, wgpu (29) leaves
+        // the levels that a dispatch reads and the next writes in the layout of the read, and the
+        // next submission expects another (the validation layer's InvalidImageLayout); a real GPU
+        // may then read garbage. The timestamps bracket the first and the last pass.
+        let (first, last) = (1, levels);
         for (k, group) in (1..=levels).zip(&groups) {
             let (width, height) = level_size(map.width, map.height, k);
+            let timestamp_writes = timestamp_writes
+                .as_ref()
+                .filter(|_| k == first || k == last)
+                .map(|t| wgpu::ComputePassTimestampWrites {
+                    query_set: t.query_set,
+                    beginning_of_pass_write_index: t
+                        .beginning_of_pass_write_index
+                        .filter(|_| k == first),
+                    end_of_pass_write_index: t.end_of_pass_write_index.filter(|_| k == last),
+                });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pyramid reduce"),
+                timestamp_writes,
+            });
+            pass.set_pipeline(&self.reduce);
             pass.set_bind_group(0, group, &[]);
             pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
         }
-        drop(pass);
+        if levels == 0 {
+            // a 1x1 map has no level to reduce; its timestamps are written all the same (an
+            // unwritten query may never resolve)
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pyramid reduce"),
+                timestamp_writes,
+            });
+        }
         HeightPyramid::from_texture(texture, kind, (map.width, map.height))
     }
 }

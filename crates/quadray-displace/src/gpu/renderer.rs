@@ -355,7 +355,7 @@ impl Renderer {
                 None,
             )
         })?;
-        gpu.queue.submit([encoder.finish()]);
+        gpu.submit(frame_work("displacement frame", s), encoder.finish());
         let search = read_texture_f32(gpu, &targets[4], 0, 2)?;
         let pixels = |v: Vec<f32>| -> Vec<[f32; 4]> {
             v.chunks_exact(4)
@@ -407,7 +407,7 @@ impl Renderer {
                 )
             })??;
             timer.resolve(&mut encoder);
-            gpu.queue.submit([encoder.finish()]);
+            gpu.submit(frame_work("timed displacement frame", s), encoder.finish());
             timer.collect(gpu)?;
             if frame == 1 {
                 timer.clear();
@@ -415,6 +415,16 @@ impl Renderer {
         }
         Ok(timer.summaries()[0])
     }
+}
+
+/// What a frame of `s` is, for the error of a GPU wait that runs out.
+fn frame_work(what: &str, s: &Settings) -> String {
+    format!(
+        "{what} {}x{} ({})",
+        s.size.width,
+        s.size.height,
+        s.method.name()
+    )
 }
 
 /// The per-map bind group with `traced` (a pyramid or the cone map) in the pyramid's slot.

@@ -17,6 +17,9 @@ use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use std::collections::BTreeMap;
 use wgpu::util::DeviceExt;
 
+/// One pass of a frame: which, and what it records into an encoder.
+type FrameStep<'a> = (Pass, Box<dyn Fn(&mut wgpu::CommandEncoder) + 'a>);
+
 /// Everything one scene needs on the GPU at one set of sizes.
 pub struct Renderer<'g> {
     gpu: &'g Gpu,
@@ -107,29 +110,20 @@ impl<'g> Renderer<'g> {
     ) -> Result<(), IndirectError> {
         let gpu = self.gpu;
         let run = self.passes_run(method, rebuild);
+        let timer = timed.then_some(&self.timer);
         gpu.checked(|| {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let timer = timed.then_some(&self.timer);
-            let slot = |pass: Pass| timer.map(|t| (t, pass as u32));
-            let slots = |a: Pass, b: Pass| timer.map(|t| (t, a as u32, b as u32));
-            self.record_light(&mut encoder, &run, timer);
-            self.gbuffer.record(
-                &mut encoder,
-                self.vertices.slice(..),
-                self.vertex_count,
-                timer.and_then(|t| t.render_pass(Pass::GBuffer as u32)),
-            );
-            self.gather.record_indirect(
-                &mut encoder,
-                method,
-                &self.quadtree,
-                slots(Pass::Indirect, Pass::Upsample),
-            );
-            self.gather.record_direct(&mut encoder, slot(Pass::Direct));
+            for (_, record) in self.frame_steps(method, &run, timer) {
+                record(&mut encoder);
+            }
             if let Some(timer) = timer {
                 timer.resolve(&mut encoder);
             }
-            gpu.queue.submit([encoder.finish()]);
+            let names: Vec<_> = run.iter().map(|p| p.name()).collect();
+            gpu.submit(
+                format!("{}: {}", self.frame_work(method), names.join(", ")),
+                encoder.finish(),
+            );
         })?;
         if timed {
             self.timer.collect(gpu)?;
@@ -137,26 +131,112 @@ impl<'g> Renderer<'g> {
         Ok(())
     }
 
-    /// Records the light-dependent passes of `run` (RSM, pyramid and validity, cut).
-    fn record_light(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
+    /// Renders one frame of `method` from scratch one pass at a time: each pass submitted alone
+    /// and waited for (bounded), `done` told its pass and wall time. Slow; for finding the pass
+    /// that hangs or faults on a new GPU (`quadray smoke`): the error names it.
+    pub fn render_pass_by_pass(
+        &mut self,
+        method: Method,
+        mut done: impl FnMut(Pass, std::time::Duration),
+    ) -> Result<(), IndirectError> {
+        let gpu = self.gpu;
+        let run = self.passes_run(method, true);
+        for (pass, record) in self.frame_steps(method, &run, None) {
+            let start = std::time::Instant::now();
+            gpu.checked(|| {
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                record(&mut encoder);
+                gpu.submit(
+                    format!("the {} pass of {}", pass.name(), self.frame_work(method)),
+                    encoder.finish(),
+                );
+            })?;
+            gpu.wait(&format!("the {} pass", pass.name()))?;
+            done(pass, start.elapsed());
+        }
+        Ok(())
+    }
+
+    /// What a frame of `method` is, for the error of a GPU wait that runs out.
+    fn frame_work(&self, method: Method) -> String {
+        let s = &self.settings;
+        format!(
+            "an indirect frame {}x{} ({}, RSM {}^2)",
+            s.size.width,
+            s.size.height,
+            method.name(),
+            s.rsm_size
+        )
+    }
+
+    /// The passes of `run` as steps that record into an encoder, in frame order. The pyramid's
+    /// step records the validity too; the gather's the upsampling.
+    fn frame_steps<'a>(
+        &'a self,
+        method: Method,
         run: &[Pass],
-        timer: Option<&GpuTimer>,
-    ) {
-        let slot = |pass: Pass| timer.map(|t| (t, pass as u32));
+        timer: Option<&'a GpuTimer>,
+    ) -> Vec<FrameStep<'a>> {
+        let slot = move |pass: Pass| timer.map(|t| (t, pass as u32));
+        let mut steps: Vec<FrameStep<'a>> = Vec::new();
         if run.contains(&Pass::Rsm) {
-            let vertices = self.vertices.slice(..);
-            self.rsm
-                .record(encoder, vertices, self.vertex_count, slot(Pass::Rsm));
+            steps.push((
+                Pass::Rsm,
+                Box::new(move |encoder| {
+                    self.rsm.record(
+                        encoder,
+                        self.vertices.slice(..),
+                        self.vertex_count,
+                        slot(Pass::Rsm),
+                    )
+                }),
+            ));
         }
         if run.contains(&Pass::Pyramid) {
-            let slots = timer.map(|t| (t, Pass::Pyramid as u32, Pass::Validity as u32));
-            self.quadtree.record_build(encoder, slots);
+            steps.push((
+                Pass::Pyramid,
+                Box::new(move |encoder| {
+                    let slots = timer.map(|t| (t, Pass::Pyramid as u32, Pass::Validity as u32));
+                    self.quadtree.record_build(encoder, slots)
+                }),
+            ));
         }
         if run.contains(&Pass::Cut) {
-            self.quadtree.record_cut(encoder, slot(Pass::Cut));
+            steps.push((
+                Pass::Cut,
+                Box::new(move |encoder| self.quadtree.record_cut(encoder, slot(Pass::Cut))),
+            ));
         }
+        if run.contains(&Pass::GBuffer) {
+            steps.push((
+                Pass::GBuffer,
+                Box::new(move |encoder| {
+                    self.gbuffer.record(
+                        encoder,
+                        self.vertices.slice(..),
+                        self.vertex_count,
+                        timer.and_then(|t| t.render_pass(Pass::GBuffer as u32)),
+                    )
+                }),
+            ));
+        }
+        if run.contains(&Pass::Indirect) {
+            steps.push((
+                Pass::Indirect,
+                Box::new(move |encoder| {
+                    let slots = timer.map(|t| (t, Pass::Indirect as u32, Pass::Upsample as u32));
+                    self.gather
+                        .record_indirect(encoder, method, &self.quadtree, slots)
+                }),
+            ));
+        }
+        if run.contains(&Pass::Direct) {
+            steps.push((
+                Pass::Direct,
+                Box::new(move |encoder| self.gather.record_direct(encoder, slot(Pass::Direct))),
+            ));
+        }
+        steps
     }
 
     /// Rebuilds the RSM, the quadtree and the compacted cut without shading anything: the cut
@@ -164,11 +244,16 @@ impl<'g> Renderer<'g> {
     /// frame and the temporal filter's average as they are.
     pub fn build_cut(&mut self) -> Result<(), IndirectError> {
         let gpu = self.gpu;
-        let run = self.passes_run(Method::Quadtree, true);
+        let light = [Pass::Rsm, Pass::Pyramid, Pass::Cut];
         gpu.checked(|| {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            self.record_light(&mut encoder, &run, None);
-            gpu.queue.submit([encoder.finish()]);
+            for (_, record) in self.frame_steps(Method::Quadtree, &light, None) {
+                record(&mut encoder);
+            }
+            gpu.submit(
+                format!("the cut of {}", self.frame_work(Method::Quadtree)),
+                encoder.finish(),
+            );
         })?;
         Ok(())
     }
