@@ -283,7 +283,8 @@ fn height_map_seeds() -> Vec<(String, Vec<u8>)> {
 /// The height-map loader as `quadray displace` calls it, in two of its conventions: a white-is-
 /// high map resampled to a square power of two (`--resample`), and a depth photo as stored.
 fn height_map_loader(path: &Path) -> Result<bool, String> {
-    use quadray_displace::heightmap::{Convention, Fit, HeightMap, MAX_SIZE};
+    use quadray_core::image_in::MAX_SIDE;
+    use quadray_displace::heightmap::{Convention, Fit, HeightMap};
     let mut valid = false;
     for (convention, fit) in [
         (Convention::Height, Fit::Resample),
@@ -294,8 +295,8 @@ fn height_map_loader(path: &Path) -> Result<bool, String> {
                 let (w, h) = (map.width, map.height);
                 let resampled_square = fit == Fit::Exact || (w == h && w.is_power_of_two());
                 if !resampled_square
-                    || !(1..=MAX_SIZE).contains(&w)
-                    || !(1..=MAX_SIZE).contains(&h)
+                    || !(1..=MAX_SIDE).contains(&w)
+                    || !(1..=MAX_SIDE).contains(&h)
                     || map.depth.len() != w as usize * h as usize
                     || map.depth.iter().any(|d| !(0.0..=1.0).contains(d))
                 {

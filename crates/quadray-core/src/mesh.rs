@@ -165,6 +165,8 @@ pub enum MeshError {
     NodeCycle { path: PathBuf, node: usize },
     #[error("{}: no triangles", path.display())]
     NoTriangles { path: PathBuf },
+    #[error(transparent)]
+    Texture(#[from] crate::image_in::ImageReadError),
 }
 
 impl MeshError {
@@ -233,11 +235,9 @@ fn transform_vertices(
     }
 }
 
-/// Decodes a PNG or JPEG texture (within `image`'s default memory limits).
+/// Decodes a PNG or JPEG texture (within [`crate::image_in::MAX_SIDE`]).
 fn decode_texture(path: &Path, bytes: &[u8]) -> Result<Rgba8Image, MeshError> {
-    let image = image::load_from_memory(bytes)
-        .map_err(|e| MeshError::parse(path, "texture", e))?
-        .into_rgba8();
+    let image = crate::image_in::from_memory(path, bytes)?.into_rgba8();
     let (width, height) = image.dimensions();
     Ok(Rgba8Image::from_bytes(width, height, image.as_raw()))
 }

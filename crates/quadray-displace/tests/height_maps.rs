@@ -3,7 +3,9 @@
 
 use crate::common;
 
+use quadray_core::image_in::MAX_SIDE;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap, HeightMapError};
+use quadray_displace::maps::load_color;
 use quadray_displace::{Layers, Method, Settings, Size};
 
 #[test]
@@ -71,6 +73,41 @@ fn nan_empty_and_broken_files_are_refused_with_their_name() {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         assert!(err.to_string().contains(&name), "{err}");
     }
+}
+
+/// A PNG whose header claims 60000x60000 (the data of a few bytes) is refused by quadray's own
+/// limit, with the size it read, before a texel is decoded; the albedo loader says the same.
+#[test]
+fn oversized_headers_are_refused_before_decoding() {
+    let chunk = |kind: &[u8; 4], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend(kind);
+        c.extend(data);
+        c.extend(crc32fast::hash(&c[4..]).to_be_bytes());
+        c
+    };
+    let side = 60_000u32.to_be_bytes();
+    // 8-bit greyscale, deflate, no filter, not interlaced
+    let ihdr = [&side[..], &side, &[8, 0, 0, 0, 0]].concat();
+    let empty_zlib = [0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01];
+    let png = [
+        b"\x89PNG\r\n\x1a\n".to_vec(),
+        chunk(b"IHDR", &ihdr),
+        chunk(b"IDAT", &empty_zlib),
+        chunk(b"IEND", &[]),
+    ]
+    .concat();
+    let dir = std::env::temp_dir().join(format!("quadray-huge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("huge.png");
+    std::fs::write(&path, png).unwrap();
+    let expected = format!(
+        "{}: the image is 60000x60000, over quadray's limit of {MAX_SIDE}x{MAX_SIDE}",
+        path.display()
+    );
+    let err = HeightMap::load(&path, Convention::Height, Fit::Exact).unwrap_err();
+    assert_eq!(err.to_string(), expected);
+    assert_eq!(load_color(&path).unwrap_err().to_string(), expected);
 }
 
 #[test]
