@@ -110,49 +110,81 @@ fn oversized_headers_are_refused_before_decoding() {
     assert_eq!(load_color(&path).unwrap_err().to_string(), expected);
 }
 
+/// Each refusal names the parameter, its value and its range.
 #[test]
 fn absurd_parameters_are_refused() {
     let ok = Settings::default();
     assert!(ok.validate().is_ok());
+    let layers = |min, max| {
+        let c = Layers::COUNT;
+        format!(
+            "layers {min},{max} must satisfy {} <= min <= max <= {}",
+            c.min, c.max
+        )
+    };
     let bad = [
-        Settings {
-            view_angle_deg: 90.0,
-            ..ok.clone()
-        },
-        Settings {
-            view_angle_deg: f32::NAN,
-            ..ok.clone()
-        },
-        Settings {
-            depth_scale: -1.0,
-            ..ok.clone()
-        },
-        Settings {
-            depth_scale: f32::INFINITY,
-            ..ok.clone()
-        },
-        Settings {
-            size: Size::new(0, 64),
-            ..ok.clone()
-        },
-        Settings {
-            layers: Layers { min: 32, max: 8 },
-            ..ok.clone()
-        },
-        Settings {
-            layers: Layers {
-                min: 1,
-                max: 1_000_000,
+        (
+            Settings {
+                view_angle_deg: 90.0,
+                ..ok.clone()
             },
-            ..ok.clone()
-        },
-        Settings {
-            binary_steps: 1000,
-            ..ok.clone()
-        },
+            format!("view angle 90 is outside {}", Settings::VIEW_ANGLE),
+        ),
+        (
+            Settings {
+                view_angle_deg: f32::NAN,
+                ..ok.clone()
+            },
+            format!("view angle NaN is outside {}", Settings::VIEW_ANGLE),
+        ),
+        (
+            Settings {
+                depth_scale: -1.0,
+                ..ok.clone()
+            },
+            format!("depth scale -1 is outside {}", Settings::DEPTH_SCALE),
+        ),
+        (
+            Settings {
+                depth_scale: f32::INFINITY,
+                ..ok.clone()
+            },
+            format!("depth scale inf is outside {}", Settings::DEPTH_SCALE),
+        ),
+        (
+            Settings {
+                size: Size::new(0, 64),
+                ..ok.clone()
+            },
+            format!("size 0x64 has a side outside {}", Settings::SIDE),
+        ),
+        (
+            Settings {
+                layers: Layers { min: 32, max: 8 },
+                ..ok.clone()
+            },
+            layers(32, 8),
+        ),
+        (
+            Settings {
+                layers: Layers {
+                    min: 1,
+                    max: 1_000_000,
+                },
+                ..ok.clone()
+            },
+            layers(1, 1_000_000),
+        ),
+        (
+            Settings {
+                binary_steps: 1000,
+                ..ok.clone()
+            },
+            format!("binary steps 1000 is outside {}", Settings::BINARY_STEPS),
+        ),
     ];
-    for s in bad {
-        assert!(s.validate().is_err(), "{s:?} accepted");
+    for (s, expected) in bad {
+        assert_eq!(s.validate(), Err(expected), "{s:?}");
     }
     assert!("pyramid-bilinear".parse::<Method>().is_ok());
     assert!("pyramid2".parse::<Method>().unwrap_err().contains("pom"));
