@@ -223,20 +223,26 @@ mod tests {
         assert_eq!(cli.args.settings, Settings::DEFAULT);
     }
 
-    /// The flags refuse what `validate()` refuses, with the same limits.
+    /// The flags refuse what `validate()` refuses, naming the flag and the same limits.
     #[test]
     fn the_flags_refuse_values_outside_the_limits() {
-        for (flag, value) in [
-            ("--view-angle", "89.5"),
-            ("--size", "0x10"),
-            ("--depth-scale", "0"),
-            ("--layers", "9,3"),
-            ("--binary-steps", "65"),
-            ("--zoom", "NaN"),
-            ("--azimuth", "inf"),
+        let layers = format!(
+            "{} <= min <= max <= {}",
+            Layers::COUNT.min,
+            Layers::COUNT.max
+        );
+        for (flag, value, range) in [
+            ("--view-angle", "89.5", Settings::VIEW_ANGLE.to_string()),
+            ("--size", "0x10", Settings::SIDE.to_string()),
+            ("--depth-scale", "0", Settings::DEPTH_SCALE.to_string()),
+            ("--layers", "9,3", layers),
+            ("--binary-steps", "65", Settings::BINARY_STEPS.to_string()),
+            ("--zoom", "NaN", Settings::ZOOM.to_string()),
+            ("--azimuth", "inf", Settings::AZIMUTH.to_string()),
         ] {
             let argv = ["displace", "--map=m.png", "--out=o.png", flag, value];
-            assert!(Cli::try_parse_from(argv).is_err(), "{flag} {value}");
+            let e = Cli::try_parse_from(argv).err().expect(flag).to_string();
+            assert!(e.contains(flag) && e.contains(&range), "{e}");
         }
     }
 

@@ -309,26 +309,45 @@ mod tests {
         assert_eq!(cli.args.method, Method::DEFAULT);
     }
 
-    /// The flags refuse what `validate()` refuses, with the same limits.
+    /// The flags refuse what `validate()` refuses, naming the flag and the same limits.
     #[test]
     fn the_flags_refuse_values_outside_the_limits() {
-        for (flag, value) in [
-            ("--size", "0x10"),
-            ("--rsm-size", "96"),
-            ("--rsm-size", "2048"),
-            ("--limit-level", "11"),
-            ("--normal-threshold", "1.5"),
-            ("--depth-threshold", "NaN"),
-            ("--samples", "0"),
-            ("--subsample", "65"),
-            ("--shadow-steps", "0"),
-            ("--temporal-weight", "0"),
-            ("--tile-capacity", "2048"),
-            ("--tile-share", "-1"),
-            ("--validity", "global"),
+        let validities: Vec<_> = Validity::ALL.iter().map(|v| v.to_string()).collect();
+        for (flag, value, range) in [
+            ("--size", "0x10", Settings::SIDE.to_string()),
+            ("--rsm-size", "96", Settings::RSM_SIZE.to_string()),
+            ("--rsm-size", "2048", Settings::RSM_SIZE.to_string()),
+            ("--limit-level", "11", ClusterSettings::LEVEL.to_string()),
+            (
+                "--normal-threshold",
+                "1.5",
+                ClusterSettings::NORMAL_THRESHOLD.to_string(),
+            ),
+            (
+                "--depth-threshold",
+                "NaN",
+                ClusterSettings::DEPTH_THRESHOLD.to_string(),
+            ),
+            ("--samples", "0", Settings::SAMPLES.to_string()),
+            ("--subsample", "65", Settings::SUBSAMPLE.to_string()),
+            ("--shadow-steps", "0", Settings::SHADOW_STEPS.to_string()),
+            (
+                "--temporal-weight",
+                "0",
+                Settings::TEMPORAL_WEIGHT.to_string(),
+            ),
+            (
+                "--tile-capacity",
+                "2048",
+                Settings::TILE_CAPACITY.to_string(),
+            ),
+            ("--tile-share", "-1", Settings::TILE_SHARE.to_string()),
+            ("--validity", "global", validities.join(", ")),
         ] {
-            let argv = ["indirect", "--out=o.png", flag, value];
-            assert!(Cli::try_parse_from(argv).is_err(), "{flag} {value}");
+            // `=` so that a negative value reaches the flag's parser rather than clap's.
+            let argv = ["indirect", "--out=o.png", &format!("{flag}={value}")];
+            let e = Cli::try_parse_from(argv).err().expect(flag).to_string();
+            assert!(e.contains(flag) && e.contains(&range), "{e}");
         }
     }
 

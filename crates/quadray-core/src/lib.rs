@@ -1,9 +1,10 @@
-//! What quadray's techniques share: image output and error heat maps, medians of timings, the
-//! JSON and text files the programs write, the mesh loader (OBJ, glTF, PLY) the renderers
-//! share, the CPU ray tracing geometry ([`geom`]: rays, convex polygons, a SAH BVH) and the
-//! random generator ([`random`]).
+//! What quadray's techniques share: image input (held to one size limit) and output, error heat
+//! maps, medians of timings, the JSON and text files the programs write, the mesh loader (OBJ,
+//! glTF, PLY) the renderers share, the CPU ray tracing geometry ([`geom`]: rays, convex polygons,
+//! a SAH BVH) and the random generator ([`random`]).
 
 pub mod geom;
+pub mod image_in;
 pub mod image_out;
 pub mod mesh;
 pub mod random;

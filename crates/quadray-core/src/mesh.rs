@@ -1,9 +1,9 @@
 //! Triangle meshes and their materials, loaded from OBJ (+MTL), glTF 2.0 (.gltf/.glb) and PLY.
 //!
-//! Every loader ends in the same checks (`MeshBuilder::finish`): positions must be finite,
-//! indices in range; faces with a repeated vertex or zero area are dropped (and counted in a
-//! warning); a file with no triangle left is an error. Normals missing from the file are generated,
-//! area-weighted.
+//! Every loader ends in the same checks (`MeshBuilder::finish`): coordinates within
+//! [`MAX_COORDINATE`] (before and after a glTF node's transform), indices in range; faces with a
+//! repeated vertex or zero area are dropped (and counted in a warning); a file with no triangle
+//! left is an error. Normals missing from the file are generated, area-weighted.
 
 pub(crate) mod gltf;
 mod obj;
@@ -11,8 +11,52 @@ mod ply;
 
 use crate::image_out::Rgba8Image;
 use glam::{Mat3, Mat4, Vec2, Vec3};
+use std::fmt;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
+
+/// The largest |coordinate| a vertex may have, in its file's units, wherever a scene places it.
+///
+/// Every pipeline holds positions in f32, whose spacing reaches 1 at 2^23 (8.4e6): within 1e7 a
+/// coordinate is still exact to a unit, so a model in metres as wide as a country (UTM coordinates
+/// included) or in millimetres as wide as a town loads. Far beyond, the ray tracer's grid, the BVH
+/// and the RSM's frustum, all sized to the bounds, lose the rest of the model (one vertex at 1e38
+/// left a picture of background only), and near 1e19 squared lengths and cross products overflow.
+/// The bound refuses what no f32 pipeline can use; it cannot make a model of mixed scales safe (a
+/// small object beside a vertex near the limit may still vanish).
+pub const MAX_COORDINATE: f32 = 1e7;
+
+/// A vertex coordinate beyond [`MAX_COORDINATE`], or not a number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FarCoordinate {
+    /// `x`, `y` or `z`.
+    pub axis: char,
+    pub value: f32,
+}
+
+impl FarCoordinate {
+    /// The first of `positions` with a coordinate outside the limit: its index and the coordinate.
+    pub fn find(positions: impl IntoIterator<Item = Vec3>) -> Option<(usize, FarCoordinate)> {
+        positions.into_iter().enumerate().find_map(|(i, p)| {
+            let axis = (0..3).find(|&a| p[a].is_nan() || p[a].abs() > MAX_COORDINATE)?;
+            let far = FarCoordinate {
+                axis: ['x', 'y', 'z'][axis],
+                value: p[axis],
+            };
+            Some((i, far))
+        })
+    }
+}
+
+impl fmt::Display for FarCoordinate {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} = {:e} is outside the limit |coordinate| <= {MAX_COORDINATE:e}",
+            self.axis, self.value
+        )
+    }
+}
 
 /// A surface description common to the three formats (Phong-style, plus emission and refraction).
 #[derive(Clone, Debug, PartialEq)]
@@ -97,15 +141,12 @@ pub enum MeshError {
         format: &'static str,
         reason: String,
     },
-    #[error(
-        "{}: mesh `{mesh}` vertex {vertex} is not finite: {position}",
-        path.display()
-    )]
-    NonFiniteVertex {
+    #[error("{}: mesh `{mesh}` vertex {vertex}: {coordinate}", path.display())]
+    FarVertex {
         path: PathBuf,
         mesh: String,
         vertex: usize,
-        position: Vec3,
+        coordinate: FarCoordinate,
     },
     #[error(
         "{}: mesh `{mesh}` index {index} is out of range ({vertex_count} vertices)",
@@ -124,6 +165,8 @@ pub enum MeshError {
     NodeCycle { path: PathBuf, node: usize },
     #[error("{}: no triangles", path.display())]
     NoTriangles { path: PathBuf },
+    #[error(transparent)]
+    Texture(#[from] crate::image_in::ImageReadError),
 }
 
 impl MeshError {
@@ -149,6 +192,15 @@ impl Model {
             .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
                 (lo.min(p), hi.max(p))
             })
+    }
+
+    /// Checks that `m` (a scene's placement of the model) keeps every vertex within
+    /// [`MAX_COORDINATE`]; `path` is the model's file, for the error.
+    pub fn check_placed(&self, path: &Path, m: Mat4) -> Result<(), MeshError> {
+        self.meshes.iter().try_for_each(|mesh| {
+            let placed = mesh.positions.iter().map(|&p| m.transform_point3(p));
+            check_coordinates(path, &mesh.name, placed)
+        })
     }
 
     /// The model with `m` applied to positions and normals (winding kept front-facing when `m`
@@ -183,11 +235,9 @@ fn transform_vertices(
     }
 }
 
-/// Decodes a PNG or JPEG texture (within `image`'s default memory limits).
+/// Decodes a PNG or JPEG texture (within [`crate::image_in::MAX_SIDE`]).
 fn decode_texture(path: &Path, bytes: &[u8]) -> Result<Rgba8Image, MeshError> {
-    let image = image::load_from_memory(bytes)
-        .map_err(|e| MeshError::parse(path, "texture", e))?
-        .into_rgba8();
+    let image = crate::image_in::from_memory(path, bytes)?.into_rgba8();
     let (width, height) = image.dimensions();
     Ok(Rgba8Image::from_bytes(width, height, image.as_raw()))
 }
@@ -292,7 +342,8 @@ struct MeshBuilder {
 impl MeshBuilder {
     /// Checks the data and makes the mesh; also returns how many degenerate faces were dropped.
     fn finish(mut self, path: &Path) -> Result<(Mesh, usize), MeshError> {
-        self.check_finite(path)?;
+        let check = |b: &Self| check_coordinates(path, &b.name, b.positions.iter().copied());
+        check(&self)?;
         if self.to_world != Mat4::IDENTITY {
             transform_vertices(
                 &mut self.positions,
@@ -300,8 +351,8 @@ impl MeshBuilder {
                 &mut self.triangles,
                 self.to_world,
             );
-            // A finite vertex can still overflow under a huge scale.
-            self.check_finite(path)?;
+            // A vertex in range can leave it under a huge scale.
+            check(&self)?;
         }
         let vertex_count = self.positions.len();
         if let Some(&index) = self
@@ -340,17 +391,22 @@ impl MeshBuilder {
         };
         Ok((mesh, dropped))
     }
+}
 
-    fn check_finite(&self, path: &Path) -> Result<(), MeshError> {
-        match self.positions.iter().position(|p| !p.is_finite()) {
-            None => Ok(()),
-            Some(vertex) => Err(MeshError::NonFiniteVertex {
-                path: path.to_owned(),
-                mesh: self.name.clone(),
-                vertex,
-                position: self.positions[vertex],
-            }),
-        }
+/// Every coordinate of `positions` within [`MAX_COORDINATE`], or the first vertex beyond.
+fn check_coordinates(
+    path: &Path,
+    mesh: &str,
+    positions: impl IntoIterator<Item = Vec3>,
+) -> Result<(), MeshError> {
+    match FarCoordinate::find(positions) {
+        None => Ok(()),
+        Some((vertex, coordinate)) => Err(MeshError::FarVertex {
+            path: path.to_owned(),
+            mesh: mesh.to_owned(),
+            vertex,
+            coordinate,
+        }),
     }
 }
 

@@ -13,8 +13,23 @@ use std::fmt;
 use std::str::FromStr;
 
 /// A number a setting can hold.
-pub trait Number: Copy + PartialOrd + fmt::Display + FromStr + Send + Sync + 'static {}
-impl Number for f32 {}
+pub trait Number: Copy + PartialOrd + fmt::Display + FromStr + Send + Sync + 'static {
+    /// The number as messages write it.
+    fn shown(self) -> String {
+        self.to_string()
+    }
+}
+impl Number for f32 {
+    /// Huge values in scientific notation: `f32::MAX`, the bound of "any finite value", is
+    /// 3.4028235e38 rather than 39 digits.
+    fn shown(self) -> String {
+        if self.abs() >= 1e7 {
+            format!("{self:e}")
+        } else {
+            self.to_string()
+        }
+    }
+}
 impl Number for u32 {}
 
 /// The values a numeric setting may take: `min..=max`, or `(min, max]` when the minimum itself
@@ -63,7 +78,7 @@ impl<T: Number> Limits<T> {
         if self.contains(value) {
             Ok(value)
         } else {
-            Err(format!("{value} is outside {self}"))
+            Err(format!("{} is outside {self}", value.shown()))
         }
     }
 
@@ -82,10 +97,11 @@ impl<T: Number> Limits<T> {
 
 impl<T: Number> fmt::Display for Limits<T> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (min, max) = (self.min.shown(), self.max.shown());
         if self.min_excluded {
-            write!(f, "({}, {}]", self.min, self.max)
+            write!(f, "({min}, {max}]")
         } else {
-            write!(f, "{}..={}", self.min, self.max)
+            write!(f, "{min}..={max}")
         }
     }
 }
@@ -173,6 +189,10 @@ mod tests {
         let f = Limits::closed(-f32::MAX, f32::MAX).parser();
         assert!(f("inf").is_err() && f("NaN").is_err());
         assert_eq!(f("-3.5"), Ok(-3.5));
+        assert_eq!(
+            f("-1e39").unwrap_err(),
+            "-inf is outside -3.4028235e38..=3.4028235e38"
+        );
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! in assets/malformed.
 
 use glam::{Mat4, Vec3};
-use quadray_core::mesh::{Mesh, MeshError, load_model};
+use quadray_core::mesh::{FarCoordinate, MAX_COORDINATE, Mesh, MeshError, load_model};
 use std::path::{Path, PathBuf};
 
 use crate::common;
@@ -288,6 +288,45 @@ fn obj_validation() {
     );
 }
 
+/// A coordinate no f32 pipeline can use is refused, the message naming the file, the vertex, its
+/// value and the limit; a vertex at the limit still loads.
+#[test]
+fn far_coordinates_are_refused_by_name() {
+    let dir = scratch("far_coordinates");
+    let obj =
+        |far: &str| format!("o far\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv {far} 1 0\nf 1 2 3\nf 2 4 3\n");
+    let path = write(&dir, "far.obj", obj("1e38"));
+    assert_eq!(
+        error_message(&path),
+        format!(
+            "{}: mesh `far` vertex 3: x = 1e38 is outside the limit |coordinate| <= 1e7",
+            path.display()
+        )
+    );
+    assert!(matches!(
+        load_model(&path),
+        Err(MeshError::FarVertex {
+            vertex: 3,
+            coordinate: FarCoordinate {
+                axis: 'x',
+                value: 1e38
+            },
+            ..
+        })
+    ));
+    let at_limit = write(&dir, "at_limit.obj", obj(&(-MAX_COORDINATE).to_string()));
+    assert_eq!(load_model(&at_limit).unwrap().triangle_count(), 2);
+
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+               property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+               end_header\n0 0 0\n1 0 0\n0 -1e20 0\n3 0 1 2\n";
+    let message = error_message(&write(&dir, "far.ply", ply));
+    assert!(
+        message.contains("far.ply") && message.contains("vertex 2: y = -1e20 is outside"),
+        "{message}"
+    );
+}
+
 const PLY_HEADER_END: &str = "element face 3\nproperty list uchar int vertex_indices\nend_header\n";
 
 #[test]
@@ -393,6 +432,14 @@ fn gltf_node_transforms_and_primitive_modes() {
         assert_eq!(model.materials[mesh.material], Default::default());
     }
 
+    // A node's scale can carry a vertex in range beyond the limit.
+    let huge = r#"[{"scale":[1e8,1,1],"mesh":0}]"#;
+    let message = error_message(&write(&dir, "huge.gltf", gltf(huge, 4)));
+    assert!(
+        message.contains("huge.gltf") && message.contains("vertex 1: x = 1e8 is outside"),
+        "{message}"
+    );
+
     let cycle = r#"[{"children":[1]},{"children":[0],"mesh":0}]"#;
     let message = error_message(&write(&dir, "cycle.gltf", gltf(cycle, 4)));
     assert!(
@@ -461,7 +508,7 @@ fn truncated_files_never_panic() {
 const MALFORMED: &[(&str, Result<usize, &str>)] = &[
     (
         "gltf2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb",
-        Err("vertex 0 is not finite"),
+        Err("vertex 0: x = -inf is outside the limit"),
     ),
     (
         "gltf2/IncorrectVertexArrays/Cube.bin",

@@ -349,6 +349,16 @@ fn bad_toml_values_are_refused_with_the_reason() {
             "more than one",
         ),
         ("[[lights]]", "[[lamps]]", "lamps"),
+        (
+            "max = [0.4, 1.1, 0.3]",
+            "max = [0.4, 1e38, 0.3]",
+            "box max: y = 1e38 is outside the limit |coordinate| <= 1e7",
+        ),
+        (
+            "[1.6, 0.0, -0.2], [1.2, 0.0, 0.5]]",
+            "[1.6, 0.0, -2e7], [1.2, 0.0, 0.5]]",
+            "polygon 0: vertex 1: z = -2e7 is outside the limit",
+        ),
     ];
     for (from, to, why) in cases {
         assert!(good.contains(from), "{from}");
@@ -361,4 +371,27 @@ fn bad_toml_values_are_refused_with_the_reason() {
             "{why}: {e}"
         );
     }
+}
+
+#[test]
+fn a_transform_that_carries_a_mesh_beyond_the_coordinate_limit_is_refused() {
+    let file = asset("scenes/far.toml");
+    let scene = |scale: &str| {
+        format!(
+            "[camera]\nposition = [0, 0, 5]\ntarget = [0, 0, 0]\nfov_y_deg = 40\n\
+             [[objects]]\nmesh = \"../meshes/cornell_box/cornell_box.obj\"\nscale = {scale}\n"
+        )
+    };
+    assert!(SceneDescription::from_toml(&scene("1000"), &file).is_ok());
+    let e = SceneDescription::from_toml(&scene("1e5"), &file)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("object 0: ")
+            && e.contains("cornell_box.obj: mesh `floor` vertex 0: x = ")
+            && e.ends_with(
+                "is outside the limit |coordinate| <= 1e7, once the object's transform places it"
+            ),
+        "{e}"
+    );
 }

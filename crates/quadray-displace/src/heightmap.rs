@@ -1,6 +1,7 @@
 //! Height maps in the spec's convention: depth in `[0, 1]` (0 = the polygon's plane, 1 = deepest),
 //! any width x height, row-major with row 0 at v = 0.
 
+use quadray_core::image_in::{self, ImageReadError, MAX_SIDE};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -55,17 +56,10 @@ pub enum Fit {
 #[derive(Debug, Error)]
 #[allow(missing_docs)] // each variant's message says what its fields are
 pub enum HeightMapError {
-    #[error("{path}: cannot read the image: {reason}")]
-    Unreadable { path: PathBuf, reason: String },
+    #[error(transparent)]
+    Image(#[from] ImageReadError),
     #[error("{path}: the image is empty (0 texels)")]
     Empty { path: PathBuf },
-    #[error("{path}: {width}x{height} is outside the supported 1x1 .. {max}x{max}")]
-    Size {
-        path: PathBuf,
-        width: u32,
-        height: u32,
-        max: u32,
-    },
     #[error("{path}: texel ({x}, {y}) is {value}, not a finite number")]
     NotFinite {
         path: PathBuf,
@@ -76,9 +70,6 @@ pub enum HeightMapError {
     #[error("{path}: the depth photo has no valid (non-zero) measurement")]
     NoMeasurement { path: PathBuf },
 }
-
-/// Largest map side accepted: 8192^2 floats is 256 MiB with its pyramid; beyond that GPUs refuse.
-pub const MAX_SIZE: u32 = 8192;
 
 #[derive(Clone, Debug, PartialEq)]
 /// A `width` x `height` height field in depth convention; uv [0, 1)^2 spans it once, texel
@@ -143,14 +134,7 @@ impl HeightMap {
         if width == 0 || height == 0 || depth.is_empty() {
             return Err(HeightMapError::Empty { path: name.into() });
         }
-        if width > MAX_SIZE || height > MAX_SIZE {
-            return Err(HeightMapError::Size {
-                path: name.into(),
-                width,
-                height,
-                max: MAX_SIZE,
-            });
-        }
+        image_in::check_size(name, width, height)?;
         assert_eq!(
             depth.len(),
             width as usize * height as usize,
@@ -164,19 +148,10 @@ impl HeightMap {
         })
     }
 
-    /// Loads an 8- or 16-bit greyscale (or RGB: the first channel) PNG, or a float EXR.
+    /// Loads an 8- or 16-bit greyscale (or RGB: the first channel) PNG, or a float EXR, of at
+    /// most [`MAX_SIDE`] a side.
     pub fn load(path: &Path, convention: Convention, fit: Fit) -> Result<Self, HeightMapError> {
-        let img = image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| HeightMapError::Unreadable {
-                path: path.into(),
-                reason: e.to_string(),
-            })?
-            .decode()
-            .map_err(|e| HeightMapError::Unreadable {
-                path: path.into(),
-                reason: e.to_string(),
-            })?;
+        let img = image_in::open(path)?;
         let (w, h) = (img.width(), img.height());
         // The first channel, normalised to [0,1] for integer formats and as stored for floats.
         let raw: Vec<f32> = img.to_luma32f().into_raw();
@@ -249,7 +224,7 @@ fn to_depth(
 
 fn nearest_power_of_two(n: u32) -> u32 {
     let up = n.max(2).next_power_of_two();
-    if up - n > n - up / 2 { up / 2 } else { up }.clamp(2, MAX_SIZE)
+    if up - n > n - up / 2 { up / 2 } else { up }.clamp(2, MAX_SIDE)
 }
 
 /// Bilinear resampling with texel centres aligned (corners map to corners).
@@ -318,14 +293,20 @@ mod tests {
         ));
         let err = HeightMap::from_values(
             p,
-            MAX_SIZE + 1,
+            MAX_SIDE + 1,
             1,
-            &vec![0.0; MAX_SIZE as usize + 1],
+            &vec![0.0; MAX_SIDE as usize + 1],
             Convention::Depth,
             Fit::Exact,
         )
         .unwrap_err();
-        assert!(matches!(err, HeightMapError::Size { .. }), "{err}");
+        assert!(
+            matches!(
+                err,
+                HeightMapError::Image(ImageReadError::TooLarge { width, .. }) if width == MAX_SIDE + 1
+            ),
+            "{err}"
+        );
     }
 
     #[test]

@@ -89,12 +89,7 @@ impl BundledMap {
 
 /// Loads an albedo image as 8-bit RGBA.
 pub fn load_color(path: &Path) -> Result<Rgba8Image, HeightMapError> {
-    let img = image::open(path)
-        .map_err(|e| HeightMapError::Unreadable {
-            path: path.into(),
-            reason: e.to_string(),
-        })?
-        .to_rgba8();
+    let img = quadray_core::image_in::open(path)?.to_rgba8();
     Ok(Rgba8Image::from_bytes(
         img.width(),
         img.height(),

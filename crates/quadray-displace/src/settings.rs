@@ -275,42 +275,76 @@ impl Default for Settings {
 mod tests {
     use super::*;
 
+    /// Each refusal names the parameter and its declared range.
     #[test]
     fn validate_uses_the_declared_limits() {
         let ok = Settings::default();
         assert!(ok.validate().is_ok());
         let bad = [
-            Settings {
-                view_angle_deg: 89.5,
-                ..ok.clone()
-            },
-            Settings {
-                size: Size::new(0, 10),
-                ..ok.clone()
-            },
-            Settings {
-                depth_scale: 0.0,
-                ..ok.clone()
-            },
-            Settings {
-                layers: Layers { min: 9, max: 3 },
-                ..ok.clone()
-            },
-            Settings {
-                binary_steps: 65,
-                ..ok.clone()
-            },
-            Settings {
-                light_azimuth_deg: f32::INFINITY,
-                ..ok.clone()
-            },
-            Settings {
-                zoom: f32::NAN,
-                ..ok.clone()
-            },
+            (
+                Settings {
+                    view_angle_deg: 89.5,
+                    ..ok.clone()
+                },
+                "view angle 89.5",
+                Settings::VIEW_ANGLE.to_string(),
+            ),
+            (
+                Settings {
+                    size: Size::new(0, 10),
+                    ..ok.clone()
+                },
+                "size 0x10",
+                Settings::SIDE.to_string(),
+            ),
+            (
+                Settings {
+                    depth_scale: 0.0,
+                    ..ok.clone()
+                },
+                "depth scale 0",
+                Settings::DEPTH_SCALE.to_string(),
+            ),
+            (
+                Settings {
+                    layers: Layers { min: 9, max: 3 },
+                    ..ok.clone()
+                },
+                "layers 9,3",
+                format!(
+                    "{} <= min <= max <= {}",
+                    Layers::COUNT.min,
+                    Layers::COUNT.max
+                ),
+            ),
+            (
+                Settings {
+                    binary_steps: 65,
+                    ..ok.clone()
+                },
+                "binary steps 65",
+                Settings::BINARY_STEPS.to_string(),
+            ),
+            (
+                Settings {
+                    light_azimuth_deg: f32::INFINITY,
+                    ..ok.clone()
+                },
+                "light azimuth inf",
+                Settings::AZIMUTH.to_string(),
+            ),
+            (
+                Settings {
+                    zoom: f32::NAN,
+                    ..ok.clone()
+                },
+                "zoom NaN",
+                Settings::ZOOM.to_string(),
+            ),
         ];
-        for s in bad {
-            assert!(s.validate().is_err(), "{s:?}");
+        for (s, what, range) in bad {
+            let e = s.validate().unwrap_err();
+            assert!(e.starts_with(what) && e.ends_with(&range), "{e}");
         }
     }
 

@@ -3,7 +3,9 @@
 
 use crate::common;
 
+use quadray_core::image_in::MAX_SIDE;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap, HeightMapError};
+use quadray_displace::maps::load_color;
 use quadray_displace::{Layers, Method, Settings, Size};
 
 #[test]
@@ -73,49 +75,116 @@ fn nan_empty_and_broken_files_are_refused_with_their_name() {
     }
 }
 
+/// A PNG whose header claims 60000x60000 (the data of a few bytes) is refused by quadray's own
+/// limit, with the size it read, before a texel is decoded; the albedo loader says the same.
+#[test]
+fn oversized_headers_are_refused_before_decoding() {
+    let chunk = |kind: &[u8; 4], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend(kind);
+        c.extend(data);
+        c.extend(crc32fast::hash(&c[4..]).to_be_bytes());
+        c
+    };
+    let side = 60_000u32.to_be_bytes();
+    // 8-bit greyscale, deflate, no filter, not interlaced
+    let ihdr = [&side[..], &side, &[8, 0, 0, 0, 0]].concat();
+    let empty_zlib = [0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01];
+    let png = [
+        b"\x89PNG\r\n\x1a\n".to_vec(),
+        chunk(b"IHDR", &ihdr),
+        chunk(b"IDAT", &empty_zlib),
+        chunk(b"IEND", &[]),
+    ]
+    .concat();
+    let dir = std::env::temp_dir().join(format!("quadray-huge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("huge.png");
+    std::fs::write(&path, png).unwrap();
+    let expected = format!(
+        "{}: the image is 60000x60000, over quadray's limit of {MAX_SIDE}x{MAX_SIDE}",
+        path.display()
+    );
+    let err = HeightMap::load(&path, Convention::Height, Fit::Exact).unwrap_err();
+    assert_eq!(err.to_string(), expected);
+    assert_eq!(load_color(&path).unwrap_err().to_string(), expected);
+}
+
+/// Each refusal names the parameter, its value and its range.
 #[test]
 fn absurd_parameters_are_refused() {
     let ok = Settings::default();
     assert!(ok.validate().is_ok());
+    let layers = |min, max| {
+        let c = Layers::COUNT;
+        format!(
+            "layers {min},{max} must satisfy {} <= min <= max <= {}",
+            c.min, c.max
+        )
+    };
     let bad = [
-        Settings {
-            view_angle_deg: 90.0,
-            ..ok.clone()
-        },
-        Settings {
-            view_angle_deg: f32::NAN,
-            ..ok.clone()
-        },
-        Settings {
-            depth_scale: -1.0,
-            ..ok.clone()
-        },
-        Settings {
-            depth_scale: f32::INFINITY,
-            ..ok.clone()
-        },
-        Settings {
-            size: Size::new(0, 64),
-            ..ok.clone()
-        },
-        Settings {
-            layers: Layers { min: 32, max: 8 },
-            ..ok.clone()
-        },
-        Settings {
-            layers: Layers {
-                min: 1,
-                max: 1_000_000,
+        (
+            Settings {
+                view_angle_deg: 90.0,
+                ..ok.clone()
             },
-            ..ok.clone()
-        },
-        Settings {
-            binary_steps: 1000,
-            ..ok.clone()
-        },
+            format!("view angle 90 is outside {}", Settings::VIEW_ANGLE),
+        ),
+        (
+            Settings {
+                view_angle_deg: f32::NAN,
+                ..ok.clone()
+            },
+            format!("view angle NaN is outside {}", Settings::VIEW_ANGLE),
+        ),
+        (
+            Settings {
+                depth_scale: -1.0,
+                ..ok.clone()
+            },
+            format!("depth scale -1 is outside {}", Settings::DEPTH_SCALE),
+        ),
+        (
+            Settings {
+                depth_scale: f32::INFINITY,
+                ..ok.clone()
+            },
+            format!("depth scale inf is outside {}", Settings::DEPTH_SCALE),
+        ),
+        (
+            Settings {
+                size: Size::new(0, 64),
+                ..ok.clone()
+            },
+            format!("size 0x64 has a side outside {}", Settings::SIDE),
+        ),
+        (
+            Settings {
+                layers: Layers { min: 32, max: 8 },
+                ..ok.clone()
+            },
+            layers(32, 8),
+        ),
+        (
+            Settings {
+                layers: Layers {
+                    min: 1,
+                    max: 1_000_000,
+                },
+                ..ok.clone()
+            },
+            layers(1, 1_000_000),
+        ),
+        (
+            Settings {
+                binary_steps: 1000,
+                ..ok.clone()
+            },
+            format!("binary steps 1000 is outside {}", Settings::BINARY_STEPS),
+        ),
     ];
-    for s in bad {
-        assert!(s.validate().is_err(), "{s:?} accepted");
+    for (s, expected) in bad {
+        assert_eq!(s.validate(), Err(expected), "{s:?}");
     }
     assert!("pyramid-bilinear".parse::<Method>().is_ok());
     assert!("pyramid2".parse::<Method>().unwrap_err().contains("pom"));

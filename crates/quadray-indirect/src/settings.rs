@@ -738,49 +738,84 @@ mod tests {
         assert!(r.cluster.start_level.is_some() && r.tile_capacity.is_some());
     }
 
+    /// Each refusal names the parameter and its declared range.
     #[test]
     fn validate_uses_the_declared_limits() {
         let ok = Settings::DEFAULT;
         assert!(ok.validate().is_ok());
+        let top = ok.rsm_size.ilog2();
+        let big = Size::new(8192, 8192);
         let bad = [
-            Settings {
-                rsm_size: 96,
-                ..ok.clone()
-            },
-            Settings {
-                size: Size::new(0, 4),
-                ..ok.clone()
-            },
-            Settings {
-                cluster: ClusterSettings {
-                    limit_level: Some(7),
-                    ..ClusterSettings::DEFAULT
+            (
+                Settings {
+                    rsm_size: 96,
+                    ..ok.clone()
                 },
-                ..ok.clone()
-            },
-            Settings {
-                cluster: ClusterSettings {
-                    normal_threshold: f32::NAN,
-                    ..ClusterSettings::DEFAULT
+                "RSM size 96 must be a power of two in",
+                Settings::RSM_SIZE.to_string(),
+            ),
+            (
+                Settings {
+                    size: Size::new(0, 4),
+                    ..ok.clone()
                 },
-                ..ok.clone()
-            },
-            Settings {
-                temporal_weight: 0.0,
-                ..ok.clone()
-            },
-            Settings {
-                tile_capacity: Some(2048),
-                ..ok.clone()
-            },
-            Settings {
-                size: Size::new(8192, 8192),
-                tile_capacity: Some(1024),
-                ..ok.clone()
-            },
+                "size 0x4",
+                Settings::SIDE.to_string(),
+            ),
+            (
+                Settings {
+                    cluster: ClusterSettings {
+                        limit_level: Some(7),
+                        ..ClusterSettings::DEFAULT
+                    },
+                    ..ok.clone()
+                },
+                "levels must satisfy limit (7) <= start",
+                format!("<= {top} (the 1x1 level of a {} RSM)", ok.rsm_size),
+            ),
+            (
+                Settings {
+                    cluster: ClusterSettings {
+                        normal_threshold: f32::NAN,
+                        ..ClusterSettings::DEFAULT
+                    },
+                    ..ok.clone()
+                },
+                "normal threshold NaN",
+                ClusterSettings::NORMAL_THRESHOLD.to_string(),
+            ),
+            (
+                Settings {
+                    temporal_weight: 0.0,
+                    ..ok.clone()
+                },
+                "temporal weight 0",
+                Settings::TEMPORAL_WEIGHT.to_string(),
+            ),
+            (
+                Settings {
+                    tile_capacity: Some(2048),
+                    ..ok.clone()
+                },
+                "tile capacity 2048",
+                Settings::TILE_CAPACITY.to_string(),
+            ),
+            (
+                Settings {
+                    size: big,
+                    tile_capacity: Some(1024),
+                    ..ok.clone()
+                },
+                "per-tile cuts of 1024 nodes",
+                format!(
+                    "lower the tile capacity to {} or less",
+                    Settings::tile_capacity_within(big, Settings::MAX_TILE_LIST_BYTES)
+                ),
+            ),
         ];
-        for s in bad {
-            assert!(s.validate().is_err(), "{s:?}");
+        for (s, what, range) in bad {
+            let e = s.validate().unwrap_err();
+            assert!(e.starts_with(what) && e.ends_with(&range), "{e}");
         }
     }
 }

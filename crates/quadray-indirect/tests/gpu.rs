@@ -520,56 +520,104 @@ fn subsampled_indirect_stays_close_to_full_resolution() {
     assert!(e.rel_l1 < 0.10, "{e:?}");
 }
 
+/// Each refusal names the parameter and its range.
 #[test]
 fn absurd_settings_are_refused() {
     let gpu = gpu();
     let scene = Scene::cornell();
-    for bad in [
-        Settings {
-            rsm_size: 48,
-            ..settings(32)
-        },
-        Settings {
-            cluster: ClusterSettings {
-                limit_level: Some(4),
-                start_level: Some(2),
-                ..ClusterSettings::DEFAULT
+    let tile_lists = format!(
+        "over {} MiB: lower the tile capacity to",
+        Settings::MAX_TILE_LIST_BYTES >> 20
+    );
+    for (bad, what, range) in [
+        (
+            Settings {
+                rsm_size: 48,
+                ..settings(32)
             },
-            ..settings(32)
-        },
-        Settings {
-            cluster: ClusterSettings {
-                depth_threshold: f32::NAN,
-                ..ClusterSettings::DEFAULT
+            "RSM size 48 must be a power of two in",
+            Settings::RSM_SIZE.to_string(),
+        ),
+        (
+            Settings {
+                cluster: ClusterSettings {
+                    limit_level: Some(4),
+                    start_level: Some(2),
+                    ..ClusterSettings::DEFAULT
+                },
+                ..settings(32)
             },
-            ..settings(32)
-        },
-        Settings {
-            size: Size::new(0, 32),
-            ..settings(32)
-        },
-        Settings {
-            temporal_weight: 0.0,
-            ..settings(32)
-        },
-        Settings {
-            temporal_weight: f32::NAN,
-            ..settings(32)
-        },
-        Settings {
-            tile_error: Some(-0.1),
-            ..settings(32)
-        },
-        Settings {
-            tile_capacity: Some(2048),
-            ..settings(32)
-        },
-        Settings {
-            tile_capacity: Some(1024),
-            ..Settings::sized(4096, 4096, 32)
-        },
+            "levels must satisfy limit (4) <= start (2)",
+            "<= 5 (the 1x1 level of a 32 RSM)".to_string(),
+        ),
+        (
+            Settings {
+                cluster: ClusterSettings {
+                    depth_threshold: f32::NAN,
+                    ..ClusterSettings::DEFAULT
+                },
+                ..settings(32)
+            },
+            "depth threshold NaN",
+            ClusterSettings::DEPTH_THRESHOLD.to_string(),
+        ),
+        (
+            Settings {
+                size: Size::new(0, 32),
+                ..settings(32)
+            },
+            "size 0x32",
+            Settings::SIDE.to_string(),
+        ),
+        (
+            Settings {
+                temporal_weight: 0.0,
+                ..settings(32)
+            },
+            "temporal weight 0",
+            Settings::TEMPORAL_WEIGHT.to_string(),
+        ),
+        (
+            Settings {
+                temporal_weight: f32::NAN,
+                ..settings(32)
+            },
+            "temporal weight NaN",
+            Settings::TEMPORAL_WEIGHT.to_string(),
+        ),
+        (
+            Settings {
+                tile_error: Some(-0.1),
+                ..settings(32)
+            },
+            "tile error -0.1",
+            Settings::TILE_ERROR.to_string(),
+        ),
+        (
+            Settings {
+                tile_capacity: Some(2048),
+                ..settings(32)
+            },
+            "tile capacity 2048",
+            Settings::TILE_CAPACITY.to_string(),
+        ),
+        (
+            Settings {
+                tile_capacity: Some(1024),
+                ..Settings::sized(4096, 4096, 32)
+            },
+            "per-tile cuts of 1024 nodes for a 4096x4096 picture",
+            tile_lists.clone(),
+        ),
     ] {
-        assert!(Renderer::new(&gpu, &scene, bad).is_err());
+        let e = match Renderer::new(&gpu, &scene, bad) {
+            Ok(_) => panic!("{what}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.starts_with(&format!("invalid parameters: {what}")) && e.contains(&range),
+            "{e}"
+        );
     }
 }
 

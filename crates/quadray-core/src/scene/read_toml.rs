@@ -5,7 +5,7 @@ use super::{
     Camera, Intensity, Light, Material, Object, SceneDescription, Shape, Spot, Transform,
     check_light, stem,
 };
-use crate::mesh::load_model;
+use crate::mesh::{FarCoordinate, load_model};
 use glam::Vec3;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -224,6 +224,9 @@ fn object(
         (Some(mesh), None, None, None) => {
             let path = dir.join(mesh);
             let model = load_model(&path).map_err(|e| e.to_string())?;
+            model
+                .check_placed(&path, transform.matrix())
+                .map_err(|e| format!("{e}, once the object's transform places it"))?;
             Shape::Mesh {
                 path,
                 model: Box::new(model),
@@ -231,7 +234,10 @@ fn object(
         }
         (None, Some(name), None, None) => Shape::Builtin(name),
         (None, None, Some(b), None) => {
-            if !(b.min.is_finite() && b.max.is_finite()) || b.min.cmpge(b.max).any() {
+            if let Some((corner, c)) = FarCoordinate::find([b.min, b.max]) {
+                return Err(format!("box {}: {c}", ["min", "max"][corner]));
+            }
+            if b.min.cmpge(b.max).any() {
                 return Err("box min must be below max".into());
             }
             Shape::Box {
@@ -247,8 +253,8 @@ fn object(
                         polygon.len()
                     ));
                 }
-                if polygon.iter().any(|v| !v.is_finite()) {
-                    return Err(format!("polygon {p}: a vertex is not finite"));
+                if let Some((v, c)) = FarCoordinate::find(polygon.iter().copied()) {
+                    return Err(format!("polygon {p}: vertex {v}: {c}"));
                 }
             }
             Shape::Polygons(polygons)
