@@ -528,3 +528,21 @@ fn a_still_camera_gathers_what_bevy_draws_later() {
         frames - switched
     );
 }
+
+/// The plugin's passes inside Bevy's frame (its RSM, quadtree, G-buffer translation, gather and
+/// composite on Bevy's device) under the Khronos validation layer with synchronization validation:
+/// the tests above, run again in a child process with the layer, print no message of it.
+#[test]
+fn the_plugin_passes_the_validation_layer() {
+    let mut rerun = std::process::Command::new(std::env::current_exe().unwrap());
+    rerun.args([
+        "--exact",
+        "plugin_matches_quadray_and_adds_light_only_where_it_should",
+        "a_still_camera_gathers_what_bevy_draws_later",
+        "--test-threads",
+        "1",
+    ]);
+    if let Err(problem) = quadray_gpu::validation::run_under_layer(&mut rerun, "the GI tests") {
+        panic!("{problem}");
+    }
+}

@@ -93,6 +93,10 @@ fn cases() -> Vec<Case> {
         run: Box::new(indirect_temporal),
     });
     cases.push(Case {
+        name: "indirect-output".into(),
+        run: Box::new(indirect_output),
+    });
+    cases.push(Case {
         name: "indirect-cut-view".into(),
         run: Box::new(indirect_cut_view),
     });
@@ -279,6 +283,40 @@ fn indirect_temporal(gpu: &Gpu, size: u32, done: Done) -> Result<()> {
         scene.camera.position = turn * scene.camera.position;
         scene.light.spot.direction = turn * scene.light.spot.direction;
         renderer.set_view(&scene);
+    }
+    Ok(())
+}
+
+/// The output pass into a caller's texture of each format it writes, after a frame.
+fn indirect_output(gpu: &Gpu, size: u32, done: Done) -> Result<()> {
+    let scene = Scene::cornell();
+    let settings = indirect_settings(size, |_| {});
+    let mut renderer = step(done, "setup", || {
+        Ok(IndirectRenderer::new(gpu, &scene, settings)?)
+    })?;
+    step(done, "frame", || {
+        Ok(renderer.render_frame(IndirectMethod::DEFAULT)?)
+    })?;
+    for format in [
+        wgpu::TextureFormat::Rgba32Float,
+        wgpu::TextureFormat::Rgba16Float,
+        wgpu::TextureFormat::Rgba8Unorm,
+    ] {
+        step(done, &format!("{format:?}"), || {
+            let pass = quadray_indirect::OutputPass::new(
+                &gpu.device,
+                format,
+                quadray_indirect::OutputTerm::Combined,
+            )?;
+            let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+            let texture =
+                quadray_gpu::texture_2d(&gpu.device, "output", (size, size), format, usage);
+            let view = texture.create_view(&Default::default());
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            gpu.checked(|| pass.record(&gpu.device, &mut encoder, renderer.gather(), &view))?;
+            gpu.submit(format!("the output pass into {format:?}"), encoder.finish());
+            Ok(gpu.wait("the output pass")?)
+        })?;
     }
     Ok(())
 }

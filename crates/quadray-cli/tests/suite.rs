@@ -14,3 +14,4 @@ mod raytrace_cli;
 mod scene_cli;
 mod slurm;
 mod tiles_cli;
+mod validation;

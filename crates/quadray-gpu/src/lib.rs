@@ -53,6 +53,80 @@ pub enum GpuError {
     Validation(String),
     #[error("{0}")]
     Setting(String),
+    #[error("{device} allows {limit} = {have}, but {needed_by} needs {needed}")]
+    Limit {
+        device: String,
+        limit: &'static str,
+        have: u64,
+        needed: u64,
+        needed_by: String,
+    },
+}
+
+/// An adapter limit that a technique's passes rely on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Limit {
+    /// The side of a 2-D texture.
+    TextureDimension2d,
+    /// The bytes of one storage-buffer binding.
+    StorageBufferBindingSize,
+    /// Storage buffers one shader stage binds.
+    StorageBuffersPerShaderStage,
+    /// Bytes of workgroup memory one compute workgroup declares.
+    ComputeWorkgroupStorageSize,
+}
+
+impl Limit {
+    /// wgpu's name of the limit.
+    pub fn name(self) -> &'static str {
+        match self {
+            Limit::TextureDimension2d => "max_texture_dimension_2d",
+            Limit::StorageBufferBindingSize => "max_storage_buffer_binding_size",
+            Limit::StorageBuffersPerShaderStage => "max_storage_buffers_per_shader_stage",
+            Limit::ComputeWorkgroupStorageSize => "max_compute_workgroup_storage_size",
+        }
+    }
+
+    /// Its value in `limits`.
+    pub fn of(self, limits: &wgpu::Limits) -> u64 {
+        match self {
+            Limit::TextureDimension2d => limits.max_texture_dimension_2d.into(),
+            Limit::StorageBufferBindingSize => limits.max_storage_buffer_binding_size,
+            Limit::StorageBuffersPerShaderStage => {
+                limits.max_storage_buffers_per_shader_stage.into()
+            }
+            Limit::ComputeWorkgroupStorageSize => limits.max_compute_workgroup_storage_size.into(),
+        }
+    }
+}
+
+/// What a setting or a pass needs of one [`Limit`].
+#[derive(Clone, Debug)]
+pub struct LimitNeed {
+    pub limit: Limit,
+    pub needed: u64,
+    /// The setting or pass that needs it, as the user would recognise it (`--size 9000x9000`).
+    pub needed_by: String,
+}
+
+/// Checks `needs` against a device's `limits` before anything is created, so that a device
+/// below them fails with the limit and the setting named, not with a validation error deep in a
+/// pass. `device` names it in the error.
+pub fn check_limits(
+    limits: &wgpu::Limits,
+    device: &str,
+    needs: &[LimitNeed],
+) -> Result<(), GpuError> {
+    match needs.iter().find(|n| n.needed > n.limit.of(limits)) {
+        Some(need) => Err(GpuError::Limit {
+            device: device.into(),
+            limit: need.limit.name(),
+            have: need.limit.of(limits),
+            needed: need.needed,
+            needed_by: need.needed_by.clone(),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Keeps Mesa's Vulkan device-selection layer from probing Wayland and X11 when a program that

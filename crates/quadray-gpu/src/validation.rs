@@ -7,11 +7,9 @@
 //! ```no_run
 //! let mut command = std::process::Command::new("target/release/quadray");
 //! command.args(["smoke", "--size", "16"]);
-//! quadray_gpu::validation::under_layer(&mut command);
-//! let output = command.output().unwrap();
-//! let report = quadray_gpu::validation::LayerReport::parse(&String::from_utf8_lossy(&output.stdout));
-//! assert!(report.active && report.synchronization, "the layer did not run");
-//! assert!(report.unexpected().is_empty(), "{}", report.describe_unexpected());
+//! if let Err(problem) = quadray_gpu::validation::run_under_layer(&mut command, "quadray smoke") {
+//!     panic!("{problem}"); // a VUID and its message, one a line
+//! }
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -47,6 +45,30 @@ pub fn under_layer(command: &mut Command) -> &mut Command {
     command
         .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
         .env("VK_LAYER_SETTINGS_PATH", settings_file())
+}
+
+/// Runs `command` under the layer and checks it: it succeeded, the layer ran, and it printed no
+/// error or warning that [`ALLOWED`] does not cover. The error says which, for `what`.
+pub fn run_under_layer(command: &mut Command, what: &str) -> Result<std::process::Output, String> {
+    if !layer_installed() {
+        return Err(format!(
+            "{what}: the Khronos validation layer is not installed (scripts/setup.sh: \
+             vulkan-validationlayers)"
+        ));
+    }
+    let output = under_layer(command)
+        .output()
+        .map_err(|e| format!("{what}: cannot start: {e}"))?;
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    LayerReport::parse(&stdout).check(what)?;
+    if !output.status.success() {
+        return Err(format!(
+            "{what} failed ({}): {stdout}{}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        ));
+    }
+    Ok(output)
 }
 
 /// Messages that are the layer's own fault, not quadray's, each with its reason: (VUID, a text
@@ -145,6 +167,24 @@ impl LayerReport {
             .collect()
     }
 
+    /// `Ok` when the layer ran with synchronization validation and printed nothing unexpected;
+    /// else what went wrong, for `what` (the program or test that ran).
+    pub fn check(&self, what: &str) -> Result<(), String> {
+        if !(self.active && self.synchronization) {
+            return Err(format!(
+                "{what}: the validation layer's status line with synchronization validation is \
+                 missing: the layer did not run (scripts/setup.sh installs vulkan-validationlayers)"
+            ));
+        }
+        match self.unexpected().len() {
+            0 => Ok(()),
+            n => Err(format!(
+                "{what}: {n} validation messages:\n{}",
+                self.describe_unexpected()
+            )),
+        }
+    }
+
     /// One line per unexpected message: its VUID and the start of its text.
     pub fn describe_unexpected(&self) -> String {
         self.unexpected()
@@ -158,12 +198,14 @@ impl LayerReport {
     }
 }
 
-/// `VUID(SEVERITY / TYPE): msgNum: ...` -> (VUID, SEVERITY).
+/// `VUID(SEVERITY / TYPE): msgNum: ...` -> (VUID, SEVERITY), also after other text on the line
+/// (the test harness's `test name ... ` before a message printed during the test).
 fn message_head(line: &str) -> Option<(&str, &str)> {
     let (head, _) = line.split_once("): msgNum:")?;
-    let (vuid, kind) = head.split_once('(')?;
+    let (before, kind) = head.rsplit_once('(')?;
     let (severity, _) = kind.split_once(" / ")?;
-    (!vuid.is_empty() && !vuid.contains(char::is_whitespace)).then_some((vuid, severity))
+    let vuid = before.rsplit(char::is_whitespace).next()?;
+    (!vuid.is_empty()).then_some((vuid, severity))
 }
 
 #[cfg(test)]
@@ -188,6 +230,7 @@ VUID_Undefined(WARN / SPEC): msgNum: 2044605652 - Validation Warning: [ VUID_Und
     Objects: 1
         [0] 0x55d6397177b0, type: 3, name: NULL
 displace-pyramid-build/point: done in 26.8 ms
+test examples::gi_gbuffer ... VUID_Undefined(WARN / SPEC): msgNum: 1 - Validation Warning: [ VUID_Undefined ] | Something else.
 ";
 
     #[test]
@@ -199,11 +242,13 @@ displace-pyramid-build/point: done in 26.8 ms
             vuids,
             [
                 "UNASSIGNED-CoreValidation-DrawState-InvalidImageLayout",
+                "VUID_Undefined",
                 "VUID_Undefined"
             ]
         );
         let unexpected = report.unexpected();
-        assert_eq!(unexpected.len(), 1);
+        assert_eq!(unexpected.len(), 2);
+        assert!(unexpected[1].text.ends_with("Something else."));
         assert!(unexpected[0].text.contains("mip level 1"));
         assert!(unexpected[0].text.ends_with("name: NULL"));
         assert!(report.describe_unexpected().starts_with(

@@ -520,6 +520,40 @@ fn subsampled_indirect_stays_close_to_full_resolution() {
     assert!(e.rel_l1 < 0.10, "{e:?}");
 }
 
+/// A device below what the settings need is refused before anything is created, naming the
+/// limit, the device's value and the setting: WebGL2-class limits (2048^2 textures, 4 storage
+/// buffers a stage, 16 KiB of workgroup memory) against 4096x4096 and the gather's buffers.
+#[test]
+fn a_device_below_the_settings_limits_is_refused_by_name() {
+    let mut settings = Settings::DEFAULT;
+    settings.size = quadray_indirect::Size::new(4096, 4096);
+    let needs = quadray_indirect::Gather::limit_needs(&settings);
+    let small = wgpu::Limits::downlevel_webgl2_defaults();
+    let error = quadray_gpu::check_limits(&small, "a WebGL2 device", &needs).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "a WebGL2 device allows max_texture_dimension_2d = 2048, but --size 4096x4096 needs 4096"
+    );
+    let default_needs = quadray_indirect::Gather::limit_needs(&Settings::DEFAULT);
+    let gles = wgpu::Limits::downlevel_defaults();
+    let error = quadray_gpu::check_limits(&gles, "a GLES device", &default_needs)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.starts_with("a GLES device allows max_storage_buffers_per_shader_stage = 4, but the gather passes needs"),
+        "{error}"
+    );
+    // lavapipe holds the defaults, but binds at most 128 MiB: not a vec4 a pixel at 4096x4096
+    let lavapipe = gpu().device.limits();
+    quadray_gpu::check_limits(&lavapipe, "lavapipe", &default_needs).unwrap();
+    let error = quadray_gpu::check_limits(&lavapipe, "lavapipe", &needs).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "lavapipe allows max_storage_buffer_binding_size = 134217728, but --size 4096x4096 \
+         needs 268435456"
+    );
+}
+
 /// Each refusal names the parameter and its range.
 #[test]
 fn absurd_settings_are_refused() {

@@ -1,10 +1,13 @@
 //! The viewer in a real window: under Xvfb with the software Vulkan driver it draws a few frames
 //! with a scripted camera, saves a screenshot and the command line that reproduces it, and that
-//! command, run headless by `quadray`, renders the same picture.
+//! command, run headless by `quadray`, renders the same picture. The viewer runs under the
+//! Khronos validation layer: its frames (surface, swapchain, both techniques' passes) print no
+//! message.
 //!
 //! Needs Xvfb (`scripts/setup.sh` installs it) and the `quadray` program built beside the viewer,
 //! as `cargo test --workspace` does.
 
+use quadray_gpu::validation;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -59,14 +62,21 @@ impl Drop for Xvfb {
     }
 }
 
-/// Runs `program args` on the display and waits (at most `limit`) for it to succeed.
+/// Runs `program args` on the display under the Khronos validation layer and waits (at most
+/// `limit`) for it to succeed with no message of the layer.
 fn run_on(display: &str, program: &Path, args: &[&str], limit: Duration) {
-    let mut child = Command::new(program)
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let log = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("xvfb-{}-{run}.log", std::process::id()));
+    let mut command = Command::new(program);
+    validation::under_layer(&mut command);
+    let mut child = command
         .args(args)
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
         .env("RUST_LOG", "error")
-        .stdout(Stdio::null())
+        .stdout(std::fs::File::create(&log).unwrap())
         .spawn()
         .unwrap_or_else(|e| panic!("start {}: {e}", program.display()));
     let deadline = Instant::now() + limit;
@@ -77,6 +87,11 @@ fn run_on(display: &str, program: &Path, args: &[&str], limit: Duration) {
                 "{} {args:?} failed: {status}",
                 program.display()
             );
+            let printed = std::fs::read_to_string(&log).unwrap();
+            let what = format!("{} {args:?}", program.display());
+            if let Err(problem) = validation::LayerReport::parse(&printed).check(&what) {
+                panic!("{problem}");
+            }
             return;
         }
         if Instant::now() > deadline {

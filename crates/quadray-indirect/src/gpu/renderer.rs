@@ -39,6 +39,8 @@ impl<'g> Renderer<'g> {
     /// picture with [`IndirectError::Settings`].
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: Settings) -> Result<Self, IndirectError> {
         settings.validate().map_err(IndirectError::Settings)?;
+        let needs = Gather::limit_needs(&settings);
+        quadray_gpu::check_limits(&gpu.device.limits(), &gpu.describe(), &needs)?;
         let (d, q) = (&gpu.device, &gpu.queue);
         let renderer = gpu.checked(|| {
             let rsm = RsmPass::new(d, settings.rsm_size);

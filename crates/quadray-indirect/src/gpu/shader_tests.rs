@@ -103,3 +103,42 @@ fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
         assert!(seen.contains(s.wgsl), "no shader declares {}", s.wgsl);
     }
 }
+
+/// The limits [`super::Gather::limit_needs`] declares are the shaders' own: the most storage
+/// buffers one shader binds, and the per-tile kernel's workgroup memory.
+#[test]
+fn the_declared_limit_needs_are_the_shaders() {
+    use super::gather::{STORAGE_BUFFERS_PER_STAGE, TILE_WORKGROUP_BYTES};
+    let mut most_storage = (0, "");
+    for (name, parts) in super::shaders() {
+        let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
+        let module = naga::front::wgsl::parse_str(&shader_source(&parts)).unwrap();
+        let storage = module
+            .global_variables
+            .iter()
+            .filter(|(_, v)| matches!(v.space, naga::AddressSpace::Storage { .. }))
+            .count() as u64;
+        if storage > most_storage.0 {
+            most_storage = (storage, name);
+        }
+        if name == "gather tiles" {
+            let mut layouter = naga::proc::Layouter::default();
+            layouter.update(module.to_ctx()).unwrap();
+            let workgroup: u64 = module
+                .global_variables
+                .iter()
+                .filter(|(_, v)| v.space == naga::AddressSpace::WorkGroup)
+                .map(|(_, v)| u64::from(layouter[v.ty].size))
+                .sum();
+            assert_eq!(
+                workgroup, TILE_WORKGROUP_BYTES,
+                "the per-tile kernel's workgroup memory"
+            );
+        }
+    }
+    assert_eq!(
+        most_storage.0, STORAGE_BUFFERS_PER_STAGE,
+        "storage buffers of `{}`, the most of any shader",
+        most_storage.1
+    );
+}

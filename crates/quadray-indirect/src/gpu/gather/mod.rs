@@ -18,10 +18,11 @@ mod temporal;
 mod tiles;
 mod upsample;
 
+use super::contract::GpuNode;
 use super::contract::compute_pass;
 use super::gbuffer::GBufferViews;
 use super::light::Spot;
-use super::quadtree::LightQuadtree;
+use super::quadtree::{LightQuadtree, node_count};
 use super::rsm::RsmViews;
 use crate::IndirectError;
 use crate::settings::{Method, Settings};
@@ -29,7 +30,7 @@ use brute_force::BruteForce;
 use cut::Cut;
 use direct::Direct;
 use passes::Passes;
-use quadray_gpu::GpuTimer;
+use quadray_gpu::{GpuTimer, Limit, LimitNeed};
 use resources::Resources;
 use rsm_sampling::RsmSampling;
 use temporal::Temporal;
@@ -52,6 +53,12 @@ pub(crate) fn shaders() -> Vec<(&'static str, Vec<&'static str>)> {
     ]
 }
 
+/// Storage buffers the most demanding pass binds in its compute stage (the contract test counts
+/// every shader's).
+pub(crate) const STORAGE_BUFFERS_PER_STAGE: u64 = 16;
+/// Workgroup memory of the per-tile cuts' kernel in bytes (the contract test sums its variables).
+pub(crate) const TILE_WORKGROUP_BYTES: u64 = 15_492;
+
 /// The shading passes and the radiance they write, at one set of sizes.
 pub struct Gather {
     res: Resources,
@@ -65,6 +72,47 @@ pub struct Gather {
 }
 
 impl Gather {
+    /// What the passes of `settings` need of the device's limits, each with the setting or the
+    /// pass that needs it; [`Gather::new`] checks them first.
+    pub fn limit_needs(settings: &Settings) -> Vec<LimitNeed> {
+        let s = settings;
+        let size = format!("--size {}x{}", s.size.width, s.size.height);
+        let rsm = format!("--rsm-size {}", s.rsm_size);
+        let need = |limit, needed, needed_by: &str| LimitNeed {
+            limit,
+            needed,
+            needed_by: needed_by.into(),
+        };
+        let pixels = u64::from(s.size.width) * u64::from(s.size.height);
+        let nodes = node_count(s.rsm_size) * size_of::<GpuNode>() as u64;
+        let side = s.size.width.max(s.size.height).into();
+        vec![
+            need(Limit::TextureDimension2d, side, &size),
+            need(Limit::TextureDimension2d, s.rsm_size.into(), &rsm),
+            // a vec4 of radiance a pixel
+            need(Limit::StorageBufferBindingSize, pixels * 16, &size),
+            need(Limit::StorageBufferBindingSize, nodes, &rsm),
+            need(
+                Limit::StorageBufferBindingSize,
+                s.tile_list_bytes(),
+                &format!(
+                    "{size} with --tile-capacity {}",
+                    s.tile_capacity_or_default()
+                ),
+            ),
+            need(
+                Limit::StorageBuffersPerShaderStage,
+                STORAGE_BUFFERS_PER_STAGE,
+                "the gather passes",
+            ),
+            need(
+                Limit::ComputeWorkgroupStorageSize,
+                TILE_WORKGROUP_BYTES,
+                "the per-tile cuts (--method quadtree-tiles)",
+            ),
+        ]
+    }
+
     /// The gather of `settings` (sizes, samples, subsampling) reading `quadtree`, the RSM it was
     /// built from and the caller's G-buffer (`settings.size`).
     pub fn new(
@@ -75,6 +123,7 @@ impl Gather {
         gbuffer: GBufferViews,
     ) -> Result<Self, IndirectError> {
         settings.validate().map_err(IndirectError::Settings)?;
+        quadray_gpu::check_limits(&device.limits(), "the device", &Self::limit_needs(settings))?;
         let res = Resources::new(device, settings, quadtree, rsm, gbuffer);
         Ok(Self {
             cut: Cut::new(device, &res),
