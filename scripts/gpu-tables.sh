@@ -9,7 +9,7 @@
 # (two paired rounds, Bevy's render diagnostics), then, while the time budget lasts, the paper
 # tables of `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
 # name from the adapter, e.g. bench/nvidia-h200/) with every stats file and a summary.md of the
-# tables, and packs it into gpu-tables.tar.gz beside it (a device call returns few files).
+# tables, and packs it into gpu-tables.tar.gz beside it (one file to copy off the machine).
 #
 #   scripts/gpu-tables.sh [--quick] [--smoke-only] [--smoke REGEX] [--bin PATH] [--bevy-bin PATH]
 #                         [--out DIR] [--budget SECONDS]

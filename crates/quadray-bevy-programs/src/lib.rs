@@ -14,8 +14,8 @@ use bevy::winit::WinitPlugin;
 use std::time::Duration;
 
 /// Bevy's asset plugin reading the repository's `assets/<folder>`: under `BEVY_ASSET_ROOT` when
-/// that is set (Bevy's own variable; for a binary run outside the checkout it was built in, as on
-/// a lent GPU), else in the checkout it was built in.
+/// that is set (Bevy's own variable; for a binary copied to another machine and run outside the
+/// checkout it was built in), else in the checkout it was built in.
 pub fn repository_assets(folder: &str) -> AssetPlugin {
     let root = match std::env::var_os("BEVY_ASSET_ROOT") {
         // Bevy joins a relative path to BEVY_ASSET_ROOT itself

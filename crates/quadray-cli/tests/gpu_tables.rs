@@ -1,6 +1,6 @@
-//! `scripts/gpu-tables.sh`, the one command that refreshes the GPU tables when a GPU is lent,
+//! `scripts/gpu-tables.sh`, the one command that refreshes the GPU tables on a machine with a GPU,
 //! tried on whatever adapter the suite has (lavapipe) in its quick mode, so that it still runs
-//! the day a GPU comes: every table row written, the results packed for the device call.
+//! the day a GPU comes: the smoke stage's lines, every table row written, the results packed.
 
 use crate::common::scratch;
 use std::path::Path;
