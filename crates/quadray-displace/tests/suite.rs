@@ -5,3 +5,4 @@
 mod common;
 mod gpu_vs_reference;
 mod height_maps;
+mod non_finite;

@@ -5,5 +5,6 @@
 mod counts;
 mod gpu;
 mod layers;
+mod non_finite;
 mod output;
 mod visibility;

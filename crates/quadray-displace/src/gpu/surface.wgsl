@@ -129,8 +129,10 @@ fn linear_search(p0: vec2f, e: vec2f, view_z: f32) -> Bracket {
     var d = depth_bilinear(depth_map, surface.pyramid, p0);
     b.fetches = BILINEAR_FETCHES;
     b.gap_above = d;
-    // The ray is at or below every surface point by z = 1, so this ends after `layers` steps.
-    while b.z_below < d && f32(b.steps) < layers + 2.0 {
+    // The ray is at or below every surface point by z = 1, so this ends after `layers` steps;
+    // the integer bound holds where a NaN view direction makes `layers` NaN.
+    let max_steps = u32(frame.layers_max) + 1u;
+    while b.z_below < d && f32(b.steps) < layers + 2.0 && b.steps <= max_steps {
         b.z_above = b.z_below;
         b.gap_above = d - b.z_above;
         b.z_below += dz;

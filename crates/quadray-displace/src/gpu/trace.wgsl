@@ -103,6 +103,13 @@ fn pyramid_trace(pyramid: texture_2d<f32>, info: PyramidInfo, p0: vec2f, e: vec2
     let delta = 0.001;
     var t: TraceHit;
     t.z = z_start;
+    // A ray that is not a number (NaN or infinite p0 or e: a degenerate tangent frame) meets
+    // nothing, at once rather than after up to the whole iteration cap. Tested on the exponent
+    // bits: WGSL lets a compiler assume that floats are never NaN and fold a float test away.
+    if any((bitcast<vec4u>(vec4f(p0, e)) & vec4u(0x7f800000u)) == vec4u(0x7f800000u)) {
+        t.missed = true;
+        return t;
+    }
     // Start no coarser than the ray needs: on levels whose nodes exceed the ray's footprint a read
     // can barely move it, so each such level costs a read for little. The trace is exact from any
     // level (every node bounds all the texels below it); nodes of about half the footprint
@@ -255,7 +262,8 @@ fn bilinear_trace(pyramid: texture_2d<f32>, depth_map: texture_2d<f32>, info: Py
         if t.missed || t.capped {
             break;
         }
-        if round >= round_cap {
+        // The iteration cap bounds the whole trace, not each search in it.
+        if round >= round_cap || t.iterations >= info.iteration_cap {
             t.capped = true;
             break;
         }

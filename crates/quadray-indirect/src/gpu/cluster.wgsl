@@ -27,17 +27,20 @@ fn pack(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let t = vec2<i32>(id.xy);
+    let flux = textureLoad(rsm_flux, t, 0).rgb;
+    let pos = textureLoad(rsm_pos, t, 0);
     let n = textureLoad(rsm_normal, t, 0);
+    // a texel the kernel cannot take (NaN, infinite, a zero normal) packs as a cleared one
+    let vpl = n.w > 0.5 && kernel_vpl(flux, pos, n.xyz);
     var node: Node;
-    node.flux = vec4<f32>(textureLoad(rsm_flux, t, 0).rgb, n.w);
-    node.pos = textureLoad(rsm_pos, t, 0);
-    node.normal = vec4<f32>(n.xyz, 1.0);
+    node.flux = select(vec4<f32>(0.0), vec4<f32>(flux, n.w), vpl);
+    node.pos = select(vec4<f32>(0.0), pos, vpl);
+    node.normal = vec4<f32>(select(vec3<f32>(0.0), n.xyz, vpl), 1.0);
     let index = node_index(params, 0u, id.xy);
     nodes[index] = node;
     // a VPL: a box and a cone of zero size; an empty texel: an empty box
-    let empty = n.w < 0.5;
-    let lo = select(node.pos.xyz, vec3<f32>(EMPTY_BOX), empty);
-    let hi = select(node.pos.xyz, vec3<f32>(-EMPTY_BOX), empty);
+    let lo = select(vec3<f32>(EMPTY_BOX), node.pos.xyz, vpl);
+    let hi = select(vec3<f32>(-EMPTY_BOX), node.pos.xyz, vpl);
     bounds[index] = NodeBounds(vec4<f32>(lo, 1.0), vec4<f32>(hi, 0.0));
 }
 

@@ -15,7 +15,10 @@ fn texel_irradiance(t: vec2<i32>, r: Receiver, r_min: f32) -> vec3<f32> {
         fetches += 2u;
         let p = load_rsm_position(t);
         let flux = load_rsm_flux(t);
-        e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, r_min);
+        // (a texel the kernel cannot take is empty, as the quadtree packs it)
+        if (kernel_vpl(flux, p, n.xyz)) {
+            e = vpl_irradiance(flux, p.xyz, n.xyz, r.x, r.n, r_min);
+        }
     }
     return e;
 }

@@ -5,6 +5,25 @@ fn luminance(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
 
+// Whether every component of v is a finite number, read from the exponent bits: WGSL lets a
+// compiler assume that floats are never NaN or infinite and fold a float test (v != v) away.
+fn all_finite(v: vec4<f32>) -> bool {
+    return all((bitcast<vec4<u32>>(v) & vec4<u32>(0x7f800000u)) != vec4<u32>(0x7f800000u));
+}
+
+// Whether a surface point x with normal n can enter the kernel (a receiver, a VPL): x finite, n
+// finite and not zero (a degenerate triangle's). Callers take any other texel as empty: its NaN
+// would reach every sum, cluster and tile it joins.
+fn kernel_point(x: vec3<f32>, n: vec3<f32>) -> bool {
+    let n2 = dot(n, n);
+    return all_finite(vec4<f32>(x, n2)) && n2 > 0.0;
+}
+
+// Whether an RSM texel (flux, position and depth, normal) can enter the kernel as a VPL.
+fn kernel_vpl(flux: vec3<f32>, pos: vec4<f32>, n: vec3<f32>) -> bool {
+    return kernel_point(pos.xyz, n) && all_finite(vec4<f32>(flux, pos.w));
+}
+
 // Irradiance at x (normal n) from a VPL or cluster of flux `flux` at xp (normal np), with the
 // 1/r^4 clamped at r_min (the spec's kernel; the reference uses the same). A diffuse VPL radiates
 // flux / pi * cos: the 1/pi the spec's formula (after the RSM paper) leaves out is put back so

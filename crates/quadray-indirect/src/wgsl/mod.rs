@@ -22,8 +22,9 @@ pub fn prelude() -> String {
 pub const NODE: &str = include_str!("node.wgsl");
 
 /// The VPL kernel: `vpl_irradiance` (a VPL or cluster's irradiance at a receiver, 1/r^4 clamped
-/// at `r_min`), `vpl_vector` (its vector irradiance) and `luminance`. Needs [`NODE`]. Accessors:
-/// none.
+/// at `r_min`), `vpl_vector` (its vector irradiance), `luminance`, and what it may be given:
+/// `kernel_point` (a receiver: finite, a non-zero normal), `kernel_vpl` (an RSM texel) and
+/// `all_finite`. Needs [`NODE`]. Accessors: none.
 pub const KERNEL: &str = include_str!("kernel.wgsl");
 
 /// The spot light: the `Light` uniform's layout, `spot_intensity` and `light_depth` (the RSM's

@@ -99,7 +99,9 @@ fn receiver(pixel: vec2<u32>) -> Receiver {
     r.x = p.xyz;
     r.n = textureLoad(g_normal, t, 0).xyz;
     r.albedo = textureLoad(g_albedo, t, 0).rgb;
-    r.covered = p.w > 0.5;
+    // a texel the kernel cannot take sees no geometry: its NaN would spread through its tile's
+    // cut and the neighbours that upsample or reproject from it
+    r.covered = p.w > 0.5 && kernel_point(r.x, r.n);
     return r;
 }
 

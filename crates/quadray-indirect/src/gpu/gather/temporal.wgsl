@@ -23,14 +23,13 @@ fn temporal_blend(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let index = pixel_index(id.xy);
     let now = indirect[index];
-    let p = textureLoad(g_pos, vec2<i32>(id.xy), 0);
-    if (p.w <= 0.5) {
+    let r = receiver(id.xy);
+    if (!r.covered) {
         history[index] = vec4<f32>(now.rgb, 0.0);
         history_normal[index] = vec4<f32>(0.0);
         return;
     }
-    let n = textureLoad(g_normal, vec2<i32>(id.xy), 0).xyz;
-    let then = previous_view_proj * vec4<f32>(p.xyz, 1.0);
+    let then = previous_view_proj * vec4<f32>(r.x, 1.0);
     var sum = vec3<f32>(0.0);
     var weight = 0.0;
     if (then.w > 0.0) {
@@ -47,7 +46,7 @@ fn temporal_blend(@builtin(global_invocation_id) id: vec3<u32>) {
                 let h = previous[i];
                 let w = mix(1.0 - f, f, offset);
                 let same_depth = h.w > 0.0 && abs(h.w - then.w) <= SAME_SURFACE * then.w;
-                if (same_depth && dot(previous_normal[i].xyz, n) >= shade.normal_agreement) {
+                if (same_depth && dot(previous_normal[i].xyz, r.n) >= shade.normal_agreement) {
                     sum += w.x * w.y * h.rgb;
                     weight += w.x * w.y;
                 }
@@ -58,8 +57,8 @@ fn temporal_blend(@builtin(global_invocation_id) id: vec3<u32>) {
     if (weight > 0.01) {
         average = mix(sum / weight, now.rgb, shade.temporal_weight);
     }
-    let depth = (viewer.view_proj * vec4<f32>(p.xyz, 1.0)).w;
+    let depth = (viewer.view_proj * vec4<f32>(r.x, 1.0)).w;
     history[index] = vec4<f32>(average, depth);
-    history_normal[index] = vec4<f32>(n, 0.0);
+    history_normal[index] = vec4<f32>(r.n, 0.0);
     indirect[index] = vec4<f32>(average, now.w);
 }
