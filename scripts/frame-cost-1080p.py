@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The frame cost at 1920x1080 on the tile map (issue 13): per method and view angle the mean
+"""The frame cost at 1920x1080 on the tile map: per method and view angle the mean
 iterations and texel fetches per pixel that `quadray displace` counts in the shader, then GPU-time
 ratios to POM-16 from paired rounds (each round times every method once, in turn, so slow phases
 of a shared machine hit all of them; the ratio is the median over rounds of the per-round ratios).

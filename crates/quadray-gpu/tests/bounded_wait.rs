@@ -105,20 +105,8 @@ fn a_shader_that_never_ends_is_an_error_within_the_bound() {
         std::thread::sleep(Duration::from_millis(50));
     };
     let took = start.elapsed();
-    let mut stdout = String::new();
-    child
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut stdout)
-        .unwrap();
-    let mut stderr = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut stderr)
-        .unwrap();
+    let stdout = read_all(child.stdout.take());
+    let stderr = read_all(child.stderr.take());
     assert!(status.success(), "{stdout}{stderr}");
     let line = stdout
         .lines()
@@ -153,13 +141,7 @@ fn an_absurd_bound_is_refused_by_name() {
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut stdout = String::new();
-    child
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut stdout)
-        .unwrap();
+    let stdout = read_all(child.stdout.take());
     assert!(child.wait().unwrap().success(), "{stdout}");
     assert!(
         stdout.contains(
@@ -190,4 +172,11 @@ fn the_timer_resolves_only_the_passes_that_wrote() {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     timer.resolve(&mut encoder);
     assert!(timer.passes_to_resolve().is_empty());
+}
+
+/// All that a child's pipe gives until it closes.
+fn read_all(pipe: Option<impl Read>) -> String {
+    let mut text = String::new();
+    pipe.unwrap().read_to_string(&mut text).unwrap();
+    text
 }

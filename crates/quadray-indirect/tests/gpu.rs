@@ -415,7 +415,7 @@ fn near_field_nodes_are_split_by_their_bound() {
 #[test]
 fn shared_far_clusters_are_exact_at_tile_corners_and_cut_evaluations() {
     let gpu = gpu();
-    // the 128x128 picture: at 64x64 a tile spans twice the room and little is far
+    // a 128x128 picture: at 64x64 a tile spans twice the room and little is far
     let side = 128;
     let sized = || Settings {
         samples: 64,

@@ -359,7 +359,7 @@ fn options(scheme: SchemeChoice, nth: Nth) -> RunOptions {
     }
 }
 
-/// The bar, at most 1e-4 of the shading points, rounded up to whole points on these small
+/// The bar, at most 1e-4 of the shading points, rounded up to whole points on these small
 /// test images (grazing light can still flip a rare point in the pure shadow-volume mode).
 fn assert_same_as_conventional(scene: &Scene, what: &str) {
     for (scheme, nth) in [

@@ -227,7 +227,7 @@ pub fn pyramid_build(bench: &Bench, tiles: &HeightMap) -> Result<Table, Displace
     Ok(build)
 }
 
-/// Relaxed cone stepping's preprocessing at the sizes the issue names: the cone map built on the
+/// Relaxed cone stepping's preprocessing at 1024^2, 2048^2 and 4096^2: the cone map built on the
 /// CPU (all cores), median seconds of a few builds (each takes seconds: no warm-up build).
 pub fn cone_build(bench: &Bench, tiles: &HeightMap) -> Result<Table, DisplaceError> {
     let runs = if bench.quick { 3 } else { 5 };

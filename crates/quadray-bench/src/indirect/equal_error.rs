@@ -66,7 +66,7 @@ pub struct EqualErrorOptions {
 }
 
 impl EqualErrorOptions {
-    /// The setting: 128x128 images, 256^2 and 512^2 RSMs; quick: 64x64 and 64^2.
+    /// The study's setting: 128x128 images, 256^2 and 512^2 RSMs; quick: 64x64 and 64^2.
     pub fn new(quick: bool, size: Option<u32>, rsm_size: Option<u32>, scenes: Vec<String>) -> Self {
         let rsm_sizes = match (rsm_size, quick) {
             (Some(s), _) => vec![s],
