@@ -1,10 +1,9 @@
 //! The methods `quadray displace --method` accepts, each described once in [`DESCRIPTIONS`]: its
-//! name, help line, ground truth, how a caption spells its budget, and the settings the demo and
-//! the benchmarks run it with. The command line's choices, the captions and every benchmark's
-//! list of methods are read from there.
+//! name, help line, ground truth and how a caption spells its budget. The command line's choices,
+//! the captions and every benchmark's list of methods are read from there; the settings the demo
+//! and the benchmarks run each with are [`crate::Settings`]'s (`Method::shown`, `Method::timed`).
 
 use crate::reference::Surface;
-use crate::settings::{Layers, Settings};
 use std::fmt;
 use std::str::FromStr;
 
@@ -67,39 +66,7 @@ pub struct Description {
     pub conservative_pyramid: bool,
     /// How its caption spells its budget.
     pub budget: Budget,
-    /// The settings the demo and the accuracy tables show it with: the budget an engine ships
-    /// where one does.
-    pub shown: Settings,
-    /// The settings the timing tables run: the paper's 16 layers (and 5 binary steps) where
-    /// layers count, the chapter's budget for cone stepping.
-    pub timed: Settings,
 }
-
-/// The paper's equal budget for the timing tables.
-const fn sixteen_layers(method: Method) -> Settings {
-    Settings {
-        method,
-        layers: Layers { min: 16, max: 16 },
-        binary_steps: 5,
-        ..Settings::DEFAULT
-    }
-}
-
-const fn defaults(method: Method) -> Settings {
-    Settings {
-        method,
-        ..Settings::DEFAULT
-    }
-}
-
-/// Relaxed cone step mapping with 15 cone steps and 8 binary steps: a fixed budget in the range
-/// the chapter's shaders use.
-const RELAXED_CONE: Settings = Settings {
-    method: Method::Cone,
-    layers: Layers { min: 15, max: 15 },
-    binary_steps: 8,
-    ..Settings::DEFAULT
-};
 
 /// Every method's description, in [`Method`]'s order.
 pub const DESCRIPTIONS: [Description; 9] = [
@@ -111,8 +78,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: true,
         conservative_pyramid: false,
         budget: Budget::None,
-        shown: defaults(Method::Pyramid),
-        timed: sixteen_layers(Method::Pyramid),
     },
     Description {
         method: Method::PyramidAscend,
@@ -122,8 +87,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: true,
         conservative_pyramid: false,
         budget: Budget::None,
-        shown: defaults(Method::PyramidAscend),
-        timed: sixteen_layers(Method::PyramidAscend),
     },
     Description {
         method: Method::PyramidBilinear,
@@ -133,8 +96,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: true,
         conservative_pyramid: true,
         budget: Budget::None,
-        shown: defaults(Method::PyramidBilinear),
-        timed: sixteen_layers(Method::PyramidBilinear),
     },
     Description {
         method: Method::Bump,
@@ -144,8 +105,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: false,
         conservative_pyramid: false,
         budget: Budget::None,
-        shown: defaults(Method::Bump),
-        timed: sixteen_layers(Method::Bump),
     },
     Description {
         method: Method::Parallax,
@@ -155,8 +114,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: true,
         conservative_pyramid: false,
         budget: Budget::None,
-        shown: defaults(Method::Parallax),
-        timed: sixteen_layers(Method::Parallax),
     },
     Description {
         method: Method::Pom,
@@ -166,12 +123,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: true,
         conservative_pyramid: false,
         budget: Budget::Layers,
-        // As Bevy ships it: 16 layers at grazing angles down to 1 head-on.
-        shown: Settings {
-            layers: Layers { min: 1, max: 16 },
-            ..defaults(Method::Pom)
-        },
-        timed: sixteen_layers(Method::Pom),
     },
     Description {
         method: Method::Relief,
@@ -181,13 +132,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: true,
         conservative_pyramid: false,
         budget: Budget::LayersAndBinary,
-        // As three.js's example ships it: 20..25 layers and 5 binary steps.
-        shown: Settings {
-            layers: Layers { min: 20, max: 25 },
-            binary_steps: 5,
-            ..defaults(Method::Relief)
-        },
-        timed: sixteen_layers(Method::Relief),
     },
     Description {
         method: Method::Cone,
@@ -197,8 +141,6 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: true,
         conservative_pyramid: false,
         budget: Budget::ConeSteps,
-        shown: RELAXED_CONE,
-        timed: RELAXED_CONE,
     },
     Description {
         method: Method::Mesh,
@@ -208,18 +150,15 @@ pub const DESCRIPTIONS: [Description; 9] = [
         searches: false,
         conservative_pyramid: false,
         budget: Budget::None,
-        shown: defaults(Method::Mesh),
-        timed: sixteen_layers(Method::Mesh),
     },
 ];
 
-// Each description sits at its method's index and its settings run that method.
+// Each description sits at its method's index.
 const _: () = {
     let mut i = 0;
     while i < DESCRIPTIONS.len() {
         let d = &DESCRIPTIONS[i];
         assert!(d.method as usize == i);
-        assert!(d.shown.method as usize == i && d.timed.method as usize == i);
         i += 1;
     }
 };
@@ -266,16 +205,6 @@ impl Method {
     /// See [`Description::truth`].
     pub fn truth(self) -> Option<Surface> {
         self.describe().truth
-    }
-
-    /// See [`Description::shown`].
-    pub fn shown(self) -> Settings {
-        self.describe().shown.clone()
-    }
-
-    /// See [`Description::timed`].
-    pub fn timed(self) -> Settings {
-        self.describe().timed.clone()
     }
 }
 

@@ -304,7 +304,7 @@ fn interpolated_attributes(triangle: &[Vertex], weights: [f64; 3]) -> (DVec2, [D
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Size;
+    use quadray_core::settings::Size;
 
     /// The torus's MikkTSpace tangents follow the surface's own parameter directions: +u around
     /// the ring, +v around the tube (a flipped sign or a swapped axis would trace every ray the

@@ -169,6 +169,56 @@ pub struct Settings {
     pub show_iterations: bool,
 }
 
+impl Method {
+    /// The settings the demo and the accuracy tables show the method with: the budget an engine
+    /// ships where one does.
+    pub fn shown(self) -> Settings {
+        match self {
+            // As Bevy ships it: 16 layers at grazing angles down to 1 head-on.
+            Method::Pom => Settings {
+                layers: Layers { min: 1, max: 16 },
+                method: self,
+                ..Settings::DEFAULT
+            },
+            // As three.js's example ships it: 20..25 layers and 5 binary steps.
+            Method::Relief => Settings {
+                layers: Layers { min: 20, max: 25 },
+                binary_steps: 5,
+                method: self,
+                ..Settings::DEFAULT
+            },
+            Method::Cone => RELAXED_CONE,
+            _ => Settings {
+                method: self,
+                ..Settings::DEFAULT
+            },
+        }
+    }
+
+    /// The settings the timing tables run: the paper's 16 layers (and 5 binary steps) where
+    /// layers count, the chapter's budget for cone stepping.
+    pub fn timed(self) -> Settings {
+        match self {
+            Method::Cone => RELAXED_CONE,
+            _ => Settings {
+                layers: Layers { min: 16, max: 16 },
+                binary_steps: 5,
+                method: self,
+                ..Settings::DEFAULT
+            },
+        }
+    }
+}
+
+/// Relaxed cone step mapping with 15 cone steps and 8 binary steps: a fixed budget in the range
+/// the chapter's shaders use.
+const RELAXED_CONE: Settings = Settings {
+    method: Method::Cone,
+    layers: Layers { min: 15, max: 15 },
+    binary_steps: 8,
+    ..Settings::DEFAULT
+};
+
 impl Settings {
     /// Every parameter's default (the flags' defaults too).
     pub const DEFAULT: Settings = Settings {

@@ -4,6 +4,7 @@
 
 mod counts;
 mod gpu;
+mod layering;
 mod layers;
 mod non_finite;
 mod output;

@@ -1,7 +1,6 @@
 //! The height pyramid as a GPU resource on the caller's device: what a shader including
 //! `trace.wgsl` reads.
 
-use super::pyramid_build::PyramidBuilder;
 use crate::heightmap::HeightMap;
 use crate::pyramid::{Addressing, Pyramid};
 
@@ -83,17 +82,6 @@ impl HeightPyramid {
             PyramidKind::Conservative(addressing) => Pyramid::build_conservative(map, addressing),
         };
         Self::upload(device, queue, &pyramid, kind)
-    }
-
-    /// Builds the pyramid with compute passes (bit-identical to [`HeightPyramid::build_cpu`]);
-    /// keep a [`PyramidBuilder`] instead to build many.
-    pub fn build_gpu(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        map: &HeightMap,
-        kind: PyramidKind,
-    ) -> Self {
-        PyramidBuilder::new(device).build(device, queue, map, kind)
     }
 
     /// Uploads every level of a pyramid built on the CPU; `kind` says which one it is.

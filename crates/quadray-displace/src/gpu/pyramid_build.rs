@@ -5,6 +5,19 @@ use super::height_pyramid::{HeightPyramid, PyramidKind};
 use crate::heightmap::HeightMap;
 use crate::pyramid::{Addressing, level_size};
 
+impl HeightPyramid {
+    /// Builds the pyramid with compute passes (bit-identical to [`HeightPyramid::build_cpu`]);
+    /// keep a [`PyramidBuilder`] instead to build many.
+    pub fn build_gpu(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        map: &HeightMap,
+        kind: PyramidKind,
+    ) -> Self {
+        PyramidBuilder::new(device).build(device, queue, map, kind)
+    }
+}
+
 /// Builds min-depth pyramids on the GPU; keeps its pipelines for any number of maps.
 pub struct PyramidBuilder {
     reduce: wgpu::ComputePipeline,
