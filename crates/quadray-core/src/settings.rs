@@ -39,6 +39,9 @@ pub struct Limits<T> {
     pub min: T,
     pub max: T,
     pub min_excluded: bool,
+    /// The part of the range an interactive control spans, where the whole range is too wide to
+    /// pick from (a threshold up to `f32::MAX`); `None`: all of it.
+    pub interactive: Option<(T, T)>,
 }
 
 impl<T: Number> Limits<T> {
@@ -48,6 +51,7 @@ impl<T: Number> Limits<T> {
             min,
             max,
             min_excluded: false,
+            interactive: None,
         }
     }
 
@@ -57,7 +61,22 @@ impl<T: Number> Limits<T> {
             min,
             max,
             min_excluded: true,
+            interactive: None,
         }
+    }
+
+    /// These limits with `min..=max` as the part an interactive control spans (the viewer's
+    /// sliders).
+    pub const fn interactive(self, min: T, max: T) -> Self {
+        Self {
+            interactive: Some((min, max)),
+            ..self
+        }
+    }
+
+    /// The range an interactive control spans: [`Limits::interactive`]'s, else the limits'.
+    pub fn interactive_range(&self) -> (T, T) {
+        self.interactive.unwrap_or((self.min, self.max))
     }
 
     pub fn contains(&self, value: T) -> bool {

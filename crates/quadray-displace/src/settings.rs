@@ -52,7 +52,7 @@ pub struct Layers {
 
 impl Layers {
     /// Either count.
-    pub const COUNT: Limits<u32> = Limits::closed(1, 4096);
+    pub const COUNT: Limits<u32> = Limits::closed(1, 4096).interactive(1, 256);
 
     /// Both counts within [`Layers::COUNT`], `min` not above `max`.
     pub fn check(&self) -> Result<(), String> {
@@ -241,13 +241,13 @@ impl Settings {
     /// Either side of [`Settings::size`].
     pub const SIDE: Limits<u32> = Limits::closed(1, 8192);
     /// [`Settings::depth_scale`]: a flat surface makes no search.
-    pub const DEPTH_SCALE: Limits<f32> = Limits::above(0.0, 10.0);
+    pub const DEPTH_SCALE: Limits<f32> = Limits::above(0.0, 10.0).interactive(0.01, 0.5);
     /// [`Settings::binary_steps`].
-    pub const BINARY_STEPS: Limits<u32> = Limits::closed(0, 64);
+    pub const BINARY_STEPS: Limits<u32> = Limits::closed(0, 64).interactive(0, 16);
     /// [`Settings::azimuth_deg`] and [`Settings::light_azimuth_deg`]: any finite angle.
-    pub const AZIMUTH: Limits<f32> = Limits::closed(-f32::MAX, f32::MAX);
+    pub const AZIMUTH: Limits<f32> = Limits::closed(-f32::MAX, f32::MAX).interactive(-180.0, 180.0);
     /// [`Settings::zoom`].
-    pub const ZOOM: Limits<f32> = Limits::closed(0.05, 20.0);
+    pub const ZOOM: Limits<f32> = Limits::closed(0.05, 20.0).interactive(0.2, 4.0);
 
     /// Refuses parameters that would make no picture or an absurd amount of work.
     pub fn validate(&self) -> Result<(), String> {

@@ -284,7 +284,7 @@ impl ClusterSettings {
     /// levels bound them further in [`Settings::validate`]).
     pub const LEVEL: Limits<u32> = Limits::closed(0, 10);
     /// [`ClusterSettings::depth_threshold`].
-    pub const DEPTH_THRESHOLD: Limits<f32> = Limits::closed(0.0, f32::MAX);
+    pub const DEPTH_THRESHOLD: Limits<f32> = Limits::closed(0.0, f32::MAX).interactive(0.001, 0.5);
     /// [`ClusterSettings::normal_threshold`].
     pub const NORMAL_THRESHOLD: Limits<f32> = Limits::closed(-1.0, 1.0);
 
@@ -490,13 +490,13 @@ impl Settings {
     pub const SIDE: Limits<u32> = Limits::closed(1, 8192);
     /// [`Settings::rsm_size`] (also a power of two): 1024^2 VPLs make a 67 MB quadtree, within
     /// every adapter's storage-buffer limit.
-    pub const RSM_SIZE: Limits<u32> = Limits::closed(4, 1024);
+    pub const RSM_SIZE: Limits<u32> = Limits::closed(4, 1024).interactive(8, 1024);
     /// [`Settings::samples`].
-    pub const SAMPLES: Limits<u32> = Limits::closed(1, 65536);
+    pub const SAMPLES: Limits<u32> = Limits::closed(1, 65536).interactive(1, 2048);
     /// [`Settings::rsm_radius`].
     pub const RSM_RADIUS: Limits<f32> = Limits::above(0.0, 1.0);
     /// [`Settings::subsample`].
-    pub const SUBSAMPLE: Limits<u32> = Limits::closed(1, 64);
+    pub const SUBSAMPLE: Limits<u32> = Limits::closed(1, 64).interactive(1, 8);
     /// [`Settings::shadow_steps`].
     pub const SHADOW_STEPS: Limits<u32> = Limits::closed(1, 64);
     /// [`Settings::shadow_thickness`].
@@ -504,11 +504,11 @@ impl Settings {
     /// [`Settings::temporal_weight`].
     pub const TEMPORAL_WEIGHT: Limits<f32> = Limits::above(0.0, 1.0);
     /// [`Settings::tile_error`].
-    pub const TILE_ERROR: Limits<f32> = Limits::closed(0.0, f32::MAX);
+    pub const TILE_ERROR: Limits<f32> = Limits::closed(0.0, f32::MAX).interactive(0.0002, 1.0);
     /// [`Settings::tile_capacity`]: up to what a tile's frontier holds in workgroup memory.
     pub const TILE_CAPACITY: Limits<u32> = Limits::closed(1, TILE_FRONTIER);
     /// [`Settings::tile_share`].
-    pub const TILE_SHARE: Limits<f32> = Limits::closed(0.0, 1000.0);
+    pub const TILE_SHARE: Limits<f32> = Limits::closed(0.0, 1000.0).interactive(0.0, 8.0);
 
     /// Bytes the per-tile cuts' lists may take, a storage buffer every adapter binds.
     pub const MAX_TILE_LIST_BYTES: u64 = 128 << 20;

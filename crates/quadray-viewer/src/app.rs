@@ -1,6 +1,6 @@
 //! The window: winit events, the wgpu surface, egui's panel, and the frame loop.
 
-use crate::Args;
+use crate::args::{Args, Technique};
 use crate::displace_view::{DisplaceView, MapChoice};
 use crate::indirect_view::IndirectView;
 use anyhow::{Context, Result};
@@ -14,30 +14,6 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
 const PANEL_WIDTH: f32 = 300.0;
-
-/// The technique on screen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Technique {
-    Displace,
-    Indirect,
-}
-
-/// A combo box that sets `value` to one of `choices`, each shown by `name`.
-pub fn choice_box<T: Copy + PartialEq>(
-    ui: &mut egui::Ui,
-    label: &str,
-    value: &mut T,
-    choices: &[T],
-    name: impl Fn(T) -> String,
-) {
-    egui::ComboBox::from_label(label)
-        .selected_text(name(*value))
-        .show_ui(ui, |ui| {
-            for &choice in choices {
-                ui.selectable_value(value, choice, name(choice));
-            }
-        });
-}
 
 pub fn run(args: Args, maps: Vec<MapChoice>, start: usize, settings: Settings) -> Result<()> {
     let event_loop =

@@ -2,15 +2,14 @@
 //! moving light; the frame is drawn by `quadray_displace::Renderer::draw` into an offscreen
 //! texture that egui shows, so what a person sees is exactly what `quadray displace` renders.
 
-use crate::app::choice_box;
-use crate::{absolute, shell_word};
+use crate::widgets::{absolute, choice_box, limits_slider, shell_word};
 use anyhow::Result;
 use quadray_core::image_out::Rgba8Image;
 use quadray_displace::cone::ConeMapJob;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::maps::{BUNDLED, assets_dir, load_color};
 use quadray_displace::scene::{SurfaceKind, View};
-use quadray_displace::{Lod, Method, Renderer, Settings, Size, Targets};
+use quadray_displace::{Layers, Lod, Method, Renderer, Settings, Size, Targets};
 use quadray_gpu::{Gpu, GpuTimer, read_texture_rgba8};
 use std::path::{Path, PathBuf};
 
@@ -38,9 +37,6 @@ impl MapChoice {
             .collect()
     }
 }
-
-/// The zoom the slider, the wheel and the keys move within: a useful part of [`Settings::ZOOM`].
-const ZOOM: std::ops::RangeInclusive<f32> = 0.2..=4.0;
 
 pub struct DisplaceView {
     pub maps: Vec<MapChoice>,
@@ -259,16 +255,40 @@ impl DisplaceView {
                 ..s.method.shown()
             };
         }
-        // The sliders span the useful part of each setting's limits.
-        let view_angle = Settings::VIEW_ANGLE.min..=Settings::VIEW_ANGLE.max;
-        ui.add(egui::Slider::new(&mut s.view_angle_deg, view_angle).text("view angle"));
-        ui.add(egui::Slider::new(&mut s.azimuth_deg, -180.0..=180.0).text("azimuth"));
-        ui.add(egui::Slider::new(&mut s.zoom, ZOOM).text("zoom"));
-        ui.add(egui::Slider::new(&mut s.depth_scale, 0.01..=0.5).text("depth scale"));
-        ui.add(egui::Slider::new(&mut s.layers.min, 1..=256).text("layers min"));
-        ui.add(egui::Slider::new(&mut s.layers.max, 1..=256).text("layers max"));
+        // The sliders span each setting's limits (their interactive part where declared).
+        let view_angle = Settings::VIEW_ANGLE;
+        ui.add(limits_slider(
+            &mut s.view_angle_deg,
+            view_angle,
+            "view angle",
+        ));
+        ui.add(limits_slider(
+            &mut s.azimuth_deg,
+            Settings::AZIMUTH,
+            "azimuth",
+        ));
+        ui.add(limits_slider(&mut s.zoom, Settings::ZOOM, "zoom"));
+        ui.add(limits_slider(
+            &mut s.depth_scale,
+            Settings::DEPTH_SCALE,
+            "depth scale",
+        ));
+        ui.add(limits_slider(
+            &mut s.layers.min,
+            Layers::COUNT,
+            "layers min",
+        ));
+        ui.add(limits_slider(
+            &mut s.layers.max,
+            Layers::COUNT,
+            "layers max",
+        ));
         s.layers.max = s.layers.max.max(s.layers.min);
-        ui.add(egui::Slider::new(&mut s.binary_steps, 0..=16).text("binary steps"));
+        ui.add(limits_slider(
+            &mut s.binary_steps,
+            Settings::BINARY_STEPS,
+            "binary steps",
+        ));
         let mut auto = s.lod == Lod::Auto;
         ui.checkbox(&mut auto, "LOD from derivatives");
         if auto {
@@ -283,7 +303,11 @@ impl DisplaceView {
         }
         ui.checkbox(&mut s.shadows, "self-shadowing");
         ui.checkbox(&mut s.show_iterations, "iteration heat map");
-        ui.add(egui::Slider::new(&mut s.light_azimuth_deg, 0.0..=360.0).text("light azimuth"));
+        ui.add(limits_slider(
+            &mut s.light_azimuth_deg,
+            Settings::AZIMUTH,
+            "light azimuth",
+        ));
         ui.checkbox(&mut self.animate_light, "animate light (L)");
         if s.method == Method::Mesh && self.surface == SurfaceKind::Torus {
             ui.colored_label(egui::Color32::YELLOW, "mesh needs a flat surface");
@@ -309,7 +333,8 @@ impl DisplaceView {
         }
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            s.zoom = (s.zoom * (1.0 - scroll * 0.002)).clamp(*ZOOM.start(), *ZOOM.end());
+            let (near, far) = Settings::ZOOM.interactive_range();
+            s.zoom = (s.zoom * (1.0 - scroll * 0.002)).clamp(near, far);
         }
     }
 
@@ -331,10 +356,10 @@ impl DisplaceView {
                 s.azimuth_deg += rate;
             }
             if i.key_down(egui::Key::Q) {
-                s.zoom = (s.zoom * (1.0 - dt)).max(*ZOOM.start());
+                s.zoom = (s.zoom * (1.0 - dt)).max(Settings::ZOOM.interactive_range().0);
             }
             if i.key_down(egui::Key::E) {
-                s.zoom = (s.zoom * (1.0 + dt)).min(*ZOOM.end());
+                s.zoom = (s.zoom * (1.0 + dt)).min(Settings::ZOOM.interactive_range().1);
             }
             if i.key_pressed(egui::Key::L) {
                 self.animate_light = !self.animate_light;

@@ -3,15 +3,16 @@
 //! and are tone-mapped by the same code as `quadray indirect`, so the screenshot's command line
 //! renders the same picture headless. A frame is rendered only when something changed.
 
-use crate::app::choice_box;
-use crate::{absolute, shell_word};
+use crate::widgets::{absolute, choice_box, limits_slider, shell_word};
 use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::tone_map;
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
-use quadray_indirect::{FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity};
+use quadray_indirect::{
+    ClusterSettings, FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity,
+};
 use std::path::{Path, PathBuf};
 
 /// What the view shows.
@@ -367,8 +368,9 @@ impl IndirectView {
         );
         let s = &mut self.settings;
         let mut rsm_log = s.rsm_size.ilog2();
+        let (smallest, largest) = Settings::RSM_SIZE.interactive_range();
         ui.add(
-            egui::Slider::new(&mut rsm_log, 3..=10)
+            egui::Slider::new(&mut rsm_log, smallest.ilog2()..=largest.ilog2())
                 .custom_formatter(|v, _| format!("{}", 1u32 << v as u32))
                 .text("RSM size"),
         );
@@ -386,12 +388,20 @@ impl IndirectView {
         if (start, limit) != (levels.start, levels.limit) {
             (c.start_level, c.limit_level) = (Some(start), Some(limit.min(start)));
         }
-        ui.add(
-            egui::Slider::new(&mut c.depth_threshold, 0.0..=0.5)
-                .logarithmic(true)
-                .text("depth threshold"),
+        let (depth, normal) = (
+            ClusterSettings::DEPTH_THRESHOLD,
+            ClusterSettings::NORMAL_THRESHOLD,
         );
-        ui.add(egui::Slider::new(&mut c.normal_threshold, -1.0..=1.0).text("normal threshold"));
+        ui.add(limits_slider(
+            &mut c.depth_threshold,
+            depth,
+            "depth threshold",
+        ));
+        ui.add(limits_slider(
+            &mut c.normal_threshold,
+            normal,
+            "normal threshold",
+        ));
         let mut recursive = c.validity == Validity::Recursive;
         ui.checkbox(&mut recursive, "recursive validity");
         c.validity = if recursive {
@@ -400,17 +410,18 @@ impl IndirectView {
             Validity::Local
         };
         ui.checkbox(&mut c.flux_weighted, "flux-weighted means");
-        ui.add(
-            egui::Slider::new(&mut s.samples, 1..=2048)
-                .logarithmic(true)
-                .text("RSM samples"),
-        );
+        ui.add(limits_slider(
+            &mut s.samples,
+            Settings::SAMPLES,
+            "RSM samples",
+        ));
         ui.add_enabled(
             self.method.subsamples(),
-            egui::Slider::new(&mut s.subsample, 1..=8).text(format!(
-                "sub-sampling ({})",
-                Method::subsampling_names().join(", ")
-            )),
+            limits_slider(
+                &mut s.subsample,
+                Settings::SUBSAMPLE,
+                &format!("sub-sampling ({})", Method::subsampling_names().join(", ")),
+            ),
         );
         let criterion = s.tile_criterion;
         choice_box(
@@ -425,18 +436,20 @@ impl IndirectView {
             s.tile_error = None;
         }
         let mut tile_error = s.tile_error_or_default();
-        ui.add(
-            egui::Slider::new(&mut tile_error, 0.0002..=1.0)
-                .logarithmic(true)
-                .text("tile error (quadtree-tiles)"),
-        );
+        let error = Settings::TILE_ERROR;
+        ui.add(limits_slider(
+            &mut tile_error,
+            error,
+            "tile error (quadtree-tiles)",
+        ));
         if tile_error != s.tile_error_or_default() {
             s.tile_error = Some(tile_error);
         }
-        ui.add(
-            egui::Slider::new(&mut s.tile_share, 0.0..=8.0)
-                .text("shared beyond, tile extents (quadtree-tiles, 0: off)"),
-        );
+        ui.add(limits_slider(
+            &mut s.tile_share,
+            Settings::TILE_SHARE,
+            "shared beyond, tile extents (quadtree-tiles, 0: off)",
+        ));
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
         ui.checkbox(&mut s.indirect_shadows, "indirect shadows (quadtree)");
