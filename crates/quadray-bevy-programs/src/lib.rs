@@ -28,14 +28,6 @@ pub fn repository_assets(folder: &str) -> AssetPlugin {
     }
 }
 
-/// The value after `flag` on the command line, if any.
-pub fn flag_value(args: &[String], flag: &str) -> Option<String> {
-    args.iter()
-        .position(|a| a == flag)
-        .and_then(|i| args.get(i + 1))
-        .cloned()
-}
-
 /// Off-screen rendering: where the picture goes, the image the camera renders into, and the
 /// frames to wait and to time.
 #[derive(Resource)]

@@ -50,3 +50,54 @@ fn the_gi_program_adds_the_bounce_to_its_headless_picture() {
     assert!(brighter >= 3900, "only {brighter} of 4096 pixels brighter");
     assert_eq!(darker, 0, "{darker} pixels darker with the bounce");
 }
+
+/// `--scene` renders a glTF of the user's from outside the repository's assets (here the bundled
+/// Cornell box copied elsewhere): the same picture as the bundled one. A flag the program does
+/// not know, and a scene that is not there or not glTF, are refused by name.
+#[test]
+fn the_gi_program_renders_a_users_gltf_and_refuses_what_it_cannot_use() {
+    let dir = std::env::temp_dir().join(format!("quadray-bevy-gi-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes");
+    let copy = dir.join("my room.gltf");
+    std::fs::copy(assets.join("cornell_spot.gltf"), &copy).unwrap();
+    let (own, bundled) = std::thread::scope(|s| {
+        let own = s.spawn(|| screenshot(&dir, "own", &["--scene", copy.to_str().unwrap()]));
+        let bundled = s.spawn(|| screenshot(&dir, "bundled", &[]));
+        (own.join().unwrap(), bundled.join().unwrap())
+    });
+    assert_eq!(own.dimensions(), (64, 64));
+    let differing = own
+        .pixels()
+        .zip(bundled.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(
+        differing, 0,
+        "{differing} pixels differ from the bundled scene's"
+    );
+
+    let refused = |args: &[&str], needle: &str| {
+        let run = Command::new(env!("CARGO_BIN_EXE_quadray-bevy-gi"))
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: `{needle}` not in {stderr}"
+        );
+    };
+    refused(&["--scenee", "x.gltf"], "unexpected argument '--scenee'");
+    refused(
+        &["--scene", "/no/such/room.gltf"],
+        "--scene /no/such/room.gltf: cannot read it",
+    );
+    refused(
+        &["--scene", "room.obj"],
+        "--scene room.obj: not a glTF scene (.gltf or .glb)",
+    );
+    refused(&["--size", "0x64"], "--size");
+    refused(&["--frames", "5"], "--screenshot");
+}

@@ -344,9 +344,17 @@ fn check_rsm_size(size: u32) -> Result<u32, String> {
     }
 }
 
-#[cfg(feature = "cli")]
-fn parse_rsm_size(text: &str) -> Result<u32, String> {
-    check_rsm_size(Settings::RSM_SIZE.parser()(text)?)
+impl Settings {
+    /// `--size`'s parser (`WxH`, each side within [`Settings::SIDE`]), also for a program with a
+    /// command line of its own.
+    pub fn parse_size(text: &str) -> Result<Size, String> {
+        quadray_core::settings::checked(check_size)(text)
+    }
+
+    /// `--rsm-size`'s parser (a power of two within [`Settings::RSM_SIZE`]), likewise.
+    pub fn parse_rsm_size(text: &str) -> Result<u32, String> {
+        check_rsm_size(Settings::RSM_SIZE.parser()(text)?)
+    }
 }
 
 /// Sizes and the parameters of every method.
@@ -358,7 +366,7 @@ pub struct Settings {
     #[cfg_attr(feature = "cli", arg(
         long,
         default_value_t = Settings::DEFAULT.size,
-        value_parser = quadray_core::settings::checked(check_size),
+        value_parser = Settings::parse_size,
     ))]
     pub size: Size,
     /// Side of the square reflective shadow map in texels (a power of two): how many VPLs the
@@ -366,7 +374,7 @@ pub struct Settings {
     #[cfg_attr(feature = "cli", arg(
         long,
         default_value_t = Settings::DEFAULT.rsm_size,
-        value_parser = parse_rsm_size,
+        value_parser = Settings::parse_rsm_size,
     ))]
     pub rsm_size: u32,
     /// The quadtree's parameters, for the quadtree methods.

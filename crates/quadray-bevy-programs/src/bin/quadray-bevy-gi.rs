@@ -7,13 +7,15 @@
 //!
 //! `cargo run --release --bin quadray-bevy-gi` (`--bin`, not `-p`: Cargo then resolves features
 //! as for the whole workspace, and what the test build compiled is reused).
-//! Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi] [--cut-view]
-//! [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the light still and
-//! saves the picture. `--frames N` (with `--screenshot`) times N frames with the light turning
-//! and prints their median and Bevy's render diagnostics of the bounce (GPU time of the light's
-//! passes, the gather and the composite; clusters in the cut; VPL evaluations and texel fetches
-//! per shaded pixel): the benchmark of the bounce's cost in a Bevy frame. `--size WxH` (default
-//! 256x256) and `--rsm-size N` (default 128) size the off-screen picture and the RSM.
+//! `--scene PATH` shows a glTF or GLB scene of your own instead (its camera and its first spot
+//! light). Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
+//! [--cut-view] [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the
+//! light still and saves the picture. `--frames N` (with `--screenshot`) times N frames with the
+//! light turning and prints their median and Bevy's render diagnostics of the bounce (GPU time of
+//! the light's passes, the gather and the composite; clusters in the cut; VPL evaluations and
+//! texel fetches per shaded pixel): the benchmark of the bounce's cost in a Bevy frame. `--size
+//! WxH` (default 256x256) and `--rsm-size N` (default 128) size the off-screen picture and the
+//! RSM. `--help` lists the flags; an unknown one is refused.
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -22,11 +24,11 @@ use bevy::pbr::DefaultOpaqueRendererMethod;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy::world_serialization::WorldAssetRoot;
+use clap::Parser;
 use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
-use quadray_bevy_programs::{
-    Offscreen, add_default_plugins, flag_value, repository_assets, set_title,
-};
-use quadray_indirect::{Method, Settings};
+use quadray_bevy_programs::{Offscreen, add_default_plugins, repository_assets, set_title};
+use quadray_indirect::{Method, Settings, Size};
+use std::path::{Path, PathBuf};
 
 const SCENE: &str = "scenes/cornell_spot.gltf";
 /// The methods M cycles through.
@@ -54,69 +56,96 @@ struct Shown {
     rsm_size: u32,
 }
 
+/// The command line (`--help` lists it).
+#[derive(Parser)]
+#[command(
+    name = "quadray-bevy-gi",
+    version,
+    about = "One bounce of indirect light from quadray's light quadtree in a Bevy app"
+)]
+struct Args {
+    /// A glTF or GLB scene of your own: its camera, its first spot light turning and giving the
+    /// bounce (default: the bundled Cornell box).
+    #[arg(long, value_name = "PATH.gltf")]
+    scene: Option<PathBuf>,
+    /// Render off screen, save the picture here and exit.
+    #[arg(long, value_name = "PNG")]
+    screenshot: Option<String>,
+    /// With --screenshot: time this many frames with the light turning, print their median and
+    /// Bevy's render diagnostics of the bounce.
+    #[arg(long, requires = "screenshot", value_parser = clap::value_parser!(u32).range(1..))]
+    frames: Option<u32>,
+    /// The first frame's method: quadtree-tiles, quadtree, rsm or reference (M cycles them).
+    #[arg(long, default_value_t = Method::DEFAULT)]
+    method: Method,
+    /// Start without the bounce (G turns it on).
+    #[arg(long)]
+    no_gi: bool,
+    /// Start with the cut over the RSM in a corner (C toggles it).
+    #[arg(long)]
+    cut_view: bool,
+    /// The off-screen picture's size, WxH.
+    #[arg(long, default_value = "256x256", value_parser = Settings::parse_size)]
+    size: Size,
+    /// The RSM's side, a power of two.
+    #[arg(long, default_value_t = 128, value_parser = Settings::parse_rsm_size)]
+    rsm_size: u32,
+}
+
+/// The scene file under the asset root.
+#[derive(Resource, Clone)]
+struct SceneFile(String);
+
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let value = |flag: &str| flag_value(&args, flag);
-    let method = match value("--method").map(|m| m.parse::<Method>()) {
-        None => Method::DEFAULT,
-        Some(Ok(m)) => m,
-        Some(Err(e)) => {
-            eprintln!("--method: {e}");
+    let args = Args::parse();
+    let (assets, scene) = match &args.scene {
+        None => (repository_assets(""), SCENE.to_string()),
+        Some(path) => scene_assets(path).unwrap_or_else(|e| {
+            eprintln!("error: --scene {}: {e}", path.display());
             std::process::exit(2);
-        }
+        }),
     };
-    let offscreen = value("--screenshot");
-    let timed = match value("--frames").map(|n| n.parse::<usize>()) {
-        None => 0,
-        Some(Ok(n)) if n > 0 && offscreen.is_some() => n,
-        _ => {
-            eprintln!("--frames: expected a positive count, with --screenshot");
-            std::process::exit(2);
-        }
-    };
-    let size = match value("--size").map(|s| parse_size(&s)) {
-        None => (256, 256),
-        Some(Some(size)) => size,
-        Some(None) => {
-            eprintln!("--size: expected WIDTHxHEIGHT, each 1..=8192");
-            std::process::exit(2);
-        }
-    };
-    let rsm_size = match value("--rsm-size").map(|n| n.parse::<u32>()) {
-        None => 128,
-        Some(Ok(n)) => n,
-        Some(Err(e)) => {
-            eprintln!("--rsm-size: {e}");
-            std::process::exit(2);
-        }
-    };
+    let timed = args.frames.unwrap_or(0) as usize;
     let shown = Shown {
-        gi: !args.iter().any(|a| a == "--no-gi"),
-        method,
-        cut_view: args.iter().any(|a| a == "--cut-view"),
-        turning: offscreen.is_none() || timed > 0,
-        size,
-        rsm_size,
+        gi: !args.no_gi,
+        method: args.method,
+        cut_view: args.cut_view,
+        turning: args.screenshot.is_none() || timed > 0,
+        size: (args.size.width, args.size.height),
+        rsm_size: args.rsm_size,
     };
     let mut app = App::new();
-    let assets = repository_assets("");
     // the scene loads in a few frames; each frame gathers anew while the light turns (on the
     // CPU rasteriser about a second a frame at this size)
-    let offscreen = offscreen.map(|path| Offscreen::new(path, 60, timed));
+    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 60, timed));
     add_default_plugins(&mut app, assets, offscreen);
     app.insert_resource(DefaultOpaqueRendererMethod::deferred())
         .add_plugins(IndirectLightPlugin)
         .insert_resource(shown)
+        .insert_resource(SceneFile(scene))
         .add_systems(Startup, setup)
         .add_systems(Update, (configure, keys, turn_light, show_title).chain())
         .run();
 }
 
-/// `WIDTHxHEIGHT`, each side 1..=8192.
-fn parse_size(text: &str) -> Option<(u32, u32)> {
-    let (w, h) = text.split_once('x')?;
-    let side = |s: &str| s.parse::<u32>().ok().filter(|n| (1..=8192).contains(n));
-    Some((side(w)?, side(h)?))
+/// Bevy's asset plugin reading the folder of a scene file of the user's, and the file's name
+/// under it: a glTF or GLB file that exists.
+fn scene_assets(path: &Path) -> Result<(AssetPlugin, String), String> {
+    let gltf = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+    if !gltf {
+        return Err("not a glTF scene (.gltf or .glb)".into());
+    }
+    let path = std::fs::canonicalize(path).map_err(|e| format!("cannot read it: {e}"))?;
+    let (Some(folder), Some(name)) = (path.parent(), path.file_name()) else {
+        return Err("not a file".into());
+    };
+    let assets = AssetPlugin {
+        file_path: folder.to_string_lossy().into_owned(),
+        ..default()
+    };
+    Ok((assets, name.to_string_lossy().into_owned()))
 }
 
 fn setup(
@@ -125,9 +154,10 @@ fn setup(
     mut images: ResMut<Assets<Image>>,
     offscreen: Option<ResMut<Offscreen>>,
     shown: Res<Shown>,
+    scene: Res<SceneFile>,
 ) {
     commands.spawn(WorldAssetRoot(
-        assets.load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
+        assets.load(GltfAssetLabel::Scene(0).from_asset(scene.0.clone())),
     ));
     if let Some(mut offscreen) = offscreen {
         let (width, height) = shown.size;

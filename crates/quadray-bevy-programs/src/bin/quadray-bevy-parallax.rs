@@ -13,10 +13,9 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::image::ImageLoaderSettings;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
+use clap::Parser;
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
-use quadray_bevy_programs::{
-    Offscreen, add_default_plugins, flag_value, repository_assets, set_title,
-};
+use quadray_bevy_programs::{Offscreen, add_default_plugins, repository_assets, set_title};
 
 const METHODS: [&str; 3] = [
     "Bevy parallax occlusion mapping",
@@ -43,21 +42,36 @@ struct Cube;
 #[derive(Resource)]
 struct FirstMethod(usize);
 
+/// The command line (`--help` lists it).
+#[derive(Parser)]
+#[command(
+    name = "quadray-bevy-parallax",
+    version,
+    about = "Bevy's parallax example with Bevy's POM, Bevy's relief mapping and quadray's pyramid"
+)]
+struct Args {
+    /// The method shown first (Space cycles them).
+    #[arg(long, value_enum, default_value_t = ShownMethod::Pyramid)]
+    method: ShownMethod,
+    /// Render off screen, save the picture here and exit.
+    #[arg(long, value_name = "PNG")]
+    screenshot: Option<String>,
+}
+
+/// The methods Space cycles through, in their order.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ShownMethod {
+    Pom,
+    Relief,
+    Pyramid,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let value = |flag: &str| flag_value(&args, flag);
-    let method = match value("--method").as_deref() {
-        None | Some("pyramid") => 2,
-        Some("pom") => 0,
-        Some("relief") => 1,
-        Some(other) => {
-            eprintln!("--method {other}: expected pom, relief or pyramid");
-            std::process::exit(2);
-        }
-    };
+    let args = Args::parse();
+    let method = args.method as usize;
     let mut app = App::new();
     let assets = repository_assets("heightmaps/bevy_parallax");
-    let offscreen = value("--screenshot").map(|path| Offscreen::new(path, 300, 0));
+    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 300, 0));
     add_default_plugins(&mut app, assets, offscreen);
     app.add_plugins(PyramidDisplacementPlugin)
         .insert_resource(FirstMethod(method))
