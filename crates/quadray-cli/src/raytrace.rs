@@ -5,35 +5,25 @@ use anyhow::{Context, bail, ensure};
 use indicatif::{ProgressBar, ProgressStyle};
 use quadray_core::image_out::{EXPOSURE, check_exposure};
 use quadray_shadows::scene::{BUILTINS, Scene};
-use quadray_shadows::{Nth, Region, RunOptions, SchemeChoice, cost};
+use quadray_shadows::{Nth, Region, SchemeChoice, Settings, cost};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+/// `quadray raytrace`'s flags: the render's [`Settings`], then what is not one: the scene, the
+/// files written, the actions that replace the render, and the work items and turntable frames
+/// a job splits into.
 #[derive(clap::Args)]
 pub struct RaytraceArgs {
+    #[command(flatten)]
+    settings: Settings,
     /// A scene file: TOML, or glTF 2.0 (.gltf, .glb).
     #[arg(long, conflicts_with = "builtin")]
     scene: Option<PathBuf>,
     /// A builtin look-alike of the paper's scenes: glasses, desk, stars, kaist.
     #[arg(long)]
     builtin: Option<String>,
-    /// Shadow scheme: hst, volume, conventional, bvh, or embree (built with --features embree).
-    #[arg(long, default_value = "hst")]
-    shadows: SchemeChoice,
-    /// HST threshold: auto (the cost model's prediction) or a number.
-    #[arg(long, default_value = "auto")]
-    nth: String,
-    /// Image size WxH.
-    #[arg(long, default_value = "512x480", value_parser = quadray_core::parse_size)]
-    size: (u32, u32),
-    /// Samples per pixel.
-    #[arg(long, default_value_t = 1)]
-    spp: u32,
-    /// Recursion depth of reflection and refraction.
-    #[arg(long, default_value_t = 5)]
-    depth: u32,
     /// Output PNG, or EXR for the radiance as 32-bit floats; with --tiles or --frames, the folder
     /// the work item's tile goes to (frameFFFF-tileTTTT.exr, its stats beside it).
     #[arg(long)]
@@ -44,9 +34,6 @@ pub struct RaytraceArgs {
     /// Statistics JSON (times, sub-schemes, N_th, p, alpha, ...).
     #[arg(long)]
     stats: Option<PathBuf>,
-    /// Also run the conventional test at every shading point and count disagreements.
-    #[arg(long)]
-    check: bool,
     /// Only measure the machine constants C_s, C_i, C_c, C_o (nanoseconds) and print them.
     #[arg(long)]
     calibrate: bool,
@@ -128,20 +115,8 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     // Named like the loader's errors: "FILE: reason".
     let invalid = |e: quadray_shadows::BuildError| anyhow::anyhow!("{source}: {e}");
     scene.validate().map_err(invalid)?;
-    let nth = match args.nth.as_str() {
-        "auto" => Nth::Auto,
-        n => match n.parse::<f32>() {
-            Ok(v) if v >= 0.0 => Nth::Fixed(v),
-            _ => bail!("--nth {n:?}: expected auto or a number >= 0"),
-        },
-    };
-    let (width, height) = args.size;
-    if width == 0 || height == 0 || width > 16384 || height > 16384 {
-        bail!("--size {width}x{height}: each side must be 1..=16384");
-    }
-    if args.spp == 0 || args.spp > 1024 || args.depth > 64 {
-        bail!("--spp must be 1..=1024 and --depth at most 64");
-    }
+    let settings = args.settings;
+    let (width, height) = (settings.size.width, settings.size.height);
     let degrees = args.orbit.unwrap_or(0.0);
     ensure!(
         degrees.is_finite(),
@@ -156,22 +131,12 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         let prep =
             quadray_shadows::prepare(orbit(scene, degrees * frame as f32), SchemeChoice::Hst)
                 .map_err(invalid)?;
-        let (predicted, _) = prep.predicted_nth(&cost::calibrate(), args.depth);
+        let (predicted, _) = prep.predicted_nth(&cost::calibrate(), settings.depth);
         // Exactly the f32 that --nth auto uses; Display prints it so that it parses back exactly.
         println!("{}", predicted as f32);
         return Ok(());
     }
     let out = args.out.context("--out FILE.png is required")?;
-    let opts = RunOptions {
-        scheme: args.shadows,
-        nth,
-        width,
-        height,
-        spp: args.spp,
-        depth: args.depth,
-        check: args.check,
-        costs: None,
-    };
     let job = (args.tiles.is_some() || frames.is_some()).then(|| WorkItems {
         tiles: args.tiles.unwrap_or(1),
         frames: frames.unwrap_or_else(|| {
@@ -185,7 +150,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         }
         let scene = orbit(scene, degrees * args.frame.unwrap_or(0) as f32);
         let full = Region::full(width, height);
-        let (radiance, report) = render(scene, &opts, full, &invalid)?;
+        let (radiance, report) = render(scene, &settings, full, &invalid)?;
         if is_exr(&out) {
             tiles::write_exr(&out, &radiance, (width, height), None)?;
         } else {
@@ -206,7 +171,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         items.tiles
     );
     ensure!(
-        !(opts.scheme == SchemeChoice::Hst && nth == Nth::Auto),
+        !(settings.scheme == SchemeChoice::Hst && settings.nth == Nth::Auto),
         "work items with --shadows hst need one N_th for all: compute it once with --print-nth \
          and give it with --nth"
     );
@@ -219,28 +184,22 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         "--out {}: with --tiles or --frames, the folder the tiles go to",
         out.display()
     );
-    let nth_text = match (opts.scheme, nth) {
-        (SchemeChoice::Hst, Nth::Fixed(n)) => n.to_string(),
-        _ => "-".into(),
-    };
-    let settings = format!(
-        "{} nth {nth_text} {width}x{height} spp {} depth {} orbit {degrees}",
-        format!("{:?}", opts.scheme).to_lowercase(),
-        args.spp,
-        args.depth
+    let pixels = format!(
+        "{} --orbit {degrees}",
+        pixel_settings(&settings).to_args().join(" ")
     );
-    let fingerprint = Fingerprint::of(&scene, &settings);
+    let fingerprint = Fingerprint::of(&scene, &pixels);
     let (frame, tile) = items.item(items.index_from(args.tile)?);
     let region = tiles::band(width, height, tile, items.tiles);
     let scene = orbit(scene, degrees * frame as f32);
-    let (radiance, report) = render(scene, &opts, region, &invalid)?;
+    let (radiance, report) = render(scene, &settings, region, &invalid)?;
     let header = TileHeader {
         image: (width, height),
         region,
         tile,
         items,
         frame,
-        settings,
+        settings: pixels,
         fingerprint,
     };
     let path = out.join(tiles::tile_file_name(frame, tile));
@@ -250,15 +209,29 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `settings` with those that change no pixel at their defaults, so that the tiles of one picture
+/// match whatever they were: N_th beside another scheme than HST, and `--check`.
+fn pixel_settings(settings: &Settings) -> Settings {
+    let defaults = Settings::DEFAULT;
+    Settings {
+        nth: match settings.scheme {
+            SchemeChoice::Hst => settings.nth,
+            _ => defaults.nth,
+        },
+        check: defaults.check,
+        ..*settings
+    }
+}
+
 /// Prepares `scene`, renders `region` of the picture with a progress bar and prints the times.
 fn render(
     scene: Scene,
-    opts: &RunOptions,
+    settings: &Settings,
     region: Region,
     invalid: &dyn Fn(quadray_shadows::BuildError) -> anyhow::Error,
 ) -> anyhow::Result<(quadray_shadows::Radiance, quadray_shadows::RunReport)> {
-    let prep = quadray_shadows::prepare(scene, opts.scheme).map_err(invalid)?;
-    let costs = opts.costs.unwrap_or_else(cost::calibrate);
+    let prep = quadray_shadows::prepare(scene, settings.scheme).map_err(invalid)?;
+    let costs = cost::calibrate();
     let tiles = region.width.div_ceil(16) as u64 * region.height.div_ceil(16) as u64;
     let bar = ProgressBar::new(tiles).with_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} tiles {elapsed}",
@@ -270,26 +243,24 @@ fn render(
         let n = done.fetch_add(1, Ordering::Relaxed) + 1;
         if log && n * 10 / tiles != (n - 1) * 10 / tiles {
             eprintln!(
-                "rows {}..{} of {}x{}: {}% ({n}/{tiles} blocks of 16x16) {:.1}s",
+                "rows {}..{} of {}: {}% ({n}/{tiles} blocks of 16x16) {:.1}s",
                 region.y,
                 region.y + region.height,
-                opts.width,
-                opts.height,
+                settings.size,
                 n * 100 / tiles,
                 start.elapsed().as_secs_f64()
             );
         }
     };
     let (radiance, report) =
-        quadray_shadows::render_prepared_region(&prep, opts, &costs, region, &step);
+        quadray_shadows::render_prepared_region(&prep, settings, &costs, region, &step);
     bar.finish_and_clear();
     let t = &report.times_s;
     println!(
-        "{} {} {}x{}: preprocess {:.3}s (shadow volumes {:.3}s) shadow {:.3}s other {:.3}s total {:.3}s, N_th predicted {:.2}{}",
+        "{} {} {}: preprocess {:.3}s (shadow volumes {:.3}s) shadow {:.3}s other {:.3}s total {:.3}s, N_th predicted {:.2}{}",
         report.scene,
-        report.scheme,
-        opts.width,
-        opts.height,
+        settings.scheme,
+        settings.size,
         t.preprocess,
         t.shadow_volumes,
         t.shadow,
@@ -335,4 +306,117 @@ pub fn bench(quick: bool, out: &Path) -> anyhow::Result<()> {
     }
     println!("wrote {}", out.join("shadows.md").display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+    use proptest::prelude::*;
+    use quadray_core::settings::{Limits, Size};
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: RaytraceArgs,
+    }
+
+    fn parsed(settings: &Settings) -> Settings {
+        let mut argv = vec!["raytrace".to_string(), "--builtin=stars".into()];
+        argv.extend(settings.to_args());
+        Cli::try_parse_from(&argv)
+            .unwrap_or_else(|e| panic!("{argv:?}: {e}"))
+            .args
+            .settings
+    }
+
+    /// Valid settings, every field drawn from its declared limits (Embree where this build has
+    /// it).
+    fn valid_settings() -> impl Strategy<Value = Settings> {
+        let schemes: Vec<SchemeChoice> = SchemeChoice::ALL
+            .into_iter()
+            .filter(|s| s.name().parse::<SchemeChoice>().is_ok())
+            .collect();
+        let nth = prop_oneof![
+            Just(Nth::Auto),
+            (0.0f32..=1e6)
+                .prop_filter("inside the limits", |n| Settings::NTH.contains(*n))
+                .prop_map(Nth::Fixed),
+        ];
+        let u = |l: Limits<u32>| l.min..=l.max;
+        (
+            proptest::sample::select(schemes),
+            nth,
+            (u(Settings::SIDE), u(Settings::SIDE)),
+            u(Settings::SPP),
+            u(Settings::DEPTH),
+            any::<bool>(),
+        )
+            .prop_map(|(scheme, nth, (w, h), spp, depth, check)| Settings {
+                scheme,
+                nth,
+                size: Size::new(w, h),
+                spp,
+                depth,
+                check,
+            })
+    }
+
+    /// No flags: the library's defaults.
+    #[test]
+    fn the_flags_defaults_are_the_settings_defaults() {
+        let cli = Cli::try_parse_from(["raytrace", "--builtin=stars"]).unwrap();
+        assert_eq!(cli.args.settings, Settings::DEFAULT);
+    }
+
+    /// The flags refuse what `validate()` refuses, naming the flag and the same limits.
+    #[test]
+    fn the_flags_refuse_values_outside_the_limits() {
+        let schemes: Vec<_> = SchemeChoice::ALL.iter().map(|s| s.to_string()).collect();
+        for (flag, value, range) in [
+            ("--shadows", "raster", schemes.join(", ")),
+            ("--nth", "-3", Settings::NTH.to_string()),
+            ("--nth", "inf", Settings::NTH.to_string()),
+            ("--size", "0x10", Settings::SIDE.to_string()),
+            ("--size", "16385x16", Settings::SIDE.to_string()),
+            ("--spp", "0", Settings::SPP.to_string()),
+            ("--depth", "65", Settings::DEPTH.to_string()),
+        ] {
+            // `=` so that a negative value reaches the flag's parser rather than clap's.
+            let argv = ["raytrace", "--builtin=stars", &format!("{flag}={value}")];
+            let e = Cli::try_parse_from(argv).err().expect(flag).to_string();
+            assert!(e.contains(flag) && e.contains(&range), "{e}");
+        }
+    }
+
+    /// Tiles of other schemes match whatever N_th they were given, and `--check` changes no
+    /// pixel; every other setting tells tiles apart.
+    #[test]
+    fn only_the_settings_that_change_pixels_tell_tiles_apart() {
+        let conventional = Settings {
+            scheme: SchemeChoice::Conventional,
+            ..Settings::DEFAULT
+        };
+        let other_nth = Settings {
+            nth: Nth::Fixed(3.0),
+            check: true,
+            ..conventional
+        };
+        assert_eq!(pixel_settings(&conventional), pixel_settings(&other_nth));
+        let hst = Settings {
+            nth: Nth::Fixed(3.0),
+            ..Settings::DEFAULT
+        };
+        assert_eq!(pixel_settings(&hst), hst);
+    }
+
+    proptest! {
+        /// The tiles carry `Settings::to_args` as their readable settings: every valid setting
+        /// must come back through the CLI's flags unchanged.
+        #[test]
+        fn settings_round_trip_through_the_flags(settings in valid_settings()) {
+            prop_assert!(settings.validate().is_ok(), "{settings:?}");
+            prop_assert_eq!(parsed(&settings), settings);
+        }
+    }
 }

@@ -8,7 +8,7 @@ use exr::prelude::{
     Encoding, Image, ImageAttributes, Layer, LayerAttributes, ReadChannels, ReadLayers,
     SpecificChannels, Vec2, WritableImage, read,
 };
-use quadray_shadows::{Radiance, Region};
+use quadray_shadows::{Radiance, Region, Settings};
 use std::fmt::Write as _;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -17,8 +17,8 @@ use std::path::{Path, PathBuf};
 /// after `--tile`: a Kubernetes Indexed Job's, then a Slurm job array's.
 pub const INDEX_VARIABLES: [&str; 2] = ["JOB_COMPLETION_INDEX", "SLURM_ARRAY_TASK_ID"];
 
-/// The largest image a tile may claim to belong to (the CLI's own `--size` limit).
-const MAX_SIDE: usize = 16384;
+/// The largest image a tile may claim to belong to (`--size`'s limit).
+const MAX_SIDE: usize = Settings::SIDE.max as usize;
 
 /// The work items of a tiled render or a turntable: every frame of `frames` cut into `tiles`
 /// horizontal bands, numbered frame by frame.
@@ -159,7 +159,7 @@ pub struct TileHeader {
     pub items: WorkItems,
     /// Which frame.
     pub frame: u32,
-    /// The settings that change pixels, readable (scheme, N_th, size, samples, depth, orbit).
+    /// The settings that change pixels, readable: their `quadray raytrace` flags and `--orbit`.
     pub settings: String,
     /// [`Fingerprint`] of the scene and the settings.
     pub fingerprint: String,

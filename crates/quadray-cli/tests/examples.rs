@@ -152,32 +152,20 @@ fn gi_gbuffer_draws_what_quadray_indirect_draws() {
     );
 }
 
-/// `hst_scene` against `quadray raytrace --scene assets/scenes/example-hst.toml --shadows hst
-/// --nth 8 --size 320x240`: pixel for pixel, no tolerance (the same polygons, vertices and
-/// materials), and not an empty picture.
+/// `hst_scene` against `quadray raytrace --scene assets/scenes/example-hst.toml` with the
+/// example's settings as flags (`--shadows hst --nth 8 --size 320x240 ...`): pixel for pixel, no
+/// tolerance (the same polygons, vertices and materials), and not an empty picture.
 #[test]
 fn hst_scene_draws_what_quadray_raytrace_draws() {
     let example = hst_scene::render(hst_scene::scene().unwrap()).unwrap();
-    let options = hst_scene::options();
     let dir = scratch("hst-scene");
     let scene_file = assets().join("scenes/example-hst.toml");
-    let size = format!("{}x{}", options.width, options.height);
-    let nth = hst_scene::NTH.to_string();
-    let cli = quadray_picture(
-        &[
-            "raytrace",
-            "--scene",
-            scene_file.to_str().unwrap(),
-            "--shadows",
-            "hst",
-            "--nth",
-            &nth,
-            "--size",
-            &size,
-        ],
-        &dir,
-        "hst",
-    );
+    let flags = hst_scene::settings().to_args();
+    let args: Vec<&str> = ["raytrace", "--scene", scene_file.to_str().unwrap()]
+        .into_iter()
+        .chain(flags.iter().map(String::as_str))
+        .collect();
+    let cli = quadray_picture(&args, &dir, "hst");
     let differing = example
         .pixels
         .iter()

@@ -35,6 +35,9 @@ fn raytrace_writes_the_picture_and_the_stats() {
         "scheme",
         "width",
         "height",
+        "spp",
+        "depth",
+        "check",
         "polygons",
         "lights",
         "shadow_polygons",
@@ -55,6 +58,7 @@ fn raytrace_writes_the_picture_and_the_stats() {
     for key in ["sustain", "self_shadow", "shadow_volume", "conventional"] {
         assert!(json["subschemes"][key].as_u64().is_some());
     }
+    assert_eq!(json["nth"]["asked"]["fixed"].as_f64(), Some(6.0));
     assert_eq!(json["nth"]["used"].as_f64(), Some(6.0));
     assert_eq!(json["grid"].as_array().unwrap().len(), 3);
     assert_eq!(json["disagreements"].as_u64(), Some(0));

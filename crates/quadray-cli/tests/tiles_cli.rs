@@ -121,7 +121,7 @@ fn tiles_from_a_slurm_array_merge_into_the_one_process_render() {
             "--out",
             &s("x.png"),
         ],
-        "other settings (hst nth 5",
+        "other settings (--shadows hst --nth 5",
     );
     quadray_refuses(&["merge", &s("one.png"), "--out", &s("x.png")], "one.png");
 }

@@ -11,7 +11,9 @@
 
 use glam::Vec3;
 use quadray_core::image_out::Rgba8Image;
-use quadray_shadows::{BuildError, Camera, Light, Material, Nth, RunOptions, Scene, SchemeChoice};
+use quadray_shadows::{
+    BuildError, Camera, Light, Material, Nth, Scene, SchemeChoice, Settings, Size,
+};
 use std::path::Path;
 
 /// HST's threshold N_th, fixed so that the picture does not depend on timing (`Nth::Auto`
@@ -74,23 +76,19 @@ pub fn scene() -> Result<Scene, BuildError> {
     Ok(s)
 }
 
-/// How it is rendered: HST at [`NTH`], 320 x 240, reflections to depth 5.
-pub fn options() -> RunOptions {
-    RunOptions {
+/// How it is rendered: HST at [`NTH`], 320 x 240, reflections to depth 5 (the default).
+pub fn settings() -> Settings {
+    Settings {
         scheme: SchemeChoice::Hst,
         nth: Nth::Fixed(NTH),
-        width: 320,
-        height: 240,
-        spp: 1,
-        depth: 5,
-        check: false,
-        costs: None,
+        size: Size::new(320, 240),
+        ..Settings::DEFAULT
     }
 }
 
-/// The picture of `scene` rendered with `options`.
+/// The picture of `scene` rendered with [`settings`].
 pub fn render(scene: Scene) -> Result<Rgba8Image, BuildError> {
-    let (image, report) = quadray_shadows::run(scene, &options(), &|| {})?;
+    let (image, report) = quadray_shadows::run(scene, &settings(), &|| {})?;
     let shares = &report.subschemes;
     println!(
         "{} polygons, {} shadow polygons; decisions: {} sustained, {} self-shadowed, {} by \

@@ -3,8 +3,9 @@
 //! hybrid switch between them with its cost model, and a SAH BVH (and, with the `embree` feature,
 //! Intel Embree) as today's baselines.
 //!
-//! Rooms, from the bottom up: [`scene`] (a scene built in code with [`Scene::new`] and its
-//! `add_` methods, procedural look-alikes of the paper's scenes, TOML scene files), [`clip`]
+//! Rooms, from the bottom up: [`settings`] (what a user configures: the one [`Settings`] type
+//! that `quadray raytrace`'s flags are), [`scene`] (a scene built in code with [`Scene::new`] and
+//! its `add_` methods, procedural look-alikes of the paper's scenes, TOML scene files), [`clip`]
 //! (polygon clipping), [`grid`] (SEADS, 3DDDA, mailboxes), [`occlusion`] (the [`Occluder`]
 //! interface of shadow rays: the grid, the BVH, `embree`), [`shadow`] (shadow polygons and HST's
 //! state machine), [`mod@prepare`] (what a scheme builds before rendering),
@@ -19,7 +20,7 @@
 //!
 //! ```
 //! use glam::Vec3;
-//! use quadray_shadows::{Camera, Light, Material, Nth, RunOptions, Scene, SchemeChoice};
+//! use quadray_shadows::{Camera, Light, Material, Nth, Scene, SchemeChoice, Settings, Size};
 //!
 //! let camera = Camera { position: Vec3::new(0.0, 2.0, 4.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
 //! let mut scene = Scene::new("doc", camera);
@@ -28,17 +29,14 @@
 //! let floor = [[-2.0, 0.0, -2.0], [-2.0, 0.0, 2.0], [2.0, 0.0, 2.0], [2.0, 0.0, -2.0]];
 //! let corners = floor.map(|p| scene.add_vertex(Vec3::from_array(p)));
 //! scene.add_face(corners.to_vec(), grey).unwrap();
-//! let options = RunOptions {
+//! let settings = Settings {
 //!     scheme: SchemeChoice::Hst,
 //!     nth: Nth::Fixed(8.0),
-//!     width: 32,
-//!     height: 24,
-//!     spp: 1,
+//!     size: Size::new(32, 24),
 //!     depth: 2,
-//!     check: false,
-//!     costs: None,
+//!     ..Settings::DEFAULT
 //! };
-//! let (image, report) = quadray_shadows::run(scene, &options, &|| {}).unwrap();
+//! let (image, report) = quadray_shadows::run(scene, &settings, &|| {}).unwrap();
 //! assert_eq!((image.width, report.polygons), (32, 1));
 //! ```
 //!
@@ -91,6 +89,7 @@ pub mod occlusion;
 pub mod pilot;
 pub mod prepare;
 pub mod scene;
+pub mod settings;
 pub mod shadow;
 pub mod stats;
 pub mod trace;
@@ -102,75 +101,13 @@ use cost::{MachineCosts, SceneStats};
 pub use occlusion::Occluder;
 pub use prepare::{Prepared, Scheme};
 use quadray_core::image_out::Rgba8Image;
+pub use quadray_core::settings::Size;
 pub use scene::{BuildError, Camera, Light, Material, Scene};
 use serde::Serialize;
+pub use settings::{Nth, SchemeChoice, Settings};
 use stats::RenderStats;
-use trace::Settings;
+use trace::Job;
 pub use trace::{Radiance, Region};
-
-/// How the HST threshold is chosen.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Nth {
-    /// Equation 12 from measured machine constants and the scene's statistics.
-    Auto,
-    /// This N_th.
-    Fixed(f32),
-}
-
-/// The shadow scheme asked for on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SchemeChoice {
-    /// A shadow ray per light through the grid.
-    Conventional,
-    /// Shadow volumes: depth counts carried along every ray segment.
-    Volume,
-    /// The hybrid switch (HST) with threshold N_th.
-    Hst,
-    /// A shadow ray per light through a SAH BVH.
-    Bvh,
-    /// Embree occlusion rays; needs the `embree` feature.
-    Embree,
-}
-
-impl std::str::FromStr for SchemeChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "conventional" => Ok(Self::Conventional),
-            "volume" => Ok(Self::Volume),
-            "hst" => Ok(Self::Hst),
-            "bvh" => Ok(Self::Bvh),
-            "embree" if cfg!(feature = "embree") => Ok(Self::Embree),
-            "embree" => {
-                Err("this quadray was built without Embree (cargo build --features embree)".into())
-            }
-            _ => Err(format!(
-                "unknown shadow scheme {s:?} (conventional, volume, hst, bvh, embree)"
-            )),
-        }
-    }
-}
-
-/// One render's parameters.
-#[derive(Clone, Copy, Debug)]
-pub struct RunOptions {
-    /// How shadows are decided.
-    pub scheme: SchemeChoice,
-    /// HST's threshold (ignored by the other schemes).
-    pub nth: Nth,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    /// Recursion depth of reflection and refraction.
-    pub depth: u32,
-    /// Also run the conventional test at every shading point and count disagreements.
-    pub check: bool,
-    /// Machine constants; measured when `nth` is `Auto` and none are given.
-    pub costs: Option<MachineCosts>,
-}
 
 /// CPU seconds (all threads), as the paper's table 4 reports CPU minutes.
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -204,6 +141,8 @@ pub struct Subschemes {
 #[derive(Clone, Copy, Debug, Serialize)]
 /// The N_th of a render: predicted, as the paper writes it, and used.
 pub struct NthReport {
+    /// What the settings asked for ([`Settings::nth`]).
+    pub asked: Nth,
     /// What `--nth auto` uses: equation 12 with the pilot's corrections ([`cost::FollowUp`]).
     pub predicted: f64,
     /// Equation 12 as the paper writes it.
@@ -219,16 +158,10 @@ pub struct NthReport {
 pub struct RunReport {
     /// The scene's name.
     pub scene: String,
-    /// The scheme's name.
-    pub scheme: String,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    /// Recursion depth.
-    pub depth: u32,
+    /// What was rendered: the settings' own fields (scheme, width, height, spp, depth, check;
+    /// the N_th asked for is `nth.asked`).
+    #[serde(flatten)]
+    pub settings: Settings,
     /// Polygons of the scene.
     pub polygons: usize,
     /// Point lights.
@@ -272,40 +205,51 @@ pub struct RunReport {
     pub forced_conventional: u64,
 }
 
-/// Checks the scene, builds what the scheme needs, predicts N_th and renders.
+/// Checks the scene, builds what the scheme needs, measures the machine constants
+/// ([`cost::calibrate`]), predicts N_th and renders. `on_tile` is called after each finished
+/// block of 16x16 pixels: a progress bar's hook, not a setting (it changes nothing rendered).
 pub fn run(
     scene: Scene,
-    opts: &RunOptions,
+    settings: &Settings,
     on_tile: &(dyn Fn() + Sync),
 ) -> Result<(Rgba8Image, RunReport), BuildError> {
-    let prepared = prepare(scene, opts.scheme)?;
-    let costs = opts.costs.unwrap_or_else(cost::calibrate);
-    Ok(render_prepared(&prepared, opts, &costs, on_tile))
+    let prepared = prepare(scene, settings.scheme)?;
+    Ok(render_prepared(
+        &prepared,
+        settings,
+        &cost::calibrate(),
+        on_tile,
+    ))
+}
+
+/// The shadow test `choice` names, HST with threshold `nth`.
+fn scheme(choice: SchemeChoice, nth: f32) -> Scheme {
+    match choice {
+        SchemeChoice::Conventional => Scheme::Conventional,
+        SchemeChoice::Volume => Scheme::Volume,
+        SchemeChoice::Hst => Scheme::Hst { nth },
+        SchemeChoice::Bvh => Scheme::Bvh,
+        SchemeChoice::Embree => Scheme::Embree,
+    }
 }
 
 /// The preprocessing step alone (grid, and shadow polygons or BVH when the scheme needs them),
 /// after checking the scene ([`Scene::validate`]).
-pub fn prepare(scene: Scene, scheme: SchemeChoice) -> Result<Prepared, BuildError> {
+pub fn prepare(scene: Scene, choice: SchemeChoice) -> Result<Prepared, BuildError> {
     scene.validate()?;
-    let s = match scheme {
-        SchemeChoice::Conventional => Scheme::Conventional,
-        SchemeChoice::Volume => Scheme::Volume,
-        SchemeChoice::Hst => Scheme::Hst { nth: 0.0 },
-        SchemeChoice::Bvh => Scheme::Bvh,
-        SchemeChoice::Embree => Scheme::Embree,
-    };
-    Ok(Prepared::new(scene, s))
+    Ok(Prepared::new(scene, scheme(choice, 0.0)))
 }
 
-/// Renders an already prepared scene.
+/// Renders an already prepared scene with the machine constants `costs` (measured once by
+/// [`cost::calibrate`] and shared by a series of renders).
 pub fn render_prepared(
     prep: &Prepared,
-    opts: &RunOptions,
+    settings: &Settings,
     costs: &MachineCosts,
     on_tile: &(dyn Fn() + Sync),
 ) -> (Rgba8Image, RunReport) {
-    let full = Region::full(opts.width, opts.height);
-    let (radiance, report) = render_prepared_region(prep, opts, costs, full, on_tile);
+    let full = Region::full(settings.size.width, settings.size.height);
+    let (radiance, report) = render_prepared_region(prep, settings, costs, full, on_tile);
     (radiance.to_rgba8(1.0), report)
 }
 
@@ -313,45 +257,35 @@ pub fn render_prepared(
 /// the report's counts and times are the region's.
 pub fn render_prepared_region(
     prep: &Prepared,
-    opts: &RunOptions,
+    settings: &Settings,
     costs: &MachineCosts,
     region: Region,
     on_tile: &(dyn Fn() + Sync),
 ) -> (Radiance, RunReport) {
     let stats = *prep.stats();
     let equation_12 = cost::predicted_nth(costs, &stats);
-    let (predicted, follow_up) = prep.predicted_nth(costs, opts.depth);
-    let used = match opts.nth {
+    let (predicted, follow_up) = prep.predicted_nth(costs, settings.depth);
+    let used = match settings.nth {
         Nth::Auto => predicted,
         Nth::Fixed(n) => n as f64,
     };
-    let scheme = match opts.scheme {
-        SchemeChoice::Conventional => Scheme::Conventional,
-        SchemeChoice::Volume => Scheme::Volume,
-        SchemeChoice::Hst => Scheme::Hst { nth: used as f32 },
-        SchemeChoice::Bvh => Scheme::Bvh,
-        SchemeChoice::Embree => Scheme::Embree,
-    };
-    let settings = Settings {
-        width: opts.width,
-        height: opts.height,
-        spp: opts.spp,
-        depth: opts.depth,
-        scheme,
-        check: opts.check,
+    let job = Job {
+        settings: *settings,
+        scheme: scheme(settings.scheme, used as f32),
         time_decisions: false,
     };
-    let (image, r) = trace::render_region(prep, settings, region, on_tile);
+    let (image, r) = trace::render_region(prep, job, region, on_tile);
     let nth = NthReport {
+        asked: settings.nth,
         predicted,
         equation_12,
         follow_up,
-        used: match scheme {
+        used: match job.scheme {
             Scheme::Hst { nth } => Some(nth as f64),
             _ => None,
         },
     };
-    (image, report(prep, &settings, &r, &stats, costs, nth))
+    (image, report(prep, settings, &r, &stats, costs, nth))
 }
 
 fn report(
@@ -365,11 +299,7 @@ fn report(
     let shadow = r.shadow_cpu_s();
     RunReport {
         scene: prep.scene.name.clone(),
-        scheme: settings.scheme.name().into(),
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
-        depth: settings.depth,
+        settings: *settings,
         polygons: prep.polygons.len(),
         lights: prep.scene.lights.len(),
         shadow_polygons: prep.volumes.as_ref().map_or(0, |v| v.polygon_count()),

@@ -7,10 +7,12 @@ use crate::cost::{
 };
 use crate::grid::{CellRecord, Grid, Mailbox};
 use crate::prepare::{Prepared, Scheme};
-use crate::trace::{Pinhole, Settings, render};
+use crate::settings::{Nth, SchemeChoice, Settings};
+use crate::trace::{Job, Pinhole, render};
 use glam::Vec3;
 use quadray_core::geom::{ConvexPolygon, Ray};
 use quadray_core::random::SplitMix;
+use quadray_core::settings::Size;
 use std::hint::black_box;
 
 impl Prepared {
@@ -39,16 +41,20 @@ pub fn follow_up(prep: &Prepared, nth: f64, depth: u32) -> FollowUp {
         return FollowUp::default();
     }
     let pilot = |nth: f32, time_decisions| {
-        let settings = Settings {
-            width: 96,
-            height: 72,
-            spp: 1,
-            depth,
+        // Every field named: a new setting's default must not move the prediction unseen.
+        let job = Job {
+            settings: Settings {
+                scheme: SchemeChoice::Hst,
+                nth: Nth::Fixed(nth),
+                size: Size::new(96, 72),
+                spp: 1,
+                depth,
+                check: false,
+            },
             scheme: Scheme::Hst { nth },
-            check: false,
             time_decisions,
         };
-        render(prep, settings, &|| {}).1
+        render(prep, job, &|| {}).1
     };
     // This one also warms the caches for the timed ones.
     let r = pilot(nth as f32, false);

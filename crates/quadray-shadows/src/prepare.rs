@@ -28,19 +28,6 @@ pub enum Scheme {
     Embree,
 }
 
-impl Scheme {
-    /// The name the command line and the stats use.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Scheme::Conventional => "conventional",
-            Scheme::Volume => "volume",
-            Scheme::Hst { .. } => "hst",
-            Scheme::Bvh => "bvh",
-            Scheme::Embree => "embree",
-        }
-    }
-}
-
 /// Everything built before rendering: polygons, grid, shadow polygons, BVH.
 pub struct Prepared {
     /// The scene prepared.

@@ -39,7 +39,7 @@ pub struct RenderStats {
     pub shadow_ticks: u64,
     /// (See `shadow_ticks`.)
     pub tile_ticks: u64,
-    /// With [`crate::trace::Settings::time_decisions`]: HST's shadow-volume decisions (the
+    /// With [`crate::trace::Job::time_decisions`]: HST's shadow-volume decisions (the
     /// crossing tests) and its shadow rays, timed and binned by N_s.
     pub shadow_volume_costs: CostBins,
     /// (See `shadow_volume_costs`.)

@@ -8,9 +8,10 @@ use crate::occlusion::{GridOccluder, Occluder};
 use crate::prepare::{Prepared, Scheme};
 use crate::scene::{BUILTINS, Face, Scene};
 use crate::shadow::{LightState, ShadowVolumes, depth_at};
-use crate::{Nth, RunOptions, SchemeChoice, run};
+use crate::{BuildError, Nth, RunReport, SchemeChoice, Settings, Size};
 use glam::Vec3;
 use quadray_core::geom::{ConvexPolygon, Ray};
+use quadray_core::image_out::Rgba8Image;
 use quadray_core::random::SplitMix;
 use std::path::Path;
 
@@ -341,21 +342,28 @@ fn depth_count_along_segments_equals_polygons_counted_to_the_light() {
     }
 }
 
-fn options(scheme: SchemeChoice, nth: Nth) -> RunOptions {
-    RunOptions {
+/// Machine constants of the tests: fixed, so that no test waits for a calibration.
+const COSTS: MachineCosts = MachineCosts {
+    c_s: 5.0,
+    c_i: 20.0,
+    c_c: 3.0,
+    c_o: 5.0,
+};
+
+/// [`crate::run`] with [`COSTS`] for the measured constants.
+fn run(scene: Scene, settings: &Settings) -> Result<(Rgba8Image, RunReport), BuildError> {
+    let prep = crate::prepare(scene, settings.scheme)?;
+    Ok(crate::render_prepared(&prep, settings, &COSTS, &|| {}))
+}
+
+fn options(scheme: SchemeChoice, nth: Nth) -> Settings {
+    Settings {
         scheme,
         nth,
-        width: 96,
-        height: 72,
-        spp: 1,
+        size: Size::new(96, 72),
         depth: 4,
         check: true,
-        costs: Some(MachineCosts {
-            c_s: 5.0,
-            c_i: 20.0,
-            c_c: 3.0,
-            c_o: 5.0,
-        }),
+        ..Settings::DEFAULT
     }
 }
 
@@ -375,8 +383,8 @@ fn assert_same_as_conventional(scene: &Scene, what: &str) {
 
 /// Renders with `--check` and asserts on more than `min_points` shading points that at most the
 /// bar's share disagrees with the conventional test.
-fn assert_agrees(scene: &Scene, opts: &RunOptions, min_points: u64, what: &str) {
-    let (_, r) = run(scene.clone(), opts, &|| {}).unwrap();
+fn assert_agrees(scene: &Scene, opts: &Settings, min_points: u64, what: &str) {
+    let (_, r) = run(scene.clone(), opts).unwrap();
     let bad = r.disagreements.unwrap();
     let points = r.shading_points;
     assert!(points > min_points, "{what}: {points} shading points");
@@ -461,12 +469,12 @@ fn transmission_updates_the_carried_state() {
 
 #[test]
 fn renders_are_deterministic_and_not_empty() {
-    let opts = RunOptions {
+    let opts = Settings {
         check: false,
         ..options(SchemeChoice::Hst, Nth::Fixed(8.0))
     };
-    let (a, r) = run(Scene::builtin("stars").unwrap(), &opts, &|| {}).unwrap();
-    let (b, _) = run(Scene::builtin("stars").unwrap(), &opts, &|| {}).unwrap();
+    let (a, r) = run(Scene::builtin("stars").unwrap(), &opts).unwrap();
+    let (b, _) = run(Scene::builtin("stars").unwrap(), &opts).unwrap();
     assert_eq!(a, b);
     assert!(
         a.pixels
@@ -638,9 +646,8 @@ fn the_bunny_in_the_cornell_box_decides_like_the_conventional_test() {
         (SchemeChoice::Volume, Nth::Auto),
         (SchemeChoice::Hst, Nth::Fixed(16.0)),
     ] {
-        let opts = RunOptions {
-            width: 160,
-            height: 120,
+        let opts = Settings {
+            size: Size::new(160, 120),
             ..options(scheme, nth)
         };
         assert_agrees(&scene, &opts, 10_000, "bunny");
@@ -653,9 +660,8 @@ fn the_bunny_in_the_cornell_box_decides_like_the_conventional_test() {
 fn the_buddha_in_the_cornell_box_decides_like_the_conventional_test() {
     let scene = asset_scene("scenes/shadows-buddha.toml");
     assert!(scene.faces.len() > 100_000, "{} faces", scene.faces.len());
-    let opts = RunOptions {
-        width: 160,
-        height: 120,
+    let opts = Settings {
+        size: Size::new(160, 120),
         ..options(SchemeChoice::Hst, Nth::Fixed(16.0))
     };
     assert_agrees(&scene, &opts, 10_000, "buddha");
@@ -795,6 +801,6 @@ fn the_builder_refuses_bad_faces_and_scenes_with_clear_errors() {
     s.lights.truncate(1);
     s.validate().unwrap();
     s.lights[0].position.x = f32::NAN;
-    let e = run(s, &options(SchemeChoice::Hst, Nth::Fixed(4.0)), &|| {}).unwrap_err();
+    let e = run(s, &options(SchemeChoice::Hst, Nth::Fixed(4.0))).unwrap_err();
     assert!(e.to_string().contains("not finite"), "{e}");
 }

@@ -7,6 +7,7 @@ use crate::grid::{CellRecord, Mailbox};
 use crate::occlusion::Occluder;
 use crate::prepare::{Prepared, Scheme};
 use crate::scene::MAX_LIGHTS;
+use crate::settings::Settings;
 use crate::shadow::LightState;
 use crate::stats::RenderStats;
 use glam::Vec3;
@@ -17,23 +18,16 @@ use std::time::Instant;
 
 const TILE: u32 = 16;
 
-/// One render's parameters.
+/// One render: the user's settings and the shadow test they resolve to.
 #[derive(Clone, Copy, Debug)]
-pub struct Settings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    /// Recursion depth of reflection and refraction.
-    pub depth: u32,
-    /// How shadows are decided.
+pub struct Job {
+    /// Size, samples, depth and `check` (the scheme and N_th as resolved in `scheme`).
+    pub settings: Settings,
+    /// How shadows are decided: `settings.scheme` with its N_th known (`Nth::Auto` predicted).
     pub scheme: Scheme,
-    /// Also run the conventional test at every shading point and count disagreements.
-    pub check: bool,
     /// Also time HST's shadow-volume decisions and shadow rays one by one (the pilot render of
-    /// the N_th prediction does; two clock reads per decision are not free).
+    /// the N_th prediction does; two clock reads per decision are not free). Not a setting: a
+    /// user's render never times them.
     pub time_decisions: bool,
 }
 
@@ -74,7 +68,7 @@ type States = [LightState; MAX_LIGHTS];
 
 struct Tracer<'a, S> {
     prep: &'a Prepared,
-    settings: Settings,
+    job: Job,
     test: S,
 }
 
@@ -138,32 +132,28 @@ impl Radiance {
 }
 
 /// Renders the scene; `on_tile` is called after each finished tile (for a progress bar). The
-/// scene must have at most [`MAX_LIGHTS`] lights and the structures `settings.scheme` needs must
+/// scene must have at most [`MAX_LIGHTS`] lights and the structures `job.scheme` needs must
 /// have been prepared.
-pub fn render(
-    prep: &Prepared,
-    settings: Settings,
-    on_tile: &(dyn Fn() + Sync),
-) -> (Rgba8Image, RenderStats) {
-    let full = Region::full(settings.width, settings.height);
-    let (radiance, stats) = render_region(prep, settings, full, on_tile);
+pub fn render(prep: &Prepared, job: Job, on_tile: &(dyn Fn() + Sync)) -> (Rgba8Image, RenderStats) {
+    let size = job.settings.size;
+    let full = Region::full(size.width, size.height);
+    let (radiance, stats) = render_region(prep, job, full, on_tile);
     (radiance.to_rgba8(1.0), stats)
 }
 
-/// [`render`] of the pixels in `region` alone (inside the `settings.width` x `settings.height`
-/// image), as radiance: every pixel depends only on its own rays, so regions rendered apart are
-/// bit for bit the same pixels as the whole render.
+/// [`render`] of the pixels in `region` alone (inside the `job.settings.size` image), as
+/// radiance: every pixel depends only on its own rays, so regions rendered apart are bit for bit
+/// the same pixels as the whole render.
 pub fn render_region(
     prep: &Prepared,
-    settings: Settings,
+    job: Job,
     region: Region,
     on_tile: &(dyn Fn() + Sync),
 ) -> (Radiance, RenderStats) {
+    let size = job.settings.size;
     assert!(
-        region.x + region.width <= settings.width && region.y + region.height <= settings.height,
-        "region {region:?} outside the {}x{} image",
-        settings.width,
-        settings.height
+        region.x + region.width <= size.width && region.y + region.height <= size.height,
+        "region {region:?} outside the {size} image",
     );
     assert!(
         prep.scene.lights.len() <= MAX_LIGHTS,
@@ -171,28 +161,28 @@ pub fn render_region(
     );
     let volumes = || prep.volumes.as_ref().expect("shadow volumes prepared");
     let grid_rays = || ShadowRays(prep.grid_occluder());
-    match settings.scheme {
-        Scheme::Conventional => render_with(prep, settings, region, grid_rays(), on_tile),
+    match job.scheme {
+        Scheme::Conventional => render_with(prep, job, region, grid_rays(), on_tile),
         Scheme::Bvh => {
             let bvh = prep.bvh_occluder().expect("BVH prepared");
-            render_with(prep, settings, region, ShadowRays(bvh), on_tile)
+            render_with(prep, job, region, ShadowRays(bvh), on_tile)
         }
         #[cfg(feature = "embree")]
         Scheme::Embree => {
             let embree = prep.embree.as_ref().expect("Embree scene prepared");
-            render_with(prep, settings, region, ShadowRays(embree), on_tile)
+            render_with(prep, job, region, ShadowRays(embree), on_tile)
         }
         #[cfg(not(feature = "embree"))]
-        Scheme::Embree => render_with(prep, settings, region, grid_rays(), on_tile),
-        Scheme::Volume => render_with(prep, settings, region, Volumes(volumes()), on_tile),
+        Scheme::Embree => render_with(prep, job, region, grid_rays(), on_tile),
+        Scheme::Volume => render_with(prep, job, region, Volumes(volumes()), on_tile),
         Scheme::Hst { nth } => {
             let test = Hybrid {
                 volumes: volumes(),
                 rays: prep.grid_occluder(),
                 nth,
-                time_decisions: settings.time_decisions,
+                time_decisions: job.time_decisions,
             };
-            render_with(prep, settings, region, test, on_tile)
+            render_with(prep, job, region, test, on_tile)
         }
     }
 }
@@ -200,16 +190,12 @@ pub fn render_region(
 /// [`render_region`] with the shadow test chosen.
 fn render_with<S: ShadowTest>(
     prep: &Prepared,
-    settings: Settings,
+    job: Job,
     region: Region,
     test: S,
     on_tile: &(dyn Fn() + Sync),
 ) -> (Radiance, RenderStats) {
-    let tracer = Tracer {
-        prep,
-        settings,
-        test,
-    };
+    let tracer = Tracer { prep, job, test };
     let tiles: Vec<Region> = (0..region.height.div_ceil(TILE))
         .flat_map(|ty| {
             (0..region.width.div_ceil(TILE)).map(move |tx| Region {
@@ -254,7 +240,8 @@ impl<S: ShadowTest> Tracer<'_, S> {
     fn tile(&self, tile: Region) -> (Vec<[f32; 3]>, RenderStats) {
         let start = crate::ticks();
         let prep = self.prep;
-        let (w, h) = (self.settings.width, self.settings.height);
+        let settings = &self.job.settings;
+        let (w, h) = (settings.size.width, settings.size.height);
         let mut scratch = Scratch {
             objects: Mailbox::new(prep.polygons.len()),
             rays: self.test.rays(),
@@ -271,7 +258,7 @@ impl<S: ShadowTest> Tracer<'_, S> {
                 *s = LightState::at_eye(lv.eye_depth);
             }
         }
-        let spp = self.settings.spp.max(1);
+        let spp = settings.spp.max(1);
         let mut pixels = Vec::new();
         for y in tile.y..tile.y + tile.height {
             for x in tile.x..tile.x + tile.width {
@@ -292,7 +279,7 @@ impl<S: ShadowTest> Tracer<'_, S> {
                         cam.position,
                         d,
                         None,
-                        self.settings.depth,
+                        settings.depth,
                         eye_states,
                     );
                 }
@@ -352,7 +339,7 @@ impl<S: ShadowTest> Tracer<'_, S> {
         );
         sc.stats.shadow_ticks += crate::ticks().wrapping_sub(shadow_start);
         sc.stats.shadow_decisions += lights.len() as u64;
-        if self.settings.check {
+        if self.job.settings.check {
             let mut differs = 0;
             for (l, light) in lights.iter().enumerate() {
                 let to_light = light.position - p;

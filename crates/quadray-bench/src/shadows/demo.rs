@@ -5,7 +5,9 @@
 use super::measure::bench_scenes;
 use quadray_core::FileError;
 use quadray_core::image_out::{heat_map, montage};
-use quadray_shadows::{Nth, RunOptions, SchemeChoice, cost, run};
+use quadray_shadows::{
+    BuildError, Scene, SchemeChoice, Settings, Size, cost, prepare, render_prepared,
+};
 use std::path::{Path, PathBuf};
 
 /// A pixel difference this large (of 255, largest channel) is white in the heat map.
@@ -23,29 +25,26 @@ pub fn render_demo(
     progress("machine constants");
     let costs = cost::calibrate();
     let (width, height) = (size, (size * 15 / 16).max(1));
-    let options = |scheme, check| RunOptions {
-        scheme,
-        nth: Nth::Auto,
-        width,
-        height,
-        spp: 1,
-        depth: 5,
-        check,
-        costs: Some(costs),
+    // One calibration for every render: `quadray_shadows::run` would measure it each time.
+    let run = |scene: Scene, scheme, check| -> Result<_, BuildError> {
+        let settings = Settings {
+            scheme,
+            size: Size::new(width, height),
+            check,
+            ..Settings::DEFAULT
+        };
+        let prep = prepare(scene, scheme)?;
+        Ok(render_prepared(&prep, &settings, &costs, &|| {}))
     };
     let mut files = Vec::new();
     for scene in scenes {
         let name = scene.name.clone();
         progress(&format!("{name}: conventional"));
         let invalid = |e: quadray_shadows::BuildError| FileError::new(Path::new(&name), e);
-        let (conventional, c) = run(
-            scene.clone(),
-            &options(SchemeChoice::Conventional, false),
-            &|| {},
-        )
-        .map_err(invalid)?;
+        let (conventional, c) =
+            run(scene.clone(), SchemeChoice::Conventional, false).map_err(invalid)?;
         progress(&format!("{name}: hst"));
-        let (hst, h) = run(scene, &options(SchemeChoice::Hst, true), &|| {}).map_err(invalid)?;
+        let (hst, h) = run(scene, SchemeChoice::Hst, true).map_err(invalid)?;
         let difference: Vec<f32> = conventional
             .pixels
             .iter()

@@ -9,7 +9,7 @@ use quadray_core::{write_json, write_text};
 use quadray_shadows::cost::{self, MachineCosts, SceneStats};
 use quadray_shadows::scene::{BUILTINS, Scene, SceneError, assets_dir};
 use quadray_shadows::{
-    Nth, Prepared, RunOptions, RunReport, SchemeChoice, prepare, render_prepared,
+    Nth, Prepared, RunReport, SchemeChoice, Settings, Size, prepare, render_prepared,
 };
 use serde::Serialize;
 use std::path::Path;
@@ -79,7 +79,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// One scheme prepared for timing: preprocessing times of `runs` preparations, the checked
 /// render (disagreements) and the timed renders so far.
 struct Contender {
-    opts: RunOptions,
+    settings: Settings,
     prep: Prepared,
     preprocess: Vec<f64>,
     check: RunReport,
@@ -89,26 +89,26 @@ struct Contender {
 impl Contender {
     fn new(
         scene: &Scene,
-        opts: RunOptions,
+        settings: Settings,
         costs: &MachineCosts,
         runs: usize,
     ) -> Result<Self, FileError> {
         let mut preprocess = Vec::new();
         let mut prep = None;
         for _ in 0..runs {
-            let p = prepare(scene.clone(), opts.scheme)
+            let p = prepare(scene.clone(), settings.scheme)
                 .map_err(|e| FileError::new(Path::new(&scene.name), e))?;
             preprocess.push(p.preprocess_s);
             prep = Some(p);
         }
         let prep = prep.expect("at least one run");
-        let checked = RunOptions {
+        let checked = Settings {
             check: true,
-            ..opts
+            ..settings
         };
         let (_, check) = render_prepared(&prep, &checked, costs, &|| {});
         Ok(Self {
-            opts,
+            settings,
             prep,
             preprocess,
             check,
@@ -117,7 +117,7 @@ impl Contender {
     }
 
     fn render(&mut self, costs: &MachineCosts) {
-        let report = render_prepared(&self.prep, &self.opts, costs, &|| {}).1;
+        let report = render_prepared(&self.prep, &self.settings, costs, &|| {}).1;
         self.reports.push(report);
     }
 
@@ -126,7 +126,7 @@ impl Contender {
         let shadow = median(self.reports.iter().map(|r| r.times_s.shadow).collect());
         let other = median(self.reports.iter().map(|r| r.times_s.other).collect());
         SchemeRow {
-            scheme: self.check.scheme.clone(),
+            scheme: self.check.settings.scheme.to_string(),
             nth: self.check.nth.used,
             preprocess: pre,
             shadow,
@@ -175,15 +175,11 @@ pub fn bench_shadows(
     };
     let costs = cost::calibrate();
     progress(&format!("machine constants (ns): {costs:?}"));
-    let base = RunOptions {
+    let base = Settings {
         scheme: SchemeChoice::Conventional,
-        nth: Nth::Auto,
-        width,
-        height,
-        spp: 1,
+        size: Size::new(width, height),
         depth,
-        check: false,
-        costs: Some(costs),
+        ..Settings::DEFAULT
     };
     let mut scenes = Vec::new();
     let all = bench_scenes().map_err(|e| FileError::new(&e.path, &e.reason))?;
@@ -200,7 +196,7 @@ pub fn bench_shadows(
         }
         let mut contenders: Vec<Contender> = schemes
             .iter()
-            .map(|&scheme| Contender::new(&scene, RunOptions { scheme, ..base }, &costs, runs))
+            .map(|&scheme| Contender::new(&scene, Settings { scheme, ..base }, &costs, runs))
             .collect::<Result<_, _>>()?;
         // Interleaved rounds, so that a busy spell of the machine weighs on every scheme alike.
         for _ in 0..runs {
@@ -214,7 +210,7 @@ pub fn bench_shadows(
         let stats = *prep.stats();
         let equation_12 = cost::predicted_nth(&costs, &stats);
         let (predicted, follow_up) = prep.predicted_nth(&costs, depth);
-        let hst_at = |nth: f64| RunOptions {
+        let hst_at = |nth: f64| Settings {
             scheme: SchemeChoice::Hst,
             nth: Nth::Fixed(nth as f32),
             ..base
