@@ -19,7 +19,7 @@ pub(crate) const TILE_FRONTIER: u32 = 1024;
 /// Per-tile cuts: a node more than this many times `r_min` across, with a receiver of the tile
 /// within `r_min` of its box, holds the kernel's near field, where its children's sum agrees
 /// with it however far both are from its VPLs'; the bound, not the estimate, decides it
-/// (`near_field` in tiles.wgsl; BENCHMARKS.md, "The default method at equal error").
+/// (`near_field` in wgsl/tile_rule.wgsl; BENCHMARKS.md, "The default method at equal error").
 pub const NEAR_FIELD_SIZE: f32 = 4.0;
 
 /// How the indirect term is computed.
