@@ -7,4 +7,5 @@ mod gpu;
 mod layers;
 mod non_finite;
 mod output;
+mod tile_cut;
 mod visibility;
