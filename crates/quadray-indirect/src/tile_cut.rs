@@ -1,17 +1,19 @@
 //! The CPU's twin of the per-tile cuts ([`Method::QuadtreeTiles`]: `gpu/gather/tiles.wgsl` with
-//! the rules of `wgsl/tile_rule.wgsl`): the same phases, in f32 as there, over the quadtree's
-//! nodes and the G-buffer's receivers read back. The receivers' box and groups, the coarse
-//! estimate and the threshold, the refinement level by level (bound, estimate, split bins, the
-//! list's capacity), the far nodes shared at the tile's corners; the kernel is the reference's
-//! [`vpl_kernel`]. Each tile's list comes out in the twin's order (the shader's is its threads'),
-//! with the nodes whose decision lay within [`TIE`] of its threshold, where f32 sums in another
-//! order may decide the other way.
+//! the rules of `wgsl/tile_rule.wgsl`): the same phases, in f32 as there (the kernel: the
+//! reference's [`vpl_kernel`] rounded to f32), over the quadtree's nodes and the G-buffer's
+//! receivers read back. The receivers' box and groups, the coarse estimate and the threshold, the
+//! refinement level by level (bound, estimate, split bins, the list's capacity), the far nodes
+//! shared at the tile's corners. Each tile's list comes out in the twin's order (the shader's is
+//! its threads'), with the nodes whose decision lay within [`TIE`] of its threshold, where f32
+//! sums in another order may decide the other way.
 
 use crate::frame::{CutNode, Receiver};
 use crate::reference::vpl_kernel;
 #[cfg(doc)]
 use crate::settings::Method;
-use crate::settings::{NEAR_FIELD_SIZE, Settings, TILE, TileCriterion};
+use crate::settings::{
+    CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, Settings, TILE, TileCriterion,
+};
 use glam::{DVec3, Vec3, Vec4};
 use std::f32::consts::PI;
 
@@ -20,17 +22,12 @@ pub const TIE: f32 = 1e-5;
 
 /// A tile's pixels.
 pub const TILE_PIXELS: usize = (TILE * TILE) as usize;
-const SPLIT_BINS: u32 = 16;
 const CORNERS: [usize; 4] = [
     0,
     TILE as usize - 1,
     TILE_PIXELS - TILE as usize,
     TILE_PIXELS - 1,
 ];
-/// An empty box's lo and an uncovered pixel's position (node.wgsl's `EMPTY_BOX`).
-const EMPTY_BOX: f32 = 1e30;
-/// node.wgsl's `CONE_SLACK`.
-const CONE_SLACK: f32 = 1e-3;
 
 /// What the twin reads, as the renderer reads it back.
 pub struct TileInput<'a> {

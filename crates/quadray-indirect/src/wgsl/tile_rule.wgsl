@@ -8,9 +8,8 @@
 // EMPTY_BOX); `fn tile_sample(q: u32) -> u32`, the sample pixel of quadrant q (its first covered
 // pixel, TILE_PIXELS where none).
 
+// (TILE, NEAR_FIELD_SIZE, EMPTY_BOX, CONE_SLACK and SPLIT_BINS come from the prelude)
 const TILE_PIXELS: u32 = TILE * TILE;
-// splits are ordered by bins of powers of two of how far a node's bound exceeds the threshold
-const SPLIT_BINS: u32 = 16u;
 const CORNERS: array<u32, 4> = array<u32, 4>(0u, TILE - 1u, TILE_PIXELS - TILE, TILE_PIXELS - 1u);
 
 // The tile's receivers in two groups, its box halved across its longest side (a tile on a depth
