@@ -78,42 +78,6 @@ fn corner_visibility(p: vec3<f32>) -> u32 {
     return seen;
 }
 
-// The shared nodes' vector irradiance at each corner receiver (with indirect shadows, those the
-// corner sees): a quarter of the workgroup per corner, each thread a share of the nodes, then
-// summed per corner (one colour channel in each of the reduction arrays). Every invocation
-// calls it.
-fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat3x3<f32>, 4> {
-    let x = tile_x[CORNERS[local % 4u]];
-    var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    for (var i = local / 4u; i < listed; i += TILE_PIXELS / 4u) {
-        let entry = frontier[0][i];
-        if ((entry & SHARED) != 0u) {
-            fetches++;
-            let node = nodes[entry & ~SHARED];
-            // (evaluated either way, as a pixel's own sum does before its shadow test)
-            let seen = !corner_shadows || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
-            v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, terms.r_min) * f32(seen);
-        }
-    }
-    reduce_lo[local] = v[0];
-    reduce_hi[local] = v[1];
-    reduce_n[local] = vec4<f32>(v[2], 0.0);
-    workgroupBarrier();
-    for (var stride = TILE_PIXELS / 2u; stride >= 4u; stride >>= 1u) {
-        if (local < stride) {
-            reduce_lo[local] += reduce_lo[local + stride];
-            reduce_hi[local] += reduce_hi[local + stride];
-            reduce_n[local] += reduce_n[local + stride];
-        }
-        workgroupBarrier();
-    }
-    var corners: array<mat3x3<f32>, 4>;
-    for (var c = 0u; c < 4u; c++) {
-        corners[c] = mat3x3<f32>(reduce_lo[c], reduce_hi[c], reduce_n[c].xyz);
-    }
-    return corners;
-}
-
 // Stores every thread's counts: those outside the picture's with the tile's first pixel.
 fn store_tile_counts(pixel: vec2<u32>, inside: bool, local: u32) {
     if (!inside) {
@@ -399,6 +363,42 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
         shared_total = atomicLoad(&shared_count);
     }
     return workgroupUniformLoad(&shared_total);
+}
+
+// Phase 4, then: the shared nodes' vector irradiance at each corner receiver (with indirect
+// shadows, those the corner sees): a quarter of the workgroup per corner, each thread a share of
+// the nodes, then summed per corner (one colour channel in each of the reduction arrays). Every
+// invocation calls it.
+fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat3x3<f32>, 4> {
+    let x = tile_x[CORNERS[local % 4u]];
+    var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var i = local / 4u; i < listed; i += TILE_PIXELS / 4u) {
+        let entry = frontier[0][i];
+        if ((entry & SHARED) != 0u) {
+            fetches++;
+            let node = nodes[entry & ~SHARED];
+            // (evaluated either way, as a pixel's own sum does before its shadow test)
+            let seen = !corner_shadows || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
+            v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, terms.r_min) * f32(seen);
+        }
+    }
+    reduce_lo[local] = v[0];
+    reduce_hi[local] = v[1];
+    reduce_n[local] = vec4<f32>(v[2], 0.0);
+    workgroupBarrier();
+    for (var stride = TILE_PIXELS / 2u; stride >= 4u; stride >>= 1u) {
+        if (local < stride) {
+            reduce_lo[local] += reduce_lo[local + stride];
+            reduce_hi[local] += reduce_hi[local + stride];
+            reduce_n[local] += reduce_n[local + stride];
+        }
+        workgroupBarrier();
+    }
+    var corners: array<mat3x3<f32>, 4>;
+    for (var c = 0u; c < 4u; c++) {
+        corners[c] = mat3x3<f32>(reduce_lo[c], reduce_hi[c], reduce_n[c].xyz);
+    }
+    return corners;
 }
 
 // Phase 5: a covered pixel's sum of its tile's list. Where the pixel lies on the corners'
