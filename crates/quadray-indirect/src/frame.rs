@@ -132,7 +132,7 @@ impl Frame {
 }
 
 /// A cluster of the cut: its level (0 = one RSM texel) and its node's column and row there.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct CutNode {
     /// Quadtree level, 0 being the RSM itself.
     pub level: u32,

@@ -25,6 +25,7 @@ pub mod picture;
 pub mod reference;
 pub mod scene;
 mod settings;
+pub mod tile_cut;
 pub mod wgsl;
 
 /// Anything that can go wrong between a scene file and a measured picture.

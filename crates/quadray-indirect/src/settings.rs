@@ -19,8 +19,17 @@ pub(crate) const TILE_FRONTIER: u32 = 1024;
 /// Per-tile cuts: a node more than this many times `r_min` across, with a receiver of the tile
 /// within `r_min` of its box, holds the kernel's near field, where its children's sum agrees
 /// with it however far both are from its VPLs'; the bound, not the estimate, decides it
-/// (`near_field` in tiles.wgsl; BENCHMARKS.md, "The default method at equal error").
+/// (`near_field` in wgsl/tile_rule.wgsl; BENCHMARKS.md, "The default method at equal error").
 pub const NEAR_FIELD_SIZE: f32 = 4.0;
+/// An empty box's lo (its hi is the negative): any box joined with it is that box. A tile's
+/// uncovered pixel lies there (per-tile cuts), never the one nearest a node.
+pub(crate) const EMPTY_BOX: f32 = 1e30;
+/// Widens a normal cone's half-angle (radians) past f32's rounding in acos near 1, so that the
+/// cone still holds every VPL normal.
+pub(crate) const CONE_SLACK: f32 = 1e-3;
+/// Per-tile cuts order a level's splits by bins of powers of two of how far a node's bound
+/// exceeds the threshold, the highest first.
+pub(crate) const SPLIT_BINS: u32 = 16;
 
 /// How the indirect term is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -7,9 +7,10 @@ use glam::{Vec2, Vec3, Vec4};
 use quadray_gpu::Gpu;
 use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
 use quadray_indirect::gpu::Receiver;
+use quadray_indirect::tile_cut::{TileInput, tile_cuts};
 use quadray_indirect::{
-    ClusterSettings, Levels, Method, NEAR_FIELD_SIZE, Renderer, Scene, Settings, Size,
-    TileCriterion, Validity, WorkCounts,
+    ClusterSettings, Levels, Method, Renderer, Scene, Settings, Size, TileCriterion, Validity,
+    WorkCounts,
 };
 
 const RSM: u32 = 32;
@@ -121,27 +122,10 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     // against both groups of receivers for the non-empty ones above level 0, which are listed or
     // split, the split ones' four children visited) and the gather (the list read once into
     // workgroup memory, then each covered pixel reads and sums its nodes). With the estimate
-    // criterion, a node below the start level whose bound is over the threshold also reads its
-    // four children and evaluates itself and its non-empty ones at the sample pixels and the
-    // receiver nearest it: every split node there, and some of the listed ones (the tile reports
-    // how many, checked between the two), except in a node's near field (`near_field` in
-    // tiles.wgsl: a receiver of the tile within r_min of a node's box more than NEAR_FIELD_SIZE
-    // r_min across),
-    // where the bound alone decides
+    // criterion, the nodes whose error the tile estimated read their four children, and the
+    // evaluations that took, are the CPU twin's (`tile_cut`), but where it found a tie
     let start = c.start;
     let node_bounds = r.read_node_bounds().unwrap();
-    let r_min = scene.r_min;
-    // (margin: f32 sums in another order may tip a node on the edge either way)
-    let near_field = |(level, x, y): (u32, u32, u32), tile: &[Vec3], margin: f32| {
-        let [lo, hi] = node_bounds[node_index(level, x, y)].map(|v| Vec4::from(v).truncate());
-        let r2 = r_min * r_min;
-        (hi - lo).length_squared() > NEAR_FIELD_SIZE.powi(2) * r2 * (1.0 - margin)
-            && tile.iter().any(|&p| {
-                let gap = (lo - p).max(p - hi).max(Vec3::ZERO);
-                gap.length_squared() < r2 * (1.0 + margin)
-            })
-    };
-    let mut near_nodes = 0;
     let root = RSM.ilog2();
     let lit = |level: u32, x: u32, y: u32| nodes[node_index(level, x, y)][0][3] > 0.5;
     let start_nodes = u64::from((RSM >> start).pow(2));
@@ -149,23 +133,24 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
         .filter(|&i| lit(start, i % (RSM >> start), i / (RSM >> start)))
         .count() as u64;
     for criterion in TileCriterion::ALL {
-        let mut r = Renderer::new(
-            &gpu,
-            &scene,
-            Settings {
-                tile_criterion: criterion,
-                ..s.clone()
-            },
-        )
-        .unwrap();
+        let settings = Settings {
+            tile_criterion: criterion,
+            ..s.clone()
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
         let tiles = counted(&mut r, Method::QuadtreeTiles);
         let cuts = r.read_tile_cuts().unwrap();
         let estimates = r.read_tile_estimates().unwrap();
+        let twin = tile_cuts(&TileInput {
+            nodes: &nodes,
+            bounds: &node_bounds,
+            receivers: &receivers,
+            settings: &settings,
+            r_min: scene.r_min,
+        });
         let (mut evaluations, mut fetches, mut bounds) = (0, 3 * pixels, 0);
         let tiles_x = s.size.width.div_ceil(8);
-        for ((tile, cut), &(estimated, estimate_evaluations)) in
-            cuts.iter().enumerate().zip(&estimates)
-        {
+        for (tile, ((cut, &reported), twin)) in cuts.iter().zip(&estimates).zip(&twin).enumerate() {
             let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);
             let covered = |lx: u32, ly: u32| {
                 let (x, y) = (tx * 8 + lx, ty * 8 + ly);
@@ -174,16 +159,9 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
                     && receivers[(y * s.size.width + x) as usize].is_some()
             };
             let pixels_lit = (0..64).filter(|i| covered(i % 8, i / 8)).count() as u64;
-            let tile_receivers: Vec<Vec3> = (0..64)
-                .filter(|i| covered(i % 8, i / 8))
-                .map(|i| {
-                    let (x, y) = (tx * 8 + i % 8, ty * 8 + i / 8);
-                    Vec3::from(receivers[(y * s.size.width + x) as usize].unwrap().position)
-                })
-                .collect();
             if pixels_lit == 0 {
                 assert!(cut.is_empty());
-                assert_eq!((estimated, estimate_evaluations), (0, 0));
+                assert_eq!(reported, (0, 0));
                 continue;
             }
             let quadrants = (0..4)
@@ -198,61 +176,26 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
                 .collect();
             let listed = cut.len() as u64;
             let listed_above_0 = cut.iter().filter(|n| n.level > 0).count() as u64;
-            // what estimating a node takes: (nodes, VPL evaluations)
-            let estimate = |(level, x, y): (u32, u32, u32)| {
-                let children = (0..4)
-                    .filter(|c| lit(level - 1, 2 * x + c % 2, 2 * y + c / 2))
-                    .count() as u64;
-                (1, (quadrants + 1) * (1 + children))
-            };
-            let sum = |a: (u64, u64), b: (u64, u64)| (a.0 + b.0, a.1 + b.1);
-            let below_start = |&(level, _, _): &(u32, u32, u32)| level < start;
-            // estimated for certain: split below the start level, surely outside the near field;
-            // perhaps: also listed, or on the near field's edge
-            let surely = |n: &(u32, u32, u32)| !near_field(*n, &tile_receivers, 1e-3);
-            let perhaps = |n: &(u32, u32, u32)| !near_field(*n, &tile_receivers, -1e-3);
-            near_nodes += split
-                .iter()
-                .filter(|n| below_start(n) && !perhaps(n))
-                .count();
-            let split_estimates = split
-                .iter()
-                .copied()
-                .filter(|n| below_start(n) && surely(n))
-                .map(estimate)
-                .fold((0, 0), sum);
-            let listed_estimates = split
-                .iter()
-                .copied()
-                .filter(|n| below_start(n) && perhaps(n) && !surely(n))
-                .chain(cut.iter().map(|n| (n.level, n.x, n.y)))
-                .filter(|n| n.0 > 0 && below_start(n) && perhaps(n))
-                .map(estimate)
-                .fold((0, 0), sum);
-            let reported = (u64::from(estimated), u64::from(estimate_evaluations));
             if criterion == TileCriterion::Bound {
                 assert_eq!(reported, (0, 0));
-            } else {
-                let most = sum(split_estimates, listed_estimates);
-                assert!(
-                    split_estimates.0 <= reported.0 && reported.0 <= most.0,
-                    "tile {tile}: {reported:?} estimates, {split_estimates:?}..{most:?}"
-                );
-                assert!(
-                    split_estimates.1 <= reported.1 && reported.1 <= most.1,
-                    "tile {tile}: {reported:?} estimates, {split_estimates:?}..{most:?}"
+            } else if twin.ties.is_empty() {
+                assert_eq!(
+                    reported,
+                    (twin.estimated, twin.estimate_evaluations),
+                    "tile {tile}: nodes estimated and their evaluations, against the twin's"
                 );
             }
+            let (estimated, estimate_evaluations) = (u64::from(reported.0), u64::from(reported.1));
             let split = split.len() as u64;
             // a bound for each of the tile's two groups of receivers
             bounds += 2 * (listed_above_0 + split);
-            evaluations += lit_start * quadrants + pixels_lit * listed + reported.1;
+            evaluations += lit_start * quadrants + pixels_lit * listed + estimate_evaluations;
             fetches += start_nodes
                 + (1 + 4 * split)
                 + (listed_above_0 + split)
                 + listed
                 + pixels_lit * listed
-                + 4 * reported.0;
+                + 4 * estimated;
         }
         println!("per-tile cuts, {criterion:?}: {tiles:?}");
         assert_eq!(tiles.refused_splits, 0);
@@ -268,7 +211,6 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
         if criterion == TileCriterion::Estimate {
             let estimated: u32 = estimates.iter().map(|e| e.0).sum();
             assert!(estimated > 0, "some node's error was estimated");
-            println!("{near_nodes} split nodes in a near field");
         }
     }
 

@@ -389,7 +389,7 @@ fn per_tile_cuts_at_the_default_error_stay_within_their_measured_error() {
     );
 }
 
-/// The per-tile cuts' near field (`near_field` in tiles.wgsl): the atrium's columns stand on its
+/// The per-tile cuts' near field (`near_field` in wgsl/tile_rule.wgsl): the atrium's columns stand on its
 /// sun-lit floor, and the nodes around a column's foot hold the kernel's clamp, where a node's
 /// children agree with it however far both are from its VPLs; there the bound decides. The
 /// default method on the atrium at 64x64 with a 64^2 RSM: measured 0.0256 rel. L1 at 523

@@ -15,6 +15,7 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "scene::builtin"],
     &["baselines"],
     &["reference", "picture"],
+    &["tile_cut"],
     &["gpu::contract"],
     &["wgsl"],
     &["gpu::light"],

@@ -8,4 +8,5 @@ mod layering;
 mod layers;
 mod non_finite;
 mod output;
+mod tile_cut;
 mod visibility;

@@ -23,7 +23,8 @@ use glam::DVec3;
 use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::{brute_force, compare, vpl_kernel};
-use quadray_indirect::{IndirectError, Method, NEAR_FIELD_SIZE, Renderer, Scene, Settings};
+use quadray_indirect::tile_cut::{self, TILE_PIXELS};
+use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -32,7 +33,7 @@ use std::path::Path;
 /// Error fractions of the tile's estimated irradiance swept (the shader's `--tile-error`).
 const TAUS: [f64; 5] = [0.01, 0.002, 0.0005, 0.0002, 0.00005];
 /// The tile's side in pixels (the shader's `TILE`).
-const TILE: usize = 8;
+const TILE: usize = TILE_PIXELS.isqrt();
 /// Pixel and VPL pairs the CPU brute force (and the oracle, as much again) may sum: the
 /// default 128x128 picture over a 256^2 RSM is 2^30, about 20 s a scene on two cores.
 const MAX_PAIRS: u64 = 1 << 32;
@@ -276,11 +277,13 @@ fn tile_cut(
         }
         // (the shader's bound splits a node in its near field: the study has no bound)
         let near_field = || {
-            (node.hi - node.lo).length() > f64::from(NEAR_FIELD_SIZE) * r_min
-                && receivers.iter().any(|r| {
-                    let gap = (node.lo - r.0).max(r.0 - node.hi).max(DVec3::ZERO);
-                    gap.length() < r_min
-                })
+            let positions = receivers.iter().map(|r| r.0.as_vec3());
+            tile_cut::near_field(
+                node.lo.as_vec3(),
+                node.hi.as_vec3(),
+                positions,
+                r_min as f32,
+            )
         };
         let split = at.0 >= start
             || (at.0 > 0 && criterion != Criterion::Oracle && near_field())
@@ -399,19 +402,17 @@ fn study_scene(
                 let per_tile: Vec<TileResult> = tiles
                     .par_iter()
                     .map(|&(tx, ty)| {
-                        // the tile's covered pixels, and the first of each quadrant
-                        let pixels: Vec<usize> = (0..TILE * TILE)
-                            .map(|i| (ty * TILE + i / TILE, tx * TILE + i % TILE))
-                            .filter(|&(y, x)| x < w && y < h)
-                            .map(|(y, x)| y * w + x)
-                            .filter(|&p| receivers[p].is_some())
-                            .collect();
-                        let quadrant = |p: usize| {
-                            (p % w % TILE) / (TILE / 2) + 2 * ((p / w % TILE) / (TILE / 2))
+                        // the tile's covered pixels, and its sample pixels
+                        let at = |i: usize| {
+                            let (y, x) = (ty * TILE + i / TILE, tx * TILE + i % TILE);
+                            (x < w && y < h && receivers[y * w + x].is_some()).then_some(y * w + x)
                         };
-                        let samples: Vec<&Receiver> = (0..4)
-                            .filter_map(|q| pixels.iter().find(|&&p| quadrant(p) == q))
-                            .map(|&p| receivers[p].as_ref().unwrap())
+                        let pixels: Vec<usize> = (0..TILE_PIXELS).filter_map(at).collect();
+                        let covered = std::array::from_fn(|i| at(i).is_some());
+                        let samples: Vec<&Receiver> = tile_cut::sample_pixels(&covered)
+                            .into_iter()
+                            .flatten()
+                            .map(|i| receivers[at(i).unwrap()].as_ref().unwrap())
                             .collect();
                         if samples.is_empty() {
                             return TileResult::default();

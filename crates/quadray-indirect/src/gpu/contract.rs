@@ -4,7 +4,9 @@
 //! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
 //! shared struct's size and field offsets against these.
 
-pub(crate) use crate::settings::{NEAR_FIELD_SIZE, TILE, TILE_FRONTIER};
+pub(crate) use crate::settings::{
+    CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, TILE, TILE_FRONTIER,
+};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -43,6 +45,9 @@ pub(crate) fn prelude() -> String {
          const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;\n\
          const TILE: u32 = {TILE}u;\n\
          const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};\n\
+         const EMPTY_BOX: f32 = {EMPTY_BOX:?};\n\
+         const CONE_SLACK: f32 = {CONE_SLACK:?};\n\
+         const SPLIT_BINS: u32 = {SPLIT_BINS}u;\n\
          const PI: f32 = {:?};\n\
          const OUTPUT_INDIRECT: u32 = {}u;\n\
          const OUTPUT_DIRECT: u32 = {}u;\n\
@@ -406,6 +411,9 @@ mod tests {
             format!("const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;"),
             format!("const TILE: u32 = {TILE}u;"),
             format!("const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};"),
+            format!("const EMPTY_BOX: f32 = {EMPTY_BOX:?};"),
+            format!("const CONE_SLACK: f32 = {CONE_SLACK:?};"),
+            format!("const SPLIT_BINS: u32 = {SPLIT_BINS}u;"),
         ] {
             assert!(prelude.contains(&line), "{line}");
         }

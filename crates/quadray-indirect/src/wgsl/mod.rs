@@ -1,5 +1,5 @@
 //! Engine-neutral WGSL: the light quadtree's node layout and pyramid addressing, the VPL kernel,
-//! the spot light, the top-down cut rule, the bound of a node's contribution, and the per-method
+//! the spot light, the top-down cut rule, the bound of a node's contribution, the per-tile cut's rules, and the per-method
 //! sums of the gather. No module declares a binding: where one needs data it calls accessor
 //! functions that the including shader defines from its own bindings (quadray's bindings files
 //! are in `gpu/`, next to the pass that declares them: `gpu/cluster.wgsl`,
@@ -44,6 +44,17 @@ pub const CUT_RULE: &str = include_str!("cut_rule.wgsl");
 /// normals lie in a cone (Lightcuts' bound with normal cones). Needs [`NODE`], [`KERNEL`].
 /// Accessors: none.
 pub const BOUND: &str = include_str!("bound.wgsl");
+
+/// The per-tile cut's rules (method `quadtree-tiles`): the receivers' groups (`receiver_group`,
+/// `group_axis`, `group_cone`), the coarse estimate and threshold (`coarse_light`,
+/// `tile_threshold`), the bound a node is held to (`tile_bound`), when the estimate decides
+/// (`near_field`, `estimate_decides`, `estimated_error`), the split bins (`split_bin`) and the
+/// nodes shared at the tile's corners (`all_corners_covered`, `shareable`); the CPU's twin is
+/// [`crate::tile_cut`]. Needs [`NODE`], [`KERNEL`], [`BOUND`]. Accessors: `load_node` (as
+/// [`CUT_RULE`]), `fn tile_position(p: u32) -> vec3<f32>`, `fn tile_normal(p: u32) -> vec3<f32>`
+/// (the tile's receiver `p`, row-major, an uncovered one at `EMPTY_BOX`) and
+/// `fn tile_sample(q: u32) -> u32` (quadrant `q`'s sample pixel, `TILE_PIXELS` where none).
+pub const TILE_RULE: &str = include_str!("tile_rule.wgsl");
 
 /// The compacted cut's sum at a receiver, `cut_sum(r, range)` (method `quadtree`). Needs
 /// [`NODE`], [`RECEIVER`]. Accessors: `fn load_cut_node(i: u32) -> Node`, cluster `i` of the cut;
@@ -90,9 +101,14 @@ fn load_rsm_position(t: vec2<i32>) -> vec4<f32> { return vec4<f32>(0.0); }
 fn load_rsm_flux(t: vec2<i32>) -> vec3<f32> { return vec3<f32>(0.0); }
 fn load_rsm_sample(i: u32) -> vec4<f32> { return vec4<f32>(0.0); }
 ";
+    const TILE_ACCESSORS: &str = "
+fn tile_position(p: u32) -> vec3<f32> { return vec3<f32>(0.0); }
+fn tile_normal(p: u32) -> vec3<f32> { return vec3<f32>(0.0); }
+fn tile_sample(q: u32) -> u32 { return 0u; }
+";
 
     /// Each module after the modules it needs, then the stub accessors it calls.
-    fn modules() -> [(&'static str, Vec<&'static str>); 10] {
+    fn modules() -> [(&'static str, Vec<&'static str>); 11] {
         [
             ("node", vec![NODE]),
             ("kernel", vec![NODE, KERNEL]),
@@ -100,6 +116,17 @@ fn load_rsm_sample(i: u32) -> vec4<f32> { return vec4<f32>(0.0); }
             ("receiver", vec![RECEIVER]),
             ("cut rule", vec![NODE, CUT_RULE, NODE_ACCESSORS]),
             ("bound", vec![NODE, KERNEL, BOUND]),
+            (
+                "tile rule",
+                vec![
+                    NODE,
+                    KERNEL,
+                    BOUND,
+                    TILE_RULE,
+                    NODE_ACCESSORS,
+                    TILE_ACCESSORS,
+                ],
+            ),
             (
                 "cut view",
                 vec![NODE, KERNEL, CUT_RULE, CUT_VIEW, NODE_ACCESSORS],
@@ -143,6 +170,7 @@ fn load_rsm_sample(i: u32) -> vec4<f32> { return vec4<f32>(0.0); }
             RECEIVER,
             CUT_RULE,
             BOUND,
+            TILE_RULE,
             GATHER_CUT,
             GATHER_LEVEL,
             GATHER_VPLS,

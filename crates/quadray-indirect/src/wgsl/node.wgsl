@@ -27,11 +27,8 @@ struct NodeBounds {
     hi: vec4<f32>,
 }
 
-// An empty box's lo (its hi is the negative): any box joined with it is that box.
-const EMPTY_BOX: f32 = 1e30;
-// Widens a normal cone's half-angle (radians) past f32's rounding in acos near 1, so that the
-// cone still holds every VPL normal.
-const CONE_SLACK: f32 = 1e-3;
+// (EMPTY_BOX, an empty box's lo, and CONE_SLACK, a normal cone's widening, come from the
+// prelude)
 
 struct ClusterParams {
     rsm_size: u32,

@@ -10,7 +10,7 @@ use crate::wgsl;
 use std::sync::OnceLock;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 2] = [wgsl::BOUND, include_str!("tiles.wgsl")];
+pub(crate) const WGSL: [&str; 3] = [wgsl::BOUND, wgsl::TILE_RULE, include_str!("tiles.wgsl")];
 
 /// The per-tile cuts' lists and their bind group (group 3).
 struct TileLists {

@@ -1,0 +1,127 @@
+//! The per-tile cuts on the GPU against their CPU twin (`quadray_indirect::tile_cut`): tile for
+//! tile the same nodes, except below a node whose decision the twin found a tie (its quantity
+//! within `TIE` of its threshold), where f32 sums in another order may decide the other way.
+
+use quadray_gpu::Gpu;
+use quadray_indirect::tile_cut::{TileInput, tile_cuts};
+use quadray_indirect::{CutNode, Method, Renderer, Scene, Settings, TileCriterion};
+use std::collections::BTreeSet;
+
+/// Whether `node` is `tied` or lies below a tied node.
+fn under_a_tie(node: CutNode, tied: &BTreeSet<CutNode>, root: u32) -> bool {
+    (node.level..=root).any(|level| {
+        let up = level - node.level;
+        tied.contains(&CutNode {
+            level,
+            x: node.x >> up,
+            y: node.y >> up,
+        })
+    })
+}
+
+/// One frame's tiles compared.
+struct Compared {
+    tiles: usize,
+    /// Tiles with a list.
+    lit: usize,
+    equal: usize,
+    /// Nodes the twin found a tie at.
+    ties: usize,
+    /// Tiles whose lists differ below a tie, and the nodes they differ in.
+    tied: usize,
+    differing: usize,
+}
+
+fn compare(gpu: &Gpu, scene: &Scene, settings: Settings) -> Compared {
+    let what = format!("{} {:?}", scene.name, settings.tile_criterion);
+    let mut r = Renderer::new(gpu, scene, settings.clone()).unwrap();
+    let frame = r.render_frame(Method::QuadtreeTiles).unwrap();
+    assert_eq!(frame.counts.refused_splits, 0, "the lists had room");
+    let (nodes, bounds) = (r.read_nodes().unwrap(), r.read_node_bounds().unwrap());
+    let receivers = r.read_receivers().unwrap();
+    let twin = tile_cuts(&TileInput {
+        nodes: &nodes,
+        bounds: &bounds,
+        receivers: &receivers,
+        settings: &settings,
+        r_min: scene.r_min,
+    });
+    let gpu_cuts = r.read_tile_cuts().unwrap();
+    let estimates = r.read_tile_estimates().unwrap();
+    assert_eq!(gpu_cuts.len(), twin.len());
+    let root = settings.rsm_size.ilog2();
+    let (mut lit, mut equal, mut tied, mut differing) = (0, 0, 0, 0);
+    let ties = twin.iter().map(|t| t.ties.len()).sum();
+    for (tile, ((gpu_cut, cpu), estimate)) in gpu_cuts.iter().zip(&twin).zip(&estimates).enumerate()
+    {
+        let on_gpu: BTreeSet<CutNode> = gpu_cut.iter().copied().collect();
+        let on_cpu: BTreeSet<CutNode> = cpu.nodes.iter().copied().collect();
+        assert_eq!(
+            on_gpu.len(),
+            gpu_cut.len(),
+            "{what}, tile {tile} lists a node twice"
+        );
+        lit += usize::from(!on_cpu.is_empty());
+        if on_gpu == on_cpu {
+            equal += 1;
+            if cpu.ties.is_empty() {
+                assert_eq!(
+                    *estimate,
+                    (cpu.estimated, cpu.estimate_evaluations),
+                    "{what}, tile {tile}: the estimates"
+                );
+            }
+            continue;
+        }
+        let ties: BTreeSet<CutNode> = cpu.ties.iter().copied().collect();
+        let apart: Vec<CutNode> = on_gpu.symmetric_difference(&on_cpu).copied().collect();
+        let unexplained: Vec<&CutNode> = apart
+            .iter()
+            .filter(|&&n| !under_a_tie(n, &ties, root))
+            .collect();
+        assert!(
+            unexplained.is_empty(),
+            "{what}, tile {tile}: the GPU's list and the twin's differ at {unexplained:?} (GPU only: {:?}, twin only: {:?}), no tie there",
+            on_gpu.difference(&on_cpu).collect::<Vec<_>>(),
+            on_cpu.difference(&on_gpu).collect::<Vec<_>>(),
+        );
+        tied += 1;
+        differing += apart.len();
+    }
+    Compared {
+        tiles: twin.len(),
+        lit,
+        equal,
+        ties,
+        tied,
+        differing,
+    }
+}
+
+#[test]
+fn gpu_tile_cuts_equal_the_cpu_twin() {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let atrium = Scene::load(&quadray_indirect::scene::scenes_dir().join("atrium.toml")).unwrap();
+    for (scene, criterion) in [
+        (Scene::cornell(), TileCriterion::Estimate),
+        (Scene::cornell(), TileCriterion::Bound),
+        (atrium, TileCriterion::Estimate),
+    ] {
+        let settings = Settings {
+            tile_criterion: criterion,
+            ..Settings::sized(64, 64, 64)
+        };
+        let c = compare(&gpu, &scene, settings);
+        println!(
+            "{} {criterion:?}: {} tiles, {} with a list, {} lists equal, {} tied nodes, {} tiles differing at ties ({} nodes)",
+            scene.name, c.tiles, c.lit, c.equal, c.ties, c.tied, c.differing
+        );
+        assert!(c.lit > 20, "{} tiles with a list", c.lit);
+        assert!(
+            c.tied * 20 <= c.lit,
+            "{} of {} tiles differ at ties",
+            c.tied,
+            c.lit
+        );
+    }
+}
