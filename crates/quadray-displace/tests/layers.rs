@@ -2,8 +2,7 @@
 //! with `crate::` or `super::` (in `use` lines and in code, not in comments) must lead to a module
 //! of its own layer or one below. A new file must be given its layer in [`LAYERS`].
 
-use crate::layering::upward_imports;
-use std::path::Path;
+use crate::layering::assert_layered;
 
 /// Every module, by layer, bottom first. `gpu` and the crate root are the facades that re-export
 /// the layers below them; the accuracy measure reads the renderer's frames, the contract test
@@ -31,7 +30,9 @@ const LAYERS: &[&[&str]] = &[
 
 #[test]
 fn every_module_imports_only_its_layer_or_below() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let wrong = upward_imports(&src, LAYERS, &[("", "lib.rs"), ("gpu", "gpu/mod.rs")]);
-    assert!(wrong.is_empty(), "{wrong:#?}");
+    assert_layered(
+        env!("CARGO_MANIFEST_DIR"),
+        LAYERS,
+        &[("", "lib.rs"), ("gpu", "gpu/mod.rs")],
+    );
 }

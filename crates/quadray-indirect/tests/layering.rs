@@ -251,3 +251,10 @@ pub fn upward_imports(src: &Path, layers: &[&[&str]], facades: &[(&str, &str)]) 
     );
     wrong
 }
+
+/// Fails naming every upward import of the crate at `manifest_dir` ([`upward_imports`] over its
+/// `src/`).
+pub fn assert_layered(manifest_dir: &str, layers: &[&[&str]], facades: &[(&str, &str)]) {
+    let wrong = upward_imports(&Path::new(manifest_dir).join("src"), layers, facades);
+    assert!(wrong.is_empty(), "{wrong:#?}");
+}

@@ -5,7 +5,7 @@
 #[path = "../../quadray-indirect/tests/layering.rs"]
 mod layering;
 
-use std::path::Path;
+use layering::assert_layered;
 
 const LAYERS: &[&[&str]] = &[
     &["widgets"],
@@ -17,7 +17,5 @@ const LAYERS: &[&[&str]] = &[
 
 #[test]
 fn every_module_imports_only_its_layer_or_below() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let wrong = layering::upward_imports(&src, LAYERS, &[("", "main.rs")]);
-    assert!(wrong.is_empty(), "{wrong:#?}");
+    assert_layered(env!("CARGO_MANIFEST_DIR"), LAYERS, &[("", "main.rs")]);
 }
