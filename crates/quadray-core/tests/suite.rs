@@ -3,5 +3,8 @@
 //! `cargo test --release -p quadray-core --test suite -- mesh::`.
 
 mod common;
+#[path = "../../quadray-indirect/tests/layering.rs"]
+mod layering;
+mod layers;
 mod mesh;
 mod scene;
