@@ -10,6 +10,9 @@ mod fuzz_loaders;
 mod gpu_tables;
 mod headless_cli;
 mod indirect_cli;
+#[path = "../../quadray-indirect/tests/layering.rs"]
+mod layering;
+mod layers;
 mod raytrace_cli;
 mod scene_cli;
 mod slurm;
