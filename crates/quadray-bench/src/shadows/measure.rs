@@ -3,9 +3,7 @@
 //! predicted N_th against the best. Every time is the median of several renders; methods are
 //! compared as ratios within one run.
 
-use super::tables::{figure6, markdown};
 use quadray_core::FileError;
-use quadray_core::{write_json, write_text};
 use quadray_shadows::cost::{self, MachineCosts, SceneStats};
 use quadray_shadows::scene::{BUILTINS, Scene, SceneError, assets_dir};
 use quadray_shadows::{
@@ -155,13 +153,8 @@ pub fn bench_scenes() -> Result<Vec<Scene>, SceneError> {
 /// Scene files of the benchmark under `assets/`.
 pub const ASSET_SCENES: [&str; 2] = ["scenes/shadows-cornell.toml", "scenes/shadows-bunny.toml"];
 
-/// Runs the whole benchmark and writes `results.json`, `shadows.md` and one figure-6 SVG per scene
-/// into `out`.
-pub fn bench_shadows(
-    quick: bool,
-    out: &Path,
-    progress: &dyn Fn(&str),
-) -> Result<BenchResults, FileError> {
+/// Runs the whole benchmark (`quick`: small pictures, one render a measurement).
+pub fn measure(quick: bool, progress: &dyn Fn(&str)) -> Result<BenchResults, FileError> {
     let (width, height, runs) = if quick { (128, 120, 1) } else { (512, 480, 5) };
     let confirm_rounds = 3 * runs;
     let depth = 5;
@@ -288,10 +281,5 @@ pub fn bench_shadows(
         costs_ns: costs,
         scenes,
     };
-    write_json(&out.join("results.json"), &results)?;
-    for s in &results.scenes {
-        figure6(&out.join(format!("fig6-{}.svg", s.scene)), s)?;
-    }
-    write_text(&out.join("shadows.md"), &markdown(&results))?;
     Ok(results)
 }

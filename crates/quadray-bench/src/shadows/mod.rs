@@ -6,4 +6,19 @@ pub mod measure;
 pub mod tables;
 
 pub use demo::render_demo;
-pub use measure::{BenchResults, bench_shadows};
+pub use measure::BenchResults;
+
+use quadray_core::FileError;
+use std::path::Path;
+
+/// Runs the whole benchmark and writes `results.json`, `shadows.md` and one figure-6 SVG per scene
+/// into `out`.
+pub fn bench_shadows(
+    quick: bool,
+    out: &Path,
+    progress: &dyn Fn(&str),
+) -> Result<BenchResults, FileError> {
+    let results = measure::measure(quick, progress)?;
+    tables::write(out, &results)?;
+    Ok(results)
+}

@@ -3,7 +3,7 @@
 
 use super::measure::{BenchResults, SceneResult};
 use crate::report::{PlotSpec, Series, Table, line_plot};
-use quadray_core::FileError;
+use quadray_core::{FileError, write_json, write_text};
 use quadray_shadows::scene::BUILTINS;
 use std::path::Path;
 
@@ -297,4 +297,13 @@ pub fn figure6(path: &Path, s: &SceneResult) -> Result<(), FileError> {
         log_y: false,
     };
     line_plot(path, &spec, &series)
+}
+
+/// Writes `results.json`, `shadows.md` and one figure-6 SVG per scene into `out`.
+pub fn write(out: &Path, results: &BenchResults) -> Result<(), FileError> {
+    write_json(&out.join("results.json"), results)?;
+    for s in &results.scenes {
+        figure6(&out.join(format!("fig6-{}.svg", s.scene)), s)?;
+    }
+    write_text(&out.join("shadows.md"), &markdown(results))
 }
