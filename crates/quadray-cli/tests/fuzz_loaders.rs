@@ -480,7 +480,7 @@ fn loaders_survive_mutated_files() {
 }
 
 #[test]
-#[ignore = "the long run: 10^4 cases per loader, minutes"]
+#[ignore = "the long run: 10^4 cases per loader, 40 s on 2 cores; run by hand before a release (BENCHMARKS.md, Fuzzed loaders)"]
 fn loaders_survive_mutated_files_long() {
     fuzz(10_000);
 }
