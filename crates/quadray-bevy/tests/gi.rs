@@ -48,8 +48,20 @@ struct Probe {
 #[derive(Resource)]
 struct Probes(Vec<Probe>);
 
+/// The glTF scene a test's app loads, and its cases (one camera each).
+#[derive(Resource, Clone)]
+struct Setup {
+    scene: &'static str,
+    cases: Vec<Case>,
+}
+
 /// Method, bounce on, cut view on.
-const CASES: [(Method, bool, bool); 5] = [
+type Case = (Method, bool, bool);
+
+/// The Cornell box lit by a spot, a point light and the sun through its open front.
+const LIGHTS_SCENE: &str = "scenes/cornell_lights.gltf";
+
+const CASES: [Case; 5] = [
     (Method::Reference, true, false),
     (Method::Quadtree, true, false),
     (Method::Quadtree, false, false),
@@ -62,12 +74,15 @@ fn setup(
     assets: Res<AssetServer>,
     mut images: ResMut<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
+    setup: Res<Setup>,
 ) {
     commands.spawn(WorldAssetRoot(
-        assets.load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
+        assets.load(GltfAssetLabel::Scene(0).from_asset(setup.scene)),
     ));
-    let probes = CASES
-        .map(|(method, enabled, cut_view)| {
+    let probes = setup
+        .cases
+        .iter()
+        .map(|&(method, enabled, cut_view)| {
             let mut indirect = ShaderBuffer::with_size((SIZE * SIZE * 16) as usize, default());
             indirect.buffer_description.usage |= BufferUsages::COPY_SRC | BufferUsages::COPY_DST;
             let mut target =
@@ -83,19 +98,25 @@ fn setup(
                 read_picture: Arc::default(),
             }
         })
-        .to_vec();
+        .collect();
     commands.insert_resource(Probes(probes));
 }
 
 /// The glTF's camera, when it appears.
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
-/// Once the glTF's camera and light exist: one camera per case with the file's projection, and
-/// the file's spot marked as the bounce's source.
+/// Bevy's lights of the three kinds, not yet marked.
+type Unmarked = (
+    Or<(With<SpotLight>, With<PointLight>, With<DirectionalLight>)>,
+    Without<IndirectLightSource>,
+);
+
+/// Once the glTF's camera and lights exist: one camera per case with the file's projection, and
+/// the file's lights marked as the bounce's sources.
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Projection), FileCamera>,
-    lights: Query<Entity, (With<SpotLight>, Without<IndirectLightSource>)>,
+    lights: Query<Entity, Unmarked>,
     probes: Res<Probes>,
 ) {
     for light in &lights {
@@ -128,9 +149,13 @@ fn configure(
     }
 }
 
-fn app() -> App {
+fn app(scene: &'static str, cases: &[Case]) -> App {
     common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
+            .insert_resource(Setup {
+                scene,
+                cases: cases.to_vec(),
+            })
             .add_plugins((IndirectLightPlugin, RenderDiagnosticsPlugin))
             .add_systems(Startup, setup)
             .add_systems(Update, configure);
@@ -144,9 +169,9 @@ fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
         .collect()
 }
 
-#[test]
-fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
-    let mut app = app();
+/// Runs `app` until every probe's camera has gathered (or has the bounce off) and its picture
+/// has been read, then a few frames more; returns the probes and each one's indirect light.
+fn gathered(app: &mut App) -> (Vec<Probe>, Vec<Vec<[f32; 3]>>) {
     app.update();
     let probes = app.world().resource::<Probes>().0.clone();
     for p in &probes {
@@ -203,18 +228,32 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
         .iter()
         .map(|p| floats(p.read_indirect.lock().unwrap().as_ref().unwrap()))
         .collect();
+    (probes, indirect)
+}
 
-    // quadray's renderer on the same file, in its units (W/sr = cd / 683; the plugin's are Bevy's,
-    // candela)
-    let gpu = quadray_gpu::Gpu::new().expect("an adapter (scripts/setup.sh installs lavapipe)");
-    let mut scene = Scene::load(&std::path::Path::new(ASSETS).join(SCENE)).unwrap();
+/// quadray's renderer on `file`, from the tests' camera, at the tests' sizes.
+fn quadray_renderer<'g>(gpu: &'g quadray_gpu::Gpu, file: &str) -> (Scene, Renderer<'g>) {
+    let mut scene = Scene::load(&std::path::Path::new(ASSETS).join(file)).unwrap();
     scene.camera.position = EYE.into();
     scene.camera.target = TARGET.into();
-    let mut renderer = Renderer::new(&gpu, &scene, Settings::sized(SIZE, SIZE, RSM)).unwrap();
+    let renderer = Renderer::new(gpu, &scene, Settings::sized(SIZE, SIZE, RSM)).unwrap();
+    (scene, renderer)
+}
+
+/// quadray's radiance in the plugin's units: candela (Bevy's) where quadray's are W/sr (cd / 683).
+fn in_candela(image: Vec<[f32; 3]>) -> Vec<[f32; 3]> {
     let cd = quadray_core::scene::LUMENS_PER_WATT;
-    let in_candela = |image: Vec<[f32; 3]>| -> Vec<[f32; 3]> {
-        image.into_iter().map(|p| p.map(|c| c * cd)).collect()
-    };
+    image.into_iter().map(|p| p.map(|c| c * cd)).collect()
+}
+
+#[test]
+fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
+    let mut app = app(SCENE, &CASES);
+    let (probes, indirect) = gathered(&mut app);
+
+    // quadray's renderer on the same file, in the plugin's units
+    let gpu = quadray_gpu::Gpu::new().expect("an adapter (scripts/setup.sh installs lavapipe)");
+    let (scene, mut renderer) = quadray_renderer(&gpu, SCENE);
     let reference_frame = renderer.render_frame(Method::Reference).unwrap();
     let quadtree_frame = renderer.render_frame(Method::Quadtree).unwrap();
     let default_frame = renderer.render_frame(Method::DEFAULT).unwrap();
@@ -349,6 +388,39 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
             .iter()
             .zip(&off[ceiling..ceiling + 3])
             .all(|(a, b)| a > b)
+    );
+}
+
+/// The sun, a point light and a spot from the same glTF file, each marked: the plugin's brute
+/// force over their RSMs (the sun's orthographic, the point light's six cube faces) is quadray's
+/// own over the same file, and its default method is as close to it as quadray's is to its own.
+#[test]
+fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
+    let cases = [
+        (Method::Reference, true, false),
+        (Method::DEFAULT, true, false),
+    ];
+    let mut app = app(LIGHTS_SCENE, &cases);
+    let (_, indirect) = gathered(&mut app);
+    let gpu = quadray_gpu::Gpu::new().expect("an adapter (scripts/setup.sh installs lavapipe)");
+    let (scene, mut renderer) = quadray_renderer(&gpu, LIGHTS_SCENE);
+    let kinds: Vec<_> = scene.lights.iter().map(|l| l.kind_name()).collect();
+    assert_eq!(kinds, ["spot", "point", "directional"]);
+    assert_eq!(renderer.view_count(), 8);
+    let reference = in_candela(renderer.render_frame(Method::Reference).unwrap().indirect);
+    let agreement = compare(&indirect[0], &reference);
+    println!("three lights: plugin brute force against quadray's: {agreement:?}");
+    assert!(agreement.rel_l1 <= 0.05, "{agreement:?}");
+    let default = in_candela(renderer.render_frame(Method::DEFAULT).unwrap().indirect);
+    let quadray_error = compare(&default, &reference).rel_l1;
+    let plugin_error = compare(&indirect[1], &indirect[0]).rel_l1;
+    println!(
+        "three lights: default method against brute force: plugin {plugin_error:.4}, quadray \
+         {quadray_error:.4}"
+    );
+    assert!(
+        plugin_error <= 1.5 * quadray_error.max(1e-3),
+        "{plugin_error} vs {quadray_error}"
     );
 }
 

@@ -36,8 +36,8 @@ pub struct IndirectArgs {
     /// frames of the sequence.
     #[arg(long, default_value_t = 20)]
     frames: u32,
-    /// Render a sequence of --frames frames with the spot turning DEG a frame about the
-    /// vertical axis; adds temporal {cut_changed_fraction, flicker_ratio, ...} to the stats, and
+    /// Render a sequence of --frames frames with the lights turning DEG a frame about the
+    /// vertical axis (a spot and the sun turn, a point light moves round the scene's middle); adds temporal {cut_changed_fraction, flicker_ratio, ...} to the stats, and
     /// with --temporal-weight below 1 temporal_unfiltered: the same frames without the filter.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     light_orbit: Option<f32>,
@@ -56,10 +56,11 @@ pub struct IndirectArgs {
     /// Camera target X,Y,Z instead of the scene file's.
     #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
     camera_target: Option<[f32; 3]>,
-    /// Spot light position X,Y,Z instead of the scene file's.
+    /// The first light's position X,Y,Z instead of the scene file's (a point or spot light).
     #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
     light_position: Option<[f32; 3]>,
-    /// Spot light direction X,Y,Z instead of the scene file's.
+    /// The first light's direction X,Y,Z instead of the scene file's (a spot's axis, the sun's
+    /// direction).
     #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
     light_direction: Option<[f32; 3]>,
     #[arg(long)]
@@ -86,8 +87,23 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     }
     set(&mut scene.camera.position, args.camera_position);
     set(&mut scene.camera.target, args.camera_target);
-    set(&mut scene.light.position, args.light_position);
-    set(&mut scene.light.spot.direction, args.light_direction);
+    let first = &mut scene.lights[0];
+    if let Some(p) = args.light_position
+        && !first.place(p.into())
+    {
+        anyhow::bail!(
+            "--light-position: the scene's first light is a {}",
+            first.describe()
+        );
+    }
+    if let Some(d) = args.light_direction
+        && !first.aim(d.into())
+    {
+        anyhow::bail!(
+            "--light-direction: the scene's first light is a {}",
+            first.describe()
+        );
+    }
     scene
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;
@@ -258,13 +274,14 @@ mod tests {
                 proptest::sample::select(TileCriterion::ALL.to_vec()),
                 proptest::option::of(u(Settings::TILE_CAPACITY)),
                 f(Settings::TILE_SHARE, 0.0, 1000.0),
+                u(Settings::MAX_LIGHTS),
             ),
         )
             .prop_map(
                 |(
                     ((w, h), rsm_log, start, limit, depth, normal, validity, flux_weighted),
                     (samples, rsm_radius, subsample, shadows, steps, thickness, temporal),
-                    (tile_error, tile_criterion, tile_capacity, tile_share),
+                    (tile_error, tile_criterion, tile_capacity, tile_share, max_lights),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
                     let start_level = start.map(|l| l.min(rsm_log));
@@ -277,6 +294,7 @@ mod tests {
                     Settings {
                         size: Size::new(w, h),
                         rsm_size: 1 << rsm_log,
+                        max_lights,
                         cluster: ClusterSettings {
                             start_level,
                             limit_level,

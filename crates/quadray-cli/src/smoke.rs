@@ -279,10 +279,8 @@ fn indirect_temporal(gpu: &Gpu, size: u32, done: Done) -> Result<()> {
             renderer.render(IndirectMethod::DEFAULT, true, false)?;
             Ok(renderer.read_frame()?)
         })?;
-        let turn = glam::Quat::from_rotation_y(3f32.to_radians());
-        scene.camera.position = turn * scene.camera.position;
-        scene.light.spot.direction = turn * scene.light.spot.direction;
-        renderer.set_view(&scene);
+        scene = scene.light_turned(3.0).camera_orbited(3.0);
+        renderer.set_view(&scene)?;
     }
     Ok(())
 }

@@ -142,7 +142,9 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
     let out = dir.join("x.png");
     let scene = dir.join("bad.toml");
     std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();
-    let cases: [(Vec<&str>, &str); 13] = [
+    let courtyard = assets().join("scenes/courtyard.toml");
+    let courtyard = courtyard.to_str().unwrap();
+    let cases: [(Vec<&str>, &str); 14] = [
         (vec!["--scene", scene.to_str().unwrap()], "bad.toml"),
         (vec!["--scene", "/nonexistent/scene.toml"], "scene.toml"),
         (vec!["--rsm-size", "100"], "power of two"),
@@ -151,7 +153,12 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         (vec!["--light-direction", "0,NaN,0"], "finite"),
         (
             vec!["--light-direction", "0,0,0"],
-            "light: direction must be finite and not zero",
+            "light options: spot light at [0.5, 0.97, 0.85]: direction must be finite and not zero",
+        ),
+        // the sun has no position to move
+        (
+            vec!["--scene", courtyard, "--light-position", "1,2,3"],
+            "--light-position: the scene's first light is a directional light along",
         ),
         (
             vec!["--tile-capacity", "0"],

@@ -100,15 +100,16 @@ fn bad_scene_files_are_refused_naming_the_file() {
     let dir = scratch("scene-bad");
     let out = dir.join("x.png");
     let recursive = "malformed/gltf2/RecursiveNodes/RecursiveNodes.gltf";
+    let dark = dir.join("dark.toml");
+    let cornell = std::fs::read_to_string(assets().join("scenes/cornell.toml")).unwrap();
+    let (head, tail) = cornell.split_once("[light]").unwrap();
+    let objects = &tail[tail.find("[[mesh]]").unwrap()..];
+    std::fs::write(&dark, format!("{head}{objects}")).unwrap();
     let cases = [
         ("raytrace", recursive, "RecursiveNodes.gltf: node"),
         ("indirect", recursive, "RecursiveNodes.gltf: node"),
-        // Point lights only.
-        (
-            "indirect",
-            "scenes/shadows-demo.toml",
-            "shadows-demo.toml: no spot light",
-        ),
+        // No light at all.
+        ("indirect", dark.to_str().unwrap(), "dark.toml: no light"),
         // quadray indirect's builtin meshes.
         (
             "raytrace",

@@ -1,4 +1,4 @@
-//! One scene description for every technique: a camera, point and spot lights, named materials
+//! One scene description for every technique: a camera, point, spot and directional lights, named materials
 //! and objects (mesh files, a technique's builtin meshes, boxes, polygons) with their transforms,
 //! plus the few per-scene settings. Read from TOML ([`SceneDescription::from_toml`]) or glTF 2.0
 //! ([`SceneDescription::load`] on a `.gltf` or `.glb`); each technique builds its own runtime scene
@@ -31,6 +31,10 @@
 //! cone_deg = 55.0                #   half-angle where the light ends
 //! falloff_deg = 15.0             #   width of the smooth edge inside the cone (default 0)
 //!
+//! [[lights]]                     # a direction without a position: a directional light (the sun)
+//! direction = [-0.3, -1.0, -0.2] # where its light travels
+//! intensity = [3.0, 3.0, 3.0]    # irradiance on a surface facing it, or `lux = [...]`
+//!
 //! [materials.porcelain]          # Whitted surfaces, referred to by name
 //! diffuse = [0.8, 0.75, 0.65]
 //! specular = 0.5                 # default 0; shininess 32, reflect 0, transmit 0, ior 1
@@ -62,8 +66,8 @@
 //! A `.gltf` or `.glb` scene gives one object (every mesh of the shown scene, placed by its node
 //! transforms, with its materials' base colours), the first perspective camera met in the node
 //! tree (required; its aspect ratio is ignored, the image size decides), and every
-//! `KHR_lights_punctual` point and spot light (directional lights are skipped with a warning;
-//! `range` is ignored). Their intensities are [`Intensity::Candela`]: colour times intensity.
+//! `KHR_lights_punctual` light: point, spot and directional (`range` is ignored). Their
+//! intensities are [`Intensity::Photometric`]: colour times intensity.
 
 mod read_gltf;
 mod read_toml;
@@ -82,7 +86,7 @@ pub struct SceneDescription {
     pub name: String,
     /// The view.
     pub camera: Camera,
-    /// Point and spot lights in file order.
+    /// Point, spot and directional lights in file order.
     pub lights: Vec<Light>,
     /// Named materials, sorted by name, then the anonymous ones of `albedo = [...]`; objects
     /// refer to them by index.
@@ -109,21 +113,43 @@ pub struct Camera {
     pub fov_y_deg: f32,
 }
 
-/// A point light, or a spot light when `spot` is set.
+/// A light: where it shines from (a point, a spot's apex, or a direction for the sun) and how
+/// strongly.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
-    /// Where the light is.
-    pub position: Vec3,
-    /// Per RGB channel, on the axis for a spot light.
+    /// Its kind, with where it is.
+    pub kind: LightKind,
+    /// Per RGB channel: intensity for point and spot lights (on the axis for a spot), irradiance
+    /// on a surface facing a directional light.
     pub intensity: Intensity,
-    /// The cone, for a spot light.
-    pub spot: Option<Spot>,
+}
+
+/// The three punctual lights of glTF's `KHR_lights_punctual`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Shines equally in all directions from `position`.
+    Point {
+        /// Where the light is.
+        position: Vec3,
+    },
+    /// Shines from `position` within a cone.
+    Spot {
+        /// The apex of the cone.
+        position: Vec3,
+        /// The cone.
+        cone: Cone,
+    },
+    /// Parallel light from infinitely far away (the sun).
+    Directional {
+        /// Where the light travels (not necessarily unit length).
+        direction: Vec3,
+    },
 }
 
 /// The cone of a spot light: full intensity inside `cone_deg - falloff_deg` of its axis, fading
 /// smoothly to zero at `cone_deg`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Spot {
+pub struct Cone {
     /// Direction of the axis (not necessarily unit length).
     pub direction: Vec3,
     /// Half-angle of the cone, in (0, 90].
@@ -132,26 +158,28 @@ pub struct Spot {
     pub falloff_deg: f32,
 }
 
-/// A light's intensity per RGB channel (for a spot light: on its axis).
+/// A light's strength per RGB channel: intensity (point and spot lights; for a spot, on its axis)
+/// or irradiance (directional lights).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Intensity {
     /// As a TOML file's `intensity` gives it: in the units of the renderer it is written for.
     Native(Vec3),
-    /// Photometric, as glTF's `KHR_lights_punctual` (or a TOML file's `candela`) gives it; each
-    /// renderer documents how it converts candela to its own units.
-    Candela(Vec3),
+    /// Photometric, as glTF's `KHR_lights_punctual` gives it (or a TOML file's `candela` or
+    /// `lux`): candela for point and spot lights, lux for directional ones; each renderer
+    /// documents how it converts them to its own units.
+    Photometric(Vec3),
 }
 
 /// Luminous efficacy of 555 nm light (lm/W): the factor between candela and W/sr.
 pub const LUMENS_PER_WATT: f32 = 683.0;
 
 impl Intensity {
-    /// Radiant intensity (W/sr per channel): native values as given, candela divided by
-    /// [`LUMENS_PER_WATT`].
-    pub fn watts_per_sr(self) -> Vec3 {
+    /// Radiometric values (W/sr per channel for point and spot lights, W/m^2 for directional
+    /// ones): native values as given, photometric ones divided by [`LUMENS_PER_WATT`].
+    pub fn radiometric(self) -> Vec3 {
         match self {
             Intensity::Native(v) => v,
-            Intensity::Candela(cd) => cd / LUMENS_PER_WATT,
+            Intensity::Photometric(v) => v / LUMENS_PER_WATT,
         }
     }
 }
@@ -368,16 +396,128 @@ impl Camera {
     }
 }
 
-impl Spot {
-    /// [`Spot::cone_deg`]: a cone, at most a half-space.
+impl Light {
+    /// Where the light is: `None` for a directional light.
+    pub fn position(&self) -> Option<Vec3> {
+        match self.kind {
+            LightKind::Point { position } | LightKind::Spot { position, .. } => Some(position),
+            LightKind::Directional { .. } => None,
+        }
+    }
+
+    /// Where the light aims: a spot's axis, the sun's direction; `None` for a point light.
+    pub fn direction(&self) -> Option<Vec3> {
+        match self.kind {
+            LightKind::Spot { cone, .. } => Some(cone.direction),
+            LightKind::Directional { direction } => Some(direction),
+            LightKind::Point { .. } => None,
+        }
+    }
+
+    /// Aims a spot or the sun along `direction`; `false` (and nothing changed) for a point light.
+    pub fn aim(&mut self, direction: Vec3) -> bool {
+        match &mut self.kind {
+            LightKind::Spot { cone, .. } => cone.direction = direction,
+            LightKind::Directional { direction: d } => *d = direction,
+            LightKind::Point { .. } => return false,
+        }
+        true
+    }
+
+    /// Moves a point or spot light to `position`; `false` (and nothing changed) for the sun.
+    pub fn place(&mut self, position: Vec3) -> bool {
+        match &mut self.kind {
+            LightKind::Point { position: p } | LightKind::Spot { position: p, .. } => *p = position,
+            LightKind::Directional { .. } => return false,
+        }
+        true
+    }
+
+    /// The light's kind in a word (`point`, `spot`, `directional`), for messages.
+    pub fn kind_name(&self) -> &'static str {
+        match self.kind {
+            LightKind::Point { .. } => "point",
+            LightKind::Spot { .. } => "spot",
+            LightKind::Directional { .. } => "directional",
+        }
+    }
+
+    /// The light turned `degrees` about the vertical axis through `pivot` (counter-clockwise
+    /// seen from above): a point light moves, a spot moves and turns, the sun turns.
+    pub fn turned(&self, degrees: f32, pivot: Vec3) -> Self {
+        let turn = glam::Quat::from_rotation_y(degrees.to_radians());
+        let kind = match self.kind {
+            LightKind::Point { position } => LightKind::Point {
+                position: pivot + turn * (position - pivot),
+            },
+            LightKind::Spot { position, cone } => LightKind::Spot {
+                position,
+                cone: Cone {
+                    direction: turn * cone.direction,
+                    ..cone
+                },
+            },
+            LightKind::Directional { direction } => LightKind::Directional {
+                direction: turn * direction,
+            },
+        };
+        Self { kind, ..*self }
+    }
+
+    /// The one check of a light, whichever technique renders it: finite, not negative, a
+    /// direction that is not zero, a valid cone.
+    pub fn validate(&self) -> Result<(), String> {
+        let (Intensity::Native(i) | Intensity::Photometric(i)) = self.intensity;
+        let what = self.describe();
+        if !i.is_finite() {
+            return Err(format!("{what}: intensity is not finite"));
+        }
+        if i.min_element() < 0.0 {
+            return Err(format!("{what}: intensity is negative"));
+        }
+        match self.kind {
+            LightKind::Point { position } | LightKind::Spot { position, .. }
+                if !position.is_finite() =>
+            {
+                Err(format!("{what}: position is not finite"))
+            }
+            LightKind::Spot { cone, .. } => cone.validate().map_err(|e| format!("{what}: {e}")),
+            LightKind::Directional { direction } => {
+                check_direction(direction).map_err(|e| format!("{what}: {e}"))
+            }
+            LightKind::Point { .. } => Ok(()),
+        }
+    }
+
+    /// "point light at (x, y, z)", "directional light along (x, y, z)": the light in messages.
+    pub fn describe(&self) -> String {
+        match (self.position(), self.kind) {
+            (Some(p), _) => format!("{} light at {p}", self.kind_name()),
+            (None, LightKind::Directional { direction }) => {
+                format!("directional light along {direction}")
+            }
+            (None, _) => unreachable!("only a directional light has no position"),
+        }
+    }
+}
+
+/// A direction must be finite and not zero.
+fn check_direction(direction: Vec3) -> Result<(), String> {
+    if direction.is_finite() && direction.length() > 1e-6 {
+        Ok(())
+    } else {
+        Err("direction must be finite and not zero".into())
+    }
+}
+
+impl Cone {
+    /// [`Cone::cone_deg`]: a cone, at most a half-space.
     pub const CONE: crate::settings::Limits<f32> = crate::settings::Limits::above(0.0, 90.0);
 
     /// The one check of a spot's cone, whichever technique renders it: a finite axis that is not
-    /// zero, the cone within [`Spot::CONE`], the falloff within the cone.
+    /// zero, the cone within [`Cone::CONE`], the falloff within the cone.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.direction.is_finite() && self.direction.length() > 1e-6) {
-            return Err("direction must be finite and not zero".into());
-        }
+        check_direction(self.direction)?;
         Self::CONE.check("cone_deg", self.cone_deg)?;
         if !(self.falloff_deg >= 0.0 && self.falloff_deg <= self.cone_deg) {
             return Err(format!(
@@ -387,19 +527,4 @@ impl Spot {
         }
         Ok(())
     }
-}
-
-fn check_light(l: &Light) -> Result<(), String> {
-    let (Intensity::Native(i) | Intensity::Candela(i)) = l.intensity;
-    if !(l.position.is_finite() && i.is_finite()) {
-        return Err(format!("light at {} is not finite", l.position));
-    }
-    if i.min_element() < 0.0 {
-        return Err(format!("light at {}: intensity is negative", l.position));
-    }
-    if let Some(s) = l.spot {
-        s.validate()
-            .map_err(|e| format!("light at {}: {e}", l.position))?;
-    }
-    Ok(())
 }

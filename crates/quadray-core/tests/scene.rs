@@ -3,7 +3,7 @@
 //! that overflow, bad values) refused with the file named, never a panic.
 
 use glam::Vec3;
-use quadray_core::scene::{Intensity, SceneDescription, Shape, Transform};
+use quadray_core::scene::{Intensity, Light, LightKind, SceneDescription, Shape, Transform};
 use std::path::{Path, PathBuf};
 
 use crate::common;
@@ -45,7 +45,7 @@ fn every_bundled_scene_file_loads() {
     for (file, lights, spots, objects, materials) in expected {
         let d = SceneDescription::load(&asset("scenes").join(file)).unwrap();
         assert_eq!(d.lights.len(), lights, "{file}");
-        let spot_count = d.lights.iter().filter(|l| l.spot.is_some()).count();
+        let spot_count = d.lights.iter().filter(|l| l.kind_name() == "spot").count();
         assert_eq!(spot_count, spots, "{file}");
         assert_eq!(d.objects.len(), objects, "{file}");
         assert_eq!(d.materials.len(), materials, "{file}");
@@ -158,9 +158,13 @@ fn the_bundled_gltf_scene_has_the_camera_and_spot_of_cornell_toml() {
     assert!(forward.abs_diff_eq(expected, 1e-6), "{c:?}");
     assert!(c.up.abs_diff_eq(Vec3::Y, 1e-6));
     assert!((c.fov_y_deg - t.fov_y_deg).abs() < 1e-4);
-    let (light, spot) = (gltf.lights[0], gltf.lights[0].spot.unwrap());
-    let expected = toml.lights[0].spot.unwrap();
-    assert!(light.position.abs_diff_eq(toml.lights[0].position, 1e-6));
+    let spot_of = |l: Light| match l.kind {
+        LightKind::Spot { position, cone } => (position, cone),
+        _ => panic!("{l:?} is not a spot"),
+    };
+    let (light, (position, spot)) = (gltf.lights[0], spot_of(gltf.lights[0]));
+    let (expected_position, expected) = spot_of(toml.lights[0]);
+    assert!(position.abs_diff_eq(expected_position, 1e-6));
     assert!(
         spot.direction
             .abs_diff_eq(expected.direction.normalize(), 1e-5),
@@ -168,8 +172,8 @@ fn the_bundled_gltf_scene_has_the_camera_and_spot_of_cornell_toml() {
     );
     assert!((spot.cone_deg - expected.cone_deg).abs() < 1e-4);
     assert!((spot.falloff_deg - expected.falloff_deg).abs() < 1e-4);
-    assert_eq!(light.intensity, Intensity::Candela(Vec3::splat(1366.0)));
-    assert_eq!(light.intensity.watts_per_sr(), Vec3::splat(2.0));
+    assert_eq!(light.intensity, Intensity::Photometric(Vec3::splat(1366.0)));
+    assert_eq!(light.intensity.radiometric(), Vec3::splat(2.0));
     // The room (10 triangles) and one block mesh placed twice by node transforms (10 each).
     let Shape::Mesh { model, .. } = &gltf.objects[0].shape else {
         panic!("a glTF scene is one mesh object");
@@ -217,6 +221,91 @@ fn technique_settings_come_from_the_gltf_scenes_extras() {
         err.contains("bad-extras.gltf") && err.contains("raytrace"),
         "{err}"
     );
+}
+
+/// glTF's three punctual lights, each read with its kind, its place or direction (spot and
+/// directional lights shine down their node's -z) and its photometric intensity.
+#[test]
+fn gltf_point_spot_and_directional_lights_are_read() {
+    let dir = scratch("gltf-lights");
+    let path = edited_gltf(&dir, "lights.gltf", |j| {
+        let lights = &mut j["extensions"]["KHR_lights_punctual"]["lights"];
+        lights
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!({"type": "directional", "intensity": 683.0}));
+        lights
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!({"type": "point", "intensity": 2.0, "color": [1, 0, 0]}));
+        let nodes = j["nodes"].as_array_mut().unwrap();
+        // the sun turned 90 degrees about x: its -z becomes -y, straight down
+        nodes.push(
+            serde_json::json!({"rotation": [-0.70710677, 0, 0, 0.70710677],
+            "extensions": {"KHR_lights_punctual": {"light": 1}}}),
+        );
+        nodes.push(serde_json::json!({"translation": [0.25, 0.5, 0.75],
+            "extensions": {"KHR_lights_punctual": {"light": 2}}}));
+        let count = nodes.len();
+        let roots = j["scenes"][0]["nodes"].as_array_mut().unwrap();
+        roots.extend([serde_json::json!(count - 2), serde_json::json!(count - 1)]);
+    });
+    let scene = SceneDescription::load(&path).unwrap();
+    let kinds: Vec<_> = scene.lights.iter().map(Light::kind_name).collect();
+    assert_eq!(kinds, ["spot", "directional", "point"]);
+    let LightKind::Directional { direction } = scene.lights[1].kind else {
+        unreachable!()
+    };
+    assert!(direction.abs_diff_eq(Vec3::NEG_Y, 1e-5), "{direction}");
+    assert_eq!(scene.lights[1].intensity.radiometric(), Vec3::ONE);
+    assert_eq!(scene.lights[2].position(), Some(Vec3::new(0.25, 0.5, 0.75)));
+    assert_eq!(
+        scene.lights[2].intensity,
+        Intensity::Photometric(Vec3::new(2.0, 0.0, 0.0))
+    );
+}
+
+/// TOML's three lights: a position (point), a position with a cone (spot), a direction alone
+/// (directional, its photometric intensity in lux); what is neither is refused by name.
+#[test]
+fn toml_lights_are_points_spots_or_the_sun_by_their_fields() {
+    let head = "[camera]\nposition = [0, 0, 2]\ntarget = [0, 0, 0]\nfov_y_deg = 40\n\
+                [[objects]]\nbox = { min = [0, 0, 0], max = [1, 1, 1] }\nalbedo = [1, 1, 1]\n";
+    let scene = |lights: &str| {
+        SceneDescription::from_toml(&format!("{head}{lights}"), Path::new("lights.toml"))
+    };
+    let ok = scene(
+        "[[lights]]\nposition = [0, 1, 0]\nintensity = [1, 1, 1]\n\
+         [[lights]]\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\ncone_deg = 30\n\
+         candela = [683, 683, 683]\n\
+         [[lights]]\ndirection = [0.1, -1, 0]\nlux = [683, 0, 0]\n",
+    )
+    .unwrap();
+    let kinds: Vec<_> = ok.lights.iter().map(Light::kind_name).collect();
+    assert_eq!(kinds, ["point", "spot", "directional"]);
+    assert_eq!(
+        ok.lights[2].intensity.radiometric(),
+        Vec3::new(1.0, 0.0, 0.0)
+    );
+    assert_eq!(ok.lights[2].position(), None);
+    for (lights, why) in [
+        ("intensity = [1, 1, 1]", "give a `position`"),
+        ("direction = [0, -1, 0]\ncandela = [1, 1, 1]", "`lux`"),
+        ("direction = [0, 0, 0]\nintensity = [1, 1, 1]", "direction"),
+        ("position = [0, 1, 0]\nlux = [1, 1, 1]", "`candela`"),
+        (
+            "direction = [0, -1, 0]\ncone_deg = 30\nintensity = [1, 1, 1]",
+            "give a `position`",
+        ),
+    ] {
+        let err = scene(&format!("[[lights]]\n{lights}\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("lights.toml") && err.contains(why),
+            "{lights}: {err}"
+        );
+    }
 }
 
 /// A change made to the bundled glTF scene's JSON.

@@ -8,10 +8,10 @@
 
 use glam::Vec3;
 use quadray_gpu::{nearest_depth, texture_2d};
-use quadray_indirect::scene::{Camera, Scene, SpotLight, Vertex};
+use quadray_indirect::scene::{Camera, Cone, Intensity, Light, LightKind, Scene, Vertex};
 use quadray_indirect::{
-    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, OutputPass, OutputTerm, RsmPass,
-    Settings, Spot,
+    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass, OutputTerm,
+    RsmPass, Settings, ViewMaps,
 };
 use wgpu::util::DeviceExt;
 
@@ -106,15 +106,17 @@ pub fn scene() -> Scene {
             up: Vec3::Y,
             fov_y_deg: 39.0,
         },
-        light: SpotLight {
-            position: Vec3::new(0.5, 0.97, 0.85),
-            spot: quadray_indirect::scene::Spot {
-                direction: Vec3::new(0.25, -1.0, -0.55),
-                cone_deg: 55.0,
-                falloff_deg: 15.0,
+        lights: vec![Light {
+            kind: LightKind::Spot {
+                position: Vec3::new(0.5, 0.97, 0.85),
+                cone: Cone {
+                    direction: Vec3::new(0.25, -1.0, -0.55),
+                    cone_deg: 55.0,
+                    falloff_deg: 15.0,
+                },
             },
-            intensity: Vec3::splat(2.0),
-        },
+            intensity: Intensity::Native(Vec3::splat(2.0)),
+        }],
         r_min: 0.05,
         triangles,
     }
@@ -195,17 +197,21 @@ pub fn render(
     });
 
     // quadray's passes on our device: the RSM, the quadtree over it, the gather into our G-buffer.
-    let spot = Spot::of_scene(&scene);
+    let lights = LightView::of_scene(&scene, s.max_lights);
     let rsm = RsmPass::new(device, s.rsm_size);
-    rsm.set_light(queue, &spot);
+    rsm.set_light(queue, &lights[0]);
     let quadtree = LightQuadtree::new(device, queue, s.rsm_size, s.cluster, rsm.views());
     let views = GBufferViews {
         position: &gbuffer[0],
         normal: &gbuffer[1],
         albedo: &gbuffer[2],
     };
-    let gather = Gather::new(device, &s, &quadtree, rsm.views(), views)?;
-    gather.set_light(queue, &spot, scene.r_min);
+    let maps = [ViewMaps {
+        rsm: rsm.views(),
+        quadtree: &quadtree,
+    }];
+    let gather = Gather::new(device, &s, &maps, views)?;
+    gather.set_lights(queue, &lights, scene.r_min);
     let output_pass = OutputPass::new(device, FLOAT_FORMAT, OutputTerm::Combined)?;
     let output_usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
     let output = texture_2d(device, "output", size, FLOAT_FORMAT, output_usage);
@@ -248,7 +254,7 @@ pub fn render(
     rsm.record(&mut encoder, vertices.slice(..), vertex_count, None);
     quadtree.record_build(&mut encoder, None);
     quadtree.record_cut(&mut encoder, None);
-    gather.record_indirect(&mut encoder, Method::DEFAULT, &quadtree, None);
+    gather.record_indirect(&mut encoder, Method::DEFAULT, &[&quadtree], None);
     gather.record_direct(&mut encoder, None);
     output_pass.record(
         device,

@@ -74,7 +74,7 @@ pub struct Frame {
     pub height: u32,
     /// One-bounce indirect radiance, what the methods differ in.
     pub indirect: Vec<[f32; 3]>,
-    /// The spot's direct radiance, the same for every method.
+    /// The lights' direct radiance, the same for every method.
     pub direct: Vec<[f32; 3]>,
     /// Pixels the upsampler recomputed at full resolution.
     pub recomputed: u32,

@@ -1,6 +1,8 @@
 //! One-bounce indirect illumination from a light quadtree (Ki & Oh, 2007): a reflective shadow map
-//! of a spot light is clustered into a quadtree of VPLs, a cut of valid clusters replaces the
-//! hundreds of thousands of VPLs, and deferred shading sums the cut per pixel.
+//! of a light is clustered into a quadtree of VPLs, a cut of valid clusters replaces the hundreds
+//! of thousands of VPLs, and deferred shading sums the cut per pixel. The paper's light is a spot;
+//! a directional light's map is orthographic, a point light's six cube faces, and several lights
+//! are the sum of their maps ([`LightView`]).
 //!
 //! Data flows one way: [`scene`] (load) -> [`gpu`] (RSM, quadtree, cut, shading) -> measured
 //! against [`reference`](mod@reference) (CPU brute force) and the GPU brute force of [`baselines`].
@@ -44,8 +46,8 @@ pub enum IndirectError {
 
 pub use frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
 pub use gpu::{
-    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, OutputPass, OutputTerm, Renderer, RsmPass,
-    RsmViews, Spot,
+    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, OutputPass, OutputTerm,
+    Projection, Renderer, RsmPass, RsmViews, ViewMaps,
 };
 pub use quadray_core::settings::Size;
 pub use scene::Scene;

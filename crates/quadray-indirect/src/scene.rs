@@ -1,5 +1,5 @@
 //! Scenes: built from the shared scene description (`quadray_core::scene`: a TOML or glTF file)
-//! with its camera, its first spot light and its objects (mesh files, the builtin meshes of
+//! with its camera, its lights (point, spot and directional) and its objects (mesh files, the builtin meshes of
 //! `scene/builtin.rs`, boxes, polygons), flattened into one triangle list with a per-vertex
 //! albedo, which is all the RSM and G-buffer passes need.
 
@@ -9,8 +9,7 @@ use builtin::{builtin_triangles, cuboid};
 use glam::{Mat4, Vec3};
 use quadray_core::FileError;
 use quadray_core::mesh::Model;
-pub use quadray_core::scene::Camera;
-pub use quadray_core::scene::Spot;
+pub use quadray_core::scene::{Camera, Cone, Intensity, Light, LightKind};
 use quadray_core::scene::{Object, SceneDescription, Shape};
 use std::path::{Path, PathBuf};
 
@@ -24,47 +23,6 @@ pub struct Vertex {
     pub normal: [f32; 3],
     /// Diffuse albedo in [0, 1] per channel.
     pub albedo: [f32; 3],
-}
-
-/// The spot light whose RSM makes the VPLs: the scene description's cone ([`Spot`]: full
-/// intensity inside `cone_deg - falloff_deg` of its axis, fading smoothly to zero at
-/// `cone_deg`, which is also half the RSM's field of view) at a position, with its intensity as
-/// radiant intensity.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SpotLight {
-    /// Apex of the cone (world).
-    pub position: Vec3,
-    /// The cone.
-    pub spot: Spot,
-    /// Radiant intensity on the axis (W/sr per channel).
-    pub intensity: Vec3,
-}
-
-impl SpotLight {
-    /// World -> light view.
-    pub fn view(&self) -> Mat4 {
-        let dir = self.spot.direction.normalize();
-        let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-        glam::Mat4::look_to_rh(self.position, dir, up)
-    }
-
-    /// Far plane of the light over geometry within `bounds` (min, max): everything is closer.
-    pub fn far(&self, bounds: (Vec3, Vec3)) -> f32 {
-        let (lo, hi) = bounds;
-        self.position.distance((lo + hi) * 0.5) + extent_of(bounds)
-    }
-
-    /// World -> light clip space (the RSM and shadow map projection) over geometry within
-    /// `bounds`: a square perspective of twice the cone.
-    pub fn view_proj(&self, bounds: (Vec3, Vec3)) -> Mat4 {
-        let far = self.far(bounds);
-        glam::Mat4::perspective_rh(
-            (2.0 * self.spot.cone_deg).to_radians(),
-            1.0,
-            far * 1e-3,
-            far,
-        ) * self.view()
-    }
 }
 
 /// Axis-aligned bounds (min, max) of `points`.
@@ -86,8 +44,10 @@ pub struct Scene {
     pub name: String,
     /// The camera pictures are rendered from.
     pub camera: Camera,
-    /// The spot light whose RSM makes the VPLs.
-    pub light: SpotLight,
+    /// The lights whose RSMs make the VPLs, in the file's order (a renderer takes the first
+    /// [`crate::Settings::max_lights`]). Their intensities are radiometric here: W/sr for point
+    /// and spot lights, W/m^2 for directional ones ([`Intensity::Native`]).
+    pub lights: Vec<Light>,
     /// Clamp of the VPL kernel's distance (world units): 1/r^4 is taken at no less than this.
     pub r_min: f32,
     /// Every object's triangles in world space.
@@ -119,26 +79,27 @@ impl Scene {
         })
     }
 
-    /// This renderer's scene: the camera, the first spot light (a warning names the lights left
-    /// out: further spots, point lights) and every object as triangles. A material gives an
-    /// object its albedo (its diffuse colour; the other fields are the ray tracer's); without
-    /// one, mesh files keep their base colours (times their texture at each vertex) and builtin
-    /// meshes their own. A photometric intensity (candela, glTF's) becomes radiant intensity:
-    /// `I / 683` W/sr.
+    /// This renderer's scene: the camera, every light, and every object as triangles. A
+    /// material gives an object its albedo (its diffuse colour; the other fields are the ray
+    /// tracer's); without one, mesh files keep their base colours (times their texture at each
+    /// vertex) and builtin meshes their own. A photometric intensity (glTF's) becomes a
+    /// radiometric one: candela / 683 W/sr, lux / 683 W/m^2.
     pub fn from_description(d: &SceneDescription) -> Result<Self, String> {
-        let mut spots = d.lights.iter().filter_map(|l| l.spot.map(|spot| (l, spot)));
-        let (light, spot) = spots.next().ok_or(
-            "no spot light (quadray indirect renders one: a light with direction and cone_deg, \
-             or a glTF spot light)",
-        )?;
-        let left_out = d.lights.len() - 1;
-        if left_out > 0 {
-            tracing::warn!(
-                "scene {}: {left_out} more lights left out (quadray indirect renders the first \
-                 spot light)",
-                d.name
+        if d.lights.is_empty() {
+            return Err(
+                "no light (quadray indirect renders point, spot and directional \
+                        lights: give the scene a [[lights]] entry or a glTF punctual light)"
+                    .into(),
             );
         }
+        let lights = d
+            .lights
+            .iter()
+            .map(|l| Light {
+                intensity: Intensity::Native(l.intensity.radiometric()),
+                ..*l
+            })
+            .collect();
         let mut triangles = Vec::new();
         for (i, object) in d.objects.iter().enumerate() {
             triangles.extend(object_triangles(object, d).map_err(|e| format!("object {i}: {e}"))?);
@@ -146,11 +107,7 @@ impl Scene {
         let scene = Self {
             name: d.name.clone(),
             camera: d.camera,
-            light: SpotLight {
-                position: light.position,
-                spot,
-                intensity: light.intensity.watts_per_sr(),
-            },
+            lights,
             r_min: d.technique_settings::<FileSettings>("indirect")?.r_min,
             triangles,
         };
@@ -163,24 +120,25 @@ impl Scene {
         Self::parse(CORNELL_TOML, "cornell").expect("the built-in Cornell scene is valid")
     }
 
-    /// Checks the camera, the light and `r_min` (after loading, or after changing them).
+    /// Checks the camera, the lights and `r_min` (after loading, or after changing them).
     pub fn validate(&self) -> Result<(), String> {
         self.camera.validate()?;
-        let l = &self.light;
-        if !(l.position.is_finite() && l.intensity.is_finite()) {
-            return Err("light has a non-finite value".into());
+        if self.lights.is_empty() {
+            return Err("no light".into());
         }
-        l.spot.validate().map_err(|e| format!("light: {e}"))?;
-        // the RSM sees the whole cone: twice it must stay below a half-space
-        if l.spot.cone_deg > Self::MAX_CONE_DEG {
-            return Err(format!(
-                "light: cone_deg {} is over {} (the RSM's field of view is twice the cone)",
-                l.spot.cone_deg,
-                Self::MAX_CONE_DEG
-            ));
-        }
-        if l.intensity.min_element() < 0.0 {
-            return Err("light intensity is negative".into());
+        for light in &self.lights {
+            light.validate()?;
+            // the RSM sees the whole cone: twice it must stay below a half-space
+            if let LightKind::Spot { cone, .. } = light.kind
+                && cone.cone_deg > Self::MAX_CONE_DEG
+            {
+                return Err(format!(
+                    "{}: cone_deg {} is over {} (the RSM's field of view is twice the cone)",
+                    light.describe(),
+                    cone.cone_deg,
+                    Self::MAX_CONE_DEG
+                ));
+            }
         }
         if !(self.r_min.is_finite() && self.r_min > 0.0) {
             return Err(format!("r_min {} must be positive", self.r_min));
@@ -188,12 +146,15 @@ impl Scene {
         Ok(())
     }
 
-    /// The scene with its spot turned `degrees` about the vertical axis (counter-clockwise seen
-    /// from above), as `--light-orbit` turns it a frame at a time.
+    /// The scene with every light turned `degrees` about the vertical axis through the middle of
+    /// its geometry (counter-clockwise seen from above), as `--light-orbit` turns it a frame at a
+    /// time: a spot and the sun turn, a point light moves round.
     pub fn light_turned(&self, degrees: f32) -> Self {
-        let turn = glam::Quat::from_rotation_y(degrees.to_radians());
+        let (lo, hi) = self.bounds();
         let mut out = self.clone();
-        out.light.spot.direction = turn * self.light.spot.direction;
+        for light in &mut out.lights {
+            *light = light.turned(degrees, lo.midpoint(hi));
+        }
         out
     }
 
@@ -223,21 +184,6 @@ impl Scene {
         extent_of(self.bounds())
     }
 
-    /// World -> light view.
-    pub fn light_view(&self) -> Mat4 {
-        self.light.view()
-    }
-
-    /// World -> light clip space (the RSM and shadow map projection).
-    pub fn light_view_proj(&self) -> Mat4 {
-        self.light.view_proj(self.bounds())
-    }
-
-    /// Far plane of the light: everything in the scene is closer.
-    pub fn light_far(&self) -> f32 {
-        self.light.far(self.bounds())
-    }
-
     /// World -> camera clip space for a picture of this aspect ratio (width / height).
     pub fn camera_view_proj(&self, aspect: f32) -> Mat4 {
         let c = &self.camera;
@@ -254,7 +200,7 @@ impl Scene {
 pub const CORNELL_TOML: &str = include_str!("../../../assets/scenes/cornell.toml");
 
 /// The bundled scene files of this technique, in `scenes_dir()`.
-pub const BUNDLED_SCENES: [&str; 7] = [
+pub const BUNDLED_SCENES: [&str; 10] = [
     "cornell.toml",
     "cornell_obj.toml",
     "cornell_bunny.toml",
@@ -262,6 +208,9 @@ pub const BUNDLED_SCENES: [&str; 7] = [
     "atrium.toml",
     "cornell_spot.gltf",
     "leak.toml",
+    "courtyard.toml",
+    "lamplit_room.toml",
+    "cornell_lights.gltf",
 ];
 
 /// Directory of the bundled scene files.
@@ -403,16 +352,35 @@ mod tests {
         assert!((scene.extent() - 3f32.sqrt()).abs() < 1e-4);
     }
 
+    /// The first light's cone, for scenes lit by a spot.
+    fn cone(scene: &Scene) -> Cone {
+        match scene.lights[0].kind {
+            LightKind::Spot { cone, .. } => cone,
+            _ => panic!("{}: not a spot", scene.lights[0].describe()),
+        }
+    }
+
     #[test]
     fn the_light_turns_about_the_vertical_axis() {
         let scene = Scene::cornell();
-        let d = scene.light.spot.direction;
-        let t = scene.light_turned(90.0).light.spot.direction;
+        let d = cone(&scene).direction;
+        let t = cone(&scene.light_turned(90.0)).direction;
         assert!((t.y - d.y).abs() < 1e-6, "{d} -> {t}");
         assert!(
             (t.x - d.z).abs() < 1e-5 && (t.z + d.x).abs() < 1e-5,
             "{d} -> {t}"
         );
+    }
+
+    #[test]
+    fn every_bundled_scene_loads() {
+        for file in BUNDLED_SCENES {
+            let scene = Scene::load(&scenes_dir().join(file)).unwrap();
+            assert!(
+                !scene.lights.is_empty() && !scene.triangles.is_empty(),
+                "{file}"
+            );
+        }
     }
 
     #[test]
@@ -493,11 +461,11 @@ mod tests {
         };
         assert!(gltf.camera.position.abs_diff_eq(toml.camera.position, 1e-6));
         assert!((gltf.camera.fov_y_deg - toml.camera.fov_y_deg).abs() < 1e-4);
-        let direction = toml.light.spot.direction.normalize();
-        assert!(gltf.light.spot.direction.abs_diff_eq(direction, 1e-5));
-        assert_eq!(gltf.light.intensity, toml.light.intensity);
-        assert!((gltf.light.spot.cone_deg - toml.light.spot.cone_deg).abs() < 1e-4);
-        assert!((gltf.light.spot.falloff_deg - toml.light.spot.falloff_deg).abs() < 1e-4);
+        let (g, t) = (cone(&gltf), cone(&toml));
+        assert!(g.direction.abs_diff_eq(t.direction.normalize(), 1e-5));
+        assert_eq!(gltf.lights[0].intensity, toml.lights[0].intensity);
+        assert!((g.cone_deg - t.cone_deg).abs() < 1e-4);
+        assert!((g.falloff_deg - t.falloff_deg).abs() < 1e-4);
         assert_eq!(gltf.r_min, toml.r_min);
         let (lo, hi) = gltf.bounds();
         assert!(close(lo.to_array(), [0.0; 3], 1e-6) && close(hi.to_array(), [1.0; 3], 1e-6));
@@ -515,22 +483,39 @@ mod tests {
     }
 
     #[test]
-    fn the_first_spot_light_is_used_and_a_scene_without_one_is_refused() {
-        let two_spots = CORNELL_TOML.replace(
+    fn every_light_is_kept_in_order_and_a_scene_without_one_is_refused() {
+        let three = CORNELL_TOML.replace(
             "[[mesh]]",
-            "[[lights]]\nposition = [0.2, 0.9, 0.5]\ndirection = [0, -1, 0]\ncone_deg = 30\n\
-             intensity = [9, 9, 9]\n[[lights]]\nposition = [0.5, 0.5, 0.5]\n\
-             intensity = [1, 1, 1]\n[[mesh]]",
+            "[[lights]]\nposition = [0.5, 0.5, 0.5]\ncandela = [683, 683, 683]\n\
+             [[lights]]\ndirection = [0.2, -1, 0.1]\nlux = [1366, 0, 0]\n[[mesh]]",
         );
-        let scene = Scene::parse(&two_spots, "two").unwrap();
-        assert_eq!(scene.light.intensity, Vec3::splat(2.0));
+        let scene = Scene::parse(&three, "three").unwrap();
+        let kinds: Vec<_> = scene.lights.iter().map(Light::kind_name).collect();
+        assert_eq!(kinds, ["spot", "point", "directional"]);
+        // photometric intensities become radiometric ones
+        let radiometric: Vec<_> = scene.lights.iter().map(|l| l.intensity).collect();
+        assert_eq!(
+            radiometric,
+            [
+                Intensity::Native(Vec3::splat(2.0)),
+                Intensity::Native(Vec3::ONE),
+                Intensity::Native(Vec3::new(2.0, 0.0, 0.0))
+            ]
+        );
+        let dark = format!(
+            "{}\n[[mesh]]",
+            CORNELL_TOML.split("[light]").next().unwrap()
+        );
+        let err = Scene::parse(
+            &dark.replace("[[mesh]]", "[[mesh]]\nbuiltin = \"room\""),
+            "dark",
+        )
+        .unwrap_err();
+        assert!(err.contains("no light"), "{err}");
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes");
-        let points = std::fs::read_to_string(dir.join("shadows-demo.toml")).unwrap();
-        let err = Scene::parse_in(&points, "shadows-demo", &dir).unwrap_err();
-        assert!(err.contains("no spot light"), "{err}");
-        let missing = Scene::load(&dir.join("shadows-demo.toml")).unwrap_err();
+        let missing = Scene::load(&dir.join("no-such-scene.toml")).unwrap_err();
         assert!(
-            missing.to_string().contains("shadows-demo.toml"),
+            missing.to_string().contains("no-such-scene.toml"),
             "{missing}"
         );
     }

@@ -378,14 +378,23 @@ pub struct Settings {
         value_parser = Settings::parse_size,
     ))]
     pub size: Size,
-    /// Side of the square reflective shadow map in texels (a power of two): how many VPLs the
-    /// spot makes.
+    /// Side of the square reflective shadow map in texels (a power of two): how many VPLs a
+    /// spot or directional light makes (a point light: six times as many).
     #[cfg_attr(feature = "cli", arg(
         long,
         default_value_t = Settings::DEFAULT.rsm_size,
         value_parser = Settings::parse_rsm_size,
     ))]
     pub rsm_size: u32,
+    /// The most lights rendered: the scene's first N, each with its own RSM of --rsm-size^2
+    /// texels and light quadtree (a point light six, one per cube face), so the light's work
+    /// grows linearly with the count.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.max_lights,
+        value_parser = Settings::MAX_LIGHTS.parser(),
+    ))]
+    pub max_lights: u32,
     /// The quadtree's parameters, for the quadtree methods.
     #[cfg_attr(feature = "cli", command(flatten))]
     pub cluster: ClusterSettings,
@@ -489,6 +498,7 @@ impl Settings {
     pub const DEFAULT: Settings = Settings {
         size: Size::new(512, 512),
         rsm_size: 512,
+        max_lights: 4,
         cluster: ClusterSettings::DEFAULT,
         samples: 256,
         rsm_radius: 1.0,
@@ -508,6 +518,8 @@ impl Settings {
     /// [`Settings::rsm_size`] (also a power of two): 1024^2 VPLs make a 67 MB quadtree, within
     /// every adapter's storage-buffer limit.
     pub const RSM_SIZE: Limits<u32> = Limits::closed(4, 1024).interactive(8, 1024);
+    /// [`Settings::max_lights`].
+    pub const MAX_LIGHTS: Limits<u32> = Limits::closed(1, 16);
     /// [`Settings::samples`].
     pub const SAMPLES: Limits<u32> = Limits::closed(1, 65536).interactive(1, 2048);
     /// [`Settings::rsm_radius`].
@@ -653,6 +665,7 @@ impl Settings {
         }
         ClusterSettings::DEPTH_THRESHOLD.check("depth threshold", c.depth_threshold)?;
         ClusterSettings::NORMAL_THRESHOLD.check("normal threshold", c.normal_threshold)?;
+        Self::MAX_LIGHTS.check("max lights", s.max_lights)?;
         Self::SAMPLES.check("samples", s.samples)?;
         Self::RSM_RADIUS.check("RSM radius", s.rsm_radius)?;
         Self::SUBSAMPLE.check("subsample", s.subsample)?;
@@ -689,6 +702,7 @@ impl Settings {
         let mut args: Vec<(&str, String)> = vec![
             ("--size", s.size.to_string()),
             ("--rsm-size", s.rsm_size.to_string()),
+            ("--max-lights", s.max_lights.to_string()),
             ("--depth-threshold", c.depth_threshold.to_string()),
             ("--normal-threshold", c.normal_threshold.to_string()),
             ("--validity", c.validity.to_string()),

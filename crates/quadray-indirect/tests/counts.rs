@@ -6,7 +6,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use quadray_gpu::Gpu;
 use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
-use quadray_indirect::gpu::Receiver;
+use quadray_indirect::gpu::{LightView, Receiver};
 use quadray_indirect::tile_cut::{TileInput, tile_cuts};
 use quadray_indirect::{
     ClusterSettings, Levels, Method, Renderer, Scene, Settings, Size, TileCriterion, Validity,
@@ -220,7 +220,7 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
         s.rsm_radius * RSM as f32 * std::f32::consts::SQRT_2,
         SAMPLE_SEED,
     );
-    let view_proj = scene.light_view_proj();
+    let view_proj = LightView::of_scene(&scene, 1)[0].view_proj;
     let side = RSM as f32;
     // one receiver's (evaluations, fetches) past its G-buffer reads
     let sampled = |receiver: &Receiver| {

@@ -679,8 +679,8 @@ fn temporal_filter_is_the_running_average_of_the_unfiltered_frames() {
         let mut average: Option<Vec<[f32; 3]>> = None;
         for frame in 0..4 {
             let turned = scene.light_turned(5.0 * frame as f32);
-            plain.set_view(&turned);
-            filtered.set_view(&turned);
+            plain.set_view(&turned).unwrap();
+            filtered.set_view(&turned).unwrap();
             let now = render(&mut plain, Method::Quadtree);
             let brute_force = render(&mut filtered, Method::Reference);
             assert!(compare(&brute_force, &render(&mut plain, Method::Reference)).rel_l1 < 1e-6);
@@ -707,8 +707,8 @@ fn temporal_filter_is_the_running_average_of_the_unfiltered_frames() {
         let mut last_view = scene.light_turned(15.0).camera_view_proj(1.0);
         for (turn, orbit) in [(20.0, 3.0), (25.0, 8.0)] {
             let moved = scene.light_turned(turn).camera_orbited(orbit);
-            plain.set_view(&moved);
-            filtered.set_view(&moved);
+            plain.set_view(&moved).unwrap();
+            filtered.set_view(&moved).unwrap();
             let now = render(&mut plain, Method::Quadtree);
             let shown = render(&mut filtered, Method::Quadtree);
             let points = filtered.read_receivers().unwrap();
@@ -964,7 +964,7 @@ fn a_moved_camera_renders_the_new_view_alone() {
     for method in Method::ALL {
         let mut moved = Renderer::new(&gpu, &before, s.clone()).unwrap();
         render(&mut moved, method);
-        moved.set_view(&after);
+        moved.set_view(&after).unwrap();
         let moved = render(&mut moved, method);
         let fresh = render(&mut Renderer::new(&gpu, &after, s.clone()).unwrap(), method);
         // the same up to the last bits of float sums (the one cut: 4e-8)

@@ -5,8 +5,8 @@
 use quadray_gpu::{Gpu, read_buffer, read_texture_f32, texture_2d, texture_2d_with_data};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{
-    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, OutputPass, OutputTerm, Renderer,
-    RsmPass, RsmViews, Scene, Settings, Spot,
+    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass, OutputTerm,
+    Renderer, RsmPass, RsmViews, Scene, Settings, ViewMaps,
 };
 use wgpu::util::DeviceExt;
 
@@ -54,7 +54,7 @@ fn clean_inputs(gpu: &Gpu, scene: &Scene) -> (Texels, Texels) {
             .collect()
     });
     let rsm = RsmPass::new(d, s.rsm_size);
-    rsm.set_light(q, &Spot::of_scene(scene));
+    rsm.set_light(q, &LightView::of_scene(scene, 1)[0]);
     let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("vertices"),
         contents: bytemuck::cast_slice(&scene.triangles),
@@ -109,8 +109,12 @@ fn frame(
         albedo: &g_albedo,
     };
     let quadtree = LightQuadtree::new(d, q, s.rsm_size, s.cluster, rsm_views);
-    let gather = Gather::new(d, &s, &quadtree, rsm_views, gbuffer_views).unwrap();
-    gather.set_light(q, &Spot::of_scene(scene), scene.r_min);
+    let maps = [ViewMaps {
+        rsm: rsm_views,
+        quadtree: &quadtree,
+    }];
+    let gather = Gather::new(d, &s, &maps, gbuffer_views).unwrap();
+    gather.set_lights(q, &LightView::of_scene(scene, 1), scene.r_min);
     let aspect = size.0 as f32 / size.1 as f32;
     gather.set_camera(q, scene.camera_view_proj(aspect), scene.camera.position);
     let output = texture_2d(
@@ -124,7 +128,7 @@ fn frame(
     let mut encoder = d.create_command_encoder(&Default::default());
     quadtree.record_build(&mut encoder, None);
     quadtree.record_cut(&mut encoder, None);
-    gather.record_indirect(&mut encoder, method, &quadtree, None);
+    gather.record_indirect(&mut encoder, method, &[&quadtree], None);
     gather.record_direct(&mut encoder, None);
     output_pass.record(
         d,

@@ -6,6 +6,7 @@ mod counts;
 mod gpu;
 mod layering;
 mod layers;
+mod lights;
 mod non_finite;
 mod output;
 mod tile_cut;

@@ -82,7 +82,9 @@ impl Pose {
     fn of(scene: &Scene) -> Self {
         let eye = scene.camera.position;
         let (yaw, pitch) = yaw_pitch(scene.camera.target - eye);
-        let (light_yaw, light_pitch) = yaw_pitch(scene.light.spot.direction);
+        // a point light has no aim to drag: its yaw and pitch stay unused
+        let (light_yaw, light_pitch) =
+            yaw_pitch(scene.lights[0].direction().unwrap_or(Vec3::NEG_Y));
         Self {
             eye,
             yaw,
@@ -105,7 +107,7 @@ impl Pose {
                 Quat::from_axis_angle(light, self.light_phase) * light.any_orthonormal_vector();
             light = Quat::from_axis_angle(axis, 15f32.to_radians()) * light;
         }
-        scene.light.spot.direction = light;
+        scene.lights[0].aim(light);
         scene
     }
 }
@@ -252,7 +254,7 @@ impl IndirectView {
         if !(self.redraw || self.rebuild) {
             return Ok(None);
         }
-        renderer.set_view(&scene);
+        renderer.set_view(&scene)?;
         self.timing = renderer.time(self.method, self.rebuild, 1)?;
         self.redraw = false;
         self.rebuild = false;
@@ -313,14 +315,18 @@ impl IndirectView {
             format!("--exposure {}", self.exposure),
             format!("--camera-position {}", v(scene.camera.position.to_array())),
             format!("--camera-target {}", v(scene.camera.target.to_array())),
-            format!("--light-position {}", v(scene.light.position.to_array())),
-            format!(
-                "--light-direction {}",
-                v(scene.light.spot.direction.to_array())
-            ),
-            "--frames 1 --out".into(),
-            shell_word(out),
-        ]);
+        ])
+        .chain(
+            scene.lights[0]
+                .position()
+                .map(|p| format!("--light-position {}", v(p.to_array()))),
+        )
+        .chain(
+            scene.lights[0]
+                .direction()
+                .map(|d| format!("--light-direction {}", v(d.to_array()))),
+        )
+        .chain(["--frames 1 --out".into(), shell_word(out)]);
         Some(words.collect::<Vec<_>>().join(" "))
     }
 

@@ -2,14 +2,15 @@
 //! Cornell box with the brute force, the error heat map and the paper's one cut beside them; the
 //! one cut and the centre tile's per-tile cut over the RSM; the paper's figure 9 (quadtree against RSM
 //! sampling at equal time and at 2040 samples, and the per-tile cuts); the atrium; the leak scene with and without
-//! indirect shadows beside the ground truth with visibility.
+//! indirect shadows beside the ground truth with visibility; the sunlit courtyard and the room lit
+//! by three point lights beside their ground truths.
 
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
-use quadray_indirect::picture::tone_map;
+use quadray_indirect::picture::{flip_against, tone_map};
 use quadray_indirect::reference::{compare, error_map, ground_truth};
 use quadray_indirect::scene::scenes_dir;
-use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
+use quadray_indirect::{Frame, IndirectError, Method, Renderer, Scene, Settings};
 use std::path::{Path, PathBuf};
 
 const EXPOSURE: f32 = 1.0;
@@ -162,7 +163,53 @@ pub fn render_demo(
 
     progress("leak scene: indirect shadows and the ground truth");
     files.push(leak_picture(gpu, size, &out.join("leak.png"))?);
+    for (scene, what) in [
+        ("courtyard", "the sun"),
+        ("lamplit_room", "three point lights"),
+    ] {
+        progress(&format!("{scene}: {what} and the ground truth"));
+        let path = out.join(format!("{scene}.png"));
+        files.push(lights_picture(gpu, size, scene, &path)?);
+    }
     Ok(files)
+}
+
+/// A scene lit by other lights than a spot (`scenes_dir()/NAME.toml`): the direct light, with the
+/// default method's bounce, and with the bounce from every VPL with exact visibility (the ground
+/// truth; a 32^2 RSM a light view keeps it to seconds), the indirect light of both with its FLIP
+/// and the error heat map.
+fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathBuf, IndirectError> {
+    let scene = Scene::load(&scenes_dir().join(format!("{name}.toml")))?;
+    let (w, h) = (size * 4 / 3, size);
+    let settings = Settings {
+        indirect_shadows: true,
+        ..Settings::sized(w, h, 32)
+    };
+    let mut r = Renderer::new(gpu, &scene, settings)?;
+    let frame = r.render_frame(Method::DEFAULT)?;
+    let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
+    let tile = |v: &[[f32; 3]]| tone_map(w, h, v, EXPOSURE);
+    let with_truth = Frame {
+        indirect: truth.clone(),
+        ..frame.clone()
+    }
+    .combined();
+    let flip = flip_against(&frame, &truth, EXPOSURE);
+    let pictures = [
+        ("direct".into(), tile(&frame.direct)),
+        (
+            format!("+ {}, shadows", Method::DEFAULT),
+            tile(&frame.combined()),
+        ),
+        ("+ ground truth".into(), tile(&with_truth)),
+        (format!("indirect, FLIP {flip:.3}"), tile(&frame.indirect)),
+        ("indirect, ground truth".into(), tile(&truth)),
+        (
+            "error".into(),
+            heat_map(w, h, &error_map(&frame.indirect, &truth), 0.5),
+        ),
+    ];
+    save(&montage(&pictures, 3), path)
 }
 
 /// The leak scene's indirect light without and with indirect shadows, beside one bounce from

@@ -237,7 +237,7 @@ pub fn measure(
         let view = scene
             .light_turned(orbit.light_degrees * f as f32)
             .camera_orbited(orbit.camera_degrees * f as f32);
-        renderer.set_view(&view);
+        renderer.set_view(&view)?;
         let (image, cut) = frame_and_cut(renderer, method)?;
         let reference = renderer.render_frame(Method::Reference)?.indirect;
         let mut new = None;
@@ -259,7 +259,7 @@ pub fn measure(
         }
         sums.add(image, cut, &reference, new.as_deref());
         if let Some(plain) = plain.as_mut() {
-            plain.set_view(&view);
+            plain.set_view(&view)?;
             let (image, cut) = frame_and_cut(plain, method)?;
             plain_sums.add(image, cut, &reference, new.as_deref());
         }
@@ -268,7 +268,7 @@ pub fn measure(
         }
         previous_reference = Some(reference);
     }
-    renderer.set_view(scene);
+    renderer.set_view(scene)?;
     let pairs = f64::from(frames.saturating_sub(1).max(1));
     let figures = |sums: &Sums| Temporal {
         degrees_per_frame: orbit.light_degrees,

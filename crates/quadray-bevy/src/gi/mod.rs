@@ -1,7 +1,10 @@
-//! One bounce of indirect light from a Bevy `SpotLight` through quadray's light quadtree
-//! (`quadray_indirect`): the light's reflective shadow map, the cluster pyramid and its cut, the
-//! gather over the camera's deferred G-buffer, added to the lit HDR picture before tone mapping.
-//! Bevy's own direct light, shadows, materials and exposure stay as they are.
+//! One bounce of indirect light from Bevy's lights (`DirectionalLight`, `PointLight` and
+//! `SpotLight`, each marked with [`IndirectLightSource`]) through quadray's light quadtree
+//! (`quadray_indirect`): each light's reflective shadow maps (a spot's one, the sun's one
+//! orthographic over the scene, a point light's six cube faces), their cluster pyramids and cuts,
+//! the gather over the camera's deferred G-buffer summing them, added to the lit HDR picture
+//! before tone mapping. Bevy's own direct light, shadows, cascades, materials and exposure stay as
+//! they are.
 //!
 //! ```no_run
 //! use bevy::pbr::DefaultOpaqueRendererMethod;
@@ -31,9 +34,11 @@
 //! gathers every frame: Bevy's G-buffer changes without the camera moving (a mesh's pipeline
 //! compiled frames after it loaded, render layers switched).
 //!
-//! Units: the light's intensity is Bevy's (luminous power, lumens; a spot's luminous intensity
-//! is that over 4 pi, as Bevy lights it), so the indirect light is in the same units as Bevy's
-//! direct light and is scaled by the camera's exposure as Bevy's is.
+//! Units: the lights' intensities are Bevy's (a point or spot light's luminous power in lumens,
+//! its luminous intensity that over 4 pi, as Bevy lights it; a directional light's illuminance
+//! in lux), so the indirect light is in the same units as Bevy's direct light and is scaled by the
+//! camera's exposure as Bevy's is. The lights are taken in a fixed order (directional, spot, point
+//! lights, each kind by entity) up to the first camera's [`Settings::max_lights`].
 
 mod render;
 
@@ -47,13 +52,13 @@ use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
 use bevy::render::extract_resource::{ExtractResource, ExtractResourcePlugin};
 use bevy::render::storage::ShaderBuffer;
 use bevy::shader::Shader;
-use quadray_indirect::scene::{Spot, SpotLight as QuadraySpot, Vertex};
-use quadray_indirect::{Method, Settings};
+use quadray_indirect::scene::{Cone, Intensity, Light, LightKind, Vertex};
+use quadray_indirect::{Method, Scene, Settings};
 use std::sync::Arc;
 
 const GBUFFER_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d11");
 
-/// Adds [`IndirectLight`] to the cameras that carry it, from the spot light marked
+/// Adds [`IndirectLight`] to the cameras that carry it, from the lights marked
 /// [`IndirectLightSource`]. Add it after `DefaultPlugins`; the cameras need deferred rendering
 /// (`DefaultOpaqueRendererMethod::deferred()` or deferred materials) and `Msaa::Off`.
 pub struct IndirectLightPlugin;
@@ -71,7 +76,7 @@ impl Plugin for IndirectLightPlugin {
         .init_resource::<IndirectLightScene>()
         .add_systems(
             PostUpdate,
-            (collect_triangles, collect_light)
+            (collect_triangles, collect_lights)
                 .after(bevy::transform::TransformSystems::Propagate)
                 .after(bevy::camera::visibility::VisibilitySystems::VisibilityPropagate),
         );
@@ -79,7 +84,7 @@ impl Plugin for IndirectLightPlugin {
     }
 }
 
-/// On a camera: add one bounce of indirect light from the [`IndirectLightSource`] spot (to the
+/// On a camera: add one bounce of indirect light from the [`IndirectLightSource`] lights (to the
 /// HDR picture, before tone mapping: the camera gets `Hdr` and Bevy's depth and deferred prepasses).
 #[derive(Component, Clone, Debug, ExtractComponent)]
 #[require(DepthPrepass, DeferredPrepass, Hdr)]
@@ -118,42 +123,74 @@ impl Default for IndirectLight {
     }
 }
 
-/// On a `SpotLight`: the light whose first bounce [`IndirectLight`] cameras add (the first
-/// one marked, when several are).
+/// On a `DirectionalLight`, `PointLight` or `SpotLight`: a light whose first bounce
+/// [`IndirectLight`] cameras add.
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct IndirectLightSource;
 
 /// What the render world needs of the main world's scene: its triangles (rebuilt when a mesh,
-/// material or transform changes) and the marked spot light.
+/// material or transform changes) and the marked lights.
 #[derive(Resource, Clone, Default, ExtractResource)]
 struct IndirectLightScene {
     triangles: Arc<Vec<[Vertex; 3]>>,
     /// Counts the rebuilds of `triangles`.
     generation: u64,
-    light: Option<QuadraySpot>,
+    lights: Vec<Light>,
+}
+
+/// A Bevy colour times a strength, as a light's RGB intensity.
+fn coloured(color: Color, strength: f32) -> Intensity {
+    let c = LinearRgba::from(color);
+    Intensity::Native(Vec3::new(c.red, c.green, c.blue) * strength)
+}
+
+/// Bevy's directional light as quadray's: its illuminance along the transform's forward.
+pub fn quadray_directional(light: &DirectionalLight, transform: &GlobalTransform) -> Light {
+    Light {
+        kind: LightKind::Directional {
+            direction: transform.forward().as_vec3(),
+        },
+        intensity: coloured(light.color, light.illuminance),
+    }
+}
+
+/// Bevy's point light as quadray's: luminous intensity (lumens over 4 pi, as Bevy lights it).
+pub fn quadray_point(light: &PointLight, transform: &GlobalTransform) -> Light {
+    Light {
+        kind: LightKind::Point {
+            position: transform.translation(),
+        },
+        intensity: coloured(light.color, light.intensity / (4.0 * std::f32::consts::PI)),
+    }
 }
 
 /// Bevy's spot light as quadray's: luminous intensity (lumens over 4 pi, as Bevy lights a spot)
 /// on the axis, the outer angle as the cone, the fade from the inner angle as its falloff.
-pub fn quadray_spot(light: &SpotLight, transform: &GlobalTransform) -> QuadraySpot {
-    let colour = LinearRgba::from(light.color);
-    let candela = light.intensity / (4.0 * std::f32::consts::PI);
+pub fn quadray_spot(light: &SpotLight, transform: &GlobalTransform) -> Light {
     let cone_deg = light.outer_angle.to_degrees();
-    QuadraySpot {
-        position: transform.translation(),
-        spot: Spot {
-            direction: transform.forward().as_vec3(),
-            cone_deg,
-            falloff_deg: (light.outer_angle - light.inner_angle)
-                .to_degrees()
-                .clamp(0.0, cone_deg),
+    Light {
+        kind: LightKind::Spot {
+            position: transform.translation(),
+            cone: Cone {
+                direction: transform.forward().as_vec3(),
+                cone_deg,
+                falloff_deg: (light.outer_angle - light.inner_angle)
+                    .to_degrees()
+                    .clamp(0.0, cone_deg),
+            },
         },
-        intensity: Vec3::new(colour.red, colour.green, colour.blue) * candela,
+        intensity: coloured(light.color, light.intensity / (4.0 * std::f32::consts::PI)),
     }
 }
 
-fn collect_light(
-    lights: Query<(&SpotLight, &GlobalTransform), With<IndirectLightSource>>,
+/// The marked lights of one kind, by entity.
+type Marked<'w, 's, L> =
+    Query<'w, 's, (Entity, &'static L, &'static GlobalTransform), With<IndirectLightSource>>;
+
+fn collect_lights(
+    directional: Marked<DirectionalLight>,
+    spots: Marked<SpotLight>,
+    points: Marked<PointLight>,
     cameras: Query<(), With<IndirectLight>>,
     mut scene: ResMut<IndirectLightScene>,
     mut warned: Local<Option<String>>,
@@ -164,43 +201,48 @@ fn collect_light(
             *warned = Some(message);
         }
     };
-    let light = lights.iter().next().map(|(l, t)| quadray_spot(l, t));
-    let light = match light {
-        None if !cameras.is_empty() => {
-            warn(
-                "quadray indirect light: no SpotLight has IndirectLightSource; add that component \
-                 to the spot light whose bounce the IndirectLight cameras should show"
-                    .into(),
-            );
-            None
+    fn sorted<L: Component>(
+        q: &Marked<L>,
+        convert: fn(&L, &GlobalTransform) -> Light,
+    ) -> Vec<(Entity, Light)> {
+        let mut lights: Vec<_> = q.iter().map(|(e, l, t)| (e, convert(l, t))).collect();
+        lights.sort_by_key(|(e, _)| *e);
+        lights
+    }
+    let marked = [
+        sorted(&directional, quadray_directional),
+        sorted(&spots, quadray_spot),
+        sorted(&points, quadray_point),
+    ]
+    .concat();
+    if marked.is_empty() && !cameras.is_empty() {
+        warn(
+            "quadray indirect light: no light has IndirectLightSource; add that component to \
+             the DirectionalLight, PointLight or SpotLight whose bounce the IndirectLight cameras \
+             should show"
+                .into(),
+        );
+    }
+    let mut lights = Vec::new();
+    for (entity, light) in marked {
+        let max = Scene::MAX_CONE_DEG;
+        let checked = light.validate().and_then(|()| match light.kind {
+            LightKind::Spot { cone, .. } if cone.cone_deg > max => Err(format!(
+                "its outer angle {:.1} degrees is over {max} (the RSM sees twice the cone)",
+                cone.cone_deg
+            )),
+            _ => Ok(()),
+        });
+        match checked {
+            Ok(()) => lights.push(light),
+            Err(e) => warn(format!(
+                "quadray indirect light: the IndirectLightSource {} {entity} is skipped: {e}",
+                light.kind_name()
+            )),
         }
-        Some(l) => match l.spot.validate().and_then(|()| {
-            let max = quadray_indirect::Scene::MAX_CONE_DEG;
-            if l.spot.cone_deg > max {
-                Err(format!(
-                    "its outer angle {:.1} degrees is over {max} (the RSM sees twice the cone)",
-                    l.spot.cone_deg
-                ))
-            } else if !(l.position.is_finite() && l.intensity.is_finite())
-                || l.intensity.min_element() < 0.0
-            {
-                Err("its position or intensity is not finite and positive".into())
-            } else {
-                Ok(())
-            }
-        }) {
-            Ok(()) => Some(l),
-            Err(e) => {
-                warn(format!(
-                    "quadray indirect light: the IndirectLightSource spot is skipped: {e}"
-                ));
-                None
-            }
-        },
-        None => None,
-    };
-    if scene.light != light {
-        scene.light = light;
+    }
+    if scene.lights != lights {
+        scene.lights = lights;
     }
 }
 

@@ -1,4 +1,4 @@
-//! The render world's side: per light, quadray's RSM and light quadtree; per camera, the
+//! The render world's side: per light view, quadray's RSM and light quadtree; per camera, the
 //! G-buffer translated from Bevy's, quadray's gather, the additive composite into the view and,
 //! on request, the cut over the RSM drawn into the tone-mapped picture.
 
@@ -24,9 +24,9 @@ use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery
 use bevy::render::storage::GpuShaderBuffer;
 use bevy::render::view::{ExtractedView, ViewTarget};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
-use quadray_indirect::scene::SpotLight as QuadraySpot;
+use quadray_indirect::scene::Light;
 use quadray_indirect::{FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, RsmPass, Settings};
-use quadray_indirect::{Spot, scene::bounds_of};
+use quadray_indirect::{LightView, ViewMaps, scene::bounds_of};
 use std::num::NonZero;
 use std::sync::{Mutex, PoisonError};
 
@@ -250,21 +250,71 @@ fn composite_pipeline(
     pipeline
 }
 
-/// The light's side, shared by every camera: its RSM over the scene's triangles and the light
-/// quadtree built over it.
+/// The lights' side, shared by every camera: an RSM over the scene's triangles and the light
+/// quadtree built over it per light view.
 #[derive(Resource, Default)]
 struct LightState(Option<LightPasses>);
 
-struct LightPasses {
+/// One light view's RSM and quadtree.
+struct ViewMapsPasses {
     rsm: RsmPass,
     quadtree: LightQuadtree,
+}
+
+struct LightPasses {
+    /// One a light view, in the order of `lights`' views; the first's cut is the one the cut
+    /// view and the diagnostics show.
+    views: Vec<ViewMapsPasses>,
+    /// Counts the times `views` was made anew: a camera's gather reads the maps of one.
+    maps_generation: u64,
     rsm_size: u32,
+    /// The first camera's [`Settings::max_lights`], which `lights` was taken with.
+    max_lights: u32,
     vertices: Option<(wgpu::Buffer, u32)>,
     generation: u64,
-    light: Option<QuadraySpot>,
-    spot: Option<Spot>,
-    /// The RSM, pyramid and cut are to be recorded again (the light or the scene changed).
+    lights: Vec<Light>,
+    /// The lights' RSM views, one a `views` entry.
+    light_views: Vec<LightView>,
+    /// The RSMs, pyramids and cuts are to be recorded again (a light or the scene changed).
     stale: bool,
+}
+
+impl LightPasses {
+    fn maps(&self) -> Vec<ViewMaps<'_>> {
+        self.views
+            .iter()
+            .map(|v| ViewMaps {
+                rsm: v.rsm.views(),
+                quadtree: &v.quadtree,
+            })
+            .collect()
+    }
+
+    /// The passes of `count` light views at `settings`.
+    fn make_views(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        settings: &Settings,
+        count: usize,
+    ) {
+        self.views = (0..count)
+            .map(|_| {
+                let rsm = RsmPass::new(device, settings.rsm_size);
+                let quadtree = LightQuadtree::new(
+                    device,
+                    queue,
+                    settings.rsm_size,
+                    settings.cluster,
+                    rsm.views(),
+                );
+                ViewMapsPasses { rsm, quadtree }
+            })
+            .collect();
+        self.rsm_size = settings.rsm_size;
+        self.maps_generation += 1;
+        self.stale = true;
+    }
 }
 
 fn prepare_light(
@@ -290,29 +340,23 @@ fn prepare_light(
         state.0 = None;
         return;
     }
+    let l = state.0.get_or_insert_with(|| LightPasses {
+        views: Vec::new(),
+        maps_generation: 0,
+        rsm_size: 0,
+        max_lights: settings.max_lights,
+        vertices: None,
+        generation: u64::MAX,
+        lights: Vec::new(),
+        light_views: Vec::new(),
+        stale: true,
+    });
     let cluster = settings.cluster;
-    let rebuild = state
-        .0
-        .as_ref()
-        .is_none_or(|l| l.rsm_size != settings.rsm_size);
-    if rebuild {
-        let rsm = RsmPass::new(device, settings.rsm_size);
-        let quadtree = LightQuadtree::new(device, &queue, settings.rsm_size, cluster, rsm.views());
-        state.0 = Some(LightPasses {
-            rsm,
-            quadtree,
-            rsm_size: settings.rsm_size,
-            vertices: None,
-            generation: u64::MAX,
-            light: None,
-            spot: None,
-            stale: true,
-        });
-    }
-    let Some(l) = state.0.as_mut() else { return };
-    if l.quadtree.cluster() != cluster {
-        l.quadtree.set_cluster(&queue, cluster);
-        l.stale = true;
+    for view in &mut l.views {
+        if view.quadtree.cluster() != cluster {
+            view.quadtree.set_cluster(&queue, cluster);
+            l.stale = true;
+        }
     }
     if l.generation != scene.generation {
         l.generation = scene.generation;
@@ -325,25 +369,37 @@ fn prepare_light(
             });
             (buffer, scene.triangles.len() as u32 * 3)
         });
-        l.light = None;
+        // the maps' projections follow the scene's bounds
+        l.lights.clear();
     }
-    if l.light != scene.light {
-        l.light = scene.light;
-        l.spot = scene.light.map(|light| {
-            let bounds = bounds_of(
-                scene
-                    .triangles
-                    .iter()
-                    .flatten()
-                    .map(|v| glam::Vec3::from(v.position)),
-            );
-            Spot::new(&light, bounds)
-        });
-        if let Some(spot) = &l.spot {
-            l.rsm.set_light(&queue, spot);
+    let lights: Vec<Light> = scene
+        .lights
+        .iter()
+        .take(settings.max_lights as usize)
+        .copied()
+        .collect();
+    if l.lights != lights || l.rsm_size != settings.rsm_size {
+        let bounds = bounds_of(
+            scene
+                .triangles
+                .iter()
+                .flatten()
+                .map(|v| glam::Vec3::from(v.position)),
+        );
+        l.light_views = lights
+            .iter()
+            .flat_map(|light| LightView::of_light(light, bounds))
+            .collect();
+        if l.views.len() != l.light_views.len() || l.rsm_size != settings.rsm_size {
+            l.make_views(device, &queue, settings, l.light_views.len());
         }
+        for (view, light_view) in l.views.iter().zip(&l.light_views) {
+            view.rsm.set_light(&queue, light_view);
+        }
+        l.lights = lights;
         l.stale = true;
     }
+    l.max_lights = settings.max_lights;
 }
 
 /// A camera's side: quadray's G-buffer (translated from Bevy's), its gather, composite and cut
@@ -351,6 +407,8 @@ fn prepare_light(
 #[derive(Component)]
 pub(super) struct ViewPasses {
     settings: Settings,
+    /// The light's maps the gather reads ([`LightPasses::maps_generation`]).
+    maps_generation: u64,
     format: TextureFormat,
     /// Position, normal, albedo.
     gbuffer: [wgpu::TextureView; 3],
@@ -404,7 +462,7 @@ impl ViewPasses {
             normal: &gbuffer[1],
             albedo: &gbuffer[2],
         };
-        let gather = Gather::new(device, &settings, &light.quadtree, light.rsm.views(), views)?;
+        let gather = Gather::new(device, &settings, &light.maps(), views)?;
         let uniform = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -416,7 +474,7 @@ impl ViewPasses {
         let view_uniform = uniform("quadray gi view", VIEW_UNIFORM_BYTES);
         let composite_uniform = uniform("quadray gi composite", 16);
         let cut_view_uniform = uniform("quadray gi cut view", 16);
-        let quadtree = &light.quadtree;
+        let quadtree = &light.views[0].quadtree;
         let cut_view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("quadray gi cut view"),
             layout: &pipelines.cut_view_layout,
@@ -475,6 +533,7 @@ impl ViewPasses {
         });
         Ok(Self {
             settings,
+            maps_generation: light.maps_generation,
             format,
             gbuffer,
             view_uniform,
@@ -555,19 +614,32 @@ fn prepare_views(
             width: size.x,
             height: size.y,
         };
-        // one light quadtree serves every camera: it is sized by the first camera's settings
-        if settings.rsm_size != l.rsm_size || settings.cluster != l.quadtree.cluster() {
+        // one set of light quadtrees serves every camera: made by the first camera's settings
+        if settings.rsm_size != l.rsm_size
+            || settings.max_lights != l.max_lights
+            || l.views
+                .iter()
+                .any(|v| v.quadtree.cluster() != settings.cluster)
+        {
             warn(
-                "its RSM size or cluster settings differ from the first IndirectLight camera's, \
-                 which the light's quadtree is built with: give every camera the same; no \
-                 indirect light is added"
+                "its RSM size, light count or cluster settings differ from the first \
+                 IndirectLight camera's, which the lights' quadtrees are built with: give every \
+                 camera the same; no indirect light is added"
                     .into(),
             );
             commands.entity(entity).remove::<ViewPasses>();
             continue;
         }
+        if l.views.is_empty() {
+            // no light to gather from (a warning said why)
+            commands.entity(entity).remove::<ViewPasses>();
+            continue;
+        }
         let format = target.main_texture_format();
-        let Some(passes) = passes.filter(|p| p.settings == settings && p.format == format) else {
+        let current = |p: &&ViewPasses| {
+            p.settings == settings && p.format == format && p.maps_generation == l.maps_generation
+        };
+        let Some(passes) = passes.filter(current) else {
             match ViewPasses::new(device, settings, l, &mut pipelines, format) {
                 Ok(p) => {
                     commands.entity(entity).insert(p);
@@ -580,13 +652,12 @@ fn prepare_views(
             // the new passes start next frame
             continue;
         };
-        let Some(spot) = &l.spot else { continue };
         let clip_from_world = view
             .clip_from_world
             .unwrap_or_else(|| view.clip_from_view * view.world_from_view.to_matrix().inverse());
         let eye = view.world_from_view.translation();
         passes.gather.set_camera(&queue, clip_from_world, eye);
-        passes.gather.set_light(&queue, spot, gi.r_min);
+        passes.gather.set_lights(&queue, &l.light_views, gi.r_min);
         let mut uniform: Vec<f32> = clip_from_world.inverse().to_cols_array().to_vec();
         uniform.extend([eye.x, eye.y, eye.z, 1.0]);
         uniform.extend([f32::from_bits(size.x), f32::from_bits(size.y), 0.0, 0.0]);
@@ -628,7 +699,7 @@ fn indirect_light_pass(
     let Some(l) = light.0.as_mut().filter(|_| gi.enabled) else {
         return;
     };
-    let (Some((vertices, vertex_count)), Some(_)) = (&l.vertices, &l.spot) else {
+    let (Some((vertices, vertex_count)), Some(_)) = (&l.vertices, l.views.first()) else {
         return;
     };
     let Some(translate) = pipeline_cache.get_compute_pipeline(pipelines.gbuffer) else {
@@ -680,10 +751,12 @@ fn indirect_light_pass(
     let whole = diagnostics.time_span(encoder, "quadray_gi");
     if l.stale {
         let span = diagnostics.time_span(encoder, "light");
-        l.rsm
-            .record(encoder, vertices.slice(..), *vertex_count, None);
-        l.quadtree.record_build(encoder, None);
-        l.quadtree.record_cut(encoder, None);
+        for view in &l.views {
+            view.rsm
+                .record(encoder, vertices.slice(..), *vertex_count, None);
+            view.quadtree.record_build(encoder, None);
+            view.quadtree.record_cut(encoder, None);
+        }
         l.stale = false;
         span.end(encoder);
     }
@@ -700,9 +773,10 @@ fn indirect_light_pass(
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups(size.width.div_ceil(8), size.height.div_ceil(8), 1);
     }
+    let quadtrees: Vec<&LightQuadtree> = l.views.iter().map(|v| &v.quadtree).collect();
     passes
         .gather
-        .record_indirect(encoder, gi.method, &l.quadtree, None);
+        .record_indirect(encoder, gi.method, &quadtrees, None);
     span.end(encoder);
     if diagnostics.is_some() {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -730,7 +804,7 @@ fn indirect_light_pass(
     span.end(encoder);
     whole.end(encoder);
     if diagnostics.is_some() {
-        let cut = l.quadtree.cut_count().slice(0..4);
+        let cut = l.views[0].quadtree.cut_count().slice(0..4);
         diagnostics.record_u32(encoder, &cut, "quadray_gi/cut_clusters");
         let evaluations = passes.means.slice(0..4);
         diagnostics.record_f32(
@@ -756,7 +830,7 @@ fn cut_view_pass(
     mut ctx: RenderContext,
 ) {
     let (passes, target, gi) = view.into_inner();
-    if !(gi.cut_view && gi.enabled) || light.0.as_ref().is_none_or(|l| l.spot.is_none()) {
+    if !(gi.cut_view && gi.enabled) || light.0.as_ref().is_none_or(|l| l.views.is_empty()) {
         return;
     }
     let size = passes.settings.size;

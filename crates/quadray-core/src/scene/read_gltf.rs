@@ -3,7 +3,7 @@
 //! panic on a file that mixes up its fields).
 
 use super::{
-    Camera, Intensity, Light, Object, SceneDescription, Shape, Spot, Transform, check_light, stem,
+    Camera, Cone, Intensity, Light, LightKind, Object, SceneDescription, Shape, Transform, stem,
 };
 use crate::FileError;
 use crate::mesh::gltf::{document, walk_nodes};
@@ -48,7 +48,7 @@ pub(super) fn load(path: &Path) -> Result<SceneDescription, FileError> {
         if let Some(l) = light_index {
             let light = node_light(json, l, world)
                 .map_err(|why| invalid(format!("node {index}: light {l}: {why}")))?;
-            lights.extend(light);
+            lights.push(light);
         }
         Ok(())
     })
@@ -117,16 +117,18 @@ fn node_camera(json: &gltf::json::Root, index: usize, world: Mat4) -> Result<Cam
     Ok(camera)
 }
 
-/// A point or spot light (a spot shines down its node's -z), or `None` for a directional one.
-fn node_light(json: &gltf::json::Root, index: usize, world: Mat4) -> Result<Option<Light>, String> {
+/// A point, spot or directional light (spot and directional lights shine down their node's -z).
+fn node_light(json: &gltf::json::Root, index: usize, world: Mat4) -> Result<Light, String> {
     let light = json
         .extensions
         .as_ref()
         .and_then(|e| e.khr_lights_punctual.as_ref())
         .and_then(|l| l.lights.get(index))
         .ok_or("does not exist")?;
-    let spot = match (&light.type_, &light.spot) {
-        (Checked::Valid(Type::Point), _) => None,
+    let position = world.transform_point3(Vec3::ZERO);
+    let down_z = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+    let kind = match (&light.type_, &light.spot) {
+        (Checked::Valid(Type::Point), _) => LightKind::Point { position },
         (Checked::Valid(Type::Spot), Some(s)) => {
             let (inner, outer) = (s.inner_cone_angle, s.outer_cone_angle);
             if !(0.0 <= inner && inner < outer && outer <= std::f32::consts::FRAC_PI_2) {
@@ -134,25 +136,24 @@ fn node_light(json: &gltf::json::Root, index: usize, world: Mat4) -> Result<Opti
                     "cone angles {inner}, {outer} are not 0 <= inner < outer <= pi/2"
                 ));
             }
-            Some(Spot {
-                direction: world.transform_vector3(Vec3::NEG_Z).normalize_or_zero(),
-                cone_deg: outer.to_degrees(),
-                falloff_deg: (outer - inner).to_degrees(),
-            })
+            LightKind::Spot {
+                position,
+                cone: Cone {
+                    direction: down_z,
+                    cone_deg: outer.to_degrees(),
+                    falloff_deg: (outer - inner).to_degrees(),
+                },
+            }
         }
-        (Checked::Valid(Type::Directional), _) => {
-            tracing::warn!("glTF light {index} is directional: left out (point and spot only)");
-            return Ok(None);
-        }
+        (Checked::Valid(Type::Directional), _) => LightKind::Directional { direction: down_z },
         _ => return Err("has no valid type".into()),
     };
     let light = Light {
-        position: world.transform_point3(Vec3::ZERO),
-        intensity: Intensity::Candela(Vec3::from(light.color) * light.intensity),
-        spot,
+        kind,
+        intensity: Intensity::Photometric(Vec3::from(light.color) * light.intensity),
     };
-    check_light(&light)?;
-    Ok(Some(light))
+    light.validate()?;
+    Ok(light)
 }
 
 /// A mesh error as the scene's error (its message already starts with the file).

@@ -2,8 +2,8 @@
 //! [`scene`](super)).
 
 use super::{
-    Camera, Intensity, Light, Material, Object, SceneDescription, Shape, Spot, Transform,
-    check_light, stem,
+    Camera, Cone, Intensity, Light, LightKind, Material, Object, SceneDescription, Shape,
+    Transform, stem,
 };
 use crate::mesh::{FarCoordinate, load_model};
 use glam::Vec3;
@@ -53,9 +53,10 @@ fn up() -> Vec3 {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LightToml {
-    position: Vec3,
+    position: Option<Vec3>,
     intensity: Option<Vec3>,
     candela: Option<Vec3>,
+    lux: Option<Vec3>,
     direction: Option<Vec3>,
     cone_deg: Option<f32>,
     falloff_deg: Option<f32>,
@@ -150,37 +151,54 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<SceneDescription, String>
     })
 }
 
+/// A point light (a position), a spot (a position, `direction` and `cone_deg`) or a directional
+/// light (a `direction` alone).
 fn light(l: LightToml) -> Result<Light, String> {
-    let intensity = match (l.intensity, l.candela) {
-        (Some(v), None) => Intensity::Native(v),
-        (None, Some(cd)) => Intensity::Candela(cd),
-        _ => {
+    let name = match l.position {
+        Some(p) => format!("light at {p}"),
+        None => "light without a position".to_string(),
+    };
+    let kind = match (l.position, l.direction, l.cone_deg) {
+        (Some(position), None, None) if l.falloff_deg.is_none() => LightKind::Point { position },
+        (Some(position), Some(direction), Some(cone_deg)) => LightKind::Spot {
+            position,
+            cone: Cone {
+                direction,
+                cone_deg,
+                falloff_deg: l.falloff_deg.unwrap_or(0.0),
+            },
+        },
+        (None, Some(direction), None) if l.falloff_deg.is_none() => {
+            LightKind::Directional { direction }
+        }
+        (Some(_), ..) => {
             return Err(format!(
-                "light at {}: give one of `intensity` and `candela`",
-                l.position
+                "{name}: a spot light needs `direction` and `cone_deg`"
+            ));
+        }
+        (None, ..) => {
+            return Err(format!(
+                "{name}: give a `position` (a point or spot light) or a `direction` alone (a \
+                 directional light)"
             ));
         }
     };
-    let spot = match (l.direction, l.cone_deg) {
-        (Some(direction), Some(cone_deg)) => Some(Spot {
-            direction,
-            cone_deg,
-            falloff_deg: l.falloff_deg.unwrap_or(0.0),
-        }),
-        (None, None) if l.falloff_deg.is_none() => None,
+    let photometric_key = match kind {
+        LightKind::Directional { .. } => "lux",
+        _ => "candela",
+    };
+    let intensity = match (l.intensity, l.candela, l.lux) {
+        (Some(v), None, None) => Intensity::Native(v),
+        (None, Some(v), None) if photometric_key == "candela" => Intensity::Photometric(v),
+        (None, None, Some(v)) if photometric_key == "lux" => Intensity::Photometric(v),
         _ => {
             return Err(format!(
-                "light at {}: a spot light needs `direction` and `cone_deg`",
-                l.position
+                "{name}: give one of `intensity` and `{photometric_key}`"
             ));
         }
     };
-    let light = Light {
-        position: l.position,
-        intensity,
-        spot,
-    };
-    check_light(&light)?;
+    let light = Light { kind, intensity };
+    light.validate()?;
     Ok(light)
 }
 

@@ -77,7 +77,7 @@ pub(crate) fn shader_module(
     })
 }
 
-/// WGSL `Light`: the spot light.
+/// WGSL `Light`: one RSM view of a light.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct LightUniform {
@@ -85,6 +85,7 @@ pub(crate) struct LightUniform {
     pub position: [f32; 4],
     pub direction: [f32; 4],
     pub intensity: [f32; 4],
+    pub parallel: [f32; 4],
 }
 
 /// WGSL `Raster`: a raster pass's projection.
@@ -129,8 +130,9 @@ pub(crate) struct ShadeUniform {
     pub tile_share: f32,
 }
 
-/// WGSL `LightTerms`: the gather's per-light values (the kernel's clamp, the lengths that scale
-/// with the scene), written with the light.
+/// WGSL `LightTerms`: the gather's per-view values (the kernel's clamp, the lengths that scale
+/// with the scene, where the view's low-resolution samples start: the first view, at 0, writes
+/// the radiance the others add to), written with the light.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct LightTermsUniform {
@@ -138,6 +140,7 @@ pub(crate) struct LightTermsUniform {
     pub depth_bias: f32,
     pub plane_agreement: f32,
     pub shadow_thickness: f32,
+    pub low_offset: u32,
 }
 
 /// WGSL `Camera`: the gather's per-camera values (the G-buffer's view and size), written with

@@ -28,9 +28,9 @@ mod shader_tests;
 
 pub use contract::OutputTerm;
 pub(crate) use contract::prelude;
-pub use gather::Gather;
+pub use gather::{Gather, ViewMaps};
 pub use gbuffer::GBufferViews;
-pub use light::Spot;
+pub use light::{LightView, Projection};
 pub use output::OutputPass;
 pub use quadtree::LightQuadtree;
 pub use renderer::Renderer;

@@ -5,7 +5,8 @@ struct Raster {
     view_proj: mat4x4<f32>,
     // camera position for the G-buffer (normals are turned towards the viewer)
     eye: vec4<f32>,
-    // x: solid angle of an RSM texel on the axis (it shrinks as cos^3 off axis)
+    // x: an RSM texel's solid angle on the axis (it shrinks as cos^3 off the axis), or its area
+    // across parallel light
     texel: vec4<f32>,
 }
 

@@ -1,10 +1,11 @@
 //! quadray's own renderer of a [`Scene`]: its triangles in a vertex buffer, its G-buffer, and
-//! the public passes (RSM, light quadtree, gather) recorded in one encoder per frame, timed per
-//! pass. The CLI, the viewer and the benchmarks render through it.
+//! the public passes (an RSM and a light quadtree per light view, the gather summing them)
+//! recorded in one encoder per frame, timed per pass. The CLI, the viewer and the benchmarks
+//! render through it.
 
-use super::gather::Gather;
+use super::gather::{Gather, ViewMaps};
 use super::gbuffer::GBufferPass;
-use super::light::Spot;
+use super::light::LightView;
 use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
 use crate::IndirectError;
@@ -20,14 +21,20 @@ use wgpu::util::DeviceExt;
 /// One pass of a frame: which, and what it records into an encoder.
 type FrameStep<'a> = (Pass, Box<dyn Fn(&mut wgpu::CommandEncoder) + 'a>);
 
+/// One light view's passes: its RSM and the quadtree built from it.
+struct ViewPasses {
+    rsm: RsmPass,
+    quadtree: LightQuadtree,
+}
+
 /// Everything one scene needs on the GPU at one set of sizes.
 pub struct Renderer<'g> {
     gpu: &'g Gpu,
     settings: Settings,
     vertices: wgpu::Buffer,
     vertex_count: u32,
-    rsm: RsmPass,
-    quadtree: LightQuadtree,
+    /// One a light view of the scene's first [`Settings::max_lights`] lights.
+    views: Vec<ViewPasses>,
     gbuffer: GBufferPass,
     gather: Gather,
     /// A timer for all passes; `None` when the adapter has no timestamp queries.
@@ -35,19 +42,45 @@ pub struct Renderer<'g> {
 }
 
 impl<'g> Renderer<'g> {
-    /// Uploads `scene` and builds every pass for `settings`; refuses settings that make no
-    /// picture with [`IndirectError::Settings`].
+    /// Uploads `scene` and builds every pass for `settings` (an RSM and a quadtree for each
+    /// light view of the scene's first [`Settings::max_lights`] lights; a warning names the
+    /// lights left out); refuses settings that make no picture with [`IndirectError::Settings`].
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: Settings) -> Result<Self, IndirectError> {
         settings.validate().map_err(IndirectError::Settings)?;
         let needs = Gather::limit_needs(&settings);
         quadray_gpu::check_limits(&gpu.device.limits(), &gpu.describe(), &needs)?;
+        let left_out = scene
+            .lights
+            .len()
+            .saturating_sub(settings.max_lights as usize);
+        if left_out > 0 {
+            tracing::warn!(
+                "scene {}: {left_out} of its {} lights left out (--max-lights {})",
+                scene.name,
+                scene.lights.len(),
+                settings.max_lights
+            );
+        }
+        let view_count = LightView::of_scene(scene, settings.max_lights).len();
         let (d, q) = (&gpu.device, &gpu.queue);
         let renderer = gpu.checked(|| {
-            let rsm = RsmPass::new(d, settings.rsm_size);
-            let quadtree =
-                LightQuadtree::new(d, q, settings.rsm_size, settings.cluster, rsm.views());
+            let views: Vec<ViewPasses> = (0..view_count)
+                .map(|_| {
+                    let rsm = RsmPass::new(d, settings.rsm_size);
+                    let quadtree =
+                        LightQuadtree::new(d, q, settings.rsm_size, settings.cluster, rsm.views());
+                    ViewPasses { rsm, quadtree }
+                })
+                .collect();
             let gbuffer = GBufferPass::new(d, (settings.size.width, settings.size.height));
-            let gather = Gather::new(d, &settings, &quadtree, rsm.views(), gbuffer.views())?;
+            let maps: Vec<ViewMaps> = views
+                .iter()
+                .map(|v| ViewMaps {
+                    rsm: v.rsm.views(),
+                    quadtree: &v.quadtree,
+                })
+                .collect();
+            let gather = Gather::new(d, &settings, &maps, gbuffer.views())?;
             let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("vertices"),
                 contents: bytemuck::cast_slice(&scene.triangles),
@@ -58,14 +91,13 @@ impl<'g> Renderer<'g> {
                 settings: settings.clone(),
                 vertices,
                 vertex_count: (scene.triangles.len() * 3) as u32,
-                rsm,
-                quadtree,
+                views,
                 gbuffer,
                 gather,
                 timer: GpuTimer::new(gpu, Pass::ALL.len() as u32),
             })
         })??;
-        renderer.set_view(scene);
+        renderer.set_view(scene)?;
         Ok(renderer)
     }
 
@@ -74,18 +106,29 @@ impl<'g> Renderer<'g> {
         &self.settings
     }
 
-    /// Moves the camera and the light to the scene's (its geometry must be the one the renderer
-    /// was made with); the next frame must `rebuild` if the light moved.
-    pub fn set_view(&self, scene: &Scene) {
+    /// Moves the camera and the lights to the scene's (its geometry must be the one the renderer
+    /// was made with, its lights as many views: a light may move or turn, not change its kind);
+    /// the next frame must `rebuild` if a light moved.
+    pub fn set_view(&self, scene: &Scene) -> Result<(), IndirectError> {
         let q = &self.gpu.queue;
-        let spot = Spot::of_scene(scene);
-        self.rsm.set_light(q, &spot);
-        self.gather.set_light(q, &spot, scene.r_min);
+        let lights = LightView::of_scene(scene, self.settings.max_lights);
+        if lights.len() != self.views.len() {
+            return Err(IndirectError::Settings(format!(
+                "the scene's lights make {} light views, the renderer was made for {}",
+                lights.len(),
+                self.views.len()
+            )));
+        }
+        for (view, light) in self.views.iter().zip(&lights) {
+            view.rsm.set_light(q, light);
+        }
+        self.gather.set_lights(q, &lights, scene.r_min);
         let s = self.settings();
         let view_proj = scene.camera_view_proj(s.size.width as f32 / s.size.height as f32);
         let eye = scene.camera.position;
         self.gbuffer.set_camera(q, view_proj, eye);
         self.gather.set_camera(q, view_proj, eye);
+        Ok(())
     }
 
     /// Changes the quadtree's parameters; the next frame with `rebuild` uses them.
@@ -95,7 +138,9 @@ impl<'g> Renderer<'g> {
             ..self.settings().clone()
         };
         settings.validate().map_err(IndirectError::Settings)?;
-        self.quadtree.set_cluster(&self.gpu.queue, cluster);
+        for view in &mut self.views {
+            view.quadtree.set_cluster(&self.gpu.queue, cluster);
+        }
         self.gather.reset_history();
         self.settings = settings;
         Ok(())
@@ -181,16 +226,21 @@ impl<'g> Renderer<'g> {
     ) -> Vec<FrameStep<'a>> {
         let slot = move |pass: Pass| timer.map(|t| (t, pass as u32));
         let mut steps: Vec<FrameStep<'a>> = Vec::new();
+        // a pass over the light views is timed on the first (the timer has a slot a pass)
+        let first_timed =
+            |view: usize, slot: Option<(&'a GpuTimer, u32)>| slot.filter(|_| view == 0);
         if run.contains(&Pass::Rsm) {
             steps.push((
                 Pass::Rsm,
                 Box::new(move |encoder| {
-                    self.rsm.record(
-                        encoder,
-                        self.vertices.slice(..),
-                        self.vertex_count,
-                        slot(Pass::Rsm),
-                    )
+                    for (i, view) in self.views.iter().enumerate() {
+                        view.rsm.record(
+                            encoder,
+                            self.vertices.slice(..),
+                            self.vertex_count,
+                            first_timed(i, slot(Pass::Rsm)),
+                        )
+                    }
                 }),
             ));
         }
@@ -198,15 +248,24 @@ impl<'g> Renderer<'g> {
             steps.push((
                 Pass::Pyramid,
                 Box::new(move |encoder| {
-                    let slots = timer.map(|t| (t, Pass::Pyramid as u32, Pass::Validity as u32));
-                    self.quadtree.record_build(encoder, slots)
+                    for (i, view) in self.views.iter().enumerate() {
+                        let slots = timer
+                            .filter(|_| i == 0)
+                            .map(|t| (t, Pass::Pyramid as u32, Pass::Validity as u32));
+                        view.quadtree.record_build(encoder, slots)
+                    }
                 }),
             ));
         }
         if run.contains(&Pass::Cut) {
             steps.push((
                 Pass::Cut,
-                Box::new(move |encoder| self.quadtree.record_cut(encoder, slot(Pass::Cut))),
+                Box::new(move |encoder| {
+                    for (i, view) in self.views.iter().enumerate() {
+                        view.quadtree
+                            .record_cut(encoder, first_timed(i, slot(Pass::Cut)))
+                    }
+                }),
             ));
         }
         if run.contains(&Pass::GBuffer) {
@@ -228,7 +287,7 @@ impl<'g> Renderer<'g> {
                 Box::new(move |encoder| {
                     let slots = timer.map(|t| (t, Pass::Indirect as u32, Pass::Upsample as u32));
                     self.gather
-                        .record_indirect(encoder, method, &self.quadtree, slots)
+                        .record_indirect(encoder, method, &self.quadtrees(), slots)
                 }),
             ));
         }
@@ -239,6 +298,23 @@ impl<'g> Renderer<'g> {
             ));
         }
         steps
+    }
+
+    /// The first light view's passes (the only one of a spot or a directional light): what the
+    /// read-backs of one RSM, quadtree or cut show.
+    fn first_view(&self) -> &ViewPasses {
+        &self.views[0]
+    }
+
+    /// Every light view's quadtree, in order.
+    fn quadtrees(&self) -> Vec<&LightQuadtree> {
+        self.views.iter().map(|v| &v.quadtree).collect()
+    }
+
+    /// How many light views the frames sum (a spot or a directional light one, a point light
+    /// six).
+    pub fn view_count(&self) -> usize {
+        self.views.len()
     }
 
     /// Rebuilds the RSM, the quadtree and the compacted cut without shading anything: the cut
@@ -364,16 +440,18 @@ impl<'g> Renderer<'g> {
         })
     }
 
-    /// Number of clusters in the compacted cut (after a `Quadtree` frame with rebuild).
+    /// Number of clusters in the first light view's compacted cut (after a `Quadtree` frame with
+    /// rebuild).
     pub fn clusters_in_cut(&self) -> Result<u32, IndirectError> {
-        let bytes = quadray_gpu::read_buffer(self.gpu, self.quadtree.cut_count())?;
+        let bytes = quadray_gpu::read_buffer(self.gpu, self.first_view().quadtree.cut_count())?;
         Ok(bytemuck::pod_read_unaligned(&bytes[..4]))
     }
 
-    /// The clusters of the compacted cut (after a `Quadtree` frame with rebuild), in no order.
+    /// The clusters of the first light view's compacted cut (after a `Quadtree` frame with
+    /// rebuild), in no order.
     pub fn read_cut(&self) -> Result<Vec<CutNode>, IndirectError> {
         let count = self.clusters_in_cut()? as usize;
-        let clusters = self.read_vec4(self.quadtree.cut())?;
+        let clusters = self.read_vec4(self.first_view().quadtree.cut())?;
         // three vec4 a cluster; the normal's w holds the node's index
         Ok(clusters
             .chunks_exact(3)
@@ -382,9 +460,9 @@ impl<'g> Renderer<'g> {
             .collect())
     }
 
-    /// The per-tile cuts of the last [`Method::QuadtreeTiles`] frame: each tile's clusters (tiles
-    /// of 8x8 pixels, row-major; empty where the tile sees no geometry), in no order; no tiles
-    /// before the first such frame.
+    /// The per-tile cuts of the last [`Method::QuadtreeTiles`] frame's last light view: each
+    /// tile's clusters (tiles of 8x8 pixels, row-major; empty where the tile sees no geometry),
+    /// in no order; no tiles before the first such frame.
     pub fn read_tile_cuts(&self) -> Result<Vec<Vec<CutNode>>, IndirectError> {
         let s = self.settings();
         let capacity = s.tile_capacity_or_default() as usize;
@@ -456,24 +534,24 @@ impl<'g> Renderer<'g> {
         Ok(Some((sizes, bytemuck::pod_collect_to_vec(&read(cuts)?))))
     }
 
-    /// The RSM's flux per texel, row-major (what the cut clusters).
+    /// The first light view's RSM flux per texel, row-major (what its cut clusters).
     pub fn read_rsm_flux(&self) -> Result<Vec<[f32; 3]>, IndirectError> {
-        let flux = self.read_texture(&self.rsm.textures()[0])?;
+        let flux = self.read_texture(&self.first_view().rsm.textures()[0])?;
         Ok(flux.into_iter().map(xyz).collect())
     }
 
-    /// The quadtree as built: per node (flux rgb + texel count, position + depth, normal +
+    /// The first light view's quadtree as built: per node (flux rgb + texel count, position + depth, normal +
     /// validity), finest level first.
     pub fn read_nodes(&self) -> Result<Vec<[[f32; 4]; 3]>, IndirectError> {
-        let flat = self.read_vec4(self.quadtree.nodes())?;
+        let flat = self.read_vec4(self.first_view().quadtree.nodes())?;
         Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
     }
 
-    /// What bounds each node's contribution, as built: the box of its VPLs' positions (lo,
+    /// What bounds each node of the first light view's quadtree, as built: the box of its VPLs' positions (lo,
     /// hi; empty nodes hold lo > hi) with the cosine of its normal cone's half-angle in lo's w
     /// (the cone's axis is the node's mean normal), finest level first.
     pub fn read_node_bounds(&self) -> Result<Vec<[[f32; 4]; 2]>, IndirectError> {
-        let flat = self.read_vec4(self.quadtree.bounds())?;
+        let flat = self.read_vec4(self.first_view().quadtree.bounds())?;
         Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
     }
 
@@ -494,19 +572,25 @@ impl<'g> Renderer<'g> {
             .collect())
     }
 
-    /// The RSM's VPLs (texels that see geometry), for the CPU reference.
+    /// Every light view's VPLs (texels that see geometry), view after view, for the CPU
+    /// reference: the light the frames sum.
     pub fn read_vpls(&self) -> Result<Vec<Vpl>, IndirectError> {
-        let [flux, pos, normal] = self.rsm.textures();
-        let texels = self.read_covered([flux, pos, normal], 2)?;
-        Ok(texels
-            .into_iter()
-            .flatten()
-            .map(|[flux, position, normal]| Vpl {
-                flux,
-                position,
-                normal,
-            })
-            .collect())
+        let mut vpls = Vec::new();
+        for view in &self.views {
+            let [flux, pos, normal] = view.rsm.textures();
+            let texels = self.read_covered([flux, pos, normal], 2)?;
+            vpls.extend(
+                texels
+                    .into_iter()
+                    .flatten()
+                    .map(|[flux, position, normal]| Vpl {
+                        flux,
+                        position,
+                        normal,
+                    }),
+            );
+        }
+        Ok(vpls)
     }
 
     /// The G-buffer, for the CPU reference.

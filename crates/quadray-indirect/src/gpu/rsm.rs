@@ -1,4 +1,4 @@
-//! The RSM pass: the caller's triangles rasterised from the spot light into a reflective shadow
+//! The RSM pass: the caller's triangles rasterised from one light view into a reflective shadow
 //! map (flux, position + depth, normal), the input of the light quadtree. Also the raster
 //! helpers quadray's own G-buffer pass shares.
 
@@ -6,7 +6,7 @@ use super::contract::{
     LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
     uniform_buffer, uniform_entry, whole,
 };
-use super::light::Spot;
+use super::light::LightView;
 use crate::scene::Vertex;
 use crate::wgsl;
 use quadray_gpu::{GpuTimer, cleared_attachment, nearest_depth, texture_2d};
@@ -27,9 +27,10 @@ pub(crate) const SOURCES: [&str; 3] = [wgsl::LIGHT, RASTER_WGSL, include_str!("r
 /// [`FLOAT_FORMAT`]). An empty texel has `normal.w = 0`.
 #[derive(Clone, Copy)]
 pub struct RsmViews<'a> {
-    /// rgb: flux the texel's surface reflects (W), `I(w) * solid angle * albedo`; w unused.
+    /// rgb: flux the texel's surface reflects (W), `I(w) * solid angle * albedo` (parallel
+    /// light: `E * area * albedo`); w unused.
     pub flux: &'a wgpu::TextureView,
-    /// xyz: world position; w: depth along the light's axis in units of [`Spot::extent`].
+    /// xyz: world position; w: depth along the light's axis in units of [`LightView::extent`].
     pub position: &'a wgpu::TextureView,
     /// xyz: unit normal facing the light; w: 1 where the light sees geometry, else 0.
     pub normal: &'a wgpu::TextureView,
@@ -145,7 +146,7 @@ pub(crate) fn record_raster(
     pass.draw(0..vertex_count, 0..1);
 }
 
-/// Renders the RSM of a spot light into textures it owns ([`RsmPass::views`]). Its three
+/// Renders the RSM of one light view into textures it owns ([`RsmPass::views`]). Its three
 /// Rgba32Float targets take 48 bytes a sample: open the device with the adapter's limits
 /// (`max_color_attachment_bytes_per_sample` is 32 by default).
 pub struct RsmPass {
@@ -192,18 +193,17 @@ impl RsmPass {
         }
     }
 
-    /// Sets the light the next recordings render from (per light update).
-    pub fn set_light(&self, queue: &wgpu::Queue, spot: &Spot) {
-        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&spot.uniform()));
-        let texel_side = spot.texel_side(self.rsm_size);
-        let p = spot.position;
+    /// Sets the light view the next recordings render from (per light update).
+    pub fn set_light(&self, queue: &wgpu::Queue, view: &LightView) {
+        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&view.uniform()));
+        let p = view.position;
         queue.write_buffer(
             &self.raster,
             0,
             bytemuck::bytes_of(&RasterUniform {
-                view_proj: spot.view_proj.to_cols_array_2d(),
+                view_proj: view.view_proj.to_cols_array_2d(),
                 eye: [p.x, p.y, p.z, 1.0],
-                texel: [texel_side * texel_side, 0.0, 0.0, 0.0],
+                texel: [view.texel_measure(self.rsm_size), 0.0, 0.0, 0.0],
             }),
         );
     }

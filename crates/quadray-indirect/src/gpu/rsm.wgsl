@@ -1,4 +1,4 @@
-// The reflective shadow map from the spot light: flux, position + depth, normal. Cleared texels
+// The reflective shadow map of one light view: flux, position + depth, normal. Cleared texels
 // read as empty (normal.w = 0).
 
 @group(0) @binding(1) var<uniform> light: Light;
@@ -9,16 +9,22 @@ struct RsmOut {
     @location(2) normal: vec4<f32>,
 }
 
-// Each texel is a VPL: flux = I(w) * solid angle * albedo.
+// Each texel is a VPL: flux = irradiance facing the light * the texel's area across the light
+// * albedo; from a point that area is the texel's solid angle (raster.texel.x on the axis,
+// shrinking as cos^3 off it) times d^2, so flux = I(w) * solid angle * albedo.
 @fragment
 fn rsm(v: VertexOut) -> RsmOut {
-    let to_point = v.world - light.position.xyz;
-    let w = normalize(to_point);
-    let cos_axis = dot(w, light.direction.xyz);
-    let solid_angle = raster.texel.x * cos_axis * cos_axis * cos_axis;
+    let w = light_towards(light, v.world);
+    var measure = raster.texel.x;
+    var flux = light.intensity.rgb;
+    if (!is_parallel(light)) {
+        let cos_axis = dot(w, light.direction.xyz);
+        measure *= cos_axis * cos_axis * cos_axis;
+        flux = spot_intensity(light, w);
+    }
     var out: RsmOut;
-    out.flux = vec4<f32>(spot_intensity(light, w) * solid_angle * v.albedo, 1.0);
+    out.flux = vec4<f32>(flux * measure * v.albedo, 1.0);
     out.pos = vec4<f32>(v.world, light_depth(light, v.world));
-    out.normal = vec4<f32>(facing(v.normal, -to_point), 1.0);
+    out.normal = vec4<f32>(facing(v.normal, -w), 1.0);
     return out;
 }

@@ -28,7 +28,7 @@ fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
         shared!(
             "Light",
             LightUniform,
-            [view_proj, position, direction, intensity]
+            [view_proj, position, direction, intensity, parallel]
         ),
         shared!("Raster", RasterUniform, [view_proj, eye, texel]),
         shared!(
@@ -67,7 +67,13 @@ fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
         shared!(
             "LightTerms",
             LightTermsUniform,
-            [r_min, depth_bias, plane_agreement, shadow_thickness]
+            [
+                r_min,
+                depth_bias,
+                plane_agreement,
+                shadow_thickness,
+                low_offset
+            ]
         ),
         shared!("Camera", CameraUniform, [view_proj, eye, width, height]),
         shared!("Level", LevelSlot, [level]),

@@ -1,23 +1,47 @@
-// The spot light: its uniform's layout, its intensity by direction and the RSM's depth.
-// Engine-neutral: no bindings, no accessors.
+// One RSM view of a light (a spot, a point light's cube face, the sun): its uniform's layout,
+// its light towards a point and the RSM's depth. Engine-neutral: no bindings, no accessors.
 
 struct Light {
     view_proj: mat4x4<f32>,
-    // xyz: position, w: 1 / scene extent (RSM depth unit)
+    // xyz: position (the sun: the middle of the map's near plane), w: 1 / scene extent (RSM
+    // depth unit)
     position: vec4<f32>,
-    // xyz: unit axis, w: cos(cone)
+    // xyz: unit axis, w: cos(cone) (-1: no cone)
     direction: vec4<f32>,
-    // rgb: intensity on the axis, w: cos(cone - falloff)
+    // rgb: intensity (a spot's on its axis; the sun: irradiance facing it), w: cos(cone - falloff)
     intensity: vec4<f32>,
+    // x: 1 for parallel light (the sun, an orthographic map), 0 from a point
+    parallel: vec4<f32>,
 }
 
-// Radiant intensity towards unit direction w from the light.
+fn is_parallel(light: Light) -> bool {
+    return light.parallel.x > 0.5;
+}
+
+// Radiant intensity towards unit direction w from the light (a point or spot light).
 fn spot_intensity(light: Light, w: vec3<f32>) -> vec3<f32> {
     let c = dot(w, light.direction.xyz);
     let outer = light.direction.w;
     let inner = light.intensity.w;
     let edge = select(select(0.0, 1.0, c >= outer), smoothstep(outer, inner, c), inner > outer);
     return light.intensity.rgb * edge;
+}
+
+// Unit direction the light travels in to reach x.
+fn light_towards(light: Light, x: vec3<f32>) -> vec3<f32> {
+    if (is_parallel(light)) {
+        return light.direction.xyz;
+    }
+    return normalize(x - light.position.xyz);
+}
+
+// Irradiance at x on a surface facing the light (W/m^2 per channel): I(w) / d^2, or the sun's.
+fn light_irradiance(light: Light, x: vec3<f32>) -> vec3<f32> {
+    if (is_parallel(light)) {
+        return light.intensity.rgb;
+    }
+    let to_point = x - light.position.xyz;
+    return spot_intensity(light, normalize(to_point)) / max(dot(to_point, to_point), 1e-30);
 }
 
 // Depth as the RSM stores it: distance along the light axis in units of the scene extent.

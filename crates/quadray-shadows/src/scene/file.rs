@@ -112,18 +112,29 @@ impl Scene {
                 (lo.min(v), hi.max(v))
             });
         let centre = (lo + hi) * 0.5;
+        // The ray tracer's lights are points: a spot shines from its apex in every direction,
+        // and a directional light has no point to shadow-test against.
         s.lights = d
             .lights
             .iter()
-            .map(|l| Light {
-                position: l.position,
-                intensity: match l.intensity {
-                    Intensity::Native(v) => v,
-                    Intensity::Candela(cd) => {
-                        let d2 = l.position.distance_squared(centre).max(1e-12);
-                        cd / (LUMENS_PER_WATT * std::f32::consts::PI * d2)
-                    }
-                },
+            .filter_map(|l| {
+                let Some(position) = l.position() else {
+                    tracing::warn!(
+                        "{}: left out (the ray tracer's lights are points)",
+                        l.describe()
+                    );
+                    return None;
+                };
+                Some(Light {
+                    position,
+                    intensity: match l.intensity {
+                        Intensity::Native(v) => v,
+                        Intensity::Photometric(cd) => {
+                            let d2 = position.distance_squared(centre).max(1e-12);
+                            cd / (LUMENS_PER_WATT * std::f32::consts::PI * d2)
+                        }
+                    },
+                })
             })
             .collect();
         Ok(s)

@@ -1,9 +1,10 @@
 //! The gather: deferred shading of the caller's G-buffer from the light quadtree (the compacted
 //! cut, the paper's one pass per level, per-tile cuts; the cut and RSM sampling optionally at low
 //! resolution with geometry-aware upsampling), the baselines of the same shape (RSM sampling,
-//! the brute force over every VPL), the temporal filter, and the direct light of the spot with the
-//! RSM depth as shadow map. Writes radiance buffers an [`super::OutputPass`] copies into the
-//! caller's texture.
+//! the brute force over every VPL), the temporal filter, and the direct light, each light view's
+//! RSM depth its shadow map. Every pass sums the light views (a spot or the sun one, a point light
+//! six): the first view writes the radiance, the others add. Writes radiance buffers an
+//! [`super::OutputPass`] copies into the caller's texture.
 //!
 //! One file a pass, each owning its shader, pipelines and recording, over the resources every
 //! pass shares (`resources.rs`); [`Gather`] only picks and orders them.
@@ -21,9 +22,8 @@ mod upsample;
 use super::contract::GpuNode;
 use super::contract::compute_pass;
 use super::gbuffer::GBufferViews;
-use super::light::Spot;
+use super::light::LightView;
 use super::quadtree::{LightQuadtree, node_count};
-use super::rsm::RsmViews;
 use crate::IndirectError;
 use crate::settings::{Method, Settings};
 use brute_force::BruteForce;
@@ -32,6 +32,7 @@ use direct::Direct;
 use passes::Passes;
 use quadray_gpu::{GpuTimer, Limit, LimitNeed};
 use resources::Resources;
+pub use resources::ViewMaps;
 use rsm_sampling::RsmSampling;
 use temporal::Temporal;
 use tiles::Tiles;
@@ -113,18 +114,23 @@ impl Gather {
         ]
     }
 
-    /// The gather of `settings` (sizes, samples, subsampling) reading `quadtree`, the RSM it was
-    /// built from and the caller's G-buffer (`settings.size`).
+    /// The gather of `settings` (sizes, samples, subsampling) summing the light views whose
+    /// `maps` (each an RSM and the quadtree built from it) it reads, on the caller's G-buffer
+    /// (`settings.size`).
     pub fn new(
         device: &wgpu::Device,
         settings: &Settings,
-        quadtree: &LightQuadtree,
-        rsm: RsmViews,
+        maps: &[ViewMaps],
         gbuffer: GBufferViews,
     ) -> Result<Self, IndirectError> {
         settings.validate().map_err(IndirectError::Settings)?;
+        if maps.is_empty() {
+            return Err(IndirectError::Settings(
+                "a gather needs a light view".into(),
+            ));
+        }
         quadray_gpu::check_limits(&device.limits(), "the device", &Self::limit_needs(settings))?;
-        let res = Resources::new(device, settings, quadtree, rsm, gbuffer);
+        let res = Resources::new(device, settings, maps, gbuffer);
         Ok(Self {
             cut: Cut::new(device, &res),
             passes: Passes::new(device, &res),
@@ -137,10 +143,19 @@ impl Gather {
         })
     }
 
-    /// Reads another quadtree or RSM from now on (when the caller's RSM textures change).
-    pub fn bind_rsm(&mut self, device: &wgpu::Device, quadtree: &LightQuadtree, rsm: RsmViews) {
+    /// Reads other quadtrees or RSMs from now on (when the caller's RSM textures change), one
+    /// a light view as at [`Gather::new`].
+    ///
+    /// # Panics
+    /// With another number of views than the gather was made for.
+    pub fn bind_maps(&mut self, device: &wgpu::Device, maps: &[ViewMaps]) {
         self.reset_history();
-        self.res.bind_rsm(device, quadtree, rsm);
+        self.res.bind_maps(device, maps);
+    }
+
+    /// How many light views the gather sums.
+    pub fn view_count(&self) -> usize {
+        self.res.view_count()
     }
 
     /// Shades another G-buffer of the same size from now on (when the caller's targets change).
@@ -149,10 +164,13 @@ impl Gather {
         self.res.bind_gbuffer(device, gbuffer);
     }
 
-    /// Sets the light (per light update) and the clamp `r_min` of the VPL kernel's 1/r^4
-    /// (world units).
-    pub fn set_light(&self, queue: &wgpu::Queue, spot: &Spot, r_min: f32) {
-        self.res.set_light(queue, spot, r_min);
+    /// Sets the light views (per light update), in the order of the maps, and the clamp `r_min`
+    /// of the VPL kernel's 1/r^4 (world units).
+    ///
+    /// # Panics
+    /// With another number of views than the gather was made for.
+    pub fn set_lights(&self, queue: &wgpu::Queue, lights: &[LightView], r_min: f32) {
+        self.res.set_lights(queue, lights, r_min);
     }
 
     /// Sets the camera the G-buffer is rendered from (`view_proj`: world -> clip, `eye`: its
@@ -168,26 +186,39 @@ impl Gather {
         self.temporal.reset();
     }
 
-    /// Records the indirect light of `method` (after `quadtree`'s build, and its cut for
-    /// [`Method::Quadtree`]) into `timer`'s `indirect` and `upsample` slots; with a temporal
-    /// weight below 1 (not for the brute force) the frame is then averaged with the last ones,
-    /// in the last of those slots.
+    /// Records the indirect light of `method`, summed over the light views (after each view's
+    /// `quadtrees` build, and its cut for [`Method::Quadtree`]; one a view, in the order of the
+    /// maps) into `timer`'s `indirect` and `upsample` slots; with a temporal weight below 1 (not
+    /// for the brute force) the frame is then averaged with the last ones, in the last of those
+    /// slots.
+    ///
+    /// # Panics
+    /// With another number of quadtrees than the gather has views.
     pub fn record_indirect(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         method: Method,
-        quadtree: &LightQuadtree,
+        quadtrees: &[&LightQuadtree],
         timer: Option<(&GpuTimer, u32, u32)>,
     ) {
         let res = &self.res;
+        assert_eq!(
+            quadtrees.len(),
+            res.view_count(),
+            "one quadtree a light view"
+        );
         let s = res.settings();
         // the sub-sampled methods: their passes, and the slices of their sum
         let upsampled = match method {
-            Method::Quadtree => Some((&self.cut.upsampled, Cut::slices(quadtree))),
-            Method::Rsm => Some((&self.rsm_sampling.upsampled, RsmSampling::slices(res))),
+            Method::Quadtree => Some(&self.cut.upsampled),
+            Method::Rsm => Some(&self.rsm_sampling.upsampled),
             _ => None,
         }
         .filter(|_| method.subsamples() && s.subsample > 1);
+        let slices = |quadtree| match method {
+            Method::Quadtree => Cut::slices(quadtree),
+            _ => RsmSampling::slices(res),
+        };
         let filtered = s.temporal_weight < 1.0 && method != Method::Reference;
         if filtered {
             self.temporal.record_prepare(encoder, res, method);
@@ -199,24 +230,28 @@ impl Gather {
         {
             let stamps = timer.and_then(|(t, slot, _)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "indirect", stamps);
-            res.bind_groups(&mut pass);
-            match (method, upsampled) {
-                (_, Some((upsampled, slices))) => upsampled.record_low(&mut pass, res, slices),
-                (Method::Quadtree, None) => self.cut.record(&mut pass, res, quadtree),
-                (Method::QuadtreeTiles, None) => self.tiles.record(&mut pass, res),
-                (Method::QuadtreePasses, None) => self.passes.record(&mut pass, res, quadtree),
-                (Method::Rsm, None) => self.rsm_sampling.record(&mut pass, res),
-                (Method::Reference, None) => self.brute_force.record(&mut pass, res),
+            for (view, &quadtree) in quadtrees.iter().enumerate() {
+                res.bind_groups(&mut pass, view);
+                match (method, upsampled) {
+                    (_, Some(upsampled)) => upsampled.record_low(&mut pass, res, slices(quadtree)),
+                    (Method::Quadtree, None) => self.cut.record(&mut pass, res, quadtree),
+                    (Method::QuadtreeTiles, None) => self.tiles.record(&mut pass, res),
+                    (Method::QuadtreePasses, None) => self.passes.record(&mut pass, res, quadtree),
+                    (Method::Rsm, None) => self.rsm_sampling.record(&mut pass, res),
+                    (Method::Reference, None) => self.brute_force.record(&mut pass, res),
+                }
             }
             if filtered && upsampled.is_none() {
                 self.temporal.record_blend(&mut pass, res);
             }
         }
-        if let Some((upsampled, slices)) = upsampled {
+        if let Some(upsampled) = upsampled {
             let stamps = timer.and_then(|(t, _, slot)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "upsample", stamps);
-            res.bind_groups(&mut pass);
-            upsampled.record_upsample(&mut pass, res, slices);
+            for (view, &quadtree) in quadtrees.iter().enumerate() {
+                res.bind_groups(&mut pass, view);
+                upsampled.record_upsample(&mut pass, res, slices(quadtree));
+            }
             if filtered {
                 self.temporal.record_blend(&mut pass, res);
             }
@@ -226,7 +261,8 @@ impl Gather {
         }
     }
 
-    /// Records the direct light of the spot, shadowed by the RSM depth, into `timer`'s `slot`.
+    /// Records the direct light of every light view, shadowed by its RSM depth, into `timer`'s
+    /// `slot`.
     pub fn record_direct(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -234,8 +270,10 @@ impl Gather {
     ) {
         let stamps = timer.and_then(|(t, slot)| t.compute_pass(slot));
         let mut pass = compute_pass(encoder, "direct", stamps);
-        self.res.bind_groups(&mut pass);
-        self.direct.record(&mut pass, &self.res);
+        for view in 0..self.res.view_count() {
+            self.res.bind_groups(&mut pass, view);
+            self.direct.record(&mut pass, &self.res);
+        }
     }
 
     /// The settings the gather was built with.

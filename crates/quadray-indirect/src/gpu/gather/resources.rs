@@ -1,5 +1,6 @@
 //! What every gather pass shares: the bind groups, by how often they change (group 0 per light
-//! update: the quadtree's settings, the light, the RSM, the quadtree and cut; group 1 per frame:
+//! view, set anew on each light update: the quadtree's settings, the light, the RSM, the quadtree
+//! and cut; group 1 per frame:
 //! the settings, the camera, the G-buffer and the outputs; group 2 per dispatch: a level and a
 //! slice), the buffers behind them, and how a pass makes its shader and pipelines against them.
 //! A pass that needs more binds its own groups from 3 on.
@@ -12,7 +13,7 @@ use crate::gpu::contract::{
     uniform_buffer, uniform_entry, whole,
 };
 use crate::gpu::gbuffer::{GBufferViews, camera_uniform};
-use crate::gpu::light::Spot;
+use crate::gpu::light::LightView;
 use crate::gpu::quadtree::LightQuadtree;
 use crate::gpu::rsm::RsmViews;
 use crate::settings::{Settings, TileCriterion};
@@ -75,7 +76,8 @@ pub(crate) struct Outputs {
 }
 
 impl Outputs {
-    fn new(device: &wgpu::Device, s: &Settings) -> Self {
+    /// The outputs of a picture of `s` lit through `views` light views.
+    fn new(device: &wgpu::Device, s: &Settings, views: usize) -> Self {
         let pixels = u64::from(s.size.width) * u64::from(s.size.height);
         let (lw, lh) = s.low_size();
         let samples = baselines::rsm_samples(
@@ -105,7 +107,12 @@ impl Outputs {
             }),
             indirect: storage_buffer(device, "indirect", pixels * 16),
             direct: storage_buffer(device, "direct", pixels * 16),
-            low: storage_buffer(device, "low-resolution indirect", u64::from(lw * lh) * 16),
+            // each view's own samples: the upsampling of one reads them after every view's
+            low: storage_buffer(
+                device,
+                "low-resolution indirect",
+                u64::from(lw * lh) * 16 * views as u64,
+            ),
             samples: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("rsm samples"),
                 contents: bytemuck::cast_slice(&samples),
@@ -151,30 +158,60 @@ impl Outputs {
     }
 }
 
+/// One light view's maps as the gather reads them: its RSM and the light quadtree built from it.
+#[derive(Clone, Copy)]
+pub struct ViewMaps<'a> {
+    /// The view's RSM.
+    pub rsm: RsmViews<'a>,
+    /// The quadtree built from it.
+    pub quadtree: &'a LightQuadtree,
+}
+
+/// One light view's group 0: the light, the gather's terms of it, and its bind group.
+struct ViewGroup {
+    light: wgpu::Buffer,
+    terms: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
+impl ViewGroup {
+    fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, maps: ViewMaps) -> Self {
+        let light = uniform_buffer::<LightUniform>(device, "gather light");
+        // storage, not uniform: see shared.wgsl
+        let terms = storage_buffer(
+            device,
+            "gather light terms",
+            size_of::<LightTermsUniform>() as u64,
+        );
+        Self {
+            group: light_group(device, layout, [&light, &terms], maps),
+            light,
+            terms,
+        }
+    }
+}
+
 /// The shared groups' layouts, buffers and bind groups, at one set of sizes.
 pub(crate) struct Resources {
     settings: Settings,
     light_layout: wgpu::BindGroupLayout,
     frame_layout: wgpu::BindGroupLayout,
     dispatch_layout: wgpu::BindGroupLayout,
-    /// Per light update: the light, and the gather's terms of it.
-    light: wgpu::Buffer,
-    light_terms: wgpu::Buffer,
+    /// Per light view: the light, the gather's terms of it, the maps.
+    views: Vec<ViewGroup>,
     pub outputs: Outputs,
     slots: Slots,
-    light_group: wgpu::BindGroup,
     frame_group: wgpu::BindGroup,
     dispatch_group: wgpu::BindGroup,
 }
 
 impl Resources {
-    /// The shared resources of a gather of `settings` (checked) reading `quadtree`, the RSM it
-    /// was built from and the caller's G-buffer.
+    /// The shared resources of a gather of `settings` (checked) reading the light views' `maps`
+    /// and the caller's G-buffer.
     pub fn new(
         device: &wgpu::Device,
         settings: &Settings,
-        quadtree: &LightQuadtree,
-        rsm: RsmViews,
+        maps: &[ViewMaps],
         gbuffer: GBufferViews,
     ) -> Self {
         let s = settings;
@@ -227,23 +264,17 @@ impl Resources {
             &dispatch_layout,
             vec![slots.binding(), slots.binding()],
         );
-        let light = uniform_buffer::<LightUniform>(device, "gather light");
-        // storage, not uniform: see shared.wgsl
-        let light_terms = storage_buffer(
-            device,
-            "gather light terms",
-            size_of::<LightTermsUniform>() as u64,
-        );
-        let light_group = light_group(device, &light_layout, [&light, &light_terms], quadtree, rsm);
-        let outputs = Outputs::new(device, s);
+        let views = maps
+            .iter()
+            .map(|&m| ViewGroup::new(device, &light_layout, m))
+            .collect();
+        let outputs = Outputs::new(device, s, maps.len());
         Self {
             settings: s.clone(),
-            light,
-            light_terms,
+            views,
             frame_group: outputs.frame_group(device, &frame_layout, gbuffer),
             outputs,
             slots,
-            light_group,
             dispatch_group,
             light_layout,
             frame_layout,
@@ -256,10 +287,17 @@ impl Resources {
         &self.settings
     }
 
-    /// Reads another quadtree or RSM from now on.
-    pub fn bind_rsm(&mut self, device: &wgpu::Device, quadtree: &LightQuadtree, rsm: RsmViews) {
-        let buffers = [&self.light, &self.light_terms];
-        self.light_group = light_group(device, &self.light_layout, buffers, quadtree, rsm);
+    /// How many light views the gather sums.
+    pub fn view_count(&self) -> usize {
+        self.views.len()
+    }
+
+    /// Reads other quadtrees or RSMs from now on (as many as before).
+    pub fn bind_maps(&mut self, device: &wgpu::Device, maps: &[ViewMaps]) {
+        assert_eq!(maps.len(), self.views.len(), "one maps a light view");
+        for (view, &m) in self.views.iter_mut().zip(maps) {
+            view.group = light_group(device, &self.light_layout, [&view.light, &view.terms], m);
+        }
     }
 
     /// Shades another G-buffer of the same size from now on.
@@ -269,11 +307,19 @@ impl Resources {
             .frame_group(device, &self.frame_layout, gbuffer);
     }
 
-    /// Writes the light and the gather's terms of it (the kernel's clamp `r_min`, world units).
-    pub fn set_light(&self, queue: &wgpu::Queue, spot: &Spot, r_min: f32) {
-        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&spot.uniform()));
-        let terms = spot.terms(&self.settings, r_min);
-        queue.write_buffer(&self.light_terms, 0, bytemuck::bytes_of(&terms));
+    /// Writes the light views and the gather's terms of them (the kernel's clamp `r_min`, world
+    /// units), one a view.
+    pub fn set_lights(&self, queue: &wgpu::Queue, lights: &[LightView], r_min: f32) {
+        assert_eq!(lights.len(), self.views.len(), "one light view a view");
+        let low_samples = {
+            let (w, h) = self.settings.low_size();
+            w * h
+        };
+        for (i, (view, light)) in self.views.iter().zip(lights).enumerate() {
+            queue.write_buffer(&view.light, 0, bytemuck::bytes_of(&light.uniform()));
+            let terms = light.terms(&self.settings, r_min, i as u32 * low_samples);
+            queue.write_buffer(&view.terms, 0, bytemuck::bytes_of(&terms));
+        }
     }
 
     /// Writes the camera the G-buffer is rendered from.
@@ -306,9 +352,9 @@ impl Resources {
         entries.map(|entry| compute_pipeline(device, &layout, &module, entry))
     }
 
-    /// Binds the light's and the frame's groups.
-    pub fn bind_groups(&self, pass: &mut wgpu::ComputePass) {
-        pass.set_bind_group(0, &self.light_group, &[]);
+    /// Binds light view `view`'s group and the frame's.
+    pub fn bind_groups(&self, pass: &mut wgpu::ComputePass, view: usize) {
+        pass.set_bind_group(0, &self.views[view].group, &[]);
         pass.set_bind_group(1, &self.frame_group, &[]);
     }
 
@@ -347,14 +393,13 @@ impl Resources {
     }
 }
 
-/// The per-light group: `quadtree`'s settings, the light and its terms, the RSM, the quadtree's
-/// nodes, cut and bounds.
+/// A light view's group: its quadtree's settings, the light and its terms, the RSM, the
+/// quadtree's nodes, cut and bounds.
 fn light_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     [light, terms]: [&wgpu::Buffer; 2],
-    quadtree: &LightQuadtree,
-    rsm: RsmViews,
+    ViewMaps { rsm, quadtree }: ViewMaps,
 ) -> wgpu::BindGroup {
     bind_group(
         device,

@@ -28,7 +28,8 @@ struct Shade {
     tile_share: f32,
 }
 
-// Per light update, with the light: the kernel's clamp and the lengths that scale with the scene.
+// Per light view, with the light: the kernel's clamp, the lengths that scale with the scene and
+// where the view's low-resolution samples start.
 struct LightTerms {
     // the clamp of the VPL kernel's 1/r^4 (world units)
     r_min: f32,
@@ -39,6 +40,9 @@ struct LightTerms {
     // indirect shadows: how deep behind a depth map's surface a point counts as inside the
     // occluder (world units)
     shadow_thickness: f32,
+    // where this view's low-resolution samples start; 0 for a frame's first light view, which
+    // writes the radiance the others add to
+    low_offset: u32,
 }
 
 // Per camera: the view the G-buffer was rendered from, and its size in pixels.
@@ -257,9 +261,15 @@ fn slice_range(count: u32, per_slice: u32) -> vec2<u32> {
     return vec2<u32>(first, min(first + per_slice, count));
 }
 
-// Stores one slice's share of a pixel's indirect light: the first slice writes, the others add.
+// Whether this is a frame's first light view, which writes the radiance the others add to.
+fn first_view() -> bool {
+    return terms.low_offset == 0u;
+}
+
+// Stores one slice's share of a pixel's indirect light: the first slice of the first light view
+// writes, the others add.
 fn add_indirect(index: u32, value: vec4<f32>) {
-    if (slice.level == 0u) {
+    if (slice.level == 0u && first_view()) {
         indirect[index] = value;
     } else {
         indirect[index] += value;

@@ -18,7 +18,7 @@ fn low_sample(low_xy: vec2<u32>) {
     if (r.covered) {
         e = gathered_irradiance(r);
     }
-    let index = low_xy.y * shade.low_width + low_xy.x;
+    let index = terms.low_offset + low_xy.y * shade.low_width + low_xy.x;
     if (slice.level == 0u) {
         low[index] = vec4<f32>(e, select(0.0, 1.0, r.covered));
     } else {
@@ -62,13 +62,13 @@ fn upsample_pixel(pixel: vec2<u32>) {
         let w = select(1.0 - t.x, t.x, o.x == 1) * select(1.0 - t.y, t.y, o.y == 1);
         if (agree && w > 0.0) {
             fetches++;
-            e += w * low[u32(s.y) * shade.low_width + u32(s.x)].rgb;
+            e += w * low[terms.low_offset + u32(s.y) * shade.low_width + u32(s.x)].rgb;
             weight += w;
         }
     }
     if (weight > 1e-3) {
         if (slice.level == 0u) {
-            indirect[index] = vec4<f32>(r.albedo / PI * e / weight, 0.0);
+            add_indirect(index, vec4<f32>(r.albedo / PI * e / weight, 0.0));
         }
     } else {
         add_indirect(index, vec4<f32>(r.albedo / PI * gathered_irradiance(r), 1.0));
