@@ -1,7 +1,9 @@
 //! quadray's pyramid displacement mapping as a Bevy material: exact ray casting through a
 //! max-height pyramid (Oh & Ki 2007) in place of `StandardMaterial`'s parallax mapping, with Bevy's
 //! PBR lighting and shadows kept, self-shadowing, level-of-detail, and the traced depth written so
-//! displaced surfaces intersect other geometry where they really are.
+//! displaced surfaces intersect other geometry where they really are. Every pass Bevy draws the
+//! material in traces: the forward main pass, the depth, normal and motion-vector prepasses, the
+//! deferred G-buffer (with `DefaultOpaqueRendererMethod::deferred()`) and the shadow maps.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -42,10 +44,16 @@ mod pyramid_image;
 pub use pyramid_image::{PyramidImageError, depth_map, pyramid_image};
 
 use bevy::asset::{AssetEvent, AssetId, uuid_handle};
-use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialPlugin, StandardMaterial};
+use bevy::mesh::MeshVertexBufferLayoutRef;
+use bevy::pbr::{
+    ExtendedMaterial, MaterialExtension, MaterialExtensionKey, MaterialExtensionPipeline,
+    MaterialPlugin, StandardMaterial,
+};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
-use bevy::render::render_resource::{AsBindGroup, ShaderType};
+use bevy::render::render_resource::{
+    AsBindGroup, FragmentState, RenderPipelineDescriptor, ShaderType, SpecializedMeshPipelineError,
+};
 use bevy::render::storage::ShaderBuffer;
 use bevy::shader::{Shader, ShaderRef};
 use quadray_displace::pyramid::Addressing;
@@ -154,9 +162,56 @@ impl MaterialExtension for PyramidExtension {
         MATERIAL_SHADER.into()
     }
 
-    // The depth prepass would draw the undisplaced polygon; the main pass writes the traced depth.
-    fn enable_prepass() -> bool {
-        false
+    fn prepass_fragment_shader() -> ShaderRef {
+        MATERIAL_SHADER.into()
+    }
+
+    fn deferred_fragment_shader() -> ShaderRef {
+        MATERIAL_SHADER.into()
+    }
+
+    // Bevy draws depth-only prepasses and shadow maps without a fragment stage and without the
+    // tangent frame: the polygon's depth. The trace needs both, in every prepass.
+    fn specialize(
+        _pipeline: &MaterialExtensionPipeline,
+        descriptor: &mut RenderPipelineDescriptor,
+        layout: &MeshVertexBufferLayoutRef,
+        _key: MaterialExtensionKey<Self>,
+    ) -> Result<(), SpecializedMeshPipelineError> {
+        let defs = &mut descriptor.vertex.shader_defs;
+        if !defs.contains(&"PREPASS_PIPELINE".into()) {
+            return Ok(());
+        }
+        let frame = "NORMAL_PREPASS_OR_DEFERRED_PREPASS".into();
+        if !defs.contains(&frame) {
+            defs.push(frame);
+            // Bevy's prepass locations for the normal and the tangent (prepass_io.wgsl).
+            for (attribute, location, def) in [
+                (Mesh::ATTRIBUTE_NORMAL, 3, "VERTEX_NORMALS"),
+                (Mesh::ATTRIBUTE_TANGENT, 4, "VERTEX_TANGENTS"),
+            ] {
+                if layout.0.contains(attribute.id) {
+                    let extra = layout
+                        .0
+                        .get_layout(&[attribute.at_shader_location(location)])?;
+                    descriptor.vertex.buffers[0]
+                        .attributes
+                        .extend(extra.attributes);
+                    defs.push(def.into());
+                }
+            }
+        }
+        let defs = defs.clone();
+        let fragment = descriptor.fragment.get_or_insert_with(|| FragmentState {
+            shader: MATERIAL_SHADER,
+            ..default()
+        });
+        for def in defs {
+            if !fragment.shader_defs.contains(&def) {
+                fragment.shader_defs.push(def);
+            }
+        }
+        Ok(())
     }
 }
 
@@ -178,15 +233,19 @@ pub struct PyramidUniform {
 impl From<&PyramidExtension> for PyramidUniform {
     fn from(m: &PyramidExtension) -> Self {
         let info = PyramidInfo::new(m.map_size.x, m.map_size.y, m.addressing());
-        let ready = u32::from(m.pyramid.is_some());
         Self {
             levels: info.levels,
             clamp_to_map: info.clamp_to_map,
             iteration_cap: info.iteration_cap,
             refine_cap: info.refine_cap,
             map_size: UVec2::from(info.size),
-            depth_scale: m.depth_scale,
-            flags: ready | (u32::from(m.lod) << 1),
+            // Until the pyramid is built the shader traces the fallback image: flat.
+            depth_scale: if m.pyramid.is_some() {
+                m.depth_scale
+            } else {
+                0.0
+            },
+            flags: u32::from(m.lod),
             debug_width: m.debug_width,
             shadow_strength: m.shadow_strength,
             light: m.light,

@@ -1,0 +1,280 @@
+//! The material in Bevy's shadow maps, headless on lavapipe: a displaced cone on a patch (a
+//! clamped map) floats over a flat floor that cuts through the patch's depth, so only the cone's
+//! tip stands above the floor; a spot light casts its shadow through Bevy's own shadow map and
+//! filtering. The floor's shadowed pixels against the CPU ground truth: each floor point's ray
+//! to the light traced through the height field, shadowed where it meets the surface above the
+//! floor. A shadow pass that wrote the polygon's depth would shadow the whole patch's outline.
+
+use bevy::asset::RenderAssetUsages;
+use bevy::camera::RenderTarget;
+use bevy::camera::visibility::RenderLayers;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::light::DirectionalLightShadowMap;
+use bevy::prelude::*;
+use bevy::render::gpu_readback::{Readback, ReadbackComplete};
+use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat, TextureUsages};
+use glam::DVec2;
+use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial, depth_map};
+use quadray_displace::heightmap::HeightMap;
+use quadray_displace::pyramid::Addressing;
+use quadray_displace::reference::{Ray, Surface, intersect};
+use std::sync::{Arc, Mutex};
+
+mod common;
+
+const SIZE: u32 = 64;
+const MAP: u32 = 64;
+/// The patch is 1 x 1 at this height over the floor, its depth scale (uv units per unit of
+/// depth) puts its deepest point below the floor: only depths under HEIGHT / DEPTH_SCALE = 0.75
+/// stand above it.
+const HEIGHT: f32 = 0.3;
+const DEPTH_SCALE: f32 = 0.4;
+/// The cone's radius in uv: depth r / RADIUS inside, 1 outside.
+const RADIUS: f32 = 0.45;
+const LIGHT: Vec3 = Vec3::new(1.0, 1.6, 0.2);
+const EYE: Vec3 = Vec3::new(0.0, 2.5, 0.0);
+/// The second scene, the same floor, camera and light without the patch: the lit floor each
+/// pixel's shadow is measured against.
+const BESIDE: Vec3 = Vec3::new(20.0, 0.0, 0.0);
+/// Pixels whose shadow differs from the truth's, as a share of the pixels the truth shadows:
+/// Bevy's shadow map (512 texels over the spot's cone), its depth bias and filtering blur the
+/// outline by a pixel or so.
+const MISMATCH_TOLERANCE: f64 = 0.1;
+
+/// What each scene's camera sees, read back every frame.
+#[derive(Resource)]
+struct Pictures {
+    with_patch: Handle<Image>,
+    without: Handle<Image>,
+    read: [Arc<Mutex<Option<Vec<u8>>>>; 2],
+    camera: Entity,
+}
+
+fn cone_depth(x: u32, y: u32) -> f32 {
+    let uv = (Vec2::new(x as f32, y as f32) + 0.5) / MAP as f32;
+    let r = (uv - 0.5).length();
+    (r / RADIUS).min(1.0)
+}
+
+fn setup(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<PyramidMaterial>>,
+    mut standard: ResMut<Assets<StandardMaterial>>,
+    mut images: ResMut<Assets<Image>>,
+) {
+    let texels: Vec<u8> = (0..MAP * MAP)
+        .map(|i| (cone_depth(i % MAP, i / MAP) * 255.0).round() as u8)
+        .collect();
+    let map = images.add(Image::new(
+        Extent3d {
+            width: MAP,
+            height: MAP,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        texels,
+        TextureFormat::R8Unorm,
+        RenderAssetUsages::all(),
+    ));
+    let patch = Mesh::from(Plane3d::new(Vec3::Y, Vec2::splat(0.5)))
+        .with_generated_tangents()
+        .expect("the plane has normals and uvs");
+    let mut extension = PyramidExtension::new(map, DEPTH_SCALE);
+    extension.lod = false;
+    extension.clamp_to_map = true;
+    // The patch casts shadows but no camera sees it: the light sees layer 1, the cameras do not.
+    commands.spawn((
+        Mesh3d(meshes.add(patch)),
+        MeshMaterial3d(materials.add(PyramidMaterial {
+            base: StandardMaterial::default(),
+            extension,
+        })),
+        Transform::from_xyz(0.0, HEIGHT, 0.0),
+        RenderLayers::layer(1),
+    ));
+    let floor = meshes.add(Plane3d::new(Vec3::Y, Vec2::splat(2.0)));
+    let white = standard.add(StandardMaterial {
+        perceptual_roughness: 1.0,
+        ..default()
+    });
+    let mut pictures = Vec::new();
+    for origin in [Vec3::ZERO, BESIDE] {
+        commands.spawn((
+            Mesh3d(floor.clone()),
+            MeshMaterial3d(white.clone()),
+            Transform::from_translation(origin),
+        ));
+        commands.spawn((
+            SpotLight {
+                intensity: 20_000.0,
+                range: 6.0,
+                shadow_maps_enabled: true,
+                // Bevy's biases (0.02, 1.8) would shrink the shadow of a caster this close to
+                // the floor by about a pixel all round.
+                shadow_depth_bias: 0.005,
+                shadow_normal_bias: 0.5,
+                outer_angle: 0.8,
+                inner_angle: 0.7,
+                ..default()
+            },
+            Transform::from_translation(origin + LIGHT)
+                .looking_at(origin + Vec3::new(0.0, HEIGHT, 0.0), Vec3::Y),
+            RenderLayers::from_layers(&[0, 1]),
+        ));
+        let mut target = Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
+        target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        let target = images.add(target);
+        let camera = commands
+            .spawn((
+                Camera3d::default(),
+                RenderTarget::Image(target.clone().into()),
+                Tonemapping::None,
+                Msaa::Off,
+                Transform::from_translation(origin + EYE).looking_at(origin, Vec3::NEG_Z),
+            ))
+            .id();
+        pictures.push((target, camera));
+    }
+    commands.insert_resource(Pictures {
+        with_patch: pictures[0].0.clone(),
+        without: pictures[1].0.clone(),
+        read: Default::default(),
+        camera: pictures[0].1,
+    });
+}
+
+fn app() -> App {
+    common::headless_app(|app| {
+        app.insert_resource(DirectionalLightShadowMap { size: 512 })
+            .insert_resource(GlobalAmbientLight::NONE)
+            .add_plugins(PyramidDisplacementPlugin)
+            .add_systems(Startup, setup);
+    })
+}
+
+/// Linear luminance-ish of an sRGB pixel (its green: the floor is white).
+fn linear(srgb: u8) -> f64 {
+    (f64::from(srgb) / 255.0).powf(2.2)
+}
+
+/// Per pixel: whether the floor is in the patch's shadow, on the CPU (None: off the floor).
+fn truth(map: &HeightMap, world_from_clip: Mat4, x: u32, y: u32) -> Option<bool> {
+    let world_from_clip = world_from_clip.as_dmat4();
+    let ndc = DVec2::new(
+        (f64::from(x) + 0.5) / f64::from(SIZE) * 2.0 - 1.0,
+        1.0 - (f64::from(y) + 0.5) / f64::from(SIZE) * 2.0,
+    );
+    let eye = EYE.as_dvec3();
+    let dir = (world_from_clip.project_point3(ndc.extend(0.5)) - eye).normalize();
+    let floor = eye + dir * (-eye.y / dir.y);
+    if floor.x.abs() > 2.0 || floor.z.abs() > 2.0 {
+        return None;
+    }
+    // Towards the light, through the patch's plane.
+    let towards = (LIGHT.as_dvec3() - floor).normalize();
+    let (height, s) = (f64::from(HEIGHT), f64::from(DEPTH_SCALE));
+    let on_patch = floor + towards * (height / towards.y);
+    let p0 = DVec2::new(on_patch.x + 0.5, on_patch.z + 0.5);
+    if p0.min_element() < 0.0 || p0.max_element() >= 1.0 {
+        return Some(false);
+    }
+    let ray = Ray {
+        p0,
+        e: -DVec2::new(towards.x, towards.z) / towards.y * s,
+    };
+    // The light's ray meets the surface above the floor (the patch is 1 x 1: uv units are world
+    // units), or leaves the clamped map through its side, or meets it below the floor.
+    Some(
+        intersect(map, Addressing::Clamp, Surface::Point, ray)
+            .is_some_and(|hit| hit.z * s < height),
+    )
+}
+
+#[test]
+fn the_displaced_surface_casts_its_traced_shadow() {
+    let mut app = app();
+    app.update(); // Startup: the scene and its views.
+    let pictures = app.world().resource::<Pictures>();
+    for (image, read) in [
+        (pictures.with_patch.clone(), pictures.read[0].clone()),
+        (pictures.without.clone(), pictures.read[1].clone()),
+    ] {
+        app.world_mut()
+            .spawn(Readback::texture(image))
+            .observe(move |e: On<ReadbackComplete>| *read.lock().unwrap() = Some(e.data.clone()));
+    }
+    // The scene's pipelines compile, the map's pyramid is built: wait for a shadow on the lit
+    // floor, then a few frames more.
+    let lit_mask = |app: &App| {
+        let read = &app.world().resource::<Pictures>().read;
+        let (Some(a), Some(b)) = (
+            read[0].lock().unwrap().clone(),
+            read[1].lock().unwrap().clone(),
+        ) else {
+            return None;
+        };
+        // Pixels the light reaches on the floor without the patch: lit where it reaches them
+        // with the patch too.
+        let lit_share = |x: usize| linear(a[4 * x + 1]) / linear(b[4 * x + 1]).max(1e-6);
+        let reached = (0..(SIZE * SIZE) as usize).map(|x| b[4 * x + 1] > 16);
+        Some(
+            reached
+                .enumerate()
+                .map(|(x, r)| r.then(|| lit_share(x) > 0.5))
+                .collect::<Vec<_>>(),
+        )
+    };
+    // Both floors drawn and lit, and a shadow on the patch's.
+    let shadow = |app: &App| lit_mask(app).filter(|lit| lit.contains(&Some(false)));
+    let mut frames = 0;
+    while shadow(&app).is_none() {
+        assert!(frames < 1000, "no shadow after {frames} frames");
+        app.update();
+        frames += 1;
+    }
+    for _ in 0..5 {
+        app.update();
+    }
+    let lit = lit_mask(&app).unwrap();
+    let world = app.world();
+    let pictures = world.resource::<Pictures>();
+    let entity = world.entity(pictures.camera);
+    let camera = entity.get::<Camera>().unwrap();
+    let transform = entity.get::<GlobalTransform>().unwrap();
+    let world_from_clip = (camera.clip_from_view() * transform.to_matrix().inverse()).inverse();
+    let images = world.resource::<Assets<Image>>();
+    let (_, image) = images
+        .iter()
+        .find(|(_, i)| i.texture_descriptor.format == TextureFormat::R8Unorm)
+        .expect("the cone's map");
+    let map = depth_map("cone", image).unwrap();
+    let (mut shadowed, mut mismatched) = (0, 0);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let Some(truth) = truth(&map, world_from_clip, x, y) else {
+                continue;
+            };
+            shadowed += usize::from(truth);
+            mismatched += usize::from(Some(truth) == lit[(y * SIZE + x) as usize]);
+        }
+    }
+    let fraction = mismatched as f64 / shadowed.max(1) as f64;
+    println!("{shadowed} pixels in the traced shadow, {mismatched} differ ({fraction:.4})");
+    assert!(shadowed > 100, "only {shadowed} pixels in shadow");
+    assert!(
+        fraction <= MISMATCH_TOLERANCE,
+        "{mismatched} pixels differ from the traced shadow's {shadowed}"
+    );
+}
+
+/// The shadow pass under the Khronos validation layer with synchronization validation: the test
+/// above, run again in a child process with the layer, prints no message of it.
+#[test]
+fn the_shadow_pass_passes_the_validation_layer() {
+    let mut rerun = std::process::Command::new(std::env::current_exe().unwrap());
+    rerun.args(["--exact", "the_displaced_surface_casts_its_traced_shadow"]);
+    if let Err(problem) = quadray_gpu::validation::run_under_layer(&mut rerun, "the shadow test") {
+        panic!("{problem}");
+    }
+}
