@@ -3,7 +3,7 @@
 //! medians back. CPU wall time never stands in for GPU time.
 
 use crate::{Gpu, GpuError};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 
 pub use quadray_core::stats::Summary as TimingSummary;
 
@@ -23,6 +23,9 @@ pub struct GpuTimer {
     written: AtomicU64,
     /// The passes the last resolve copied, which [`Self::collect`] reads.
     resolved: AtomicU64,
+    /// While [`Self::span`] records part of a span: bit 0 leaves out the passes' beginnings,
+    /// bit 1 their ends.
+    span: AtomicU8,
     period_ns: f64,
     /// Per pass, the durations of every frame recorded so far (ms).
     samples: Vec<Vec<f64>>,
@@ -67,6 +70,7 @@ impl GpuTimer {
             passes,
             written: AtomicU64::new(0),
             resolved: AtomicU64::new(0),
+            span: AtomicU8::new(0),
             period_ns: f64::from(gpu.queue.get_timestamp_period()),
             samples: vec![Vec::new(); passes as usize],
         }
@@ -77,28 +81,54 @@ impl GpuTimer {
     }
 
     /// The timestamp writes of pass `pass`; the pass must be recorded with them (its queries are
-    /// resolved at the next [`Self::resolve`]).
+    /// resolved at the next [`Self::resolve`]). Inside [`Self::span`], only the span's ends.
     pub fn render_pass(&self, pass: u32) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.mark(pass);
-        self.query_set
-            .as_ref()
-            .map(|query_set| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(pass * 2),
-                end_of_pass_write_index: Some(pass * 2 + 1),
-            })
+        let (query_set, beginning, end) = self.writes(pass)?;
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: beginning,
+            end_of_pass_write_index: end,
+        })
     }
 
     /// The timestamp writes of pass `pass`, as [`Self::render_pass`].
     pub fn compute_pass(&self, pass: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.mark(pass);
-        self.query_set
-            .as_ref()
-            .map(|query_set| wgpu::ComputePassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(pass * 2),
-                end_of_pass_write_index: Some(pass * 2 + 1),
-            })
+        let (query_set, beginning, end) = self.writes(pass)?;
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: beginning,
+            end_of_pass_write_index: end,
+        })
+    }
+
+    /// Records `record`'s timed passes as part of a span that several recordings time together
+    /// in one slot (the same pass once per light view): their beginnings only when `first`,
+    /// their ends only when `last`, so a slot times from its first recording's start to its last
+    /// one's end.
+    pub fn span<R>(&self, first: bool, last: bool, record: impl FnOnce() -> R) -> R {
+        let part = u8::from(!first) | (u8::from(!last) << 1);
+        self.span.store(part, Ordering::Relaxed);
+        let out = record();
+        self.span.store(0, Ordering::Relaxed);
+        out
+    }
+
+    /// Pass `pass`'s query set and its beginning's and end's query indices as the span allows
+    /// (`None` for a recording in the middle of a span, or without timestamp queries); the pass
+    /// is resolved once its end is written.
+    #[allow(clippy::type_complexity)]
+    fn writes(&self, pass: u32) -> Option<(&wgpu::QuerySet, Option<u32>, Option<u32>)> {
+        let part = self.span.load(Ordering::Relaxed);
+        let (beginning, end) = (part & 1 == 0, part & 2 == 0);
+        if end {
+            self.mark(pass);
+        }
+        let query_set = self.query_set.as_ref()?;
+        (beginning || end).then_some((
+            query_set,
+            beginning.then_some(pass * 2),
+            end.then_some(pass * 2 + 1),
+        ))
     }
 
     fn mark(&self, pass: u32) {

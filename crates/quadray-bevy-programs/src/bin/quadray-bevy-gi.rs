@@ -1,14 +1,14 @@
 //! One bounce of indirect light in a Bevy app: the bundled Cornell box glTF
 //! (`assets/scenes/cornell_spot.gltf`) loaded by Bevy's glTF loader, its spot light turning
-//! slowly, Bevy's direct light and shadows as they are, and quadray's light quadtree adding the
+//! slowly (a scene's every punctual light gives the bounce: sun, point and spot lights), Bevy's direct light and shadows as they are, and quadray's light quadtree adding the
 //! bounce. G turns the bounce on and off; M cycles the method (per-tile cuts, the quadtree's one cut,
 //! RSM sampling, every VPL); C shows the light quadtree's cut over the RSM in the top-left corner;
 //! Space stops and restarts the light. The window's title says what is shown.
 //!
 //! `cargo run --release --bin quadray-bevy-gi` (`--bin`, not `-p`: Cargo then resolves features
 //! as for the whole workspace, and what the test build compiled is reused).
-//! `--scene PATH` shows a glTF or GLB scene of your own instead (its camera and its first spot
-//! light). Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
+//! `--scene PATH` shows a glTF or GLB scene of your own instead (its camera and its punctual
+//! lights; `assets/scenes/cornell_lights.gltf` has all three kinds). Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
 //! [--cut-view] [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the
 //! light still and saves the picture. `--frames N` (with `--screenshot`) times N frames with the
 //! light turning and prints their median and Bevy's render diagnostics of the bounce (GPU time of
@@ -64,8 +64,8 @@ struct Shown {
     about = "One bounce of indirect light from quadray's light quadtree in a Bevy app"
 )]
 struct Args {
-    /// A glTF or GLB scene of your own: its camera, its first spot light turning and giving the
-    /// bounce (default: the bundled Cornell box).
+    /// A glTF or GLB scene of your own: its camera, and its punctual lights (directional, point
+    /// and spot) turning and giving the bounce (default: the bundled Cornell box).
     #[arg(long, value_name = "PATH.gltf")]
     scene: Option<PathBuf>,
     /// Render off screen, save the picture here and exit.
@@ -165,13 +165,19 @@ fn setup(
     }
 }
 
+/// A light of the three kinds glTF files hold, just loaded.
+type NewLight = (
+    Or<(Added<SpotLight>, Added<PointLight>, Added<DirectionalLight>)>,
+    Without<IndirectLightSource>,
+);
+
 /// A camera where the file's is (that one turned off) gets the bounce (deferred, no MSAA, by
-/// default a 128^2 RSM: interactive on a CPU rasteriser too); the file's spot is marked as its
-/// source. A refused RSM size is Bevy's log's warning, as for any app.
+/// default a 128^2 RSM: interactive on a CPU rasteriser too); the file's lights are marked as its
+/// sources. A refused RSM size is Bevy's log's warning, as for any app.
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Transform, &Projection), FileCamera>,
-    lights: Query<Entity, (Added<SpotLight>, Without<IndirectLightSource>)>,
+    lights: Query<Entity, NewLight>,
     offscreen: Option<Res<Offscreen>>,
     shown: Res<Shown>,
 ) {

@@ -226,21 +226,30 @@ impl<'g> Renderer<'g> {
     ) -> Vec<FrameStep<'a>> {
         let slot = move |pass: Pass| timer.map(|t| (t, pass as u32));
         let mut steps: Vec<FrameStep<'a>> = Vec::new();
-        // a pass over the light views is timed on the first (the timer has a slot a pass)
-        let first_timed =
-            |view: usize, slot: Option<(&'a GpuTimer, u32)>| slot.filter(|_| view == 0);
+        // a pass recorded once a light view is timed from the first view's start to the last's end
+        let views = self.views.len();
+        let each_view =
+            move |encoder: &mut wgpu::CommandEncoder,
+                  record: &dyn Fn(&mut wgpu::CommandEncoder, &ViewPasses)| {
+                for (i, view) in self.views.iter().enumerate() {
+                    match timer {
+                        Some(t) => t.span(i == 0, i + 1 == views, || record(encoder, view)),
+                        None => record(encoder, view),
+                    }
+                }
+            };
         if run.contains(&Pass::Rsm) {
             steps.push((
                 Pass::Rsm,
                 Box::new(move |encoder| {
-                    for (i, view) in self.views.iter().enumerate() {
+                    each_view(encoder, &|encoder, view| {
                         view.rsm.record(
                             encoder,
                             self.vertices.slice(..),
                             self.vertex_count,
-                            first_timed(i, slot(Pass::Rsm)),
+                            slot(Pass::Rsm),
                         )
-                    }
+                    })
                 }),
             ));
         }
@@ -248,12 +257,10 @@ impl<'g> Renderer<'g> {
             steps.push((
                 Pass::Pyramid,
                 Box::new(move |encoder| {
-                    for (i, view) in self.views.iter().enumerate() {
-                        let slots = timer
-                            .filter(|_| i == 0)
-                            .map(|t| (t, Pass::Pyramid as u32, Pass::Validity as u32));
+                    each_view(encoder, &|encoder, view| {
+                        let slots = timer.map(|t| (t, Pass::Pyramid as u32, Pass::Validity as u32));
                         view.quadtree.record_build(encoder, slots)
-                    }
+                    })
                 }),
             ));
         }
@@ -261,10 +268,9 @@ impl<'g> Renderer<'g> {
             steps.push((
                 Pass::Cut,
                 Box::new(move |encoder| {
-                    for (i, view) in self.views.iter().enumerate() {
-                        view.quadtree
-                            .record_cut(encoder, first_timed(i, slot(Pass::Cut)))
-                    }
+                    each_view(encoder, &|encoder, view| {
+                        view.quadtree.record_cut(encoder, slot(Pass::Cut))
+                    })
                 }),
             ));
         }
