@@ -196,8 +196,9 @@ impl Scene {
     }
 }
 
-/// The scene `quadray indirect` uses without `--scene`, also `assets/scenes/cornell.toml`.
-pub const CORNELL_TOML: &str = include_str!("../../../assets/scenes/cornell.toml");
+/// The scene `quadray indirect` uses without `--scene`, in the crate (so that it packages) and
+/// linked as `assets/scenes/cornell.toml`.
+pub const CORNELL_TOML: &str = include_str!("../scenes/cornell.toml");
 
 /// The bundled scene files of this technique, in `scenes_dir()`.
 pub const BUNDLED_SCENES: [&str; 10] = [
