@@ -610,6 +610,7 @@ fn the_plugin_passes_the_validation_layer() {
     rerun.args([
         "--exact",
         "plugin_matches_quadray_and_adds_light_only_where_it_should",
+        "plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does",
         "a_still_camera_gathers_what_bevy_draws_later",
         "--test-threads",
         "1",

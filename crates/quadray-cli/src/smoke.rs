@@ -12,6 +12,7 @@ use quadray_displace::maps::BUNDLED;
 use quadray_displace::pyramid::Addressing;
 use quadray_displace::{Lod, PyramidKind, Renderer as DisplaceRenderer};
 use quadray_gpu::Gpu;
+use quadray_indirect::scene::{Intensity, Light, LightKind};
 use quadray_indirect::{Method as IndirectMethod, Renderer as IndirectRenderer, Scene, Settings};
 use std::time::{Duration, Instant};
 
@@ -71,7 +72,9 @@ fn cases() -> Vec<Case> {
     for method in IndirectMethod::ALL {
         cases.push(Case {
             name: format!("indirect-{method}"),
-            run: Box::new(move |gpu, size, done| indirect_passes(gpu, size, method, |_| {}, done)),
+            run: Box::new(move |gpu, size, done| {
+                indirect_passes(gpu, size, &Scene::cornell(), method, |_| {}, done)
+            }),
         });
     }
     let variants: [(&str, IndirectMethod, Change); 2] = [
@@ -85,7 +88,24 @@ fn cases() -> Vec<Case> {
     for (name, method, change) in variants {
         cases.push(Case {
             name: name.into(),
-            run: Box::new(move |gpu, size, done| indirect_passes(gpu, size, method, change, done)),
+            run: Box::new(move |gpu, size, done| {
+                indirect_passes(gpu, size, &Scene::cornell(), method, change, done)
+            }),
+        });
+    }
+    // eight light views summed: the spot's, the sun's orthographic map, a point light's six faces
+    let lights: [(&str, IndirectMethod, Change); 2] = [
+        ("indirect-lights", IndirectMethod::DEFAULT, |_| {}),
+        ("indirect-lights-subsample", IndirectMethod::Quadtree, |s| {
+            s.subsample = 2
+        }),
+    ];
+    for (name, method, change) in lights {
+        cases.push(Case {
+            name: name.into(),
+            run: Box::new(move |gpu, size, done| {
+                indirect_passes(gpu, size, &three_lights(), method, change, done)
+            }),
         });
     }
     cases.push(Case {
@@ -247,18 +267,39 @@ fn indirect_settings(size: u32, change: impl Fn(&mut Settings)) -> Settings {
     settings
 }
 
-/// One indirect frame of `method` on the Cornell box, pass by pass, then its read-back.
+/// The Cornell box lit by its spot, a point light and the sun.
+fn three_lights() -> Scene {
+    let mut scene = Scene::cornell();
+    let white = |v: f32| Intensity::Native(glam::Vec3::splat(v));
+    scene.lights.extend([
+        Light {
+            kind: LightKind::Point {
+                position: glam::Vec3::new(0.75, 0.55, 0.7),
+            },
+            intensity: white(0.4),
+        },
+        Light {
+            kind: LightKind::Directional {
+                direction: glam::Vec3::new(-0.25, -0.5, -1.0),
+            },
+            intensity: white(1.0),
+        },
+    ]);
+    scene
+}
+
+/// One indirect frame of `method` on `scene`, pass by pass, then its read-back.
 fn indirect_passes(
     gpu: &Gpu,
     size: u32,
+    scene: &Scene,
     method: IndirectMethod,
     change: impl Fn(&mut Settings),
     done: Done,
 ) -> Result<()> {
-    let scene = Scene::cornell();
     let settings = indirect_settings(size, change);
     let mut renderer = step(done, "setup", || {
-        Ok(IndirectRenderer::new(gpu, &scene, settings)?)
+        Ok(IndirectRenderer::new(gpu, scene, settings)?)
     })?;
     renderer.render_pass_by_pass(method, |pass, took| done(pass.name(), took))?;
     step(done, "readback", || Ok(renderer.read_frame()?))?;
