@@ -135,14 +135,16 @@ impl<'a> TileStructure<'a> {
     }
 
     /// [`TileStructure::ratio`] of `method` over that of `brute_force` (every VPL, same scene
-    /// and RSM): 1.0 = no more tile structure than a method without tiles.
+    /// and RSM): 1.0 = no more tile structure than a method without tiles. `None` where either
+    /// has no ratio or the brute force's is 0 (its error changes only inside the tiles).
     pub fn blockiness(
         &self,
         method: &[[f32; 3]],
         brute_force: &[[f32; 3]],
         order: Order,
     ) -> Option<f64> {
-        Some(self.ratio(method, order)? / self.ratio(brute_force, order)?)
+        let (method, brute_force) = (self.ratio(method, order)?, self.ratio(brute_force, order)?);
+        (brute_force > 0.0).then(|| method / brute_force)
     }
 }
 
@@ -311,19 +313,23 @@ mod tests {
         assert!(TileStructure::new(0, 0, &[], &[]).is_none());
         assert!(TileStructure::new(u32::MAX, u32::MAX, &truth, &[]).is_none());
         let structure = TileStructure::new(W, H, &truth, &[&direct]).unwrap();
-        let (h, column) = (
-            H as usize,
-            TileStructure::new(1, H, &truth[..H as usize], &[]),
-        );
+        let h = H as usize;
+        let column = TileStructure::new(1, H, &truth[..h], &[]).unwrap();
         let pixel = TileStructure::new(1, 1, &truth[..1], &[]).unwrap();
         for order in Order::ALL {
             assert_eq!(structure.ratio(&noisy[1..], order), None);
             assert_eq!(structure.ratio(&truth, order), None, "no error, no change");
             // one column: its pairs cross boundaries and not
-            assert!(column.as_ref().unwrap().ratio(&noisy[..h], order).is_some());
+            assert!(column.ratio(&noisy[..h], order).is_some());
             // a single pixel has no neighbours
             assert_eq!(pixel.ratio(&noisy[..1], order), None);
         }
+        // a brute force whose error changes only inside the tiles gives no figure
+        let flat = vec![[0.25; 3]; truth.len()];
+        let inside = plus(&flat, |x, _| if x % TILE == 4 { 0.25 } else { 0.0 });
+        let structure = TileStructure::new(W, H, &flat, &[&direct]).unwrap();
+        assert_eq!(structure.ratio(&inside, Order::Step), Some(0.0));
+        assert_eq!(structure.blockiness(&noisy, &inside, Order::Step), None);
         // non-finite values are left out, not spread
         let mut broken = noisy.clone();
         broken[100] = [f32::NAN; 3];
