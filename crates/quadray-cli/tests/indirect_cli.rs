@@ -69,6 +69,46 @@ fn indirect_writes_pictures_stats_and_the_error_map() {
     }
 }
 
+/// `--ground-truth` writes the blockiness beside the FLIP: the tiled method's a number, the
+/// brute force's 1 (its own structure over itself), none without the ground truth.
+#[test]
+fn the_ground_truth_writes_the_blockiness() {
+    let dir = scratch("indirect-blockiness");
+    let scene = assets().join("scenes/visibility-door.toml");
+    let run = |name: &str, extra: &[&str]| {
+        let (out, stats) = (
+            dir.join(format!("{name}.png")),
+            dir.join(format!("{name}.json")),
+        );
+        let scene = scene.to_str().unwrap();
+        let args = [
+            "indirect",
+            "--scene",
+            scene,
+            "--size",
+            "64x32",
+            "--rsm-size",
+            "16",
+        ];
+        let frames = ["--frames", "0", "--indirect-shadows"];
+        quadray_writes(&[&args[..], &frames, extra].concat(), &out, &stats);
+        read_json(&stats)
+    };
+    let tiles = run("tiles", &["--ground-truth"]);
+    let brute_force = run("reference", &["--ground-truth", "--method", "reference"]);
+    for key in ["blockiness", "blockiness_bends"] {
+        let figure = tiles["ground_truth"][key].as_f64().unwrap();
+        assert!(figure.is_finite() && figure > 0.0, "{key}: {figure}");
+        assert_eq!(
+            brute_force["ground_truth"][key].as_f64(),
+            Some(1.0),
+            "{key}"
+        );
+    }
+    assert!(tiles["ground_truth"]["flip"].as_f64().unwrap() > 0.0);
+    assert!(run("none", &[])["ground_truth"].is_null());
+}
+
 #[test]
 fn per_tile_cuts_report_their_bounds_and_clusters() {
     let dir = scratch("indirect-tiles");

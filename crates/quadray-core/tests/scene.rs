@@ -34,6 +34,11 @@ fn every_bundled_scene_file_loads() {
         ("shadows-bunny.toml", 3, 0, 2, 1),
         ("shadows-cornell.toml", 3, 0, 1, 0),
         ("shadows-demo.toml", 2, 0, 4, 3),
+        ("visibility-corridor.toml", 1, 1, 10, 3),
+        ("visibility-door.toml", 1, 1, 11, 4),
+        ("visibility-gap.toml", 1, 1, 7, 3),
+        ("visibility-shelf.toml", 1, 1, 6, 4),
+        ("visibility-storeys.toml", 1, 1, 11, 4),
     ];
     let mut files: Vec<String> = std::fs::read_dir(asset("scenes"))
         .unwrap()

@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod baselines;
+pub mod blockiness;
 mod frame;
 pub mod gpu;
 pub mod picture;

@@ -13,7 +13,7 @@ const LAYERS: &[&[&str]] = &[
     &["frame"],
     &["scene", "scene::builtin"],
     &["baselines"],
-    &["reference", "picture"],
+    &["reference", "picture", "blockiness"],
     &["tile_cut"],
     &["gpu::contract"],
     &["wgsl"],

@@ -5,6 +5,7 @@
 use super::temporal::{self, Temporal};
 use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
 use quadray_gpu::Gpu;
+use quadray_indirect::blockiness::{Order, TileStructure};
 use quadray_indirect::picture::{TONE_MAP_WHITE, flip_against, tone_map};
 use quadray_indirect::reference::{self, ImageError};
 use quadray_indirect::{FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts};
@@ -18,7 +19,8 @@ pub struct RunOptions {
     pub frames: u32,
     /// Also render the GPU brute force and measure the error against it.
     pub reference: bool,
-    /// Also compute the CPU ground truth with visibility and measure the error against it.
+    /// Also compute the CPU ground truth with visibility and measure the error against it (and
+    /// the blockiness, which renders the GPU brute force too).
     pub ground_truth: bool,
     /// Also render a sequence of `frames` frames with the light turning this many degrees a
     /// frame and measure its stability.
@@ -80,6 +82,13 @@ pub struct TruthError {
     pub rmse: f64,
     /// Mean FLIP of the tone-mapped combined pictures.
     pub flip: f32,
+    /// Tile structure in the indirect term's error that the brute force's lacks, by the error's
+    /// steps across tile boundaries ([`TileStructure::blockiness`], [`Order::Step`]; 1.0 =
+    /// none); `None` where it cannot be measured.
+    pub blockiness: Option<f64>,
+    /// The same by the bends of the error there ([`Order::Bend`]), which see an error that is
+    /// continuous across the boundaries but changes slope there.
+    pub blockiness_bends: Option<f64>,
 }
 
 /// Refuses a ground truth that would trace more than [`reference::MAX_GROUND_TRUTH_RAYS`].
@@ -127,11 +136,13 @@ pub fn run(
     }
     let mut renderer = Renderer::new(gpu, scene, settings)?;
     let method = options.method;
-    let reference = if options.reference {
+    // the ground truth's blockiness holds the method's error to the brute force's
+    let brute_force = if options.reference || options.ground_truth {
         Some(renderer.render_frame(Method::Reference)?.indirect)
     } else {
         None
     };
+    let reference = brute_force.as_ref().filter(|_| options.reference);
     // The compacted cut's size is the size of the set both quadtree methods use.
     let (clusters_in_cut, mut cut) = if method.uses_quadtree() {
         renderer.render(Method::Quadtree, true, false)?;
@@ -157,17 +168,12 @@ pub fn run(
     let s = renderer.settings().resolved();
     let (w, h) = (s.size.width, s.size.height);
     let combined = frame.combined();
-    let error = reference
-        .as_ref()
-        .map(|r| reference::compare(&frame.indirect, r));
-    let error_map = reference
-        .as_ref()
-        .map(|r| heat_map(w, h, &reference::error_map(&frame.indirect, r), 0.5));
+    let error = reference.map(|r| reference::compare(&frame.indirect, r));
+    let error_map =
+        reference.map(|r| heat_map(w, h, &reference::error_map(&frame.indirect, r), 0.5));
     let combined_image = tone_map(w, h, &combined, options.exposure);
     let exposure_advice = check_exposure(&combined, options.exposure, TONE_MAP_WHITE);
-    let flip = reference
-        .as_ref()
-        .map(|r| flip_against(&frame, r, options.exposure));
+    let flip = reference.map(|r| flip_against(&frame, r, options.exposure));
     let truth = if options.ground_truth {
         let (vpls, receivers) = (renderer.read_vpls()?, renderer.read_receivers()?);
         Some(reference::ground_truth(&vpls, &receivers, scene))
@@ -190,10 +196,20 @@ pub fn run(
     };
     let ground_truth = truth.as_ref().map(|truth| {
         let e = reference::compare(&frame.indirect, truth);
+        let structure = brute_force.as_deref().and_then(|brute_force| {
+            let edges_of = [frame.direct.as_slice(), brute_force];
+            Some((TileStructure::new(w, h, truth, &edges_of)?, brute_force))
+        });
+        let blockiness = |order| {
+            let (structure, brute_force) = structure.as_ref()?;
+            structure.blockiness(&frame.indirect, brute_force, order)
+        };
         TruthError {
             rel_l1: e.rel_l1,
             rmse: e.rmse,
             flip: flip_against(&frame, truth, options.exposure),
+            blockiness: blockiness(Order::Step),
+            blockiness_bends: blockiness(Order::Bend),
         }
     });
     Ok(Outcome {
