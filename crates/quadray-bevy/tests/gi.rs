@@ -22,9 +22,7 @@ use quadray_indirect::reference::compare;
 use quadray_indirect::{Method, Renderer, Scene, Settings};
 use std::sync::{Arc, Mutex};
 
-mod common;
-
-use common::ASSETS;
+use crate::common::ASSETS;
 
 const SCENE: &str = "scenes/cornell_spot.gltf";
 const SIZE: u32 = 64;
@@ -150,7 +148,7 @@ fn configure(
 }
 
 fn app(scene: &'static str, cases: &[Case]) -> App {
-    common::headless_app(|app| {
+    crate::common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .insert_resource(Setup {
                 scene,
@@ -429,7 +427,7 @@ fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
 /// the app keeps running and Bevy's own light still draws the picture.
 #[test]
 fn misconfigured_cameras_keep_bevy_s_picture() {
-    let mut app = common::headless_app(|app| {
+    let mut app = crate::common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .add_plugins(IndirectLightPlugin);
     });
@@ -502,7 +500,7 @@ fn misconfigured_cameras_keep_bevy_s_picture() {
 /// scene's triangles arrived): the bounce follows what Bevy draws, it is not the first frame's.
 #[test]
 fn a_still_camera_gathers_what_bevy_draws_later() {
-    let mut app = common::headless_app(|app| {
+    let mut app = crate::common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .add_plugins((IndirectLightPlugin, RenderDiagnosticsPlugin))
             .add_systems(
@@ -609,9 +607,9 @@ fn the_plugin_passes_the_validation_layer() {
     let mut rerun = std::process::Command::new(std::env::current_exe().unwrap());
     rerun.args([
         "--exact",
-        "plugin_matches_quadray_and_adds_light_only_where_it_should",
-        "plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does",
-        "a_still_camera_gathers_what_bevy_draws_later",
+        "gi::plugin_matches_quadray_and_adds_light_only_where_it_should",
+        "gi::plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does",
+        "gi::a_still_camera_gathers_what_bevy_draws_later",
         "--test-threads",
         "1",
     ]);

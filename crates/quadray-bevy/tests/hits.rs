@@ -5,7 +5,6 @@
 use bevy::camera::RenderTarget;
 use bevy::camera::visibility::RenderLayers;
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::image::ImageLoaderSettings;
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{BufferUsages, TextureFormat};
@@ -20,16 +19,9 @@ use quadray_displace::reference::Surface;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-mod common;
-
-use common::ASSETS;
+use crate::common::{ANGLES_DEG, ASSETS, MAPS, eye, height_map, unit_plane};
 const SIZE: u32 = 64;
 const DEPTH_SCALE: f32 = 0.1;
-const ANGLES_DEG: [f32; 3] = [0.0, 60.0, 80.0];
-const MAPS: [&str; 2] = [
-    "heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png",
-    "heightmaps/bevy_parallax/cube_depth.png",
-];
 
 /// One camera's recording: which map, which angle, and where its hits go.
 struct View {
@@ -52,12 +44,6 @@ fn hit_buffer() -> ShaderBuffer {
     buffer
 }
 
-/// The camera of a view `angle_deg` off the plane's normal.
-fn eye(angle_deg: f32) -> Vec3 {
-    let (sin, cos) = angle_deg.to_radians().sin_cos();
-    Vec3::new(0.0, 1.1 * cos, 1.1 * sin)
-}
-
 fn setup(
     mut commands: Commands,
     assets: Res<AssetServer>,
@@ -66,16 +52,10 @@ fn setup(
     mut images: ResMut<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    let plane = Mesh::from(Plane3d::new(Vec3::Y, Vec2::splat(0.5)))
-        .with_generated_tangents()
-        .expect("the plane has normals and uvs");
-    let plane = meshes.add(plane);
+    let plane = meshes.add(unit_plane());
     let mut views = Vec::new();
     for (map, path) in MAPS.iter().enumerate() {
-        let depth: Handle<Image> = assets
-            .load_builder()
-            .with_settings(|s: &mut ImageLoaderSettings| s.is_srgb = false)
-            .load(*path);
+        let depth = height_map(&assets, path);
         for angle_deg in ANGLES_DEG {
             let layer = RenderLayers::layer(views.len() + 1);
             let hits = buffers.add(hit_buffer());
@@ -112,7 +92,7 @@ fn setup(
 }
 
 fn app() -> App {
-    common::headless_app(|app| {
+    crate::common::headless_app(|app| {
         app.add_plugins(PyramidDisplacementPlugin)
             .add_systems(Startup, setup);
     })
@@ -259,7 +239,7 @@ fn bevy_hits_agree_with_the_cpu_ground_truth() {
 #[test]
 fn the_material_passes_the_validation_layer() {
     let mut rerun = std::process::Command::new(std::env::current_exe().unwrap());
-    rerun.args(["--exact", "bevy_hits_agree_with_the_cpu_ground_truth"]);
+    rerun.args(["--exact", "hits::bevy_hits_agree_with_the_cpu_ground_truth"]);
     if let Err(problem) = quadray_gpu::validation::run_under_layer(&mut rerun, "the material test")
     {
         panic!("{problem}");

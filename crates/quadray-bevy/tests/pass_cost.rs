@@ -2,7 +2,7 @@
 //! one run with paired rounds (a benchmark, not part of the normal test run):
 //!
 //! ```sh
-//! cargo test --release -p quadray-bevy --test pass_cost -- --ignored --nocapture
+//! cargo test --release -p quadray-bevy --test suite -- pass_cost:: --ignored --nocapture
 //! ```
 //!
 //! A 1x1 plane with the tile map (depth scale 0.1, level-of-detail on, as a user gets it) fills
@@ -23,7 +23,6 @@ use bevy::core_pipeline::schedule::Core3d;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::ecs::system::NonSendMarker;
-use bevy::image::ImageLoaderSettings;
 use bevy::light::DirectionalLightShadowMap;
 use bevy::pbr::{EARLY_SHADOW_PASS, ShadowView, shared_shadow_pass};
 use bevy::prelude::*;
@@ -33,8 +32,6 @@ use bevy::render::render_resource::TextureFormat;
 use bevy::render::renderer::RenderAdapterInfo;
 use bevy::render::renderer::{RenderContext, ViewQuery};
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
-
-mod common;
 
 const SIZE: u32 = 256;
 const MAP: &str = "heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png";
@@ -85,13 +82,8 @@ fn setup(
     mut standard: ResMut<Assets<StandardMaterial>>,
     mut images: ResMut<Assets<Image>>,
 ) {
-    let depth: Handle<Image> = assets
-        .load_builder()
-        .with_settings(|s: &mut ImageLoaderSettings| s.is_srgb = false)
-        .load(MAP);
-    let plane = Mesh::from(Plane3d::new(Vec3::Y, Vec2::splat(0.5)))
-        .with_generated_tangents()
-        .expect("the plane has normals and uvs");
+    let depth = crate::common::height_map(&assets, MAP);
+    let plane = crate::common::unit_plane();
     let material = |scale| PyramidMaterial {
         base: StandardMaterial::default(),
         extension: PyramidExtension::new(depth.clone(), scale),
@@ -189,7 +181,7 @@ fn measure(app: &mut App, shown: Shown, in_view: bool, frames: usize, path: &str
 #[test]
 #[ignore = "a benchmark: about two minutes on lavapipe"]
 fn prepass_and_shadow_cost_over_the_flat_polygon() {
-    let mut app = common::headless_app(|app| {
+    let mut app = crate::common::headless_app(|app| {
         app.insert_resource(DirectionalLightShadowMap {
             size: SIZE as usize,
         })

@@ -4,6 +4,7 @@
 //! truth's hit; and the lit picture drawn wherever the prepass drew (the main pass's traced depth
 //! equals the prepass's).
 
+use crate::common::{ANGLES_DEG, MAPS, eye, height_map, unit_plane};
 use bevy::asset::uuid_handle;
 use bevy::camera::RenderTarget;
 use bevy::camera::visibility::RenderLayers;
@@ -12,7 +13,6 @@ use bevy::core_pipeline::prepass::{
 };
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::image::ImageLoaderSettings;
 use bevy::material::OpaqueRendererMethod;
 use bevy::pbr::DefaultOpaqueRendererMethod;
 use bevy::prelude::*;
@@ -38,15 +38,8 @@ use quadray_displace::pyramid::Addressing;
 use quadray_displace::reference::{Ray, Surface, bilinear_depth, intersect};
 use std::sync::{Arc, Mutex};
 
-mod common;
-
 const SIZE: u32 = 64;
 const DEPTH_SCALE: f32 = 0.1;
-const ANGLES_DEG: [f32; 3] = [0.0, 60.0, 80.0];
-const MAPS: [&str; 2] = [
-    "heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png",
-    "heightmaps/bevy_parallax/cube_depth.png",
-];
 const CLEAR: Color = Color::srgb(1.0, 0.0, 1.0);
 /// Where the depth is right, the normal may be this far off the height field's (degrees): the
 /// G-buffer's 24-bit normal, Rgb10a2's and hits a fraction of a texel apart.
@@ -114,11 +107,6 @@ struct View {
 #[derive(Resource)]
 struct Views(Vec<View>);
 
-fn eye(angle_deg: f32) -> Vec3 {
-    let (sin, cos) = angle_deg.to_radians().sin_cos();
-    Vec3::new(0.0, 1.1 * cos, 1.1 * sin)
-}
-
 fn setup(
     mut commands: Commands,
     assets: Res<AssetServer>,
@@ -127,16 +115,10 @@ fn setup(
     mut images: ResMut<Assets<Image>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    let plane = Mesh::from(Plane3d::new(Vec3::Y, Vec2::splat(0.5)))
-        .with_generated_tangents()
-        .expect("the plane has normals and uvs");
-    let plane = meshes.add(plane);
+    let plane = meshes.add(unit_plane());
     let mut views = Vec::new();
     for (map, path) in MAPS.iter().enumerate() {
-        let depth: Handle<Image> = assets
-            .load_builder()
-            .with_settings(|s: &mut ImageLoaderSettings| s.is_srgb = false)
-            .load(*path);
+        let depth = height_map(&assets, path);
         for angle_deg in ANGLES_DEG {
             for pass in [Pass::Forward, Pass::Deferred] {
                 let layer = RenderLayers::layer(views.len() + 1);
@@ -278,7 +260,7 @@ fn probe_pass(
 }
 
 fn app() -> App {
-    common::headless_app(|app| {
+    crate::common::headless_app(|app| {
         let _ = app
             .world_mut()
             .resource_mut::<Assets<Shader>>()
@@ -498,7 +480,10 @@ fn prepass_and_gbuffer_hold_the_traced_surface() {
 #[test]
 fn the_prepasses_pass_the_validation_layer() {
     let mut rerun = std::process::Command::new(std::env::current_exe().unwrap());
-    rerun.args(["--exact", "prepass_and_gbuffer_hold_the_traced_surface"]);
+    rerun.args([
+        "--exact",
+        "prepass::prepass_and_gbuffer_hold_the_traced_surface",
+    ]);
     if let Err(problem) = quadray_gpu::validation::run_under_layer(&mut rerun, "the prepass test") {
         panic!("{problem}");
     }

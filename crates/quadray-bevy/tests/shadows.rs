@@ -20,8 +20,6 @@ use quadray_displace::pyramid::Addressing;
 use quadray_displace::reference::{Ray, Surface, intersect};
 use std::sync::{Arc, Mutex};
 
-mod common;
-
 const SIZE: u32 = 64;
 const MAP: u32 = 64;
 /// The patch is 1 x 1 at this height over the floor, its depth scale (uv units per unit of
@@ -77,9 +75,7 @@ fn setup(
         TextureFormat::R8Unorm,
         RenderAssetUsages::all(),
     ));
-    let patch = Mesh::from(Plane3d::new(Vec3::Y, Vec2::splat(0.5)))
-        .with_generated_tangents()
-        .expect("the plane has normals and uvs");
+    let patch = crate::common::unit_plane();
     let mut extension = PyramidExtension::new(map, DEPTH_SCALE);
     extension.lod = false;
     extension.clamp_to_map = true;
@@ -145,7 +141,7 @@ fn setup(
 }
 
 fn app() -> App {
-    common::headless_app(|app| {
+    crate::common::headless_app(|app| {
         app.insert_resource(DirectionalLightShadowMap { size: 512 })
             .insert_resource(GlobalAmbientLight::NONE)
             .add_plugins(PyramidDisplacementPlugin)
@@ -273,7 +269,10 @@ fn the_displaced_surface_casts_its_traced_shadow() {
 #[test]
 fn the_shadow_pass_passes_the_validation_layer() {
     let mut rerun = std::process::Command::new(std::env::current_exe().unwrap());
-    rerun.args(["--exact", "the_displaced_surface_casts_its_traced_shadow"]);
+    rerun.args([
+        "--exact",
+        "shadows::the_displaced_surface_casts_its_traced_shadow",
+    ]);
     if let Err(problem) = quadray_gpu::validation::run_under_layer(&mut rerun, "the shadow test") {
         panic!("{problem}");
     }

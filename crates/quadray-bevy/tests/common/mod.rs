@@ -1,5 +1,6 @@
 //! A headless Bevy app for the tests: Bevy's default plugins reading the repository's assets, no
-//! window, and `plugin` with the test's systems added before the renderer starts.
+//! window, and `plugin` with the test's systems added before the renderer starts; and what the
+//! material's tests share: the height maps and angles they trace, the unit plane they displace.
 
 use bevy::app::PluginsState;
 use bevy::prelude::*;
@@ -7,6 +8,35 @@ use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 
 pub const ASSETS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets");
+
+/// The material tests' view angles off the plane's normal (degrees).
+pub const ANGLES_DEG: [f32; 3] = [0.0, 60.0, 80.0];
+/// The material tests' height maps: a tile map and Bevy's own parallax example's.
+pub const MAPS: [&str; 2] = [
+    "heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png",
+    "heightmaps/bevy_parallax/cube_depth.png",
+];
+
+/// The camera of a view `angle_deg` off the unit plane's normal, 1.1 from its centre.
+pub fn eye(angle_deg: f32) -> Vec3 {
+    let (sin, cos) = angle_deg.to_radians().sin_cos();
+    Vec3::new(0.0, 1.1 * cos, 1.1 * sin)
+}
+
+/// The unit plane facing +y with the tangents the material's trace needs.
+pub fn unit_plane() -> Mesh {
+    Mesh::from(Plane3d::new(Vec3::Y, Vec2::splat(0.5)))
+        .with_generated_tangents()
+        .expect("the plane has normals and uvs")
+}
+
+/// A height map loaded as linear data (not sRGB).
+pub fn height_map(assets: &AssetServer, path: &'static str) -> Handle<Image> {
+    assets
+        .load_builder()
+        .with_settings(|s: &mut bevy::image::ImageLoaderSettings| s.is_srgb = false)
+        .load(path)
+}
 
 /// The app with `add` applied (plugins, resources, systems), ready to `update`.
 pub fn headless_app(add: impl FnOnce(&mut App)) -> App {

@@ -1,0 +1,10 @@
+//! quadray-bevy's tests in a real Bevy app, headless on lavapipe, one module per file, linked as
+//! one binary (each test binary links Bevy). One file's tests:
+//! `cargo test --release -p quadray-bevy --test suite -- gi::`.
+
+mod common;
+mod gi;
+mod hits;
+mod pass_cost;
+mod prepass;
+mod shadows;
