@@ -5,8 +5,9 @@
 //! counts the plugin reports to Bevy's diagnostics against quadray's own, and the plugin's cut
 //! view against quadray's picture of the same cut; and a still camera whose G-buffer fills later.
 
-use bevy::camera::RenderTarget;
 use bevy::camera::visibility::RenderLayers;
+use bevy::camera::{Hdr, RenderTarget};
+use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::gltf::GltfAssetLabel;
@@ -422,11 +423,43 @@ fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
     );
 }
 
-/// What a Bevy user may get wrong (MSAA on, which Bevy turns off on a deferred camera; an RSM
-/// size that is not a power of two; no spot light marked as the source) is a warning in the log:
-/// the app keeps running and Bevy's own light still draws the picture.
+/// What a Bevy user may get wrong (MSAA on, which Bevy itself turns off on a deferred camera with
+/// its own warning; an RSM size that is not a power of two; no light marked as the source) is a
+/// warning in the log that names the fix, and each such camera's picture is Bevy's own: the same as a camera with the same
+/// prepasses, MSAA and HDR but no `IndirectLight`. Run in a child process, whose log is read.
 #[test]
 fn misconfigured_cameras_keep_bevy_s_picture() {
+    let output = std::process::Command::new(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "gi::misconfigured_cameras_beside_plain_ones",
+            "--ignored",
+            "--nocapture",
+        ])
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{log}");
+    for warning in [
+        "MSAA is incompatible with deferred rendering and has been disabled",
+        "its settings are refused: RSM size 100 must be a power of two",
+        "no light has IndirectLightSource; add that component to the DirectionalLight, \
+         PointLight or SpotLight",
+    ] {
+        assert!(
+            log.contains(warning),
+            "the log does not say {warning:?}:\n{log}"
+        );
+    }
+}
+
+/// The app [`misconfigured_cameras_keep_bevy_s_picture`] reads the log of: two misconfigured
+/// cameras with the plugin, each beside a camera that differs only in having no `IndirectLight`;
+/// each pair's pictures are equal, byte for byte.
+#[test]
+#[ignore = "run by misconfigured_cameras_keep_bevy_s_picture in a child process, which reads its log"]
+fn misconfigured_cameras_beside_plain_ones() {
     let mut app = crate::common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .add_plugins(IndirectLightPlugin);
@@ -437,7 +470,7 @@ fn misconfigured_cameras_keep_bevy_s_picture() {
         image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
         image
     };
-    let pictures: Vec<Handle<Image>> = (0..2)
+    let pictures: Vec<Handle<Image>> = (0..4)
         .map(|_| world.resource_mut::<Assets<Image>>().add(target()))
         .collect();
     world.spawn(WorldAssetRoot(
@@ -446,27 +479,37 @@ fn misconfigured_cameras_keep_bevy_s_picture() {
             .load(GltfAssetLabel::Scene(0).from_asset(SCENE)),
     ));
     let view = Transform::from_translation(EYE.into()).looking_at(TARGET.into(), Vec3::Y);
-    // MSAA left on; and an RSM of 100 texels a side
-    world.spawn((
-        Camera3d::default(),
-        view,
-        Msaa::Sample4,
-        RenderTarget::Image(pictures[0].clone().into()),
-        IndirectLight::default(),
-    ));
-    world.spawn((
-        Camera3d::default(),
-        view,
-        Msaa::Off,
-        RenderTarget::Image(pictures[1].clone().into()),
-        IndirectLight {
-            settings: Settings {
-                rsm_size: 100,
-                ..Settings::DEFAULT
-            },
-            ..default()
+    // MSAA left on; and an RSM of 100 texels a side; each beside a camera without the plugin
+    let bad_rsm = IndirectLight {
+        settings: Settings {
+            rsm_size: 100,
+            ..Settings::DEFAULT
         },
-    ));
+        ..default()
+    };
+    for (i, (msaa, gi)) in [
+        (Msaa::Sample4, Some(IndirectLight::default())),
+        (Msaa::Off, Some(bad_rsm)),
+        (Msaa::Sample4, None),
+        (Msaa::Off, None),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        // what IndirectLight requires, on the plain cameras too
+        let mut camera = world.spawn((
+            Camera3d::default(),
+            view,
+            msaa,
+            RenderTarget::Image(pictures[i].clone().into()),
+            DepthPrepass,
+            DeferredPrepass,
+            Hdr,
+        ));
+        if let Some(gi) = gi {
+            camera.insert(gi);
+        }
+    }
     let reads: Vec<Arc<Mutex<Option<Vec<u8>>>>> = pictures
         .iter()
         .map(|picture| {
@@ -480,7 +523,7 @@ fn misconfigured_cameras_keep_bevy_s_picture() {
             read
         })
         .collect();
-    // no spot is marked: the file's spot lights the scene as Bevy lights it, nothing more
+    // no light is marked: the file's spot lights the scene as Bevy lights it, nothing more
     let lit = |read: &Arc<Mutex<Option<Vec<u8>>>>| {
         read.lock()
             .unwrap()
@@ -492,6 +535,20 @@ fn misconfigured_cameras_keep_bevy_s_picture() {
         assert!(frames < 500, "no picture after {frames} frames");
         app.update();
         frames += 1;
+    }
+    for _ in 0..3 {
+        app.update();
+    }
+    let picture = |i: usize| reads[i].lock().unwrap().clone().unwrap();
+    for (with, without) in [(0, 2), (1, 3)] {
+        let (a, b) = (picture(with), picture(without));
+        let differing = a
+            .chunks_exact(4)
+            .zip(b.chunks_exact(4))
+            .filter(|(x, y)| x != y)
+            .count();
+        println!("misconfigured camera {with}: {differing} pixels differ from Bevy's own");
+        assert_eq!(differing, 0, "camera {with}'s picture is not Bevy's own");
     }
 }
 

@@ -614,6 +614,13 @@ fn prepare_views(
             width: size.x,
             height: size.y,
         };
+        if let Err(e) = settings.validate() {
+            warn(format!(
+                "its settings are refused: {e}; no indirect light is added"
+            ));
+            commands.entity(entity).remove::<ViewPasses>();
+            continue;
+        }
         // one set of light quadtrees serves every camera: made by the first camera's settings
         if settings.rsm_size != l.rsm_size
             || settings.max_lights != l.max_lights
