@@ -119,7 +119,8 @@ fn configure(
     probes: Res<Probes>,
 ) {
     for light in &lights {
-        commands.entity(light).insert(IndirectLightSource);
+        // (a test may despawn the light this frame)
+        commands.entity(light).try_insert(IndirectLightSource);
     }
     for (entity, projection) in &cameras {
         // the file's camera: replaced by the probes'
@@ -421,6 +422,46 @@ fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
         plugin_error <= 1.5 * quadray_error.max(1e-3),
         "{plugin_error} vs {quadray_error}"
     );
+}
+
+/// Takes every spot light out of the scene (the file's), each frame.
+fn no_spots(mut commands: Commands, spots: Query<Entity, With<SpotLight>>) {
+    for spot in &spots {
+        commands.entity(spot).despawn();
+    }
+}
+
+/// A point light inside the box (marked by `configure` as every light is).
+fn point_light() -> (PointLight, Transform) {
+    (PointLight::default(), Transform::from_xyz(0.7, 0.6, 0.6))
+}
+
+/// The marked spot despawned and a point light spawned in its stead: after a few frames the
+/// bounce is the one a fresh app with the point light alone gathers, nothing of the spot's left
+/// (the light's RSM views go from one to six and every camera's gather is made anew).
+#[test]
+fn a_light_replaced_by_another_kind_lights_as_in_a_fresh_app() {
+    let cases = [(Method::Reference, true, false)];
+    let mut switched = app(SCENE, &cases);
+    let (probes, spot) = gathered(&mut switched);
+    switched.add_systems(Update, no_spots);
+    switched.world_mut().spawn(point_light());
+    for _ in 0..10 {
+        switched.update();
+    }
+    let after = floats(probes[0].read_indirect.lock().unwrap().as_ref().unwrap());
+    let mut fresh = app(SCENE, &cases);
+    fresh.add_systems(Update, no_spots);
+    fresh.world_mut().spawn(point_light());
+    let (_, alone) = gathered(&mut fresh);
+    let stale = compare(&after, &alone[0]);
+    let changed = compare(&spot[0], &alone[0]);
+    println!("switched to a point light against a fresh app's: {stale:?}; the spot's: {changed:?}");
+    assert!(
+        changed.rel_l1 > 0.1,
+        "the two lights bounce alike: {changed:?}"
+    );
+    assert!(stale.rel_l1 < 1e-5, "{stale:?}");
 }
 
 /// What a Bevy user may get wrong (MSAA on, which Bevy itself turns off on a deferred camera with
