@@ -175,9 +175,9 @@ pub fn render_demo(
 }
 
 /// A scene lit by other lights than a spot (`scenes_dir()/NAME.toml`): the direct light, with the
-/// default method's bounce, and with the bounce from every VPL with exact visibility (the ground
-/// truth; a 32^2 RSM a light view keeps it to seconds), the indirect light of both with its FLIP
-/// and the error heat map.
+/// default method's bounce (indirect shadows on), and with the bounce from every VPL with exact
+/// visibility (the ground truth; a 32^2 RSM a light view keeps it to seconds); below, the
+/// method's bounce with its FLIP, the true bounce and the error heat map.
 fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join(format!("{name}.toml")))?;
     let (w, h) = (size * 4 / 3, size);
@@ -195,15 +195,13 @@ fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathB
     }
     .combined();
     let flip = flip_against(&frame, &truth, EXPOSURE);
+    // (short captions: the demo's smallest pictures are 128 pixels wide)
     let pictures = [
         ("direct".into(), tile(&frame.direct)),
-        (
-            format!("+ {}, shadows", Method::DEFAULT),
-            tile(&frame.combined()),
-        ),
-        ("+ ground truth".into(), tile(&with_truth)),
-        (format!("indirect, FLIP {flip:.3}"), tile(&frame.indirect)),
-        ("indirect, ground truth".into(), tile(&truth)),
+        ("+ bounce".into(), tile(&frame.combined())),
+        ("+ true bounce".into(), tile(&with_truth)),
+        (format!("FLIP {flip:.3}"), tile(&frame.indirect)),
+        ("true bounce".into(), tile(&truth)),
         (
             "error".into(),
             heat_map(w, h, &error_map(&frame.indirect, &truth), 0.5),
