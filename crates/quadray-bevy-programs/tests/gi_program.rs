@@ -31,12 +31,19 @@ fn screenshot(dir: &Path, name: &str, extra: &[&str]) -> image::RgbaImage {
 fn the_gi_program_adds_the_bounce_to_its_headless_picture() {
     let dir = std::env::temp_dir().join(format!("quadray-bevy-gi-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    // Both at once: each mostly waits on its own frames.
-    let (lit, unlit) = std::thread::scope(|s| {
+    // At once: each mostly waits on its own frames. The Cornell box's one light is a spot: with
+    // only point lights giving the bounce, none does.
+    let (lit, unlit, no_source) = std::thread::scope(|s| {
         let lit = s.spawn(|| screenshot(&dir, "bounce", &["--method", "reference"]));
         let unlit = s.spawn(|| screenshot(&dir, "no-bounce", &["--no-gi"]));
-        (lit.join().unwrap(), unlit.join().unwrap())
+        let no_source = s.spawn(|| screenshot(&dir, "no-source", &["--gi-lights", "point"]));
+        let join = |h: std::thread::ScopedJoinHandle<'_, image::RgbaImage>| h.join().unwrap();
+        (join(lit), join(unlit), join(no_source))
     });
+    assert!(
+        no_source == unlit,
+        "--gi-lights point marked the Cornell box's spot"
+    );
     assert_eq!(lit.dimensions(), (64, 64));
     assert_eq!(unlit.dimensions(), (64, 64));
     let luma = |p: &image::Rgba<u8>| p.0[..3].iter().map(|&c| u32::from(c)).sum::<u32>();
@@ -100,4 +107,8 @@ fn the_gi_program_renders_a_users_gltf_and_refuses_what_it_cannot_use() {
     );
     refused(&["--size", "0x64"], "--size");
     refused(&["--frames", "5"], "--screenshot");
+    refused(
+        &["--gi-lights", "area"],
+        "invalid value 'area' for '--gi-lights",
+    );
 }

@@ -8,7 +8,8 @@
 //! `cargo run --release --bin quadray-bevy-gi` (`--bin`, not `-p`: Cargo then resolves features
 //! as for the whole workspace, and what the test build compiled is reused).
 //! `--scene PATH` shows a glTF or GLB scene of your own instead (its camera and its punctual
-//! lights; `assets/scenes/cornell_lights.gltf` has all three kinds). Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
+//! lights; `assets/scenes/cornell_lights.gltf` has all three kinds); `--gi-lights spot,point`
+//! lets only those kinds give the bounce (default: all three). Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
 //! [--cut-view] [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the
 //! light still and saves the picture. `--frames N` (with `--screenshot`) times N frames with the
 //! light turning and prints their median and Bevy's render diagnostics of the bounce (GPU time of
@@ -90,7 +91,23 @@ struct Args {
     /// The RSM's side, a power of two.
     #[arg(long, default_value_t = 128, value_parser = Settings::parse_rsm_size)]
     rsm_size: u32,
+    /// The kinds of the scene's lights that give the bounce, comma-separated (the others light
+    /// the scene directly only).
+    #[arg(long, value_delimiter = ',', default_values = ["directional", "point", "spot"])]
+    gi_lights: Vec<GiLight>,
 }
+
+/// A kind of light `--gi-lights` names.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum GiLight {
+    Directional,
+    Point,
+    Spot,
+}
+
+/// The kinds of light marked as the bounce's sources.
+#[derive(Resource)]
+struct GiLights(Vec<GiLight>);
 
 /// The scene file under the asset root.
 #[derive(Resource, Clone)]
@@ -122,6 +139,7 @@ fn main() {
     app.insert_resource(DefaultOpaqueRendererMethod::deferred())
         .add_plugins(IndirectLightPlugin)
         .insert_resource(shown)
+        .insert_resource(GiLights(args.gi_lights.clone()))
         .insert_resource(SceneFile(scene))
         .add_systems(Startup, setup)
         .add_systems(Update, (configure, keys, turn_light, show_title).chain())
@@ -172,17 +190,25 @@ type NewLight = (
 );
 
 /// A camera where the file's is (that one turned off) gets the bounce (deferred, no MSAA, by
-/// default a 128^2 RSM: interactive on a CPU rasteriser too); the file's lights are marked as its
-/// sources. A refused RSM size is Bevy's log's warning, as for any app.
+/// default a 128^2 RSM: interactive on a CPU rasteriser too); the file's lights of the kinds
+/// `--gi-lights` names are marked as its sources. A refused RSM size is Bevy's log's warning, as for any app.
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Transform, &Projection), FileCamera>,
-    lights: Query<Entity, NewLight>,
+    lights: Query<(Entity, Has<DirectionalLight>, Has<PointLight>), NewLight>,
+    gi_lights: Res<GiLights>,
     offscreen: Option<Res<Offscreen>>,
     shown: Res<Shown>,
 ) {
-    for light in &lights {
-        commands.entity(light).insert(IndirectLightSource);
+    for (light, directional, point) in &lights {
+        let kind = match (directional, point) {
+            (true, _) => GiLight::Directional,
+            (_, true) => GiLight::Point,
+            _ => GiLight::Spot,
+        };
+        if gi_lights.0.contains(&kind) {
+            commands.entity(light).insert(IndirectLightSource);
+        }
     }
     for (file_camera, transform, projection) in &cameras {
         commands.entity(file_camera).insert(Camera {
