@@ -464,8 +464,8 @@ impl Light {
         Self { kind, ..*self }
     }
 
-    /// The one check of a light, whichever technique renders it: finite, not negative, a
-    /// direction that is not zero, a valid cone.
+    /// The one check of a light, whichever technique renders it: finite, not negative, within
+    /// the coordinates a mesh may have, a direction that is not zero, a valid cone.
     pub fn validate(&self) -> Result<(), String> {
         let (Intensity::Native(i) | Intensity::Photometric(i)) = self.intensity;
         let what = self.describe();
@@ -481,6 +481,15 @@ impl Light {
             {
                 Err(format!("{what}: position is not finite"))
             }
+            // as far as a mesh's vertices may be: beyond, f32 projections lose the scene
+            LightKind::Point { position } | LightKind::Spot { position, .. }
+                if position.abs().max_element() > crate::mesh::MAX_COORDINATE =>
+            {
+                Err(format!(
+                    "{what}: position is beyond {} in a coordinate",
+                    crate::mesh::MAX_COORDINATE
+                ))
+            }
             LightKind::Spot { cone, .. } => cone.validate().map_err(|e| format!("{what}: {e}")),
             LightKind::Directional { direction } => {
                 check_direction(direction).map_err(|e| format!("{what}: {e}"))
@@ -491,12 +500,11 @@ impl Light {
 
     /// "point light at (x, y, z)", "directional light along (x, y, z)": the light in messages.
     pub fn describe(&self) -> String {
-        match (self.position(), self.kind) {
-            (Some(p), _) => format!("{} light at {p}", self.kind_name()),
-            (None, LightKind::Directional { direction }) => {
-                format!("directional light along {direction}")
+        match self.kind {
+            LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                format!("{} light at {position}", self.kind_name())
             }
-            (None, _) => unreachable!("only a directional light has no position"),
+            LightKind::Directional { direction } => format!("directional light along {direction}"),
         }
     }
 }

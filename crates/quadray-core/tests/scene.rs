@@ -302,6 +302,10 @@ fn toml_lights_are_points_spots_or_the_sun_by_their_fields() {
         ("direction = [0, 0, 0]\nintensity = [1, 1, 1]", "direction"),
         ("position = [0, 1, 0]\nlux = [1, 1, 1]", "`candela`"),
         (
+            "position = [1e30, 0, 0]\nintensity = [1, 1, 1]",
+            "position is beyond",
+        ),
+        (
             "direction = [0, -1, 0]\ncone_deg = 30\nintensity = [1, 1, 1]",
             "give a `position`",
         ),

@@ -71,19 +71,6 @@ impl LightView {
             .collect()
     }
 
-    /// How many views the lights make (a point light six, the others one).
-    pub fn count(lights: &[Light]) -> usize {
-        lights.iter().map(|l| Self::per_light(l.kind)).sum()
-    }
-
-    /// Views a light of this kind makes.
-    pub fn per_light(kind: LightKind) -> usize {
-        match kind {
-            LightKind::Point { .. } => CUBE_FACES.len(),
-            LightKind::Spot { .. } | LightKind::Directional { .. } => 1,
-        }
-    }
-
     /// `light` (its intensity radiometric: [`crate::scene::Intensity::radiometric`]) over
     /// geometry within `bounds` (min, max): for a renderer that keeps its own scene. A
     /// directional light's map is fitted to the bounds, not to the camera's view: a moving
