@@ -52,6 +52,8 @@ struct Probes(Vec<Probe>);
 struct Setup {
     scene: &'static str,
     cases: Vec<Case>,
+    /// Every camera's settings.
+    settings: Settings,
 }
 
 /// Method, bounce on, cut view on.
@@ -117,6 +119,7 @@ fn configure(
     cameras: Query<(Entity, &Projection), FileCamera>,
     lights: Query<Entity, Unmarked>,
     probes: Res<Probes>,
+    setup: Res<Setup>,
 ) {
     for light in &lights {
         // (a test may despawn the light this frame)
@@ -137,7 +140,7 @@ fn configure(
                 Tonemapping::None,
                 Msaa::Off,
                 IndirectLight {
-                    settings: Settings::sized(SIZE, SIZE, RSM),
+                    settings: setup.settings.clone(),
                     method: p.method,
                     enabled: p.enabled,
                     cut_view: p.cut_view,
@@ -150,11 +153,16 @@ fn configure(
 }
 
 fn app(scene: &'static str, cases: &[Case]) -> App {
+    app_with(scene, cases, Settings::sized(SIZE, SIZE, RSM))
+}
+
+fn app_with(scene: &'static str, cases: &[Case], settings: Settings) -> App {
     crate::common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .insert_resource(Setup {
                 scene,
                 cases: cases.to_vec(),
+                settings,
             })
             .add_plugins((IndirectLightPlugin, RenderDiagnosticsPlugin))
             .add_systems(Startup, setup)
@@ -233,10 +241,18 @@ fn gathered(app: &mut App) -> (Vec<Probe>, Vec<Vec<[f32; 3]>>) {
 
 /// quadray's renderer on `file`, from the tests' camera, at the tests' sizes.
 fn quadray_renderer<'g>(gpu: &'g quadray_gpu::Gpu, file: &str) -> (Scene, Renderer<'g>) {
+    quadray_renderer_with(gpu, file, Settings::sized(SIZE, SIZE, RSM))
+}
+
+fn quadray_renderer_with<'g>(
+    gpu: &'g quadray_gpu::Gpu,
+    file: &str,
+    settings: Settings,
+) -> (Scene, Renderer<'g>) {
     let mut scene = Scene::load(&std::path::Path::new(ASSETS).join(file)).unwrap();
     scene.camera.position = EYE.into();
     scene.camera.target = TARGET.into();
-    let renderer = Renderer::new(gpu, &scene, Settings::sized(SIZE, SIZE, RSM)).unwrap();
+    let renderer = Renderer::new(gpu, &scene, settings).unwrap();
     (scene, renderer)
 }
 
@@ -422,6 +438,47 @@ fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
         plugin_error <= 1.5 * quadray_error.max(1e-3),
         "{plugin_error} vs {quadray_error}"
     );
+}
+
+/// Indirect shadows in the plugin walk the occupancy grid of the scene's triangles as quadray's
+/// renderer does: on the Cornell box, the plugin's shadowed bounce (the one cut and the per-tile
+/// cuts) is quadray's, far closer to it than quadray's without shadows or with the depth maps
+/// marched instead of the grid.
+#[test]
+fn plugin_s_indirect_shadows_are_quadray_s() {
+    let shadowed = Settings {
+        indirect_shadows: true,
+        ..Settings::sized(SIZE, SIZE, RSM)
+    };
+    let cases = [
+        (Method::Quadtree, true, false),
+        (Method::DEFAULT, true, false),
+    ];
+    let mut app = app_with(SCENE, &cases, shadowed.clone());
+    let (_, indirect) = gathered(&mut app);
+    let gpu = quadray_gpu::Gpu::new().expect("an adapter (scripts/setup.sh installs lavapipe)");
+    let marched = Settings {
+        shadow_grid: 0,
+        ..shadowed.clone()
+    };
+    let render = |settings: &Settings, method| {
+        let (_, mut r) = quadray_renderer_with(&gpu, SCENE, settings.clone());
+        in_candela(r.render_frame(method).unwrap().indirect)
+    };
+    for (i, method) in [Method::Quadtree, Method::DEFAULT].into_iter().enumerate() {
+        let grid = render(&shadowed, method);
+        let plugin = compare(&indirect[i], &grid).rel_l1;
+        let plain = compare(&render(&Settings::sized(SIZE, SIZE, RSM), method), &grid).rel_l1;
+        let march = compare(&render(&marched, method), &grid).rel_l1;
+        println!(
+            "{}: plugin's shadowed bounce against quadray's {plugin:.4}; quadray's without shadows {plain:.4}, with the depth maps marched {march:.4}",
+            method.name()
+        );
+        assert!(
+            plugin <= 0.25 * plain.min(march),
+            "{plugin} {plain} {march}"
+        );
+    }
 }
 
 /// Takes every spot light out of the scene (the file's), each frame.

@@ -277,13 +277,21 @@ mod tests {
                 proptest::option::of(u(Settings::TILE_CAPACITY)),
                 f(Settings::TILE_SHARE, 0.0, 1000.0),
                 u(Settings::MAX_LIGHTS),
+                u(Settings::SHADOW_GRID),
             ),
         )
             .prop_map(
                 |(
                     ((w, h), rsm_log, start, limit, depth, normal, validity, flux_weighted),
                     (samples, rsm_radius, subsample, shadows, steps, thickness, temporal),
-                    (tile_error, tile_criterion, tile_capacity, tile_share, max_lights),
+                    (
+                        tile_error,
+                        tile_criterion,
+                        tile_capacity,
+                        tile_share,
+                        max_lights,
+                        shadow_grid,
+                    ),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
                     let start_level = start.map(|l| l.min(rsm_log));
@@ -311,6 +319,7 @@ mod tests {
                         indirect_shadows: shadows,
                         shadow_steps: steps,
                         shadow_thickness: thickness,
+                        shadow_grid,
                         temporal_weight: temporal,
                         tile_error,
                         tile_criterion,
@@ -351,6 +360,7 @@ mod tests {
             ("--samples", "0", Settings::SAMPLES.to_string()),
             ("--subsample", "65", Settings::SUBSAMPLE.to_string()),
             ("--shadow-steps", "0", Settings::SHADOW_STEPS.to_string()),
+            ("--shadow-grid", "513", Settings::SHADOW_GRID.to_string()),
             (
                 "--temporal-weight",
                 "0",

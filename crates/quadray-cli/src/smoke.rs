@@ -77,9 +77,15 @@ fn cases() -> Vec<Case> {
             }),
         });
     }
-    let variants: [(&str, IndirectMethod, Change); 2] = [
+    let variants: [(&str, IndirectMethod, Change); 3] = [
+        // the occupancy grid walked (the depth maps marched where it cannot tell)
         ("indirect-shadows", IndirectMethod::DEFAULT, |s| {
             s.indirect_shadows = true
+        }),
+        // the depth maps marched alone
+        ("indirect-shadows-march", IndirectMethod::Quadtree, |s| {
+            s.indirect_shadows = true;
+            s.shadow_grid = 0;
         }),
         ("indirect-subsample", IndirectMethod::Rsm, |s| {
             s.subsample = 2

@@ -24,6 +24,7 @@ pub mod baselines;
 pub mod blockiness;
 mod frame;
 pub mod gpu;
+pub mod occupancy;
 pub mod picture;
 pub mod reference;
 pub mod scene;

@@ -421,14 +421,14 @@ pub struct Settings {
         value_parser = Settings::SUBSAMPLE.parser(),
     ))]
     pub subsample: u32,
-    /// Indirect shadows (quadtree methods): march points between each receiver and cluster and
-    /// test them against the camera's and the light's depth (off in the paper). The per-tile
-    /// cuts march from each tile's four corner receivers only, and a pixel weighs each cluster
-    /// by the corners' visibility interpolated (a pixel off the corners' surface, across a
-    /// depth edge, marches its own).
+    /// Indirect shadows (quadtree methods): test each receiver's view of each cluster, walking
+    /// the scene's occupancy grid (--shadow-grid), or marching points against the camera's and
+    /// the light's depth (off in the paper). The per-tile cuts test from each tile's four
+    /// corner receivers only, and a pixel weighs each cluster by the corners' visibility
+    /// interpolated (a pixel off the corners' surface, across a depth edge, tests its own).
     #[cfg_attr(feature = "cli", arg(long))]
     pub indirect_shadows: bool,
-    /// Points marched per receiver and cluster with --indirect-shadows.
+    /// Points marched per receiver and cluster with --indirect-shadows and --shadow-grid 0.
     #[cfg_attr(feature = "cli", arg(
         long,
         default_value_t = Settings::DEFAULT.shadow_steps,
@@ -444,6 +444,18 @@ pub struct Settings {
         value_parser = Settings::SHADOW_THICKNESS.parser(),
     ))]
     pub shadow_thickness: f32,
+    /// Cells of the scene's occupancy grid along its longest side, which indirect shadows walk
+    /// from each receiver to each cluster, so that a wall, a shelf or a slab blocks whatever the
+    /// camera and the light see of it (built from the scene's triangles by quadray's renderer
+    /// and the Bevy plugin; another renderer gives the gather its own, `Gather::set_occupancy`);
+    /// 0: march the camera's and the light's depth maps instead (--shadow-steps,
+    /// --shadow-thickness).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.shadow_grid,
+        value_parser = Settings::SHADOW_GRID.parser(),
+    ))]
+    pub shadow_grid: u32,
     /// Weight of each frame's indirect light in a running average over frames (1: off), every
     /// method but the brute force: damps the cut's popping under a moving light (see
     /// BENCHMARKS.md). Reprojected through the camera's motion (points the last frame did not
@@ -506,6 +518,7 @@ impl Settings {
         indirect_shadows: false,
         shadow_steps: 8,
         shadow_thickness: 0.03,
+        shadow_grid: 64,
         temporal_weight: 1.0,
         tile_error: None,
         tile_criterion: TileCriterion::Estimate,
@@ -530,6 +543,8 @@ impl Settings {
     pub const SHADOW_STEPS: Limits<u32> = Limits::closed(1, 64);
     /// [`Settings::shadow_thickness`].
     pub const SHADOW_THICKNESS: Limits<f32> = Limits::above(0.0, 1.0);
+    /// [`Settings::shadow_grid`]: 512 cells a side take 17 MB.
+    pub const SHADOW_GRID: Limits<u32> = Limits::closed(0, 512);
     /// [`Settings::temporal_weight`].
     pub const TEMPORAL_WEIGHT: Limits<f32> = Limits::above(0.0, 1.0);
     /// [`Settings::tile_error`].
@@ -671,6 +686,7 @@ impl Settings {
         Self::SUBSAMPLE.check("subsample", s.subsample)?;
         Self::SHADOW_STEPS.check("shadow steps", s.shadow_steps)?;
         Self::SHADOW_THICKNESS.check("shadow thickness", s.shadow_thickness)?;
+        Self::SHADOW_GRID.check("shadow grid", s.shadow_grid)?;
         Self::TEMPORAL_WEIGHT.check("temporal weight", s.temporal_weight)?;
         if let Some(error) = s.tile_error {
             Self::TILE_ERROR.check("tile error", error)?;
@@ -711,6 +727,7 @@ impl Settings {
             ("--subsample", s.subsample.to_string()),
             ("--shadow-steps", s.shadow_steps.to_string()),
             ("--shadow-thickness", s.shadow_thickness.to_string()),
+            ("--shadow-grid", s.shadow_grid.to_string()),
             ("--temporal-weight", s.temporal_weight.to_string()),
             ("--tile-criterion", s.tile_criterion.to_string()),
             ("--tile-share", s.tile_share.to_string()),

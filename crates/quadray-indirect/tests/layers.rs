@@ -12,6 +12,7 @@ const LAYERS: &[&[&str]] = &[
     &["settings"],
     &["frame"],
     &["scene", "scene::builtin"],
+    &["occupancy"],
     &["baselines"],
     &["reference", "picture", "blockiness"],
     &["tile_cut"],
@@ -36,7 +37,11 @@ const LAYERS: &[&[&str]] = &[
     &["gpu::output"],
     &["gpu::renderer"],
     &["gpu"],
-    &["gpu::shader_tests", "gpu::bound_tests"],
+    &[
+        "gpu::shader_tests",
+        "gpu::bound_tests",
+        "gpu::occupancy_tests",
+    ],
     &[""],
 ];
 

@@ -77,13 +77,14 @@ fn assert_shadows_help(what: &str, plain: &Frame, shadowed: &Frame, truth: &[[f3
     before / after
 }
 
-/// Indirect shadows (marching against the camera's and the light's depth) bring the quadtree
-/// closer to the ground truth on the leak scene and the Cornell box, with the same cut, and so
-/// do the per-tile cuts' shadows marched from the tiles' corners. At the README's setting
-/// (128x128, a 64^2 RSM; per-tile cuts with the estimate criterion, far clusters shared at 2)
-/// the picture's mean FLIP to the truth falls READMEx with the one cut and the per-tile cuts
-/// (lavapipe, 2026-11-26); the bounds leave 10% for other adapters. Without the test of the
-/// segment crossing a seen surface's plane the leak scene's ratio is READMEx and fails.
+/// Indirect shadows (the occupancy grid walked from each receiver to each cluster, the depth
+/// maps marched where the grid cannot tell) bring the quadtree closer to the ground truth on the
+/// leak scene and the Cornell box, with the same cut, and so do the per-tile cuts' shadows
+/// tested from the tiles' corners. At the README's setting (128x128, a 64^2 RSM; per-tile cuts
+/// with the estimate criterion, far clusters shared at 2) the picture's mean FLIP to the truth
+/// falls READMEx or more with the one cut and the per-tile cuts (lavapipe, 2026-11-27: leak
+/// 8.5x and 7.9x, Cornell box 3.4x and 2.6x); the bounds leave 10% for other adapters. With the
+/// depth maps marched alone (`shadow_grid` 0) the leak scene's ratios are 4.5x and 4.9x and fail.
 #[test]
 fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
@@ -93,7 +94,7 @@ fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
         tile_share: 2.0,
         ..Settings::sized(128, 128, 64)
     };
-    for (file, readme_flip) in [("leak.toml", 4.5), ("cornell.toml", 2.2)] {
+    for (file, readme_flip) in [("leak.toml", 7.9), ("cornell.toml", 2.6)] {
         let scene = Scene::load(&scenes_dir().join(file)).unwrap();
         // the same RSM and G-buffer for every frame and the truth
         let mut plain = Renderer::new(&gpu, &scene, tiled.clone()).unwrap();

@@ -24,6 +24,7 @@ use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery
 use bevy::render::storage::GpuShaderBuffer;
 use bevy::render::view::{ExtractedView, ViewTarget};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
+use quadray_indirect::occupancy::OccupancyGrid;
 use quadray_indirect::scene::Light;
 use quadray_indirect::{FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, RsmPass, Settings};
 use quadray_indirect::{LightView, ViewMaps, scene::bounds_of};
@@ -277,6 +278,12 @@ struct LightPasses {
     light_views: Vec<LightView>,
     /// The RSMs, pyramids and cuts are to be recorded again (a light or the scene changed).
     stale: bool,
+    /// The scene's occupancy grid that indirect shadows walk, at the first camera's
+    /// [`Settings::shadow_grid`] cells (none without indirect shadows, or at 0 cells: the
+    /// gathers march the depth maps), and how many times it was made.
+    occupancy: Option<OccupancyGrid>,
+    occupancy_cells: u32,
+    occupancy_generation: u64,
 }
 
 impl LightPasses {
@@ -350,6 +357,9 @@ fn prepare_light(
         lights: Vec::new(),
         light_views: Vec::new(),
         stale: true,
+        occupancy: None,
+        occupancy_cells: 0,
+        occupancy_generation: 0,
     });
     let cluster = settings.cluster;
     for view in &mut l.views {
@@ -357,6 +367,18 @@ fn prepare_light(
             view.quadtree.set_cluster(&queue, cluster);
             l.stale = true;
         }
+    }
+    let cells = if settings.indirect_shadows {
+        settings.shadow_grid
+    } else {
+        0
+    };
+    if l.generation != scene.generation || l.occupancy_cells != cells {
+        // (rebuilt with every change of the scene: a few milliseconds for thousands of
+        // triangles at 64 cells)
+        l.occupancy = (cells > 0).then(|| OccupancyGrid::of_triangles(&scene.triangles, cells));
+        l.occupancy_cells = cells;
+        l.occupancy_generation += 1;
     }
     if l.generation != scene.generation {
         l.generation = scene.generation;
@@ -409,6 +431,8 @@ pub(super) struct ViewPasses {
     settings: Settings,
     /// The light's maps the gather reads ([`LightPasses::maps_generation`]).
     maps_generation: u64,
+    /// The occupancy grid the gather walks ([`LightPasses::occupancy_generation`]).
+    occupancy_generation: u64,
     format: TextureFormat,
     /// Position, normal, albedo.
     gbuffer: [wgpu::TextureView; 3],
@@ -432,6 +456,7 @@ pub(super) struct ViewPasses {
 impl ViewPasses {
     fn new(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         settings: Settings,
         light: &LightPasses,
         pipelines: &mut Pipelines,
@@ -462,7 +487,10 @@ impl ViewPasses {
             normal: &gbuffer[1],
             albedo: &gbuffer[2],
         };
-        let gather = Gather::new(device, &settings, &light.maps(), views)?;
+        let mut gather = Gather::new(device, &settings, &light.maps(), views)?;
+        if let Some(grid) = &light.occupancy {
+            gather.set_occupancy(device, queue, grid, views);
+        }
         let uniform = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -534,6 +562,7 @@ impl ViewPasses {
         Ok(Self {
             settings,
             maps_generation: light.maps_generation,
+            occupancy_generation: light.occupancy_generation,
             format,
             gbuffer,
             view_uniform,
@@ -562,13 +591,13 @@ type Views<'w, 's> = Query<
         &'static ExtractedCamera,
         &'static ViewTarget,
         Option<&'static ViewPrepassTextures>,
-        Option<&'static ViewPasses>,
+        Option<&'static mut ViewPasses>,
     ),
 >;
 
 fn prepare_views(
     mut commands: Commands,
-    views: Views,
+    mut views: Views,
     light: Res<LightState>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
@@ -577,7 +606,7 @@ fn prepare_views(
 ) {
     let Some(l) = light.0.as_ref() else { return };
     let device = device.wgpu_device();
-    for (entity, gi, view, camera, target, prepass, passes) in &views {
+    for (entity, gi, view, camera, target, prepass, passes) in &mut views {
         let mut warn = |message: String| {
             if warned.get(&entity) != Some(&message) {
                 warn!("quadray indirect light on camera {entity}: {message}");
@@ -643,11 +672,11 @@ fn prepare_views(
             continue;
         }
         let format = target.main_texture_format();
-        let current = |p: &&ViewPasses| {
+        let current = |p: &Mut<ViewPasses>| {
             p.settings == settings && p.format == format && p.maps_generation == l.maps_generation
         };
-        let Some(passes) = passes.filter(current) else {
-            match ViewPasses::new(device, settings, l, &mut pipelines, format) {
+        let Some(mut passes) = passes.filter(current) else {
+            match ViewPasses::new(device, &queue, settings, l, &mut pipelines, format) {
                 Ok(p) => {
                     commands.entity(entity).insert(p);
                 }
@@ -659,6 +688,19 @@ fn prepare_views(
             // the new passes start next frame
             continue;
         };
+        if passes.occupancy_generation != l.occupancy_generation {
+            let passes = &mut *passes;
+            let [position, normal, albedo] = &passes.gbuffer;
+            let views = GBufferViews {
+                position,
+                normal,
+                albedo,
+            };
+            if let Some(grid) = &l.occupancy {
+                passes.gather.set_occupancy(device, &queue, grid, views);
+            }
+            passes.occupancy_generation = l.occupancy_generation;
+        }
         let clip_from_world = view
             .clip_from_world
             .unwrap_or_else(|| view.clip_from_view * view.world_from_view.to_matrix().inverse());

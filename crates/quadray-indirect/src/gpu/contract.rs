@@ -4,6 +4,7 @@
 //! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
 //! shared struct's size and field offsets against these.
 
+use crate::occupancy::{END_OFFSET_CELLS, HEADER_WORDS};
 pub(crate) use crate::settings::{
     CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, TILE, TILE_FRONTIER,
 };
@@ -12,9 +13,11 @@ use wgpu::util::DeviceExt;
 
 /// Items (VPLs, clusters, samples) one dispatch of a per-pixel sum covers; longer sums take
 /// several dispatches that add up. lavapipe (llvmpipe) silently ends an invocation's loops after
-/// 65,535 iterations in all, which cut a 512^2 brute force to the RSM's top rows; on a GPU it
-/// keeps each dispatch short.
-pub(crate) const SLICE: u32 = 32768;
+/// 65,535 iterations in all, which cut a 512^2 brute force to the RSM's top rows, and an item
+/// counts more than once where loops are nested in the sum's body (the visibility test's two,
+/// even where they do not run: at 32,768 items the cut's sum over a million clusters stopped at
+/// two thirds); on a GPU it keeps each dispatch short.
+pub(crate) const SLICE: u32 = 16384;
 /// Nodes one dispatch of a per-level pass covers: each node's cut test climbs up to 10
 /// ancestors, so fewer nodes keep it under lavapipe's limit too.
 pub(crate) const LEVEL_SLICE: u32 = 2048;
@@ -51,13 +54,21 @@ pub(crate) fn prelude() -> String {
          const PI: f32 = {:?};\n\
          const OUTPUT_INDIRECT: u32 = {}u;\n\
          const OUTPUT_DIRECT: u32 = {}u;\n\
-         const OUTPUT_COMBINED: u32 = {}u;\n",
+         const OUTPUT_COMBINED: u32 = {}u;\n\
+         const OCCUPANCY_ROW: u32 = {OCCUPANCY_ROW}u;\n\
+         const OCCUPANCY_HEADER: u32 = {}u;\n\
+         const OCCUPANCY_END_OFFSET: f32 = {END_OFFSET_CELLS:?};\n",
         std::f32::consts::PI,
         OutputTerm::Indirect as u32,
         OutputTerm::Direct as u32,
         OutputTerm::Combined as u32,
+        HEADER_WORDS,
     )
 }
+
+/// Texels a row of the occupancy grid's texture (`OCCUPANCY_ROW`): a texture, not a storage
+/// buffer, as the most demanding gather pass binds as many storage buffers as it may.
+pub(crate) const OCCUPANCY_ROW: u32 = 1024;
 
 /// A shader's whole source: the prelude, then `parts` in order.
 pub(crate) fn shader_source(parts: &[&str]) -> String {
@@ -223,6 +234,20 @@ pub(crate) fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
         visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// An unsigned integer texture read with `textureLoad`.
+pub(crate) fn uint_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         },

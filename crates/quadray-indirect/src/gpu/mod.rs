@@ -19,6 +19,8 @@ mod contract;
 mod gather;
 mod gbuffer;
 mod light;
+#[cfg(test)]
+mod occupancy_tests;
 mod output;
 mod quadtree;
 mod renderer;

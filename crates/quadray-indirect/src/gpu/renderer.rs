@@ -10,6 +10,7 @@ use super::quadtree::LightQuadtree;
 use super::rsm::RsmPass;
 use crate::IndirectError;
 use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
+use crate::occupancy::OccupancyGrid;
 use crate::picture::{cut_view, cut_view_zoom};
 use crate::scene::Scene;
 use crate::settings::{ClusterSettings, Method, Settings, TILE};
@@ -80,7 +81,11 @@ impl<'g> Renderer<'g> {
                     quadtree: &v.quadtree,
                 })
                 .collect();
-            let gather = Gather::new(d, &settings, &maps, gbuffer.views())?;
+            let mut gather = Gather::new(d, &settings, &maps, gbuffer.views())?;
+            if settings.indirect_shadows && settings.shadow_grid > 0 {
+                let grid = OccupancyGrid::of_triangles(&scene.triangles, settings.shadow_grid);
+                gather.set_occupancy(d, q, &grid, gbuffer.views());
+            }
             let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("vertices"),
                 contents: bytemuck::cast_slice(&scene.triangles),

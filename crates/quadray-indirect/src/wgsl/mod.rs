@@ -81,6 +81,13 @@ pub const GATHER_VPLS: &str = include_str!("gather_vpls.wgsl");
 /// Needs [`NODE`], [`KERNEL`], [`CUT_RULE`]. Accessor: `load_node` (as [`CUT_RULE`]).
 pub const CUT_VIEW: &str = include_str!("cut_view.wgsl");
 
+/// Visibility through the scene's occupancy grid, `grid_visibility(x, n, xp, np)` (indirect
+/// shadows): a 3D DDA from a receiver to a cluster, each end moved two cells off its surface;
+/// the CPU's twin is [`crate::occupancy::OccupancyGrid::visible`]. Needs [`NODE`] (the fetch
+/// counter). Accessors: `fn occupancy_dims() -> vec3<u32>`, `fn occupancy_origin() -> vec3<f32>`,
+/// `fn occupancy_cell() -> f32`, `fn occupancy_word(i: u32) -> u32`.
+pub const OCCUPANCY: &str = include_str!("occupancy.wgsl");
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -106,9 +113,15 @@ fn tile_position(p: u32) -> vec3<f32> { return vec3<f32>(0.0); }
 fn tile_normal(p: u32) -> vec3<f32> { return vec3<f32>(0.0); }
 fn tile_sample(q: u32) -> u32 { return 0u; }
 ";
+    const OCCUPANCY_ACCESSORS: &str = "
+fn occupancy_dims() -> vec3<u32> { return vec3<u32>(0u); }
+fn occupancy_origin() -> vec3<f32> { return vec3<f32>(0.0); }
+fn occupancy_cell() -> f32 { return 1.0; }
+fn occupancy_word(i: u32) -> u32 { return 0u; }
+";
 
     /// Each module after the modules it needs, then the stub accessors it calls.
-    fn modules() -> [(&'static str, Vec<&'static str>); 11] {
+    fn modules() -> [(&'static str, Vec<&'static str>); 12] {
         [
             ("node", vec![NODE]),
             ("kernel", vec![NODE, KERNEL]),
@@ -158,6 +171,7 @@ fn tile_sample(q: u32) -> u32 { return 0u; }
                 "gather vpls",
                 vec![NODE, KERNEL, LIGHT, RECEIVER, GATHER_VPLS, RSM_ACCESSORS],
             ),
+            ("occupancy", vec![NODE, OCCUPANCY, OCCUPANCY_ACCESSORS]),
         ]
     }
 
@@ -175,6 +189,7 @@ fn tile_sample(q: u32) -> u32 { return 0u; }
             GATHER_LEVEL,
             GATHER_VPLS,
             CUT_VIEW,
+            OCCUPANCY,
         ];
         for module in all {
             assert!(

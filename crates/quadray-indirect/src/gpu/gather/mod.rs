@@ -25,6 +25,7 @@ use super::gbuffer::GBufferViews;
 use super::light::LightView;
 use super::quadtree::{LightQuadtree, node_count};
 use crate::IndirectError;
+use crate::occupancy::OccupancyGrid;
 use crate::settings::{Method, Settings};
 use brute_force::BruteForce;
 use cut::Cut;
@@ -162,6 +163,19 @@ impl Gather {
     pub fn bind_gbuffer(&mut self, device: &wgpu::Device, gbuffer: GBufferViews) {
         self.reset_history();
         self.res.bind_gbuffer(device, gbuffer);
+    }
+
+    /// Walks the scene's occupancy `grid` for indirect shadows from now on, instead of marching
+    /// the camera's and the light's depth maps (a gather starts without one); the frame's bind
+    /// group is made anew, hence the G-buffer's views.
+    pub fn set_occupancy(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        grid: &OccupancyGrid,
+        gbuffer: GBufferViews,
+    ) {
+        self.res.set_occupancy(device, queue, grid, gbuffer);
     }
 
     /// Sets the light views (per light update), in the order of the maps, and the clamp `r_min`

@@ -8,14 +8,15 @@
 use crate::baselines;
 use crate::gpu::contract::{
     CameraUniform, ClusterUniform, GpuNode, GpuNodeBounds, LevelSlot, LightTermsUniform,
-    LightUniform, MAX_SLICES, ShadeUniform, Slots, bind_group, compute_pipeline, dispatch_2d,
-    layout, pipeline_layout, shader_module, storage_buffer, storage_entry, tex, texture_entry,
-    uniform_buffer, uniform_entry, whole,
+    LightUniform, MAX_SLICES, OCCUPANCY_ROW, ShadeUniform, Slots, bind_group, compute_pipeline,
+    dispatch_2d, layout, pipeline_layout, shader_module, storage_buffer, storage_entry, tex,
+    texture_entry, uint_texture_entry, uniform_buffer, uniform_entry, whole,
 };
 use crate::gpu::gbuffer::{GBufferViews, camera_uniform};
 use crate::gpu::light::LightView;
 use crate::gpu::quadtree::LightQuadtree;
 use crate::gpu::rsm::RsmViews;
+use crate::occupancy::OccupancyGrid;
 use crate::settings::{Settings, TileCriterion};
 use crate::wgsl;
 use wgpu::util::DeviceExt;
@@ -23,11 +24,12 @@ use wgpu::util::DeviceExt;
 /// What every gather pass's shader starts with (after the prelude): the node layout and kernel,
 /// the light, the receiver, and `shared.wgsl` (the bindings of groups 0-2, the accessors the
 /// engine-neutral modules read them with, and the helpers every pass uses).
-const SHARED_WGSL: [&str; 5] = [
+const SHARED_WGSL: [&str; 6] = [
     wgsl::NODE,
     wgsl::KERNEL,
     wgsl::LIGHT,
     wgsl::RECEIVER,
+    wgsl::OCCUPANCY,
     include_str!("shared.wgsl"),
 ];
 
@@ -73,6 +75,9 @@ pub(crate) struct Outputs {
     pub counts: wgpu::Buffer,
     /// The temporal filter's running average of the indirect light (one texel without it).
     pub history: wgpu::Buffer,
+    /// The scene's occupancy grid for indirect shadows ([`OccupancyGrid::gpu_words`], in rows
+    /// of [`OCCUPANCY_ROW`] texels; zero dimensions until one is set).
+    occupancy: wgpu::TextureView,
 }
 
 impl Outputs {
@@ -128,6 +133,7 @@ impl Outputs {
                     0
                 },
             ),
+            occupancy: occupancy_texture(device, None),
         }
     }
 
@@ -153,9 +159,49 @@ impl Outputs {
                 whole(&self.samples),
                 whole(&self.counts),
                 whole(&self.history),
+                tex(&self.occupancy),
             ],
         )
     }
+}
+
+/// An R32Uint texture of `rows` x [`OCCUPANCY_ROW`] texels for an occupancy grid's words: zeros
+/// (no grid) without `words`, else the words and zeros after the last.
+fn occupancy_texture(
+    device: &wgpu::Device,
+    words: Option<(&wgpu::Queue, &[u32])>,
+) -> wgpu::TextureView {
+    let len = words.map_or(1, |(_, w)| w.len() as u32);
+    let rows = len.div_ceil(OCCUPANCY_ROW);
+    let descriptor = wgpu::TextureDescriptor {
+        label: Some("occupancy grid"),
+        size: wgpu::Extent3d {
+            width: OCCUPANCY_ROW,
+            height: rows,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Uint,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    };
+    let texture = match words {
+        // wgpu clears a new texture: zero dimensions
+        None => device.create_texture(&descriptor),
+        Some((queue, words)) => {
+            let mut texels = words.to_vec();
+            texels.resize((rows * OCCUPANCY_ROW) as usize, 0);
+            device.create_texture_with_data(
+                queue,
+                &descriptor,
+                wgpu::util::TextureDataOrder::LayerMajor,
+                bytemuck::cast_slice(&texels),
+            )
+        }
+    };
+    texture.create_view(&Default::default())
 }
 
 /// One light view's maps as the gather reads them: its RSM and the light quadtree built from it.
@@ -247,6 +293,7 @@ impl Resources {
                 storage_entry::<[f32; 4]>(8, true),
                 storage_entry::<[u32; 4]>(9, false),
                 storage_entry::<[f32; 4]>(10, false),
+                uint_texture_entry(11),
             ],
         );
         let dispatch_layout = layout(
@@ -305,6 +352,20 @@ impl Resources {
         self.frame_group = self
             .outputs
             .frame_group(device, &self.frame_layout, gbuffer);
+    }
+
+    /// Walks `grid` for indirect shadows from now on (the frame's group is made anew, with the
+    /// G-buffer's views).
+    pub fn set_occupancy(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        grid: &OccupancyGrid,
+        gbuffer: GBufferViews,
+    ) {
+        let words = grid.gpu_words();
+        self.outputs.occupancy = occupancy_texture(device, Some((queue, &words)));
+        self.bind_gbuffer(device, gbuffer);
     }
 
     /// Writes the light views and the gather's terms of them (the kernel's clamp `r_min`, world

@@ -84,6 +84,9 @@ struct Camera {
 @group(1) @binding(9) var<storage, read_write> counts: array<vec4<u32>>;
 // the running average of the indirect light over the last frames (rgb)
 @group(1) @binding(10) var<storage, read_write> history: array<vec4<f32>>;
+// the scene's occupancy grid's words (src/occupancy.rs, `gpu_words`), OCCUPANCY_ROW a row:
+// zero dimensions where the gather has none, and indirect shadows march the depth maps instead
+@group(1) @binding(11) var occupancy: texture_2d<u32>;
 // Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
 // this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
 @group(2) @binding(0) var<uniform> current: Level;
@@ -109,11 +112,36 @@ fn receiver(pixel: vec2<u32>) -> Receiver {
     return r;
 }
 
+// The accessors of wgsl/occupancy.wgsl: the header's words, then the bits.
+fn occupancy_load(i: u32) -> u32 {
+    return textureLoad(occupancy, vec2<u32>(i % OCCUPANCY_ROW, i / OCCUPANCY_ROW), 0).x;
+}
+
+fn occupancy_dims() -> vec3<u32> {
+    return vec3<u32>(occupancy_load(0u), occupancy_load(1u), occupancy_load(2u));
+}
+
+fn occupancy_origin() -> vec3<f32> {
+    return bitcast<vec3<f32>>(vec3<u32>(occupancy_load(4u), occupancy_load(5u), occupancy_load(6u)));
+}
+
+fn occupancy_cell() -> f32 {
+    return bitcast<f32>(occupancy_load(7u));
+}
+
+fn occupancy_word(i: u32) -> u32 {
+    return occupancy_load(OCCUPANCY_HEADER + i);
+}
+
 // The kernel with indirect shadows (the accessor of wgsl/gather_cut.wgsl and gather_level.wgsl).
 fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
     let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
-    if (shade.shadow_steps == 0u || all(e == vec3<f32>(0.0)) || !visible(r.x, node.pos.xyz)) {
-        return select(vec3<f32>(0.0), e, shade.shadow_steps == 0u);
+    // (branches, not `||`: the visibility test's loops must not run without shadows, as
+    // lavapipe counts their iterations towards the summing loop's cap)
+    if (shade.shadow_steps > 0u && any(e != vec3<f32>(0.0))) {
+        if (!visible(r.x, r.n, node.pos.xyz, node.normal.xyz)) {
+            return vec3<f32>(0.0);
+        }
     }
     return e;
 }
@@ -225,11 +253,24 @@ fn light_state(x: vec3<f32>, xp: vec3<f32>, l: array<vec4<f32>, 2>, t: f32) -> u
     return select(UNSEEN, on_plane(there.xyz, seen.xyz, n), there.w > 0.0);
 }
 
-// Approximate visibility between a receiver and a cluster: no point marched between them passes
-// through a surface that the camera's or the light's depth sees, or lies in the layer behind one
-// view's surface where the other view does not see it in front. Clip coordinates are linear
-// along the segment, so the ends are projected once and the points' interpolated.
-fn visible(x: vec3<f32>, xp: vec3<f32>) -> bool {
+// Approximate visibility between a receiver (normal `n`) and a cluster (mean normal `np`):
+// through the scene's occupancy grid where the gather has one (`grid_visibility`), and
+// `marched_visible` where it has none or cannot tell.
+fn visible(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> bool {
+    if (occupancy_load(0u) > 0u) {
+        let grid = grid_visibility(x, n, xp, np);
+        if (grid != GRID_UNKNOWN) {
+            return grid == GRID_VISIBLE;
+        }
+    }
+    return marched_visible(x, xp);
+}
+
+// No point marched between a receiver and a cluster passes through a surface that the camera's
+// or the light's depth sees, or lies in the layer behind one view's surface where the other view
+// does not see it in front. Clip coordinates are linear along the segment, so the ends are
+// projected once and the points' interpolated.
+fn marched_visible(x: vec3<f32>, xp: vec3<f32>) -> bool {
     let camera = array<vec4<f32>, 2>(viewer.view_proj * vec4<f32>(x, 1.0), viewer.view_proj * vec4<f32>(xp, 1.0));
     let lit = array<vec4<f32>, 2>(light.view_proj * vec4<f32>(x, 1.0), light.view_proj * vec4<f32>(xp, 1.0));
     for (var i = 1u; i <= shade.shadow_steps; i++) {

@@ -68,10 +68,10 @@ fn tile_sample(q: u32) -> u32 {
 // tile's corner receiver c (`visible`, shared.wgsl); a pixel on the corners' surface weighs each
 // of its tile's nodes by the corners' visibility interpolated, so that a tile marches four
 // shadow rays a node instead of one a pixel.
-fn corner_visibility(p: vec3<f32>) -> u32 {
+fn corner_visibility(p: vec3<f32>, np: vec3<f32>) -> u32 {
     var seen = 0u;
     for (var c = 0u; c < 4u; c++) {
-        if (visible(tile_x[CORNERS[c]], p)) {
+        if (visible(tile_x[CORNERS[c]], tile_n[CORNERS[c]], p, np)) {
             seen |= 1u << c;
         }
     }
@@ -347,7 +347,8 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
         var index = tile_cuts[base + i];
         if (corner_shadows) {
             fetches++;
-            frontier[1][i] = corner_visibility(nodes[index].pos.xyz);
+            let node = nodes[index];
+            frontier[1][i] = corner_visibility(node.pos.xyz, node.normal.xyz);
         }
         if (sharing) {
             fetches++;

@@ -1,0 +1,348 @@
+//! The scene's occupancy grid, which indirect shadows walk between a receiver and a cluster
+//! ([`crate::Settings::shadow_grid`]): a cell is set where a triangle of the scene overlaps it, so
+//! a wall, a shelf or a slab blocks whatever the camera and the light see of it. The walk
+//! ([`OccupancyGrid::visible`]) is the CPU twin of `wgsl/occupancy.wgsl`'s `grid_visibility`; both
+//! start and end two cells off the surfaces along their normals, so that a surface never hides
+//! its own points.
+
+use crate::scene::Vertex;
+use glam::{IVec3, UVec3, Vec3};
+
+/// Cells a segment's ends are moved off their surfaces along the normals: past every cell a
+/// plane through the end may overlap (a cell's diagonal is sqrt(3) sides).
+pub const END_OFFSET_CELLS: f32 = 2.0;
+
+/// Words before the bits in [`OccupancyGrid::gpu_words`]: the dimensions (and a pad), the origin
+/// and the cell's side.
+pub const HEADER_WORDS: usize = 8;
+
+/// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OccupancyGrid {
+    dims: UVec3,
+    origin: Vec3,
+    cell: f32,
+    bits: Vec<u32>,
+}
+
+impl OccupancyGrid {
+    /// The grid of `triangles` with `cells` cells along the longest side of their bounds, and a
+    /// margin of [`END_OFFSET_CELLS`] + 1 cells all round (so a moved end stays inside).
+    pub fn of_triangles(triangles: &[[Vertex; 3]], cells: u32) -> Self {
+        let (lo, hi) =
+            crate::scene::bounds_of(triangles.iter().flatten().map(|v| Vec3::from(v.position)));
+        let (lo, hi) = if lo.cmple(hi).all() {
+            (lo, hi)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        let cell = ((hi - lo).max_element() / cells.max(1) as f32).max(1e-6);
+        let margin = END_OFFSET_CELLS + 1.0;
+        let origin = lo - Vec3::splat(margin * cell);
+        let dims = (((hi - lo) / cell).ceil() + Vec3::splat(2.0 * margin + 1.0)).as_uvec3();
+        let count = dims.x as usize * dims.y as usize * dims.z as usize;
+        let mut grid = Self {
+            dims,
+            origin,
+            cell,
+            bits: vec![0; count.div_ceil(32)],
+        };
+        for t in triangles {
+            grid.add_triangle(t.map(|v| (Vec3::from(v.position) - origin) / cell));
+        }
+        grid
+    }
+
+    /// Cells along x, y and z.
+    pub fn dims(&self) -> UVec3 {
+        self.dims
+    }
+
+    /// The side of a cell (world units).
+    pub fn cell(&self) -> f32 {
+        self.cell
+    }
+
+    /// Whether cell `c` holds a piece of a triangle (outside the grid: no).
+    pub fn occupied(&self, c: IVec3) -> bool {
+        match self.index(c) {
+            Some(i) => self.bits[i / 32] >> (i % 32) & 1 == 1,
+            None => false,
+        }
+    }
+
+    /// How many cells are set.
+    pub fn occupied_count(&self) -> u32 {
+        self.bits.iter().map(|w| w.count_ones()).sum()
+    }
+
+    /// Whether the segment from `x` (a receiver, normal `n`) to `xp` (a VPL or cluster, normal
+    /// `np`, of any length: a cluster's mean normal is shorter) crosses no set cell, its ends
+    /// moved [`END_OFFSET_CELLS`] off their surfaces (an end whose normal is shorter than 0.1
+    /// stays); `None` where a moved end lies in a set cell (another surface within two cells
+    /// of it: in a corner, under a box), which the grid cannot judge. Visits the cells the
+    /// segment passes through, in order (a 3D DDA).
+    pub fn visible(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Option<bool> {
+        let a = self.to_grid(x, n);
+        let b = self.to_grid(xp, np);
+        let d = b - a;
+        let mut c = a.floor().as_ivec3();
+        let end = b.floor().as_ivec3();
+        if self.occupied(c) || self.occupied(end) {
+            return None;
+        }
+        let step = IVec3::new(sign(d.x), sign(d.y), sign(d.z));
+        let t_delta = Vec3::new(inverse(d.x), inverse(d.y), inverse(d.z));
+        let mut t_max = Vec3::new(
+            first_crossing(a.x, d.x),
+            first_crossing(a.y, d.y),
+            first_crossing(a.z, d.z),
+        );
+        // a segment crosses at most one cell a face it passes: the bound of the walk
+        for _ in 0..=self.dims.x + self.dims.y + self.dims.z {
+            if c == end {
+                break;
+            }
+            if t_max.x <= t_max.y && t_max.x <= t_max.z {
+                c.x += step.x;
+                t_max.x += t_delta.x;
+            } else if t_max.y <= t_max.z {
+                c.y += step.y;
+                t_max.y += t_delta.y;
+            } else {
+                c.z += step.z;
+                t_max.z += t_delta.z;
+            }
+            if t_max.min_element() > 1.0 && c != end {
+                // past the end in floating point: the end's cell is the last one
+                c = end;
+            }
+            if self.occupied(c) {
+                return Some(false);
+            }
+        }
+        Some(true)
+    }
+
+    /// The grid as the gather's storage buffer reads it: [`HEADER_WORDS`] words (the
+    /// dimensions, a pad, the origin and the cell's side as `f32` bits), then the bits, cell
+    /// (x, y, z) at bit `x + dims.x * (y + dims.y * z)`.
+    pub fn gpu_words(&self) -> Vec<u32> {
+        let mut words = vec![
+            self.dims.x,
+            self.dims.y,
+            self.dims.z,
+            0,
+            self.origin.x.to_bits(),
+            self.origin.y.to_bits(),
+            self.origin.z.to_bits(),
+            self.cell.to_bits(),
+        ];
+        words.extend_from_slice(&self.bits);
+        words
+    }
+
+    /// A segment's end in grid units, moved off its surface.
+    fn to_grid(&self, p: Vec3, n: Vec3) -> Vec3 {
+        let off = if n.length() > 0.1 {
+            n.normalize() * END_OFFSET_CELLS
+        } else {
+            Vec3::ZERO
+        };
+        (p - self.origin) / self.cell + off
+    }
+
+    fn index(&self, c: IVec3) -> Option<usize> {
+        let d = self.dims.as_ivec3();
+        if c.cmplt(IVec3::ZERO).any() || c.cmpge(d).any() {
+            return None;
+        }
+        Some(c.x as usize + d.x as usize * (c.y as usize + d.y as usize * c.z as usize))
+    }
+
+    /// Sets every cell the triangle (in grid units) overlaps. A cell is the half-open
+    /// [i, i + 1): a plane on a cell boundary sets the cells above it only.
+    fn add_triangle(&mut self, t: [Vec3; 3]) {
+        if !t.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        let lo = t[0].min(t[1]).min(t[2]).floor().as_ivec3().max(IVec3::ZERO);
+        let hi = t[0]
+            .max(t[1])
+            .max(t[2])
+            .floor()
+            .as_ivec3()
+            .min(self.dims.as_ivec3() - 1);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let c = IVec3::new(x, y, z);
+                    // the box [i - 1e-5, i + 1 - 1e-4]: a plane at i is in, one at i + 1 out
+                    let centre = c.as_vec3() + Vec3::splat(0.5 - 5.5e-5);
+                    if triangle_overlaps_box(t, centre, Vec3::splat(0.5 - 4.5e-5)) {
+                        let i = self.index(c).expect("clamped to the grid");
+                        self.bits[i / 32] |= 1 << (i % 32);
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn sign(v: f32) -> i32 {
+    if v > 0.0 {
+        1
+    } else if v < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// The segment parameter between two crossings of an axis's cell faces (never, along an axis
+/// the segment does not move).
+fn inverse(d: f32) -> f32 {
+    if d == 0.0 {
+        f32::INFINITY
+    } else {
+        1.0 / d.abs()
+    }
+}
+
+/// The segment parameter at which it first crosses a face of the axis, from `a` moving `d`.
+fn first_crossing(a: f32, d: f32) -> f32 {
+    if d > 0.0 {
+        (a.floor() + 1.0 - a) / d
+    } else if d < 0.0 {
+        (a - a.floor()) / -d
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Whether triangle `t` overlaps the box of `centre` and `half` extents (the separating-axis
+/// test of Akenine-Möller: the box's axes, the triangle's normal, and the nine cross products
+/// of their edges).
+fn triangle_overlaps_box(t: [Vec3; 3], centre: Vec3, half: Vec3) -> bool {
+    let v = t.map(|p| p - centre);
+    let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    let separates = |axis: Vec3| {
+        if axis.length_squared() < 1e-12 {
+            return false;
+        }
+        let p = v.map(|p| p.dot(axis));
+        let r = half.dot(axis.abs());
+        p[0].min(p[1]).min(p[2]) > r || p[0].max(p[1]).max(p[2]) < -r
+    };
+    for e in edges {
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            if separates(axis.cross(e)) {
+                return false;
+            }
+        }
+    }
+    if [Vec3::X, Vec3::Y, Vec3::Z].into_iter().any(separates) {
+        return false;
+    }
+    !separates(edges[0].cross(edges[1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(corners: [[f32; 3]; 4]) -> [[Vertex; 3]; 2] {
+        let v = corners.map(|position| Vertex {
+            position,
+            normal: [0.0, 0.0, 1.0],
+            albedo: [0.5; 3],
+        });
+        [[v[0], v[1], v[2]], [v[0], v[2], v[3]]]
+    }
+
+    /// A floor (y = 0, 0..1 in x and z) and a thin wall at x = 0.5 up to `wall_top`.
+    fn floor_and_wall(wall_top: f32) -> Vec<[Vertex; 3]> {
+        let mut t = quad([
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 0.0, 1.0],
+            [0.0, 0.0, 1.0],
+        ])
+        .to_vec();
+        t.extend(quad([
+            [0.5, 0.0, 0.0],
+            [0.5, wall_top, 0.0],
+            [0.5, wall_top, 1.0],
+            [0.5, 0.0, 1.0],
+        ]));
+        t
+    }
+
+    #[test]
+    fn a_wall_blocks_and_the_gap_above_it_does_not() {
+        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 32);
+        let up = Vec3::Y;
+        let left = Vec3::new(0.2, 0.0, 0.5);
+        let right = Vec3::new(0.8, 0.0, 0.5);
+        assert_eq!(
+            grid.visible(left, up, right, up),
+            Some(false),
+            "through the wall"
+        );
+        let above = grid.visible(left + 0.8 * up, up, right + 0.8 * up, up);
+        assert_eq!(above, Some(true), "above it");
+        let beside = grid.visible(left, up, left + Vec3::new(0.1, 0.3, 0.2), up);
+        assert_eq!(beside, Some(true), "same side");
+        // a plane sets the cells it passes through on its right: a point just right of it
+        // starts in a set cell
+        let corner = grid.visible(Vec3::new(0.51, 0.0, 0.5), up, right, up);
+        assert_eq!(corner, None, "at the wall's foot");
+    }
+
+    #[test]
+    fn a_surface_does_not_hide_its_own_points_at_any_slope() {
+        for deg in [0.0f32, 10.0, 33.0, 45.0, 71.0] {
+            let (s, c) = deg.to_radians().sin_cos();
+            // a plane through the origin, tilted about z; normal (-s, c, 0)
+            let n = Vec3::new(-s, c, 0.0);
+            let along = Vec3::new(c, s, 0.0);
+            let t = quad([
+                (-along - Vec3::Z).to_array(),
+                (along - Vec3::Z).to_array(),
+                (along + Vec3::Z).to_array(),
+                (-along + Vec3::Z).to_array(),
+            ]);
+            let grid = OccupancyGrid::of_triangles(&t, 40);
+            for k in -4..=4 {
+                let x = along * (k as f32 * 0.1) + Vec3::Z * 0.13;
+                let xp = -along * 0.3 + n * 0.5;
+                assert_eq!(
+                    grid.visible(x, n, xp, -n),
+                    Some(true),
+                    "{deg} deg, point {k}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn grid_words_hold_the_header_and_every_set_cell() {
+        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 16);
+        let words = grid.gpu_words();
+        assert_eq!(&words[..3], &grid.dims().to_array());
+        assert_eq!(f32::from_bits(words[7]), grid.cell());
+        let set: u32 = words[HEADER_WORDS..].iter().map(|w| w.count_ones()).sum();
+        assert_eq!(set, grid.occupied_count());
+        assert!(set > 16 * 16, "the floor alone covers 16 x 16 cells: {set}");
+    }
+
+    #[test]
+    fn no_triangles_make_a_grid_that_blocks_nothing() {
+        let grid = OccupancyGrid::of_triangles(&[], 8);
+        assert_eq!(grid.occupied_count(), 0);
+        assert_eq!(
+            grid.visible(Vec3::ZERO, Vec3::Y, Vec3::ONE, Vec3::Y),
+            Some(true)
+        );
+    }
+}
