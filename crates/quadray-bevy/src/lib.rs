@@ -123,8 +123,9 @@ pub struct PyramidExtension {
     /// specular, after Bevy's shadow map) a pixel loses where the height field hides that light
     /// from it; 1 is what the height field casts, 0 turns self-shadowing off and costs nothing.
     /// Each of Bevy's directional, point and spot lights that lights the pixel, up to
-    /// [`SELF_SHADOWED_LIGHTS`], gets one ray through the pyramid (the main pass only: ambient,
-    /// environment and emissive light are untouched).
+    /// [`SELF_SHADOWED_LIGHTS`], gets one ray through the pyramid. Ambient, environment and
+    /// emissive light are untouched, and so is deferred rendering: Bevy's own lighting pass
+    /// lights the G-buffer, so only the forward main pass is self-shadowed.
     pub shadow_strength: f32,
     /// The pyramid built from `depth_map` (set by [`PyramidDisplacementPlugin`]).
     #[texture(101, sample_type = "float", filterable = false)]
