@@ -213,8 +213,8 @@ fn contact_shadow(in: PbrInput, L: vec3<f32>, light_has_them: bool) -> f32 {
 // The direct light of the lights the height field hides from the hit, each light's term exactly
 // as Bevy's apply_pbr_lighting adds it (times its shadow map and contact shadow), for the caller
 // to take out of Bevy's lit colour. Bevy 0.19 has no per-light hook, so this repeats the least of
-// its light loop (pbr_functions.wgsl): its LightingInput and each light's term; ambient,
-// environment, emissive and transmitted light stay Bevy's. The rays of at most
+// its light loop (pbr_functions.wgsl): its LightingInput and each light's term; rect lights,
+// ambient, environment, emissive and transmitted light stay Bevy's. The rays of at most
 // SELF_SHADOWED_LIGHTS lights that light the hit are traced, in this order: directional lights,
 // then the cluster's point and spot lights; later lights are not self-shadowed.
 fn hidden_direct_light(in: PbrInput, s: Surface) -> vec3<f32> {
