@@ -4,6 +4,8 @@
 //! displaced surfaces intersect other geometry where they really are. Every pass Bevy draws the
 //! material in traces: the forward main pass, the depth, normal and motion-vector prepasses, the
 //! deferred G-buffer (with `DefaultOpaqueRendererMethod::deferred()`) and the shadow maps.
+//! Self-shadowing follows Bevy's own lights: where the height field hides a light from a pixel,
+//! the main pass takes that light's contribution out (see [`PyramidExtension::shadow_strength`]).
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -55,7 +57,7 @@ use bevy::render::render_resource::{
     AsBindGroup, FragmentState, RenderPipelineDescriptor, ShaderType, SpecializedMeshPipelineError,
 };
 use bevy::render::storage::ShaderBuffer;
-use bevy::shader::{Shader, ShaderRef};
+use bevy::shader::{Shader, ShaderDefVal, ShaderRef};
 use quadray_displace::pyramid::Addressing;
 use quadray_displace::{PyramidInfo, TRACE_WGSL};
 
@@ -66,6 +68,11 @@ const TRACE_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4
 const MATERIAL_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d02");
 /// The debug buffer bound when a material records no hits.
 const NO_HITS: Handle<ShaderBuffer> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d03");
+
+/// The most lights a pixel traces its self-shadow ray to (each ray is one more trace through the
+/// pyramid): the first that light it, directional lights before the point and spot lights of the
+/// pixel's cluster. Lights beyond them light the pixel as if the height field did not hide them.
+pub const SELF_SHADOWED_LIGHTS: u32 = 8;
 
 /// Registers [`PyramidMaterial`], its shaders, and the system that builds each depth map's
 /// pyramid when the image loads (and again when it changes). Add it after `DefaultPlugins`.
@@ -112,11 +119,14 @@ pub struct PyramidExtension {
     /// `true`: rays that leave [0, 1)^2 miss and the pixel is discarded (a terrain patch);
     /// `false`: the map tiles.
     pub clamp_to_map: bool,
-    /// Self-shadowing: the share of the lit colour a pixel loses when the height field hides
-    /// [`PyramidExtension::light`] from it (0 turns it off).
+    /// Self-shadowing from the scene's lights: the share of a light's contribution (diffuse and
+    /// specular, after Bevy's shadow map) a pixel loses where the height field hides that light
+    /// from it; 1 is what the height field casts, 0 turns self-shadowing off and costs nothing.
+    /// Each of Bevy's directional, point and spot lights that lights the pixel, up to
+    /// [`SELF_SHADOWED_LIGHTS`], gets one ray through the pyramid. Ambient, environment and
+    /// emissive light are untouched, and so is deferred rendering: Bevy's own lighting pass
+    /// lights the G-buffer, so only the forward main pass is self-shadowed.
     pub shadow_strength: f32,
-    /// The self-shadowing light: world direction towards it (w = 0) or its position (w = 1).
-    pub light: Vec4,
     /// The pyramid built from `depth_map` (set by [`PyramidDisplacementPlugin`]).
     #[texture(101, sample_type = "float", filterable = false)]
     pub pyramid: Option<Handle<Image>>,
@@ -140,7 +150,6 @@ impl PyramidExtension {
             lod: true,
             clamp_to_map: false,
             shadow_strength: 0.0,
-            light: Vec4::new(0.0, 1.0, 0.0, 0.0),
             pyramid: None,
             map_size: UVec2::ONE,
             debug_hits: NO_HITS,
@@ -170,8 +179,9 @@ impl MaterialExtension for PyramidExtension {
         MATERIAL_SHADER.into()
     }
 
-    // Bevy draws depth-only prepasses and shadow maps without a fragment stage and without the
-    // tangent frame: the polygon's depth. The trace needs both, in every prepass.
+    // The main pass's light loop is bounded by SELF_SHADOWED_LIGHTS. Bevy draws depth-only
+    // prepasses and shadow maps without a fragment stage and without the tangent frame: the
+    // polygon's depth. The trace needs both, in every prepass.
     fn specialize(
         _pipeline: &MaterialExtensionPipeline,
         descriptor: &mut RenderPipelineDescriptor,
@@ -180,6 +190,12 @@ impl MaterialExtension for PyramidExtension {
     ) -> Result<(), SpecializedMeshPipelineError> {
         let defs = &mut descriptor.vertex.shader_defs;
         if !defs.contains(&"PREPASS_PIPELINE".into()) {
+            if let Some(fragment) = &mut descriptor.fragment {
+                fragment.shader_defs.push(ShaderDefVal::UInt(
+                    "SELF_SHADOWED_LIGHTS".into(),
+                    SELF_SHADOWED_LIGHTS,
+                ));
+            }
             return Ok(());
         }
         let frame = "NORMAL_PREPASS_OR_DEFERRED_PREPASS".into();
@@ -227,7 +243,6 @@ pub struct PyramidUniform {
     flags: u32,
     debug_width: u32,
     shadow_strength: f32,
-    light: Vec4,
 }
 
 impl From<&PyramidExtension> for PyramidUniform {
@@ -248,7 +263,6 @@ impl From<&PyramidExtension> for PyramidUniform {
             flags: u32::from(m.lod),
             debug_width: m.debug_width,
             shadow_strength: m.shadow_strength,
-            light: m.light,
         }
     }
 }

@@ -4,7 +4,8 @@
 // colour), and, compiled with PREPASS_PIPELINE, the depth, normal and motion-vector prepasses,
 // the deferred G-buffer and the shadow maps. Each traces the same ray from its own view and
 // writes the traced depth, so every pass sees the displaced surface where it really is. The
-// traced uv feeds Bevy's own PBR input, so lighting, shadows and textures stay Bevy's.
+// traced uv feeds Bevy's own PBR input, so lighting, shadows and textures stay Bevy's; the main
+// pass then takes out of Bevy's lit colour each light the height field hides from the hit.
 
 #import bevy_pbr::{
     pbr_fragment::pbr_input_from_standard_material,
@@ -23,8 +24,20 @@
 #else
 #import bevy_pbr::{
     forward_io::VertexOutput,
-    pbr_functions::{apply_pbr_lighting, main_pass_post_lighting_processing},
+    pbr_functions::{apply_pbr_lighting, main_pass_post_lighting_processing, calculate_diffuse_color, calculate_F0_dielectric},
+    clustered_forward as clustering,
+    lighting,
+    lighting::{LAYER_BASE, LAYER_CLEARCOAT},
+    mesh_types::MESH_FLAGS_SHADOW_RECEIVER_BIT,
+    mesh_view_bindings as view_bindings,
+    mesh_view_types,
+    shadows,
 }
+#ifdef CONTACT_SHADOWS
+#ifdef DEPTH_PREPASS
+#import bevy_pbr::pbr_functions::calculate_contact_shadow
+#endif
+#endif
 #endif
 #import quadray::trace::{PyramidInfo, ray_slope, pyramid_trace, pyramid_lod, pyramid_lit, depth_bilinear}
 
@@ -40,10 +53,9 @@ struct PyramidParams {
     depth_scale: f32,
     flags: u32,
     debug_width: u32,
-    // How much of the lit colour a self-shadowed pixel loses (0: no self-shadowing).
+    // The share of a light's contribution a pixel loses where the height field hides that light
+    // (0: no self-shadowing).
     shadow_strength: f32,
-    // The self-shadowing light: world direction towards it (w = 0) or its position (w = 1).
-    light: vec4<f32>,
 }
 
 const FLAG_LOD: u32 = 1u;
@@ -86,8 +98,17 @@ struct Surface {
     depth: f32,
     // The height field's normal at the hit, in world space.
     normal: vec3<f32>,
-    // The hit is hidden from `params.light` by the height field.
-    shadowed: bool,
+    // Where the rays towards the lights start (none where nothing was traced): the hit in the
+    // pyramid's texture space and its depth, the tangent frame and the finest level traced.
+    traced: bool,
+    texture_hit: vec2<f32>,
+    z: f32,
+    tbn: mat3x3<f32>,
+    finest: i32,
+}
+
+fn pyramid_info() -> PyramidInfo {
+    return PyramidInfo(params.levels, params.clamp_to_map, params.iteration_cap, params.refine_cap, params.map_size, vec2(0u));
 }
 
 // The height field's normal at uv `p` in quadray's tangent space (x along +u, y along +v):
@@ -113,7 +134,7 @@ fn traced_surface(in: VertexOutput, uv_dx: vec2<f32>, uv_dy: vec2<f32>, world_dx
     s.depth = in.unclipped_depth;
 #endif
     s.normal = normalize(in.world_normal);
-    s.shadowed = false;
+    s.traced = false;
 #ifdef VERTEX_TANGENTS
     let V = calculate_view(in.world_position, view.clip_from_view[3].w == 1.0);
     let tbn = calculate_tbn_mikktspace(in.world_normal, in.world_tangent);
@@ -123,7 +144,7 @@ fn traced_surface(in: VertexOutput, uv_dx: vec2<f32>, uv_dy: vec2<f32>, world_dx
     // traces flat, depth scale 0): lavapipe (Mesa 22.3) crashes drawing a G-buffer whose
     // shader reads memory under such a branch.
     if towards.z > 1.0e-4 {
-        let info = PyramidInfo(params.levels, params.clamp_to_map, params.iteration_cap, params.refine_cap, params.map_size, vec2(0u));
+        let info = pyramid_info();
         var finest = 0;
         if (params.flags & FLAG_LOD) != 0u {
             finest = pyramid_lod(info, uv_dx, uv_dy);
@@ -156,17 +177,146 @@ fn traced_surface(in: VertexOutput, uv_dx: vec2<f32>, uv_dy: vec2<f32>, world_dx
         s.depth = clip.z / clip.w;
         let n = height_field_normal(info, p0 + e * hit.z);
         s.normal = normalize(n.x * tbn[0] - n.y * tbn[1] + n.z * tbn[2]);
-#ifndef PREPASS_PIPELINE
-        if params.shadow_strength > 0.0 {
-            let L = normalize(params.light.xyz - in.world_position.xyz * params.light.w);
-            let to_light = vec3(dot(L, tbn[0]), -dot(L, tbn[1]), dot(L, tbn[2]));
-            s.shadowed = !pyramid_lit(pyramid, info, p0 + e * hit.z, hit.z, to_light, params.depth_scale, finest);
-        }
-#endif
+        s.traced = true;
+        s.texture_hit = p0 + e * hit.z;
+        s.z = hit.z;
+        s.tbn = tbn;
+        s.finest = finest;
     }
 #endif
     return s;
 }
+
+#ifndef PREPASS_PIPELINE
+// The most lights per pixel whose rays the height field may stop (`SELF_SHADOWED_LIGHTS` in lib.rs).
+const SELF_SHADOWED_LIGHTS: u32 = #{SELF_SHADOWED_LIGHTS}u;
+
+// Whether the height field lets the light in world direction L reach the traced hit.
+fn reaches_hit(s: Surface, L: vec3<f32>) -> bool {
+    let to_light = vec3(dot(L, s.tbn[0]), -dot(L, s.tbn[1]), dot(L, s.tbn[2]));
+    return pyramid_lit(pyramid, pyramid_info(), s.texture_hit, s.z, to_light, params.depth_scale, s.finest);
+}
+
+// Bevy's contact shadow towards L where the view and the light have them on.
+fn contact_shadow(in: PbrInput, L: vec3<f32>, light_has_them: bool) -> f32 {
+#ifdef CONTACT_SHADOWS
+#ifdef DEPTH_PREPASS
+    let steps = view_bindings::contact_shadows_settings.linear_steps;
+    if steps > 0u && light_has_them {
+        return calculate_contact_shadow(in.world_position.xyz, in.frag_coord.xy, L, steps);
+    }
+#endif
+#endif
+    return 1.0;
+}
+
+// The direct light of the lights the height field hides from the hit, each light's term exactly
+// as Bevy's apply_pbr_lighting adds it (times its shadow map and contact shadow), for the caller
+// to take out of Bevy's lit colour. Bevy 0.19 has no per-light hook, so this repeats the least of
+// its light loop (pbr_functions.wgsl): its LightingInput and each light's term; rect lights,
+// ambient, environment, emissive and transmitted light stay Bevy's. The rays of at most
+// SELF_SHADOWED_LIGHTS lights that light the hit are traced, in this order: directional lights,
+// then the cluster's point and spot lights; later lights are not self-shadowed.
+fn hidden_direct_light(in: PbrInput, s: Surface) -> vec3<f32> {
+    var hidden = vec3(0.0);
+    if !s.traced || params.shadow_strength <= 0.0 {
+        return hidden;
+    }
+    let NdotV = max(dot(in.N, in.V), 0.0001);
+    var input: lighting::LightingInput;
+    input.layers[LAYER_BASE].NdotV = NdotV;
+    input.layers[LAYER_BASE].N = in.N;
+    input.layers[LAYER_BASE].R = reflect(-in.V, in.N);
+    input.layers[LAYER_BASE].perceptual_roughness = in.material.perceptual_roughness;
+    input.layers[LAYER_BASE].roughness = lighting::perceptualRoughnessToRoughness(in.material.perceptual_roughness);
+    input.P = in.world_position.xyz;
+    input.V = in.V;
+    input.diffuse_color = calculate_diffuse_color(in.material.base_color.rgb, in.material.metallic, in.material.specular_transmission, in.material.diffuse_transmission);
+    input.metallic = in.material.metallic;
+    input.F0_dielectric = calculate_F0_dielectric(in.material.reflectance);
+    input.F0_metallic = in.material.base_color.rgb;
+    input.F_ab = lighting::F_AB(in.material.perceptual_roughness, NdotV);
+#ifdef STANDARD_MATERIAL_CLEARCOAT
+    input.layers[LAYER_CLEARCOAT].NdotV = max(dot(in.clearcoat_N, in.V), 0.0001);
+    input.layers[LAYER_CLEARCOAT].N = in.clearcoat_N;
+    input.layers[LAYER_CLEARCOAT].R = reflect(-in.V, in.clearcoat_N);
+    input.layers[LAYER_CLEARCOAT].perceptual_roughness = in.material.clearcoat_perceptual_roughness;
+    input.layers[LAYER_CLEARCOAT].roughness = lighting::perceptualRoughnessToRoughness(in.material.clearcoat_perceptual_roughness);
+    input.clearcoat_strength = in.material.clearcoat;
+#endif
+#ifdef STANDARD_MATERIAL_ANISOTROPY
+    input.anisotropy = in.anisotropy_strength;
+    input.Ta = in.anisotropy_T;
+    input.Ba = in.anisotropy_B;
+#endif
+    let receives_shadows = (in.flags & MESH_FLAGS_SHADOW_RECEIVER_BIT) != 0u;
+    let view_z = dot(vec4(view.view_from_world[0].z, view.view_from_world[1].z, view.view_from_world[2].z, view.view_from_world[3].z), in.world_position);
+    var traced = 0u;
+
+    for (var i = 0u; i < view_bindings::lights.n_directional_lights && traced < SELF_SHADOWED_LIGHTS; i++) {
+        let light = &view_bindings::lights.directional_lights[i];
+#ifdef LIGHTMAP
+        let enable_diffuse = ((*light).flags & mesh_view_types::DIRECTIONAL_LIGHT_FLAGS_AFFECTS_LIGHTMAPPED_MESH_DIFFUSE_BIT) != 0u;
+#else
+        let enable_diffuse = true;
+#endif
+        let term = lighting::directional_light(i, &input, enable_diffuse);
+        if all(term == vec3(0.0)) {
+            continue;
+        }
+        traced += 1u;
+        let L = (*light).direction_to_light;
+        if reaches_hit(s, L) {
+            continue;
+        }
+        var shadow = 1.0;
+        if receives_shadows && ((*light).flags & mesh_view_types::DIRECTIONAL_LIGHT_FLAGS_SHADOWS_ENABLED_BIT) != 0u {
+            shadow = shadows::fetch_directional_shadow(i, in.world_position, in.world_normal, view_z, in.frag_coord.xy);
+        }
+        shadow *= contact_shadow(in, L, receives_shadows && ((*light).flags & mesh_view_types::DIRECTIONAL_LIGHT_FLAGS_CONTACT_SHADOWS_ENABLED_BIT) != 0u);
+        hidden += term * shadow;
+    }
+
+    let cluster_index = clustering::view_fragment_cluster_index(in.frag_coord.xy, view_z, in.is_orthographic);
+    let ranges = clustering::unpack_clusterable_object_index_ranges(cluster_index);
+    // The cluster lists its point lights, then its spot lights.
+    for (var i = ranges.first_point_light_index_offset; i < ranges.first_reflection_probe_index_offset && traced < SELF_SHADOWED_LIGHTS; i++) {
+        let light_id = clustering::get_clusterable_object_id(i);
+        let light = &view_bindings::clustered_lights.data[light_id];
+        let spot = i >= ranges.first_spot_light_index_offset;
+#ifdef LIGHTMAP
+        let enable_diffuse = ((*light).flags & mesh_view_types::POINT_LIGHT_FLAGS_AFFECTS_LIGHTMAPPED_MESH_DIFFUSE_BIT) != 0u;
+#else
+        let enable_diffuse = true;
+#endif
+        var term: vec3<f32>;
+        if spot {
+            term = lighting::spot_light(light_id, &input, enable_diffuse);
+        } else {
+            term = lighting::point_light(light_id, &input, enable_diffuse, true);
+        }
+        if all(term == vec3(0.0)) {
+            continue;
+        }
+        traced += 1u;
+        let L = normalize((*light).position_radius.xyz - in.world_position.xyz);
+        if reaches_hit(s, L) {
+            continue;
+        }
+        var shadow = 1.0;
+        if receives_shadows && ((*light).flags & mesh_view_types::POINT_LIGHT_FLAGS_SHADOWS_ENABLED_BIT) != 0u {
+            if spot {
+                shadow = shadows::fetch_spot_shadow(light_id, in.world_position, in.world_normal, (*light).shadow_map_near_z, in.frag_coord.xy);
+            } else {
+                shadow = shadows::fetch_point_shadow(light_id, in.world_position, in.world_normal, in.frag_coord.xy);
+            }
+        }
+        shadow *= contact_shadow(in, L, receives_shadows && ((*light).flags & mesh_view_types::POINT_LIGHT_FLAGS_CONTACT_SHADOWS_ENABLED_BIT) != 0u);
+        hidden += term * shadow;
+    }
+    return hidden;
+}
+#endif
 
 // Bevy's PBR input of the standard material at the hit: its textures at the hit's uv, its
 // position, and the height field's normal unless the material brings a normal map of its own.
@@ -216,9 +366,9 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> PyramidO
     let s = traced_surface(in, uv_dx, uv_dy, world_dx, world_dy);
     let pbr_input = pbr_input_at(in, is_front, s);
     out.color = apply_pbr_lighting(pbr_input);
-    if s.shadowed {
-        out.color = vec4(out.color.rgb * (1.0 - params.shadow_strength), out.color.a);
-    }
+    // Bevy's sum scales direct light by the exposure.
+    let hidden = view.exposure * params.shadow_strength * hidden_direct_light(pbr_input, s);
+    out.color = vec4(max(out.color.rgb - hidden, vec3(0.0)), out.color.a);
     out.color = main_pass_post_lighting_processing(pbr_input, out.color);
 #endif
     out.depth = s.depth;

@@ -1,19 +1,20 @@
 //! The material in Bevy's shadow maps, headless on lavapipe: a displaced cone on a patch (a
 //! clamped map) floats over a flat floor that cuts through the patch's depth, so only the cone's
-//! tip stands above the floor; a spot light casts its shadow through Bevy's own shadow map and
-//! filtering. The floor's shadowed pixels against the CPU ground truth: each floor point's ray
-//! to the light traced through the height field, shadowed where it meets the surface above the
-//! floor. A shadow pass that wrote the polygon's depth would shadow the whole patch's outline.
+//! tip stands above the floor; a spot light, a directional light (its cascade) or a point light
+//! (its cube map) casts its shadow through Bevy's own shadow map and filtering. The floor's
+//! shadowed pixels against the CPU ground truth: each floor point's ray to the light traced
+//! through the height field, shadowed where it meets the surface above the floor. A shadow pass
+//! that wrote the polygon's depth would shadow the whole patch's outline.
 
 use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
 use bevy::camera::visibility::RenderLayers;
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::light::DirectionalLightShadowMap;
+use bevy::light::{CascadeShadowConfigBuilder, DirectionalLightShadowMap};
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat, TextureUsages};
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial, depth_map};
 use quadray_displace::heightmap::HeightMap;
 use quadray_displace::pyramid::Addressing;
@@ -29,15 +30,35 @@ const HEIGHT: f32 = 0.3;
 const DEPTH_SCALE: f32 = 0.4;
 /// The cone's radius in uv: depth r / RADIUS inside, 1 outside.
 const RADIUS: f32 = 0.45;
+/// The spot and the point light stand here; the directional light shines from this direction.
 const LIGHT: Vec3 = Vec3::new(1.0, 1.6, 0.2);
 const EYE: Vec3 = Vec3::new(0.0, 2.5, 0.0);
 /// The second scene, the same floor, camera and light without the patch: the lit floor each
 /// pixel's shadow is measured against.
 const BESIDE: Vec3 = Vec3::new(20.0, 0.0, 0.0);
 /// Pixels whose shadow differs from the truth's, as a share of the pixels the truth shadows:
-/// Bevy's shadow map (512 texels over the spot's cone), its depth bias and filtering blur the
-/// outline by a pixel or so.
+/// Bevy's shadow map (512 texels over the spot's cone or the directional light's cascade, 1024
+/// over a face of the point light's cube), its depth bias and filtering blur the outline by a
+/// pixel or so.
 const MISMATCH_TOLERANCE: f64 = 0.1;
+
+/// The light that casts the shadow.
+#[derive(Resource, Clone, Copy, Debug)]
+enum Caster {
+    Spot,
+    Directional,
+    Point,
+}
+
+impl Caster {
+    /// The unit direction from a floor point towards the light.
+    fn towards(self, floor: DVec3) -> DVec3 {
+        match self {
+            Caster::Directional => LIGHT.as_dvec3().normalize(),
+            Caster::Spot | Caster::Point => (LIGHT.as_dvec3() - floor).normalize(),
+        }
+    }
+}
 
 /// What each scene's camera sees, read back every frame.
 #[derive(Resource)]
@@ -55,6 +76,7 @@ fn cone_depth(x: u32, y: u32) -> f32 {
 }
 
 fn setup(
+    caster: Res<Caster>,
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<PyramidMaterial>>,
@@ -94,6 +116,30 @@ fn setup(
         perceptual_roughness: 1.0,
         ..default()
     });
+    // The light sees layer 1 too, where the patch is.
+    let light_layers = RenderLayers::from_layers(&[0, 1]);
+    if let Caster::Directional = *caster {
+        // One cascade over what the cameras see (the floor, 2.5 in front of them).
+        let cascades = CascadeShadowConfigBuilder {
+            num_cascades: 1,
+            maximum_distance: 4.0,
+            ..default()
+        };
+        commands.spawn((
+            DirectionalLight {
+                illuminance: 5_000.0,
+                shadow_maps_enabled: true,
+                // As the spot's below: Bevy's (0.02, 1.8) shrink a shadow cast this close, and
+                // with the cascade's coarser texels the spot's normal bias still does.
+                shadow_depth_bias: 0.005,
+                shadow_normal_bias: 0.2,
+                ..default()
+            },
+            cascades.build(),
+            Transform::from_translation(LIGHT).looking_at(Vec3::ZERO, Vec3::Y),
+            light_layers.clone(),
+        ));
+    }
     let mut pictures = Vec::new();
     for origin in [Vec3::ZERO, BESIDE] {
         commands.spawn((
@@ -101,23 +147,44 @@ fn setup(
             MeshMaterial3d(white.clone()),
             Transform::from_translation(origin),
         ));
-        commands.spawn((
-            SpotLight {
-                intensity: 20_000.0,
-                range: 6.0,
-                shadow_maps_enabled: true,
-                // Bevy's biases (0.02, 1.8) would shrink the shadow of a caster this close to
-                // the floor by about a pixel all round.
-                shadow_depth_bias: 0.005,
-                shadow_normal_bias: 0.5,
-                outer_angle: 0.8,
-                inner_angle: 0.7,
-                ..default()
-            },
-            Transform::from_translation(origin + LIGHT)
-                .looking_at(origin + Vec3::new(0.0, HEIGHT, 0.0), Vec3::Y),
-            RenderLayers::from_layers(&[0, 1]),
-        ));
+        let at_light = Transform::from_translation(origin + LIGHT)
+            .looking_at(origin + Vec3::new(0.0, HEIGHT, 0.0), Vec3::Y);
+        match *caster {
+            Caster::Spot => {
+                commands.spawn((
+                    SpotLight {
+                        intensity: 20_000.0,
+                        range: 6.0,
+                        shadow_maps_enabled: true,
+                        // Bevy's biases (0.02, 1.8) would shrink the shadow of a caster this
+                        // close to the floor by about a pixel all round.
+                        shadow_depth_bias: 0.005,
+                        shadow_normal_bias: 0.5,
+                        outer_angle: 0.8,
+                        inner_angle: 0.7,
+                        ..default()
+                    },
+                    at_light,
+                    light_layers.clone(),
+                ));
+            }
+            Caster::Point => {
+                commands.spawn((
+                    PointLight {
+                        intensity: 20_000.0,
+                        range: 6.0,
+                        shadow_maps_enabled: true,
+                        // Bevy's (0.08, 0.6), like the spot's, shrink a shadow cast this close.
+                        shadow_depth_bias: 0.005,
+                        shadow_normal_bias: 0.5,
+                        ..default()
+                    },
+                    at_light,
+                    light_layers.clone(),
+                ));
+            }
+            Caster::Directional => {}
+        }
         let mut target = Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
         target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
         let target = images.add(target);
@@ -140,9 +207,10 @@ fn setup(
     });
 }
 
-fn app() -> App {
+fn app(caster: Caster) -> App {
     crate::common::headless_app(|app| {
-        app.insert_resource(DirectionalLightShadowMap { size: 512 })
+        app.insert_resource(caster)
+            .insert_resource(DirectionalLightShadowMap { size: 512 })
             .insert_resource(GlobalAmbientLight::NONE)
             .add_plugins(PyramidDisplacementPlugin)
             .add_systems(Startup, setup);
@@ -155,7 +223,7 @@ fn linear(srgb: u8) -> f64 {
 }
 
 /// Per pixel: whether the floor is in the patch's shadow, on the CPU (None: off the floor).
-fn truth(map: &HeightMap, world_from_clip: Mat4, x: u32, y: u32) -> Option<bool> {
+fn truth(map: &HeightMap, caster: Caster, world_from_clip: Mat4, x: u32, y: u32) -> Option<bool> {
     let world_from_clip = world_from_clip.as_dmat4();
     let ndc = DVec2::new(
         (f64::from(x) + 0.5) / f64::from(SIZE) * 2.0 - 1.0,
@@ -168,7 +236,7 @@ fn truth(map: &HeightMap, world_from_clip: Mat4, x: u32, y: u32) -> Option<bool>
         return None;
     }
     // Towards the light, through the patch's plane.
-    let towards = (LIGHT.as_dvec3() - floor).normalize();
+    let towards = caster.towards(floor);
     let (height, s) = (f64::from(HEIGHT), f64::from(DEPTH_SCALE));
     let on_patch = floor + towards * (height / towards.y);
     let p0 = DVec2::new(on_patch.x + 0.5, on_patch.z + 0.5);
@@ -187,9 +255,10 @@ fn truth(map: &HeightMap, world_from_clip: Mat4, x: u32, y: u32) -> Option<bool>
     )
 }
 
-#[test]
-fn the_displaced_surface_casts_its_traced_shadow() {
-    let mut app = app();
+/// Bevy's picture of the floor with the shadow `caster` casts against the truth: at most
+/// MISMATCH_TOLERANCE of the pixels the truth shadows differ.
+fn shadow_mismatch(caster: Caster) {
+    let mut app = app(caster);
     app.update(); // Startup: the scene and its views.
     let pictures = app.world().resource::<Pictures>();
     for (image, read) in [
@@ -248,7 +317,7 @@ fn the_displaced_surface_casts_its_traced_shadow() {
     let (mut shadowed, mut mismatched) = (0, 0);
     for y in 0..SIZE {
         for x in 0..SIZE {
-            let Some(truth) = truth(&map, world_from_clip, x, y) else {
+            let Some(truth) = truth(&map, caster, world_from_clip, x, y) else {
                 continue;
             };
             shadowed += usize::from(truth);
@@ -256,12 +325,29 @@ fn the_displaced_surface_casts_its_traced_shadow() {
         }
     }
     let fraction = mismatched as f64 / shadowed.max(1) as f64;
-    println!("{shadowed} pixels in the traced shadow, {mismatched} differ ({fraction:.4})");
+    println!(
+        "{caster:?}: {shadowed} pixels in the traced shadow, {mismatched} differ ({fraction:.4})"
+    );
     assert!(shadowed > 100, "only {shadowed} pixels in shadow");
     assert!(
         fraction <= MISMATCH_TOLERANCE,
         "{mismatched} pixels differ from the traced shadow's {shadowed}"
     );
+}
+
+#[test]
+fn the_displaced_surface_casts_its_traced_shadow() {
+    shadow_mismatch(Caster::Spot);
+}
+
+#[test]
+fn the_directional_light_s_cascade_holds_the_traced_shadow() {
+    shadow_mismatch(Caster::Directional);
+}
+
+#[test]
+fn the_point_light_s_cube_map_holds_the_traced_shadow() {
+    shadow_mismatch(Caster::Point);
 }
 
 /// The shadow pass under the Khronos validation layer with synchronization validation: the test

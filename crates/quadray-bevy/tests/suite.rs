@@ -7,4 +7,5 @@ mod gi;
 mod hits;
 mod pass_cost;
 mod prepass;
+mod self_shadow;
 mod shadows;

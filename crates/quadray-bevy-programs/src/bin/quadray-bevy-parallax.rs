@@ -122,8 +122,8 @@ fn setup(
         ..base.clone()
     });
     let mut extension = PyramidExtension::new(depth, 0.09);
-    extension.shadow_strength = 0.6;
-    extension.light = Vec4::new(2.0, 1.0, -1.1, 1.0);
+    // The cube's bumps shadow each other from the scene's point light.
+    extension.shadow_strength = 1.0;
     let pyramid = pyramid.add(PyramidMaterial { base, extension });
 
     // AgX and TonyMcMapface need the tonemapping_luts feature; ACES does not.
