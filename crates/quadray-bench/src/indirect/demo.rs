@@ -3,7 +3,9 @@
 //! one cut and the centre tile's per-tile cut over the RSM; the paper's figure 9 (quadtree against RSM
 //! sampling at equal time and at 2040 samples, and the per-tile cuts); the atrium; the leak scene with and without
 //! indirect shadows beside the ground truth with visibility; the sunlit courtyard and the room lit
-//! by three point lights beside their ground truths.
+//! by three point lights beside their ground truths; the two visibility scenes held apart from
+//! tuning without indirect shadows, with the depth maps marched and with the occupancy grid,
+//! beside their ground truths.
 
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
@@ -171,7 +173,57 @@ pub fn render_demo(
         let path = out.join(format!("{scene}.png"));
         files.push(lights_picture(gpu, size, scene, &path)?);
     }
+    for scene in ["visibility-shelf", "visibility-storeys"] {
+        progress(&format!(
+            "{scene}: indirect shadows on a scene nobody tuned on"
+        ));
+        let path = out.join(format!("{scene}.png"));
+        files.push(held_apart_picture(gpu, size, scene, &path)?);
+    }
     Ok(files)
+}
+
+/// Exposure of the held-apart scenes' pictures: four times the others', so that the dark rooms
+/// can be seen.
+const DARK_EXPOSURE: f32 = 4.0 * EXPOSURE;
+
+/// A visibility scene held apart from tuning (`scenes_dir()/NAME.toml`): the default method's
+/// bounce without indirect shadows, with the depth maps marched alone, with the occupancy grid
+/// (the default), and the bounce from every VPL with exact visibility, each with its FLIP to the
+/// last (a 32^2 RSM keeps the ground truth to seconds).
+fn held_apart_picture(
+    gpu: &Gpu,
+    size: u32,
+    name: &str,
+    path: &Path,
+) -> Result<PathBuf, IndirectError> {
+    let scene = Scene::load(&scenes_dir().join(format!("{name}.toml")))?;
+    let (w, h) = (size * 4 / 3, size);
+    let plain = Settings::sized(w, h, 32);
+    let mut r = Renderer::new(gpu, &scene, plain.clone())?;
+    let without = r.render_frame(Method::DEFAULT)?;
+    let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
+    let shadowed = |shadow_grid| {
+        let settings = Settings {
+            indirect_shadows: true,
+            shadow_grid,
+            ..plain.clone()
+        };
+        Renderer::new(gpu, &scene, settings)?.render_frame(Method::DEFAULT)
+    };
+    let tile = |v: &[[f32; 3]]| tone_map(w, h, v, DARK_EXPOSURE);
+    let mut pictures = Vec::new();
+    // (short captions: the demo's smallest pictures are 128 pixels wide)
+    for (caption, frame) in [
+        ("none", without),
+        ("march", shadowed(0)?),
+        ("grid", shadowed(Settings::DEFAULT.shadow_grid)?),
+    ] {
+        let flip = flip_against(&frame, &truth, EXPOSURE);
+        pictures.push((format!("{caption}, FLIP {flip:.3}"), tile(&frame.indirect)));
+    }
+    pictures.push(("true bounce".into(), tile(&truth)));
+    save(&montage(&pictures, 2), path)
 }
 
 /// A scene lit by other lights than a spot (`scenes_dir()/NAME.toml`): the direct light, with the
