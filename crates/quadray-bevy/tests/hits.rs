@@ -7,7 +7,7 @@ use bevy::camera::visibility::RenderLayers;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
-use bevy::render::render_resource::{BufferUsages, TextureFormat};
+use bevy::render::render_resource::TextureFormat;
 use bevy::render::storage::ShaderBuffer;
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial, depth_map};
 use quadray_core::image_out::Rgba8Image;
@@ -34,16 +34,6 @@ struct View {
 #[derive(Resource)]
 struct Views(Vec<View>);
 
-/// Two entries per pixel (ray, hit); hit depth -2 marks a pixel no fragment wrote.
-fn hit_buffer() -> ShaderBuffer {
-    let blank: Vec<f32> = (0..SIZE * SIZE)
-        .flat_map(|_| [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -2.0, 0.0])
-        .collect();
-    let mut buffer = ShaderBuffer::new(bytemuck::cast_slice(&blank), default());
-    buffer.buffer_description.usage |= BufferUsages::COPY_SRC;
-    buffer
-}
-
 fn setup(
     mut commands: Commands,
     assets: Res<AssetServer>,
@@ -58,7 +48,7 @@ fn setup(
         let depth = height_map(&assets, path);
         for angle_deg in ANGLES_DEG {
             let layer = RenderLayers::layer(views.len() + 1);
-            let hits = buffers.add(hit_buffer());
+            let hits = buffers.add(crate::common::hit_buffer(SIZE * SIZE));
             let mut extension = PyramidExtension::new(depth.clone(), DEPTH_SCALE);
             extension.lod = false;
             extension.debug_hits = hits.clone();

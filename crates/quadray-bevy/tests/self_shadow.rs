@@ -7,14 +7,11 @@
 //! with the rule of `shadow_lit` in quadray_displace's `trace.wgsl`. No shadow maps: only the
 //! height field shadows.
 
-use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
-use bevy::render::render_resource::{
-    BufferUsages, Extent3d, TextureDimension, TextureFormat, TextureUsages,
-};
+use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::storage::ShaderBuffer;
 use glam::{DVec2, DVec3};
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial, depth_map};
@@ -78,16 +75,6 @@ fn sun_direction() -> Vec3 {
     Vec3::new(cos, sin, 0.0)
 }
 
-/// Two entries per pixel (ray, hit); hit depth -2 marks a pixel no fragment wrote.
-fn hit_buffer() -> ShaderBuffer {
-    let blank: Vec<f32> = (0..SIZE * SIZE)
-        .flat_map(|_| [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -2.0, 0.0])
-        .collect();
-    let mut buffer = ShaderBuffer::new(bytemuck::cast_slice(&blank), default());
-    buffer.buffer_description.usage |= BufferUsages::COPY_SRC;
-    buffer
-}
-
 fn setup(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
@@ -96,18 +83,8 @@ fn setup(
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
     let texels: Vec<u8> = (0..MAP * MAP).map(|i| ridge_depth(i % MAP)).collect();
-    let map = images.add(Image::new(
-        Extent3d {
-            width: MAP,
-            height: MAP,
-            depth_or_array_layers: 1,
-        },
-        TextureDimension::D2,
-        texels,
-        TextureFormat::R8Unorm,
-        RenderAssetUsages::all(),
-    ));
-    let hits = buffers.add(hit_buffer());
+    let map = images.add(crate::common::r8_height_map(MAP, texels));
+    let hits = buffers.add(crate::common::hit_buffer(SIZE * SIZE));
     let mut extension = PyramidExtension::new(map, DEPTH_SCALE);
     extension.lod = false;
     extension.shadow_strength = 1.0;

@@ -6,14 +6,13 @@
 //! through the height field, shadowed where it meets the surface above the floor. A shadow pass
 //! that wrote the polygon's depth would shadow the whole patch's outline.
 
-use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
 use bevy::camera::visibility::RenderLayers;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::light::{CascadeShadowConfigBuilder, DirectionalLightShadowMap};
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
-use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat, TextureUsages};
+use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use glam::{DVec2, DVec3};
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial, depth_map};
 use quadray_displace::heightmap::HeightMap;
@@ -86,17 +85,7 @@ fn setup(
     let texels: Vec<u8> = (0..MAP * MAP)
         .map(|i| (cone_depth(i % MAP, i / MAP) * 255.0).round() as u8)
         .collect();
-    let map = images.add(Image::new(
-        Extent3d {
-            width: MAP,
-            height: MAP,
-            depth_or_array_layers: 1,
-        },
-        TextureDimension::D2,
-        texels,
-        TextureFormat::R8Unorm,
-        RenderAssetUsages::all(),
-    ));
+    let map = images.add(crate::common::r8_height_map(MAP, texels));
     let patch = crate::common::unit_plane();
     let mut extension = PyramidExtension::new(map, DEPTH_SCALE);
     extension.lod = false;

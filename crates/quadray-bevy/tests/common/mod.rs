@@ -38,6 +38,34 @@ pub fn height_map(assets: &AssetServer, path: &'static str) -> Handle<Image> {
         .load(path)
 }
 
+/// The material's debug buffer for `pixels` pixels: two entries a pixel (ray, hit); hit depth -2
+/// marks a pixel no fragment wrote.
+pub fn hit_buffer(pixels: u32) -> bevy::render::storage::ShaderBuffer {
+    let blank: Vec<f32> = (0..pixels)
+        .flat_map(|_| [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -2.0, 0.0])
+        .collect();
+    let mut buffer =
+        bevy::render::storage::ShaderBuffer::new(bytemuck::cast_slice(&blank), default());
+    buffer.buffer_description.usage |= bevy::render::render_resource::BufferUsages::COPY_SRC;
+    buffer
+}
+
+/// A `side` x `side` height map of one byte a texel (0: the top), row-major.
+pub fn r8_height_map(side: u32, texels: Vec<u8>) -> Image {
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    Image::new(
+        Extent3d {
+            width: side,
+            height: side,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        texels,
+        TextureFormat::R8Unorm,
+        bevy::asset::RenderAssetUsages::all(),
+    )
+}
+
 /// The app with `add` applied (plugins, resources, systems), ready to `update`.
 pub fn headless_app(add: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
