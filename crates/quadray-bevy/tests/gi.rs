@@ -15,37 +15,39 @@ use bevy::pbr::DefaultOpaqueRendererMethod;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
-use bevy::render::render_resource::{BufferUsages, TextureFormat, TextureUsages};
+use bevy::render::render_resource::{BufferUsages, PipelineCache, TextureFormat, TextureUsages};
 use bevy::render::storage::ShaderBuffer;
+use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::world_serialization::WorldAssetRoot;
 use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{Method, Renderer, Scene, Settings};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use crate::common::ASSETS;
 
-const SCENE: &str = "scenes/cornell_spot.gltf";
-const SIZE: u32 = 64;
-const RSM: u32 = 64;
+pub(crate) const SCENE: &str = "scenes/cornell_spot.gltf";
+pub(crate) const SIZE: u32 = 64;
+pub(crate) const RSM: u32 = 64;
 /// Further back than the file's camera (z = 2.4), so that the background shows around the box.
 const EYE: [f32; 3] = [0.5, 0.5, 3.4];
 const TARGET: [f32; 3] = [0.5, 0.5, 0.0];
 
 /// What one camera records, read back each frame (the latest kept).
 #[derive(Clone)]
-struct Probe {
+pub(crate) struct Probe {
     method: Method,
     enabled: bool,
     cut_view: bool,
-    indirect: Handle<ShaderBuffer>,
-    picture: Handle<Image>,
-    read_indirect: Arc<Mutex<Option<Vec<u8>>>>,
+    pub(crate) indirect: Handle<ShaderBuffer>,
+    pub(crate) picture: Handle<Image>,
+    pub(crate) read_indirect: Arc<Mutex<Option<Vec<u8>>>>,
     read_picture: Arc<Mutex<Option<Vec<u8>>>>,
 }
 
 #[derive(Resource)]
-struct Probes(Vec<Probe>);
+pub(crate) struct Probes(pub(crate) Vec<Probe>);
 
 /// The glTF scene a test's app loads, and its cases (one camera each).
 #[derive(Resource, Clone)]
@@ -57,10 +59,10 @@ struct Setup {
 }
 
 /// Method, bounce on, cut view on.
-type Case = (Method, bool, bool);
+pub(crate) type Case = (Method, bool, bool);
 
 /// The Cornell box lit by a spot, a point light and the sun through its open front.
-const LIGHTS_SCENE: &str = "scenes/cornell_lights.gltf";
+pub(crate) const LIGHTS_SCENE: &str = "scenes/cornell_lights.gltf";
 
 const CASES: [Case; 5] = [
     (Method::Reference, true, false),
@@ -80,14 +82,15 @@ fn setup(
     commands.spawn(WorldAssetRoot(
         assets.load(GltfAssetLabel::Scene(0).from_asset(setup.scene)),
     ));
+    let quadray_indirect::Size { width, height } = setup.settings.size;
     let probes = setup
         .cases
         .iter()
         .map(|&(method, enabled, cut_view)| {
-            let mut indirect = ShaderBuffer::with_size((SIZE * SIZE * 16) as usize, default());
+            let mut indirect = ShaderBuffer::with_size((width * height * 16) as usize, default());
             indirect.buffer_description.usage |= BufferUsages::COPY_SRC | BufferUsages::COPY_DST;
             let mut target =
-                Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
+                Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
             target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
             Probe {
                 method,
@@ -103,8 +106,8 @@ fn setup(
     commands.insert_resource(Probes(probes));
 }
 
-/// The glTF's camera, when it appears.
-type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
+/// The glTF's camera (a node of the scene, where a test's own cameras are not), when it appears.
+type FileCamera = (Added<Camera3d>, Without<IndirectLight>, With<ChildOf>);
 
 /// Bevy's lights of the three kinds, not yet marked.
 type Unmarked = (
@@ -112,14 +115,16 @@ type Unmarked = (
     Without<IndirectLightSource>,
 );
 
-/// Once the glTF's camera and lights exist: one camera per case with the file's projection, and
-/// the file's lights marked as the bounce's sources.
+/// Once the glTF's camera and lights exist: one camera per case with the file's projection (once:
+/// a glTF spawned later keeps the probes' cameras), and the file's lights marked as the bounce's
+/// sources.
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Projection), FileCamera>,
     lights: Query<Entity, Unmarked>,
     probes: Res<Probes>,
     setup: Res<Setup>,
+    mut spawned: Local<bool>,
 ) {
     for light in &lights {
         // (a test may despawn the light this frame)
@@ -131,6 +136,9 @@ fn configure(
             is_active: false,
             ..default()
         });
+        if std::mem::replace(&mut *spawned, true) {
+            continue;
+        }
         for p in &probes.0 {
             commands.spawn((
                 Camera3d::default(),
@@ -152,34 +160,70 @@ fn configure(
     }
 }
 
-fn app(scene: &'static str, cases: &[Case]) -> App {
+pub(crate) fn app(scene: &'static str, cases: &[Case]) -> App {
     app_with(scene, cases, Settings::sized(SIZE, SIZE, RSM))
 }
 
-fn app_with(scene: &'static str, cases: &[Case], settings: Settings) -> App {
+pub(crate) fn app_with(scene: &'static str, cases: &[Case], settings: Settings) -> App {
+    app_of(scene, cases, settings, true)
+}
+
+/// The same app without the plugin: its cameras (`IndirectLight` with nothing to read it, so
+/// with the prepasses and `Hdr` it requires) show Bevy's own picture.
+pub(crate) fn app_without_plugin(scene: &'static str, cases: &[Case]) -> App {
+    app_of(scene, cases, Settings::sized(SIZE, SIZE, RSM), false)
+}
+
+fn app_of(scene: &'static str, cases: &[Case], settings: Settings, plugin: bool) -> App {
     crate::common::headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .insert_resource(Setup {
                 scene,
                 cases: cases.to_vec(),
                 settings,
-            })
-            .add_plugins((IndirectLightPlugin, RenderDiagnosticsPlugin))
+            });
+        if plugin {
+            app.add_plugins(IndirectLightPlugin);
+        }
+        app.add_plugins(RenderDiagnosticsPlugin)
             .add_systems(Startup, setup)
             .add_systems(Update, configure);
+        let compiling = Compiling::default();
+        app.insert_resource(compiling.clone());
+        app.sub_app_mut(RenderApp)
+            .insert_resource(compiling)
+            .add_systems(Render, note_compiling.in_set(RenderSystems::Cleanup));
     })
 }
 
-fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
+pub(crate) fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
     bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(bytes)
         .into_iter()
         .map(|p| [p[0], p[1], p[2]])
         .collect()
 }
 
+/// Whether Bevy's render world had a pipeline left to compile at the end of its last frame (a
+/// mesh drawn with it is missing from the picture until then); shared by both worlds.
+#[derive(Resource, Clone, Default)]
+struct Compiling(Arc<AtomicBool>);
+
+fn note_compiling(pipelines: Res<PipelineCache>, compiling: Res<Compiling>) {
+    let waiting = pipelines.waiting_pipelines().next().is_some();
+    compiling.0.store(waiting, Ordering::Relaxed);
+}
+
+/// Whether Bevy still compiles a pipeline, as its last rendered frame saw it.
+pub(crate) fn compiling(app: &App) -> bool {
+    app.world()
+        .resource::<Compiling>()
+        .0
+        .load(Ordering::Relaxed)
+}
+
 /// Runs `app` until every probe's camera has gathered (or has the bounce off) and its picture
 /// has been read, then a few frames more; returns the probes and each one's indirect light.
-fn gathered(app: &mut App) -> (Vec<Probe>, Vec<Vec<[f32; 3]>>) {
+pub(crate) fn gathered(app: &mut App) -> (Vec<Probe>, Vec<Vec<[f32; 3]>>) {
     app.update();
     let probes = app.world().resource::<Probes>().0.clone();
     for p in &probes {
@@ -193,7 +237,7 @@ fn gathered(app: &mut App) -> (Vec<Probe>, Vec<Vec<[f32; 3]>>) {
             .observe(move |e: On<ReadbackComplete>| *read.lock().unwrap() = Some(e.data.clone()));
     }
     // the scene loads, the pipelines compile, then every camera gathers: wait for light in every
-    // probe's indirect term, then render a few frames more
+    // probe's indirect term and for Bevy's last pipeline, then render a few frames more
     let lit = |p: &Probe| {
         let gathered = p
             .read_indirect
@@ -205,7 +249,7 @@ fn gathered(app: &mut App) -> (Vec<Probe>, Vec<Vec<[f32; 3]>>) {
         (gathered || !p.enabled) && p.read_picture.lock().unwrap().is_some()
     };
     let mut frames = 0;
-    while !probes.iter().all(lit) {
+    while !probes.iter().all(lit) || compiling(app) {
         if frames == 500 {
             let states: Vec<String> = probes
                 .iter()

@@ -5,6 +5,7 @@
 mod common;
 mod gi;
 mod hits;
+mod lifecycle;
 mod pass_cost;
 mod prepass;
 mod self_shadow;

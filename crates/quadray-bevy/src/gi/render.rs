@@ -675,21 +675,19 @@ fn prepare_views(
         let current = |p: &Mut<ViewPasses>| {
             p.settings == settings && p.format == format && p.maps_generation == l.maps_generation
         };
-        let Some(mut passes) = passes.filter(current) else {
-            match ViewPasses::new(device, &queue, settings, l, &mut pipelines, format) {
-                Ok(p) => {
-                    commands.entity(entity).insert(p);
-                }
+        let mut made = None;
+        let passes = match passes.filter(current) {
+            Some(passes) => passes.into_inner(),
+            None => match ViewPasses::new(device, &queue, settings, l, &mut pipelines, format) {
+                Ok(p) => made.insert(p),
                 Err(e) => {
                     warn(format!("{e}; no indirect light is added"));
                     commands.entity(entity).remove::<ViewPasses>();
+                    continue;
                 }
-            }
-            // the new passes start next frame
-            continue;
+            },
         };
         if passes.occupancy_generation != l.occupancy_generation {
-            let passes = &mut *passes;
             let [position, normal, albedo] = &passes.gbuffer;
             let views = GBufferViews {
                 position,
@@ -719,6 +717,11 @@ fn prepare_views(
         );
         let zoom = [cut_view_zoom(&passes.settings), 0, 0, 0];
         queue.write_buffer(&passes.cut_view_uniform, 0, bytemuck::cast_slice(&zoom));
+        // inserted once written: new passes record in this frame's pass already, and unwritten
+        // they would add no light (a frame without the bounce)
+        if let Some(made) = made {
+            commands.entity(entity).insert(made);
+        }
     }
 }
 
