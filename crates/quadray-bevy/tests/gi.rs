@@ -571,18 +571,7 @@ fn a_light_replaced_by_another_kind_lights_as_in_a_fresh_app() {
 /// prepasses, MSAA and HDR but no `IndirectLight`. Run in a child process, whose log is read.
 #[test]
 fn misconfigured_cameras_keep_bevy_s_picture() {
-    let output = std::process::Command::new(std::env::current_exe().unwrap())
-        .args([
-            "--exact",
-            "gi::misconfigured_cameras_beside_plain_ones",
-            "--ignored",
-            "--nocapture",
-        ])
-        .output()
-        .unwrap();
-    let log = String::from_utf8_lossy(&output.stdout).into_owned()
-        + &String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{log}");
+    let log = crate::common::child_log(&["gi::misconfigured_cameras_beside_plain_ones"]);
     for warning in [
         "MSAA is incompatible with deferred rendering and has been disabled",
         "its settings are refused: RSM size 100 must be a power of two",

@@ -256,19 +256,10 @@ fn a_resized_target_gathers_as_a_fresh_app_at_its_new_size() {
 /// despawned camera leaves nothing behind that warns).
 #[test]
 fn hdr_off_and_a_respawned_camera_log_only_the_hdr_warning() {
-    let output = std::process::Command::new(std::env::current_exe().unwrap())
-        .args([
-            "--exact",
-            "lifecycle::hdr_off_shows_bevy_s_picture_and_back_gathers_as_a_fresh_app",
-            "lifecycle::a_respawned_camera_gathers_as_a_fresh_app",
-            "--ignored",
-            "--nocapture",
-        ])
-        .output()
-        .unwrap();
-    let log = String::from_utf8_lossy(&output.stdout).into_owned()
-        + &String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{log}");
+    let log = crate::common::child_log(&[
+        "lifecycle::hdr_off_shows_bevy_s_picture_and_back_gathers_as_a_fresh_app",
+        "lifecycle::a_respawned_camera_gathers_as_a_fresh_app",
+    ]);
     for line in log.lines() {
         if line.starts_with("Hdr off:") || line.starts_with("respawned camera:") {
             println!("{line}");

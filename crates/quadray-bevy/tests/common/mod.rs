@@ -66,6 +66,21 @@ pub fn r8_height_map(side: u32, texels: Vec<u8>) -> Image {
     )
 }
 
+/// The log (stdout and stderr) of the ignored `tests` of this binary run again in a child process,
+/// which must pass.
+pub fn child_log(tests: &[&str]) -> String {
+    let output = std::process::Command::new(std::env::current_exe().unwrap())
+        .arg("--exact")
+        .args(tests)
+        .args(["--ignored", "--nocapture"])
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{log}");
+    log
+}
+
 /// The app with `add` applied (plugins, resources, systems), ready to `update`.
 pub fn headless_app(add: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
