@@ -23,7 +23,7 @@ mkdir -p "$out"
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 tuned=(visibility-door visibility-corridor visibility-gap)
-held_apart=(visibility-shelf visibility-storeys)
+held_apart=(visibility-shelf visibility-storeys visibility-pillars courtyard)
 scenes=("${tuned[@]}" "${held_apart[@]}" leak)
 run() { # scene, off|on, pictures' stem, stats file, flags...
     local scene=$1 shadows=$2 stem=$3 stats=$4

@@ -40,6 +40,7 @@ fn every_bundled_scene_file_loads() {
         ("visibility-corridor.toml", 1, 1, 10, 3),
         ("visibility-door.toml", 1, 1, 11, 4),
         ("visibility-gap.toml", 1, 1, 7, 3),
+        ("visibility-pillars.toml", 1, 1, 11, 3),
         ("visibility-shelf.toml", 1, 1, 6, 4),
         ("visibility-storeys.toml", 1, 1, 11, 4),
     ];
