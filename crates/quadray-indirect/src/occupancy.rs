@@ -3,7 +3,8 @@
 //! a wall, a shelf or a slab blocks whatever the camera and the light see of it. The walk
 //! ([`OccupancyGrid::visible`]) is the CPU twin of `wgsl/occupancy.wgsl`'s `grid_visibility`; both
 //! start and end two cells off the surfaces along their normals, so that a surface never hides
-//! its own points.
+//! its own points. The bits are stored a brick of [`BRICK`] cells to a word, so that a walk
+//! fetches a word a brick it passes through, not a cell (an empty brick is a zero word).
 
 use crate::scene::Vertex;
 use glam::{IVec3, UVec3, Vec3};
@@ -15,6 +16,21 @@ pub const END_OFFSET_CELLS: f32 = 2.0;
 /// Words before the bits in [`OccupancyGrid::gpu_words`]: the dimensions (and a pad), the origin
 /// and the cell's side.
 pub const HEADER_WORDS: usize = 8;
+
+/// The cells of a brick, one word of bits: cell (x, y, z) of a brick at bit `x + 4 * (y + 4 * z)`.
+/// The grid's dimensions are multiples of it.
+pub const BRICK: UVec3 = UVec3::new(4, 4, 2);
+
+/// What a walk between two points found, and the words it fetched.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Walk {
+    /// Visible, blocked, or `None`: a moved end lies in a set cell.
+    pub visible: Option<bool>,
+    /// Words fetched: one each time the walk enters a brick it has not just read.
+    pub fetches: u32,
+    /// Cells tested (what a grid of a word a cell would have fetched).
+    pub cells: u32,
+}
 
 /// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,13 +55,13 @@ impl OccupancyGrid {
         let cell = ((hi - lo).max_element() / cells.max(1) as f32).max(1e-6);
         let margin = END_OFFSET_CELLS + 1.0;
         let origin = lo - Vec3::splat(margin * cell);
-        let dims = (((hi - lo) / cell).ceil() + Vec3::splat(2.0 * margin + 1.0)).as_uvec3();
-        let count = dims.x as usize * dims.y as usize * dims.z as usize;
+        let cells = (((hi - lo) / cell).ceil() + Vec3::splat(2.0 * margin + 1.0)).as_uvec3();
+        let bricks = (cells + BRICK - 1) / BRICK;
         let mut grid = Self {
-            dims,
+            dims: bricks * BRICK,
             origin,
             cell,
-            bits: vec![0; count.div_ceil(32)],
+            bits: vec![0; bricks.element_product() as usize],
         };
         for t in triangles {
             grid.add_triangle(t.map(|v| (Vec3::from(v.position) - origin) / cell));
@@ -65,10 +81,8 @@ impl OccupancyGrid {
 
     /// Whether cell `c` holds a piece of a triangle (outside the grid: no).
     pub fn occupied(&self, c: IVec3) -> bool {
-        match self.index(c) {
-            Some(i) => self.bits[i / 32] >> (i % 32) & 1 == 1,
-            None => false,
-        }
+        self.index(c)
+            .is_some_and(|(word, bit)| self.bits[word] >> bit & 1 == 1)
     }
 
     /// How many cells are set.
@@ -83,12 +97,40 @@ impl OccupancyGrid {
     /// of it: in a corner, under a box), which the grid cannot judge. Visits the cells the
     /// segment passes through, in order (a 3D DDA).
     pub fn visible(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Option<bool> {
+        self.walk(x, n, xp, np).visible
+    }
+
+    /// [`Self::visible`] with the words the walk fetched, as the GPU's walk counts them: the
+    /// word last read is kept, so a brick costs one fetch however many of its cells are crossed.
+    pub fn walk(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Walk {
+        let mut reader = WordReader {
+            grid: self,
+            word: None,
+            fetches: 0,
+            cells: 0,
+        };
+        let visible = self.walk_cells(x, n, xp, np, &mut reader);
+        Walk {
+            visible,
+            fetches: reader.fetches,
+            cells: reader.cells,
+        }
+    }
+
+    fn walk_cells(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        xp: Vec3,
+        np: Vec3,
+        reader: &mut WordReader,
+    ) -> Option<bool> {
         let a = self.to_grid(x, n);
         let b = self.to_grid(xp, np);
         let d = b - a;
         let mut c = a.floor().as_ivec3();
         let end = b.floor().as_ivec3();
-        if self.occupied(c) || self.occupied(end) {
+        if reader.occupied(c) || reader.occupied(end) {
             return None;
         }
         let step = IVec3::new(sign(d.x), sign(d.y), sign(d.z));
@@ -117,16 +159,16 @@ impl OccupancyGrid {
                 // past the end in floating point: the end's cell is the last one
                 c = end;
             }
-            if self.occupied(c) {
+            if reader.occupied(c) {
                 return Some(false);
             }
         }
         Some(true)
     }
 
-    /// The grid as the gather's storage buffer reads it: [`HEADER_WORDS`] words (the
-    /// dimensions, a pad, the origin and the cell's side as `f32` bits), then the bits, cell
-    /// (x, y, z) at bit `x + dims.x * (y + dims.y * z)`.
+    /// The grid as the gather reads it: [`HEADER_WORDS`] words (the dimensions, a pad, the
+    /// origin and the cell's side as `f32` bits), then a word a [`BRICK`], brick (x, y, z) at
+    /// word `x + bricks.x * (y + bricks.y * z)`.
     pub fn gpu_words(&self) -> Vec<u32> {
         let mut words = vec![
             self.dims.x,
@@ -152,12 +194,15 @@ impl OccupancyGrid {
         (p - self.origin) / self.cell + off
     }
 
-    fn index(&self, c: IVec3) -> Option<usize> {
-        let d = self.dims.as_ivec3();
-        if c.cmplt(IVec3::ZERO).any() || c.cmpge(d).any() {
+    /// Cell `c`'s word and bit (outside the grid: none).
+    fn index(&self, c: IVec3) -> Option<(usize, u32)> {
+        if c.cmplt(IVec3::ZERO).any() || c.cmpge(self.dims.as_ivec3()).any() {
             return None;
         }
-        Some(c.x as usize + d.x as usize * (c.y as usize + d.y as usize * c.z as usize))
+        let (c, bricks) = (c.as_uvec3(), self.dims / BRICK);
+        let (b, l) = (c / BRICK, c % BRICK);
+        let word = b.x + bricks.x * (b.y + bricks.y * b.z);
+        Some((word as usize, l.x + BRICK.x * (l.y + BRICK.y * l.z)))
     }
 
     /// Sets every cell the triangle (in grid units) overlaps. A cell is the half-open
@@ -180,12 +225,39 @@ impl OccupancyGrid {
                     // the box [i - 1e-5, i + 1 - 1e-4]: a plane at i is in, one at i + 1 out
                     let centre = c.as_vec3() + Vec3::splat(0.5 - 5.5e-5);
                     if triangle_overlaps_box(t, centre, Vec3::splat(0.5 - 4.5e-5)) {
-                        let i = self.index(c).expect("clamped to the grid");
-                        self.bits[i / 32] |= 1 << (i % 32);
+                        let (word, bit) = self.index(c).expect("clamped to the grid");
+                        self.bits[word] |= 1 << bit;
                     }
                 }
             }
         }
+    }
+}
+
+/// A walk's reads of the grid: the last word fetched, how many were, and the cells tested.
+struct WordReader<'a> {
+    grid: &'a OccupancyGrid,
+    word: Option<(usize, u32)>,
+    fetches: u32,
+    cells: u32,
+}
+
+impl WordReader<'_> {
+    fn occupied(&mut self, c: IVec3) -> bool {
+        self.cells += 1;
+        let Some((index, bit)) = self.grid.index(c) else {
+            return false;
+        };
+        let bits = match self.word {
+            Some((held, bits)) if held == index => bits,
+            _ => {
+                self.fetches += 1;
+                let bits = self.grid.bits[index];
+                self.word = Some((index, bits));
+                bits
+            }
+        };
+        bits >> bit & 1 == 1
     }
 }
 

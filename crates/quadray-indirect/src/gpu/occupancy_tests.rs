@@ -1,12 +1,12 @@
 //! The occupancy grid's walk on the GPU (`wgsl/occupancy.wgsl`, `grid_visibility`) against its CPU
-//! twin ([`OccupancyGrid::visible`]) on segments between random points of the leak scene's
-//! surfaces.
+//! twin ([`OccupancyGrid::walk`]) on segments between random points of the leak scene's
+//! surfaces: the same answers from the same word fetches.
 
 use super::contract::{
     bind_group, compute_pipeline, layout, pipeline_layout, shader_module, storage_buffer,
     storage_entry, whole,
 };
-use crate::occupancy::{HEADER_WORDS, OccupancyGrid};
+use crate::occupancy::{HEADER_WORDS, OccupancyGrid, Walk};
 use crate::scene::{Scene, scenes_dir};
 use crate::wgsl;
 use glam::Vec3;
@@ -27,7 +27,7 @@ const ENTRY: &str = "
 struct Segment { x: vec4<f32>, n: vec4<f32>, xp: vec4<f32>, np: vec4<f32> }
 @group(0) @binding(0) var<storage, read> grid: array<u32>;
 @group(0) @binding(1) var<storage, read> segments: array<Segment>;
-@group(0) @binding(2) var<storage, read_write> seen: array<u32>;
+@group(0) @binding(2) var<storage, read_write> seen: array<vec2<u32>>;
 fn occupancy_dims() -> vec3<u32> { return vec3<u32>(grid[0], grid[1], grid[2]); }
 fn occupancy_origin() -> vec3<f32> { return bitcast<vec3<f32>>(vec3<u32>(grid[4], grid[5], grid[6])); }
 fn occupancy_cell() -> f32 { return bitcast<f32>(grid[7]); }
@@ -36,13 +36,14 @@ fn occupancy_word(i: u32) -> u32 { return grid[OCCUPANCY_HEADER + i]; }
 fn walk(@builtin(global_invocation_id) id: vec3<u32>) {
 if (id.x < arrayLength(&segments)) {
     let s = segments[id.x];
-    seen[id.x] = grid_visibility(s.x.xyz, s.n.xyz, s.xp.xyz, s.np.xyz);
+    let verdict = grid_visibility(s.x.xyz, s.n.xyz, s.xp.xyz, s.np.xyz);
+    seen[id.x] = vec2<u32>(verdict, fetches);
 }
 }
 ";
 
-/// Each segment's `grid_visibility`, as the CPU's answer: visible, blocked, `None` unknown.
-fn walks_on_the_gpu(grid: &OccupancyGrid, segments: &[Segment]) -> Vec<Option<bool>> {
+/// Each segment's `grid_visibility` (visible, blocked, `None` unknown) and its fetches.
+fn walks_on_the_gpu(grid: &OccupancyGrid, segments: &[Segment]) -> Vec<(Option<bool>, u32)> {
     let gpu = quadray_gpu::Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     let d = &gpu.device;
     let group_layout = layout(
@@ -51,7 +52,7 @@ fn walks_on_the_gpu(grid: &OccupancyGrid, segments: &[Segment]) -> Vec<Option<bo
         &[
             storage_entry::<[u32; HEADER_WORDS + 1]>(0, true),
             storage_entry::<Segment>(1, true),
-            storage_entry::<u32>(2, false),
+            storage_entry::<[u32; 2]>(2, false),
         ],
     );
     let module = shader_module(d, "grid walks", &[wgsl::NODE, wgsl::OCCUPANCY, ENTRY]);
@@ -65,7 +66,7 @@ fn walks_on_the_gpu(grid: &OccupancyGrid, segments: &[Segment]) -> Vec<Option<bo
     };
     let words = buffer("grid", bytemuck::cast_slice(&grid.gpu_words()));
     let input = buffer("segments", bytemuck::cast_slice(segments));
-    let output = storage_buffer(d, "seen", segments.len() as u64 * 4);
+    let output = storage_buffer(d, "seen", segments.len() as u64 * 8);
     let group = bind_group(
         d,
         "grid walks",
@@ -81,9 +82,9 @@ fn walks_on_the_gpu(grid: &OccupancyGrid, segments: &[Segment]) -> Vec<Option<bo
     }
     gpu.queue.submit([encoder.finish()]);
     let bytes = quadray_gpu::read_buffer(&gpu, &output).unwrap();
-    bytemuck::pod_collect_to_vec::<u8, u32>(&bytes)
+    bytemuck::pod_collect_to_vec::<u8, [u32; 2]>(&bytes)
         .into_iter()
-        .map(|v| (v != 2).then_some(v == 1))
+        .map(|[verdict, fetches]| ((verdict != 2).then_some(verdict == 1), fetches))
         .collect()
 }
 
@@ -122,20 +123,31 @@ fn the_gpu_walks_the_grid_as_the_cpu_does() {
     let grid = OccupancyGrid::of_triangles(&scene.triangles, 48);
     let cases = segments(&scene, 4096);
     let gpu = walks_on_the_gpu(&grid, &cases);
-    let cpu: Vec<Option<bool>> = cases
+    let cpu: Vec<Walk> = cases
         .iter()
         .map(|s| {
             let v = |a: [f32; 4]| Vec3::from_slice(&a[..3]);
-            grid.visible(v(s.x), v(s.n), v(s.xp), v(s.np))
+            grid.walk(v(s.x), v(s.n), v(s.xp), v(s.np))
         })
         .collect();
-    let count = |answer| cpu.iter().filter(|&&v| v == answer).count();
+    let count = |answer| cpu.iter().filter(|w| w.visible == answer).count();
     let (visible, unknown) = (count(Some(true)), count(None));
-    let differ = cpu.iter().zip(&gpu).filter(|(a, b)| a != b).count();
+    let differ = cpu
+        .iter()
+        .zip(&gpu)
+        .filter(|(a, b)| (a.visible, a.fetches) != **b)
+        .count();
+    let fetches: u32 = cpu.iter().map(|w| w.fetches).sum();
+    let cells: u32 = cpu.iter().map(|w| w.cells).sum();
     println!(
         "of {} segments on the CPU {visible} visible, {unknown} unknown; the GPU differs on \
-         {differ}",
+         {differ} (answer or fetches); {fetches} words fetched for {cells} cells tested",
         cases.len()
+    );
+    // a word a brick: a walk crossing several cells of a brick reads it once
+    assert!(
+        fetches * 2 <= cells,
+        "{fetches} words fetched for {cells} cells"
     );
     // (points on the boxes' thin edges start inside the box beside them)
     assert!(unknown < cases.len() / 2, "{unknown} unknown");

@@ -1,20 +1,31 @@
 // The scene's occupancy grid walked between a receiver and a cluster (indirect shadows): the
-// twin of the CPU's `OccupancyGrid::visible` (src/occupancy.rs), step for step. Accessors:
-// `occupancy_dims() -> vec3<u32>` (zero: no grid), `occupancy_origin() -> vec3<f32>`,
-// `occupancy_cell() -> f32` and `occupancy_word(i: u32) -> u32` (cell (x, y, z) at bit
-// x + dims.x * (y + dims.y * z)).
+// twin of the CPU's `OccupancyGrid::walk` (src/occupancy.rs), step for step and fetch for fetch.
+// Accessors: `occupancy_dims() -> vec3<u32>` (zero: no grid; multiples of OCCUPANCY_BRICK),
+// `occupancy_origin() -> vec3<f32>`, `occupancy_cell() -> f32` and `occupancy_word(i: u32) -> u32`
+// (a word a brick of OCCUPANCY_BRICK cells, brick (x, y, z) at word x + bricks.x * (y + bricks.y
+// * z), its cell (x, y, z) at bit x + 4 * (y + 4 * z)).
 
 // (OCCUPANCY_END_OFFSET, the cells a segment's ends are moved off their surfaces along the
-// normals, comes from the prelude)
+// normals, and OCCUPANCY_BRICK come from the prelude)
 
-fn occupied(c: vec3<i32>) -> bool {
-    let d = vec3<i32>(occupancy_dims());
-    if (any(c < vec3<i32>(0)) || any(c >= d)) {
+// Whether cell `c` is set (outside the grid: no). `held` is the walk's last word read (x: its
+// index + 1, 0 before the first; y: its bits): a brick costs one fetch however many of its
+// cells the walk crosses.
+fn occupied(c: vec3<i32>, held: ptr<function, vec2<u32>>) -> bool {
+    let d = occupancy_dims();
+    if (any(c < vec3<i32>(0)) || any(vec3<u32>(c) >= d)) {
         return false;
     }
-    let i = u32(c.x) + u32(d.x) * (u32(c.y) + u32(d.y) * u32(c.z));
-    fetches++;
-    return ((occupancy_word(i / 32u) >> (i % 32u)) & 1u) == 1u;
+    let bricks = d / OCCUPANCY_BRICK;
+    let b = vec3<u32>(c) / OCCUPANCY_BRICK;
+    let l = vec3<u32>(c) % OCCUPANCY_BRICK;
+    let word = b.x + bricks.x * (b.y + bricks.y * b.z);
+    if ((*held).x != word + 1u) {
+        fetches++;
+        *held = vec2<u32>(word + 1u, occupancy_word(word));
+    }
+    let bit = l.x + OCCUPANCY_BRICK.x * (l.y + OCCUPANCY_BRICK.y * l.z);
+    return (((*held).y >> bit) & 1u) == 1u;
 }
 
 // A segment's end in grid units, moved off its surface (an end whose normal is shorter than 0.1
@@ -54,7 +65,8 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
     let d = b - a;
     var c = vec3<i32>(floor(a));
     let end = vec3<i32>(floor(b));
-    if (occupied(c) || occupied(end)) {
+    var held = vec2<u32>(0u);
+    if (occupied(c, &held) || occupied(end, &held)) {
         return GRID_UNKNOWN;
     }
     let step = vec3<i32>(sign(d));
@@ -83,7 +95,7 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
         if (min(t_max.x, min(t_max.y, t_max.z)) > 1.0 && any(c != end)) {
             c = end;
         }
-        if (occupied(c)) {
+        if (occupied(c, &held)) {
             return GRID_BLOCKED;
         }
     }
