@@ -13,6 +13,12 @@ use glam::{IVec3, UVec3, Vec3};
 /// plane through the end may overlap (a cell's diagonal is sqrt(3) sides).
 pub const END_OFFSET_CELLS: f32 = 2.0;
 
+/// A set cell the walk enters within this many cells of either (moved) end makes the walk
+/// undecided, as an end lying on another surface's plane does: a receiver on the edge where a
+/// wall meets the ceiling, moved off the ceiling, lies in the wall's plane, and would otherwise
+/// see the wall block everything.
+pub const END_CLEARANCE_CELLS: f32 = 0.5;
+
 /// Words before the bits in [`OccupancyGrid::gpu_words`]: the dimensions (and a pad), the origin
 /// and the cell's side.
 pub const HEADER_WORDS: usize = 8;
@@ -94,7 +100,8 @@ impl OccupancyGrid {
     /// `np`, of any length: a cluster's mean normal is shorter) crosses no set cell, its ends
     /// moved [`END_OFFSET_CELLS`] off their surfaces (an end whose normal is shorter than 0.1
     /// stays); `None` where a moved end lies in a set cell (another surface within two cells
-    /// of it: in a corner, under a box), which the grid cannot judge. Visits the cells the
+    /// of it: in a corner, under a box) or the walk enters a set cell within
+    /// [`END_CLEARANCE_CELLS`] of an end, which the grid cannot judge. Visits the cells the
     /// segment passes through, in order (a 3D DDA).
     pub fn visible(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Option<bool> {
         self.walk(x, n, xp, np).visible
@@ -135,6 +142,8 @@ impl OccupancyGrid {
         }
         let step = IVec3::new(sign(d.x), sign(d.y), sign(d.z));
         let t_delta = Vec3::new(inverse(d.x), inverse(d.y), inverse(d.z));
+        // the segment parameter of the clearance at each end
+        let clearance = END_CLEARANCE_CELLS / d.length().max(1e-6);
         let mut t_max = Vec3::new(
             first_crossing(a.x, d.x),
             first_crossing(a.y, d.y),
@@ -145,6 +154,8 @@ impl OccupancyGrid {
             if c == end {
                 break;
             }
+            // the parameter where the walk enters its next cell
+            let entered = t_max.min_element();
             if t_max.x <= t_max.y && t_max.x <= t_max.z {
                 c.x += step.x;
                 t_max.x += t_delta.x;
@@ -160,7 +171,7 @@ impl OccupancyGrid {
                 c = end;
             }
             if reader.occupied(c) {
-                return Some(false);
+                return (clearance < entered && entered < 1.0 - clearance).then_some(false);
             }
         }
         Some(true)
@@ -369,6 +380,25 @@ mod tests {
         // starts in a set cell
         let corner = grid.visible(Vec3::new(0.51, 0.0, 0.5), up, right, up);
         assert_eq!(corner, None, "at the wall's foot");
+    }
+
+    #[test]
+    fn a_point_on_the_edge_of_two_surfaces_is_not_hidden_by_the_other() {
+        // the wall's plane lies on a cell boundary (x = 0.5 with 32 cells) and sets the cells to
+        // its right; a floor point of the right room on the edge, rounded to the wall's left,
+        // starts in the free cell beside the wall's and crosses the wall's at once
+        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 32);
+        let up = Vec3::Y;
+        let edge = Vec3::new(0.5 - 1e-7, 0.0, 0.5);
+        let across = Vec3::new(0.8, 0.0, 0.5);
+        assert_eq!(
+            grid.visible(edge, up, across, up),
+            None,
+            "undecided, not blocked"
+        );
+        // a real wall a few cells along the way still blocks
+        let left = Vec3::new(0.3, 0.0, 0.5);
+        assert_eq!(grid.visible(left, up, across, up), Some(false));
     }
 
     #[test]

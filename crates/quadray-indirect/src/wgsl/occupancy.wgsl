@@ -6,7 +6,8 @@
 // * z), its cell (x, y, z) at bit x + 4 * (y + 4 * z)).
 
 // (OCCUPANCY_END_OFFSET, the cells a segment's ends are moved off their surfaces along the
-// normals, and OCCUPANCY_BRICK come from the prelude)
+// normals, OCCUPANCY_END_CLEARANCE, the cells from an end within which a set cell leaves the walk
+// undecided, and OCCUPANCY_BRICK come from the prelude)
 
 // Whether cell `c` is set (outside the grid: no). `held` is the walk's last word read (x: its
 // index + 1, 0 before the first; y: its bits): a brick costs one fetch however many of its
@@ -51,8 +52,9 @@ fn occupancy_first_crossing(a: f32, d: f32) -> f32 {
 }
 
 // What the grid says of a segment: it crosses no set cell, it crosses one, or it cannot tell, as
-// an end (moved off its surface) lies in a set cell: another surface within two cells of it, in
-// a corner or under a box, where a depth map must judge instead.
+// an end (moved off its surface) lies in a set cell or within OCCUPANCY_END_CLEARANCE of one on
+// the way: another surface within two or three cells of it, in a corner or under a box, where a
+// depth map must judge instead.
 const GRID_BLOCKED = 0u;
 const GRID_VISIBLE = 1u;
 const GRID_UNKNOWN = 2u;
@@ -71,6 +73,8 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
     }
     let step = vec3<i32>(sign(d));
     let t_delta = vec3<f32>(occupancy_inverse(d.x), occupancy_inverse(d.y), occupancy_inverse(d.z));
+    // the segment parameter of the clearance at each end
+    let clearance = OCCUPANCY_END_CLEARANCE / max(length(d), 1e-6);
     var t_max = vec3<f32>(
         occupancy_first_crossing(a.x, d.x),
         occupancy_first_crossing(a.y, d.y),
@@ -82,6 +86,8 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
         if (all(c == end)) {
             break;
         }
+        // the parameter where the walk enters its next cell
+        let entered = min(t_max.x, min(t_max.y, t_max.z));
         if (t_max.x <= t_max.y && t_max.x <= t_max.z) {
             c.x += step.x;
             t_max.x += t_delta.x;
@@ -96,7 +102,7 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
             c = end;
         }
         if (occupied(c, &held)) {
-            return GRID_BLOCKED;
+            return select(GRID_UNKNOWN, GRID_BLOCKED, clearance < entered && entered < 1.0 - clearance);
         }
     }
     return GRID_VISIBLE;
