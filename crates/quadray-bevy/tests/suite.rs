@@ -5,6 +5,9 @@
 mod common;
 mod gi;
 mod hits;
+#[path = "../../quadray-indirect/tests/layering.rs"]
+mod layering;
+mod layers;
 mod lifecycle;
 mod pass_cost;
 mod prepass;

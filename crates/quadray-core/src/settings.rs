@@ -8,9 +8,17 @@
 //! assert!(ZOOM.check("zoom", 1.5).is_ok());
 //! assert_eq!(ZOOM.parser()("30").unwrap_err(), "30 is outside 0.05..=20");
 //! ```
+//!
+//! With the `cli` feature, [`to_args`] spells any settings value back as the flags that parse to
+//! it, from the settings' clap arguments and serde fields.
 
 use std::fmt;
 use std::str::FromStr;
+
+#[cfg(feature = "cli")]
+mod flags;
+#[cfg(feature = "cli")]
+pub use flags::{flags_at_default, from_args, to_args};
 
 /// A number a setting can hold.
 pub trait Number: Copy + PartialOrd + fmt::Display + FromStr + Send + Sync + 'static {

@@ -17,7 +17,7 @@ const LAYERS: &[&[&str]] = &[
         "write_text",
     ],
     &["random", "stats", "image_in"],
-    &["geom", "geom::bvh", "settings"],
+    &["geom", "geom::bvh", "settings", "settings::flags"],
     &["image_out"],
     &["mesh", "mesh::obj", "mesh::ply", "mesh::gltf"],
     &["scene", "scene::read_gltf", "scene::read_toml"],

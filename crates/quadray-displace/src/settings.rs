@@ -2,7 +2,8 @@
 //! Each is declared once, here: its field, its doc comment (the `--help` text), its default in
 //! [`Settings::DEFAULT`] and its valid values in a [`Limits`] const that both
 //! [`Settings::validate`] and the flag's parser use. With the `cli` feature the struct is
-//! `quadray displace`'s clap arguments; [`Settings::to_args`] spells them back.
+//! `quadray displace`'s clap arguments; `Settings::to_args` spells them back, and a round-trip
+//! test parses them again.
 
 use crate::method::Method;
 use quadray_core::settings::{Limits, Size};
@@ -263,33 +264,20 @@ impl Settings {
     }
 
     /// The `quadray displace` flags that render these settings (the viewer prints them beside its
-    /// screenshots; the CLI's tests parse them back).
+    /// screenshots; the CLI's tests parse them back): every clap argument with its serde field's
+    /// value.
+    #[cfg(feature = "cli")]
     pub fn to_args(&self) -> Vec<String> {
-        let s = self;
-        let mut args: Vec<String> = [
-            ("--method", s.method.to_string()),
-            ("--view-angle", s.view_angle_deg.to_string()),
-            ("--azimuth", s.azimuth_deg.to_string()),
-            ("--zoom", s.zoom.to_string()),
-            ("--light-azimuth", s.light_azimuth_deg.to_string()),
-            ("--size", s.size.to_string()),
-            ("--depth-scale", s.depth_scale.to_string()),
-            ("--layers", s.layers.to_string()),
-            ("--binary-steps", s.binary_steps.to_string()),
-            ("--lod", s.lod.to_string()),
-        ]
-        .into_iter()
-        .flat_map(|(flag, value)| [flag.to_string(), value])
-        .collect();
-        for (on, flag) in [
-            (s.shadows, "--shadows"),
-            (s.show_iterations, "--show-iterations"),
-        ] {
-            if on {
-                args.push(flag.into());
-            }
-        }
-        args
+        // serde flattens the size into `width` and `height`, writes the layers as `{min, max}`
+        // and a fixed level as `{"level": n}`: their flags are `WxH`, `MIN,MAX` and `n`.
+        quadray_core::settings::to_args(
+            self,
+            &[
+                ("size", self.size.to_string()),
+                ("layers", self.layers.to_string()),
+                ("lod", self.lod.to_string()),
+            ],
+        )
     }
 
     /// What a picture of these settings is called: the method and the budget it was given
@@ -395,6 +383,44 @@ mod tests {
         for (s, what, range) in bad {
             let e = s.validate().unwrap_err();
             assert!(e.starts_with(what) && e.ends_with(&range), "{e}");
+        }
+    }
+
+    /// Settings with every field off its default and every switch on, and the settings each
+    /// method is shown and timed with, come back through `to_args` and the clap arguments: a
+    /// field left out of the flags, or written so that it parses otherwise, fails here (a new
+    /// field first fails `flags_at_default` until it is given a value here).
+    #[cfg(feature = "cli")]
+    #[test]
+    fn every_setting_comes_back_through_its_flags() {
+        use quadray_core::settings::{flags_at_default, from_args};
+        let every = Settings {
+            method: Method::Relief,
+            view_angle_deg: 60.5,
+            size: Size::new(96, 64),
+            depth_scale: 0.25,
+            layers: Layers { min: 4, max: 40 },
+            binary_steps: 7,
+            lod: Lod::Auto,
+            shadows: true,
+            azimuth_deg: -120.25,
+            zoom: 1.5,
+            light_azimuth_deg: 200.0,
+            show_iterations: true,
+        };
+        assert!(every.validate().is_ok());
+        let args = every.to_args();
+        let defaults = Settings::DEFAULT.to_args();
+        assert_eq!(
+            flags_at_default::<Settings>(&args, &defaults),
+            Vec::<String>::new(),
+            "{args:?}"
+        );
+        let shown = Method::ALL.into_iter().flat_map(|m| [m.shown(), m.timed()]);
+        for s in [every, Settings::DEFAULT].into_iter().chain(shown) {
+            let args = s.to_args();
+            let parsed = from_args::<Settings>(&args).unwrap_or_else(|e| panic!("{args:?}: {e}"));
+            assert_eq!(parsed, s, "{args:?}");
         }
     }
 

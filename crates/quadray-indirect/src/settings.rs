@@ -4,8 +4,8 @@
 //! Each parameter is declared once, here: its field, its doc comment (the `--help` text), its
 //! default in [`Settings::DEFAULT`] and its valid values in a [`Limits`] const that both
 //! [`Settings::validate`] and the flag's parser use. With the `cli` feature the struct is
-//! `quadray indirect`'s clap arguments; [`Settings::to_args`] spells them back (the viewer's
-//! reproducing command line), and a round-trip test in the CLI parses them again.
+//! `quadray indirect`'s clap arguments; `Settings::to_args` spells them back (the viewer's
+//! reproducing command line), and a round-trip test parses them again.
 
 use quadray_core::settings::{Limits, Size};
 use serde::Serialize;
@@ -710,48 +710,12 @@ impl Settings {
     }
 
     /// The `quadray indirect` flags that render these settings (the viewer prints them beside
-    /// its screenshots; the CLI's tests parse them back). Defaults left to their rules stay
-    /// unwritten.
+    /// its screenshots; the CLI's tests parse them back): every clap argument with its serde
+    /// field's value. Defaults left to their rules (`None`) stay unwritten.
+    #[cfg(feature = "cli")]
     pub fn to_args(&self) -> Vec<String> {
-        let s = self;
-        let c = &s.cluster;
-        let mut args: Vec<(&str, String)> = vec![
-            ("--size", s.size.to_string()),
-            ("--rsm-size", s.rsm_size.to_string()),
-            ("--max-lights", s.max_lights.to_string()),
-            ("--depth-threshold", c.depth_threshold.to_string()),
-            ("--normal-threshold", c.normal_threshold.to_string()),
-            ("--validity", c.validity.to_string()),
-            ("--samples", s.samples.to_string()),
-            ("--rsm-radius", s.rsm_radius.to_string()),
-            ("--subsample", s.subsample.to_string()),
-            ("--shadow-steps", s.shadow_steps.to_string()),
-            ("--shadow-thickness", s.shadow_thickness.to_string()),
-            ("--shadow-grid", s.shadow_grid.to_string()),
-            ("--temporal-weight", s.temporal_weight.to_string()),
-            ("--tile-criterion", s.tile_criterion.to_string()),
-            ("--tile-share", s.tile_share.to_string()),
-        ];
-        let optional = [
-            ("--start-level", c.start_level.map(|l| l.to_string())),
-            ("--limit-level", c.limit_level.map(|l| l.to_string())),
-            ("--tile-error", s.tile_error.map(|e| e.to_string())),
-            ("--tile-capacity", s.tile_capacity.map(|n| n.to_string())),
-        ];
-        args.extend(optional.into_iter().filter_map(|(f, v)| Some((f, v?))));
-        let mut words: Vec<String> = args
-            .into_iter()
-            .flat_map(|(flag, value)| [flag.to_string(), value])
-            .collect();
-        for (on, flag) in [
-            (!c.flux_weighted, "--unweighted-means"),
-            (s.indirect_shadows, "--indirect-shadows"),
-        ] {
-            if on {
-                words.push(flag.into());
-            }
-        }
-        words
+        // serde flattens the size into `width` and `height`: the flag is `WxH`.
+        quadray_core::settings::to_args(self, &[("size", self.size.to_string())])
     }
 }
 
@@ -784,6 +748,54 @@ mod tests {
             (s.levels(), 0.002, 256)
         );
         assert!(r.cluster.start_level.is_some() && r.tile_capacity.is_some());
+    }
+
+    /// Settings with every field off its default, every `Option` given and every switch
+    /// flipped, and the defaults, come back through `to_args` and the clap arguments: a field
+    /// left out of the flags, or written so that it parses otherwise, fails here (a new field
+    /// first fails `flags_at_default` until it is given a value here).
+    #[cfg(feature = "cli")]
+    #[test]
+    fn every_setting_comes_back_through_its_flags() {
+        use quadray_core::settings::{flags_at_default, from_args};
+        let every = Settings {
+            size: Size::new(96, 64),
+            rsm_size: 256,
+            max_lights: 3,
+            cluster: ClusterSettings {
+                start_level: Some(5),
+                limit_level: Some(2),
+                depth_threshold: 0.125,
+                normal_threshold: -0.25,
+                validity: Validity::Local,
+                flux_weighted: false,
+            },
+            samples: 100,
+            rsm_radius: 0.3,
+            subsample: 2,
+            indirect_shadows: true,
+            shadow_steps: 5,
+            shadow_thickness: 0.1,
+            shadow_grid: 0,
+            temporal_weight: 0.67,
+            tile_error: Some(0.01),
+            tile_criterion: TileCriterion::Bound,
+            tile_capacity: Some(64),
+            tile_share: 0.0,
+        };
+        assert!(every.validate().is_ok());
+        let args = every.to_args();
+        let defaults = Settings::DEFAULT.to_args();
+        assert_eq!(
+            flags_at_default::<Settings>(&args, &defaults),
+            Vec::<String>::new(),
+            "{args:?}"
+        );
+        for s in [every, Settings::DEFAULT, Settings::DEFAULT.resolved()] {
+            let args = s.to_args();
+            let parsed = from_args::<Settings>(&args).unwrap_or_else(|e| panic!("{args:?}: {e}"));
+            assert_eq!(parsed, s, "{args:?}");
+        }
     }
 
     /// Each refusal names the parameter and its declared range.

@@ -5,8 +5,8 @@
 //! Each parameter is declared once, here: its field, its doc comment (the `--help` text), its
 //! default in [`Settings::DEFAULT`] and its valid values in a [`Limits`] const that both
 //! [`Settings::validate`] and the flag's parser use. With the `cli` feature the struct is
-//! `quadray raytrace`'s clap arguments; [`Settings::to_args`] spells them back (the tiles'
-//! fingerprint), and a round-trip test in the CLI parses them again.
+//! `quadray raytrace`'s clap arguments; `Settings::to_args` spells them back (the tiles'
+//! fingerprint), and a round-trip test parses them again.
 
 use quadray_core::settings::{Limits, Size};
 use serde::Serialize;
@@ -194,23 +194,19 @@ impl Settings {
     }
 
     /// The `quadray raytrace` flags that render these settings (the tiles of a job carry them as
-    /// their fingerprint's readable part; the CLI's tests parse them back).
+    /// their fingerprint's readable part; the CLI's tests parse them back): every clap argument
+    /// with its serde field's value.
+    #[cfg(feature = "cli")]
     pub fn to_args(&self) -> Vec<String> {
-        let s = self;
-        let mut args: Vec<String> = [
-            ("--shadows", s.scheme.to_string()),
-            ("--nth", s.nth.to_string()),
-            ("--size", s.size.to_string()),
-            ("--spp", s.spp.to_string()),
-            ("--depth", s.depth.to_string()),
-        ]
-        .into_iter()
-        .flat_map(|(flag, value)| [flag.to_string(), value])
-        .collect();
-        if s.check {
-            args.push("--check".into());
-        }
-        args
+        // serde flattens the size into `width` and `height` and skips N_th (the stats write
+        // it beside the predicted one): their flags are `WxH` and `auto` or a number.
+        quadray_core::settings::to_args(
+            self,
+            &[
+                ("size", self.size.to_string()),
+                ("nth", self.nth.to_string()),
+            ],
+        )
     }
 }
 
@@ -268,6 +264,37 @@ mod tests {
         for (s, what, range) in bad {
             let e = s.validate().unwrap_err();
             assert!(e.starts_with(what) && e.ends_with(&range), "{e}");
+        }
+    }
+
+    /// Settings with every field off its default and every switch on, and the defaults, come
+    /// back through `to_args` and the clap arguments: a field left out of the flags, or written
+    /// so that it parses otherwise, fails here (a new field first fails `flags_at_default`
+    /// until it is given a value here).
+    #[cfg(feature = "cli")]
+    #[test]
+    fn every_setting_comes_back_through_its_flags() {
+        use quadray_core::settings::{flags_at_default, from_args};
+        let every = Settings {
+            scheme: SchemeChoice::Volume,
+            nth: Nth::Fixed(6.5),
+            size: Size::new(96, 64),
+            spp: 4,
+            depth: 2,
+            check: true,
+        };
+        assert!(every.validate().is_ok());
+        let args = every.to_args();
+        let defaults = Settings::DEFAULT.to_args();
+        assert_eq!(
+            flags_at_default::<Settings>(&args, &defaults),
+            Vec::<String>::new(),
+            "{args:?}"
+        );
+        for s in [every, Settings::DEFAULT] {
+            let args = s.to_args();
+            let parsed = from_args::<Settings>(&args).unwrap_or_else(|e| panic!("{args:?}: {e}"));
+            assert_eq!(parsed, s, "{args:?}");
         }
     }
 

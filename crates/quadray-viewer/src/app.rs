@@ -130,7 +130,43 @@ impl State {
         let dt = (now - self.last_frame).as_secs_f32().min(0.1);
         self.last_frame = now;
         let scripted = args.frames.is_some();
+        self.prepare(args, scripted);
+        let raw = self.egui_state.take_egui_input(&self.window);
+        if scripted {
+            self.egui_ctx.request_repaint();
+        }
         let mut save = false;
+        let Self {
+            egui_ctx,
+            technique,
+            displace,
+            indirect,
+            gpu,
+            egui_renderer,
+            status,
+            frame_ms,
+            ..
+        } = self;
+        let gpu: &'static Gpu = gpu;
+        let full = egui_ctx.run_ui(raw, |ui| {
+            egui::Panel::left("controls")
+                .exact_size(PANEL_WIDTH)
+                .show(ui, |ui| {
+                    save |= side_panel(ui, technique, displace, indirect, status, *frame_ms);
+                });
+            egui::CentralPanel::default().show(ui, |ui| {
+                let shown = indirect
+                    .as_mut()
+                    .filter(|_| *technique == Technique::Indirect);
+                save |= central_view(ui, args, displace, shown, gpu, egui_renderer, dt);
+            });
+        });
+        self.finish(args, full, save, now)
+    }
+
+    /// Before the panel: the indirect view, made when first shown, and a scripted run's turn of
+    /// the camera after its first frame.
+    fn prepare(&mut self, args: &Args, scripted: bool) {
         if self.technique == Technique::Indirect && self.indirect.is_none() {
             self.indirect = Some(IndirectView::new(
                 self.gpu,
@@ -146,117 +182,18 @@ impl State {
                 _ => self.displace.settings.azimuth_deg += args.spin,
             }
         }
-        let raw = self.egui_state.take_egui_input(&self.window);
-        if scripted {
-            self.egui_ctx.request_repaint();
-        }
-        let Self {
-            egui_ctx,
-            technique,
-            displace,
-            indirect,
-            gpu,
-            egui_renderer,
-            status,
-            frame_ms,
-            ..
-        } = self;
-        let gpu: &'static Gpu = gpu;
-        let full = egui_ctx.run_ui(raw, |ui| {
-            egui::Panel::left("controls").exact_size(PANEL_WIDTH).show(ui, |ui| {
-                ui.horizontal(|ui| {
-                    ui.selectable_value(technique, Technique::Displace, "Displacement");
-                    ui.selectable_value(technique, Technique::Indirect, "Indirect light");
-                });
-                ui.separator();
-                if let Some(view) = indirect.as_mut().filter(|_| *technique == Technique::Indirect) {
-                    view.controls(ui);
-                    ui.separator();
-                    if let Some(t) = &view.timing {
-                        // in the order the frame runs them
-                        for pass in quadray_indirect::Pass::ALL {
-                            if let Some(ms) = t.passes.get(pass.name()) {
-                                ui.monospace(format!("{:<9}{ms:9.3} ms", pass.name()));
-                            }
-                        }
-                        ui.label(format!("GPU {:.3} ms  frame {frame_ms:.1} ms", t.total_ms));
-                    } else {
-                        ui.label(format!("GPU n/a  frame {frame_ms:.1} ms"));
-                    }
-                    if let Some(summary) = &view.cut_summary {
-                        ui.label(summary);
-                    }
-                    if let Some(e) = &view.error {
-                        ui.colored_label(egui::Color32::LIGHT_RED, e);
-                    }
-                    ui.small("Drag: look. Right drag: aim the light. W/A/S/D, Q/E, wheel: move. L: animate light. P: screenshot.");
-                } else {
-                    displace.controls(ui);
-                    ui.separator();
-                    ui.label(format!(
-                        "GPU {}  frame {:.1} ms",
-                        displace.gpu_ms.map_or("n/a".into(), |t| format!("{t:.3} ms")),
-                        frame_ms
-                    ));
-                    if let Some(p) = displace.cone_progress {
-                        ui.label(format!("building the cone map: {:.0}%", p * 100.0));
-                    }
-                    if let Some(e) = &displace.error {
-                        ui.colored_label(egui::Color32::LIGHT_RED, e);
-                    }
-                    ui.small("Drag: orbit. Right drag: light. Wheel or Q/E: zoom. W/A/S/D: move. L: animate light. P: screenshot.");
-                }
-                if ui.button("Save screenshot + command (P)").clicked() {
-                    save = true;
-                }
-                ui.label(status.as_str());
-            });
-            egui::CentralPanel::default().show(ui, |ui| {
-                let points = ui.available_size();
-                let ppp = ui.ctx().pixels_per_point();
-                let pixels = if scripted {
-                    [args.displace.size.width, args.displace.size.height]
-                } else {
-                    [(points.x * ppp) as u32, (points.y * ppp) as u32]
-                };
-                let shown = |size: [u32; 2]| {
-                    let full = egui::vec2(size[0] as f32, size[1] as f32) / ppp;
-                    // the cut view is larger than the frame: fit it
-                    full * (points.x / full.x).min(points.y / full.y).min(1.0)
-                };
-                let sense = egui::Sense::click_and_drag();
-                match indirect.as_mut().filter(|_| *technique == Technique::Indirect) {
-                    Some(view) => {
-                        if let Some((id, size)) = view.draw(ui.ctx(), pixels, dt) {
-                            let image = egui::Image::new(egui::load::SizedTexture::new(id, shown(size)));
-                            let response = ui.add(image.sense(sense));
-                            view.handle_pointer(&response, ui);
-                        }
-                        view.handle_keys(ui, dt);
-                    }
-                    None => {
-                        if let Some(id) = displace.draw(gpu, egui_renderer, pixels, dt, scripted) {
-                            let image = egui::Image::new(egui::load::SizedTexture::new(id, shown(pixels)));
-                            let response = ui.add(image.sense(sense));
-                            displace.handle_pointer(&response, ui);
-                        }
-                        displace.handle_keys(ui, dt);
-                    }
-                }
-                save |= ui.input(|i| i.key_pressed(egui::Key::P));
-                // held keys move the camera and an animated light moves by itself
-                let animating = match indirect.as_ref().filter(|_| *technique == Technique::Indirect) {
-                    Some(view) => view.animate_light,
-                    None => displace.animate_light,
-                };
-                if animating || ui.input(|i| !i.keys_down.is_empty()) {
-                    ui.ctx().request_repaint();
-                } else if displace.cone_progress.is_some() {
-                    // poll the cone map's build without redrawing the 3-D view meanwhile
-                    ui.ctx().request_repaint_after(std::time::Duration::from_millis(200));
-                }
-            });
-        });
+    }
+
+    /// After the panel: egui's platform output, when the next frame is due, the screenshot (asked
+    /// for, or at the end of a scripted run), the paint and the frame's smoothed work time;
+    /// returns true when a scripted run is over.
+    fn finish(
+        &mut self,
+        args: &Args,
+        full: egui::FullOutput,
+        save: bool,
+        started: Instant,
+    ) -> Result<bool> {
         self.egui_state
             .handle_platform_output(&self.window, full.platform_output);
         // a frame only when something moves: a CPU rasterizer idles instead of redrawing
@@ -275,7 +212,7 @@ impl State {
             println!("{cmd}");
         }
         self.paint(full.shapes, full.textures_delta, full.pixels_per_point)?;
-        let work_ms = now.elapsed().as_secs_f32() * 1e3;
+        let work_ms = started.elapsed().as_secs_f32() * 1e3;
         self.frame_ms = if self.frame_ms == 0.0 {
             work_ms
         } else {
@@ -392,4 +329,139 @@ impl ApplicationHandler for App {
             None => event_loop.set_control_flow(ControlFlow::Wait),
         }
     }
+}
+
+/// The side panel: the choice of technique, the shown one's controls, timings and errors, and the
+/// screenshot button; returns whether the button was clicked.
+fn side_panel(
+    ui: &mut egui::Ui,
+    technique: &mut Technique,
+    displace: &mut DisplaceView,
+    indirect: &mut Option<IndirectView>,
+    status: &str,
+    frame_ms: f32,
+) -> bool {
+    ui.horizontal(|ui| {
+        ui.selectable_value(technique, Technique::Displace, "Displacement");
+        ui.selectable_value(technique, Technique::Indirect, "Indirect light");
+    });
+    ui.separator();
+    match indirect
+        .as_mut()
+        .filter(|_| *technique == Technique::Indirect)
+    {
+        Some(view) => indirect_panel(ui, view, frame_ms),
+        None => displace_panel(ui, displace, frame_ms),
+    }
+    let save = ui.button("Save screenshot + command (P)").clicked();
+    ui.label(status);
+    save
+}
+
+/// The indirect view's controls, its passes' GPU times, the cut's summary and any error.
+fn indirect_panel(ui: &mut egui::Ui, view: &mut IndirectView, frame_ms: f32) {
+    view.controls(ui);
+    ui.separator();
+    if let Some(t) = &view.timing {
+        // in the order the frame runs them
+        for pass in quadray_indirect::Pass::ALL {
+            if let Some(ms) = t.passes.get(pass.name()) {
+                ui.monospace(format!("{:<9}{ms:9.3} ms", pass.name()));
+            }
+        }
+        ui.label(format!("GPU {:.3} ms  frame {frame_ms:.1} ms", t.total_ms));
+    } else {
+        ui.label(format!("GPU n/a  frame {frame_ms:.1} ms"));
+    }
+    if let Some(summary) = &view.cut_summary {
+        ui.label(summary);
+    }
+    if let Some(e) = &view.error {
+        ui.colored_label(egui::Color32::LIGHT_RED, e);
+    }
+    ui.small(
+        "Drag: look. Right drag: aim the light. W/A/S/D, Q/E, wheel: move. L: animate light. \
+         P: screenshot.",
+    );
+}
+
+/// The displacement view's controls, its GPU time, the cone map's build and any error.
+fn displace_panel(ui: &mut egui::Ui, displace: &mut DisplaceView, frame_ms: f32) {
+    displace.controls(ui);
+    ui.separator();
+    ui.label(format!(
+        "GPU {}  frame {:.1} ms",
+        displace
+            .gpu_ms
+            .map_or("n/a".into(), |t| format!("{t:.3} ms")),
+        frame_ms
+    ));
+    if let Some(p) = displace.cone_progress {
+        ui.label(format!("building the cone map: {:.0}%", p * 100.0));
+    }
+    if let Some(e) = &displace.error {
+        ui.colored_label(egui::Color32::LIGHT_RED, e);
+    }
+    ui.small(
+        "Drag: orbit. Right drag: light. Wheel or Q/E: zoom. W/A/S/D: move. L: animate light. \
+         P: screenshot.",
+    );
+}
+
+/// The 3-D view of the shown technique (`indirect` when it is shown) at the panel's size in
+/// pixels (a scripted run's: the frame size), with the pointer and keys handled; asks for the
+/// next frame while something moves. Returns whether P was pressed.
+fn central_view(
+    ui: &mut egui::Ui,
+    args: &Args,
+    displace: &mut DisplaceView,
+    mut indirect: Option<&mut IndirectView>,
+    gpu: &'static Gpu,
+    egui_renderer: &mut egui_wgpu::Renderer,
+    dt: f32,
+) -> bool {
+    let scripted = args.frames.is_some();
+    let points = ui.available_size();
+    let ppp = ui.ctx().pixels_per_point();
+    let pixels = if scripted {
+        [args.displace.size.width, args.displace.size.height]
+    } else {
+        [(points.x * ppp) as u32, (points.y * ppp) as u32]
+    };
+    let shown = |size: [u32; 2]| {
+        let full = egui::vec2(size[0] as f32, size[1] as f32) / ppp;
+        // the cut view is larger than the frame: fit it
+        full * (points.x / full.x).min(points.y / full.y).min(1.0)
+    };
+    let sense = egui::Sense::click_and_drag();
+    match &mut indirect {
+        Some(view) => {
+            if let Some((id, size)) = view.draw(ui.ctx(), pixels, dt) {
+                let image = egui::Image::new(egui::load::SizedTexture::new(id, shown(size)));
+                let response = ui.add(image.sense(sense));
+                view.handle_pointer(&response, ui);
+            }
+            view.handle_keys(ui, dt);
+        }
+        None => {
+            if let Some(id) = displace.draw(gpu, egui_renderer, pixels, dt, scripted) {
+                let image = egui::Image::new(egui::load::SizedTexture::new(id, shown(pixels)));
+                let response = ui.add(image.sense(sense));
+                displace.handle_pointer(&response, ui);
+            }
+            displace.handle_keys(ui, dt);
+        }
+    }
+    // held keys move the camera and an animated light moves by itself
+    let animating = indirect
+        .as_ref()
+        .map_or(displace.animate_light, |view| view.animate_light);
+    if animating || ui.input(|i| !i.keys_down.is_empty()) {
+        ui.ctx().request_repaint();
+    } else if displace.cone_progress.is_some() {
+        // poll the cone map's build without redrawing the 3-D view meanwhile
+        ui.ctx()
+            .request_repaint_after(std::time::Duration::from_millis(200));
+    }
+    ui.input(|i| i.key_pressed(egui::Key::P))
 }

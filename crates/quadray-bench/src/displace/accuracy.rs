@@ -1,7 +1,7 @@
 //! Accuracy against the CPU ground truth: every method by view angle on every bundled map, and
 //! how many POM layers match the pyramid.
 
-use super::{AccuracyRow, Bench, Ratios, fixed_layers, ms, ratio, ratio_text, traced};
+use super::measure::{AccuracyRow, Bench, Ratios, fixed_layers, ms, ratio, ratio_text, traced};
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::HeightMap;

@@ -1,7 +1,7 @@
 //! The paper's timing tables and figures (tables 1 and 2, figures 20 and 21, the pyramid build),
 //! the cone map build and today's frame size, each as the rows it measured.
 
-use super::{Bench, Ratios, ms, ratio, ratio_text, traced};
+use super::measure::{Bench, Ratios, ms, ratio, ratio_text, traced};
 use crate::report::{PlotSpec, Series, Table, line_plot};
 use quadray_core::stats::{Summary, time_cpu};
 use quadray_displace::accuracy::Cost;

@@ -384,7 +384,32 @@ fn fixed(v: Option<f64>, digits: usize) -> String {
 }
 
 fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), IndirectError> {
-    // what a user gets without choosing, and the paper's one cut, against RSM sampling
+    let md = [
+        defaults_table(results),
+        comparison_table(results),
+        sweep_table(results),
+    ]
+    .map(|t| t.to_markdown())
+    .join("\n");
+    write_text(&out.join("equal_error.md"), &md)?;
+    write_json(&out.join("equal_error.json"), results)?;
+    let series: Vec<Series> = results.scenes.iter().flat_map(scene_series).collect();
+    line_plot(
+        &out.join("equal_error.svg"),
+        &PlotSpec {
+            title: "Indirect light: error against VPL evaluations per pixel",
+            x_label: "VPL evaluations per shaded pixel",
+            y_label: "rel. L1 error of the indirect term",
+            log_x: true,
+            log_y: true,
+        },
+        &series,
+    )?;
+    Ok(())
+}
+
+/// What a user gets without choosing, and the paper's one cut, against RSM sampling.
+fn defaults_table(results: &EqualErrorResults) -> Table {
     let default = default_label();
     let mut defaults = Table::new(
         format!(
@@ -424,6 +449,11 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             }
         }
     }
+    defaults
+}
+
+/// Every quadtree row against RSM sampling at full resolution and at its own sub-sampling.
+fn comparison_table(results: &EqualErrorResults) -> Table {
     let mut table = Table::new(
         format!(
             "Quadtree vs RSM sampling at equal error, {0}x{0} image ({1}, {2} frames per median)",
@@ -474,6 +504,11 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             ]);
         }
     }
+    table
+}
+
+/// RSM sampling's sweep over sample counts and sub-samplings.
+fn sweep_table(results: &EqualErrorResults) -> Table {
     let mut sweep = Table::new(
         "RSM sampling sweep",
         &[
@@ -501,68 +536,53 @@ fn write_outputs(out: &Path, results: &EqualErrorResults) -> Result<(), Indirect
             ]);
         }
     }
-    let md = format!(
-        "{}\n{}\n{}",
-        defaults.to_markdown(),
-        table.to_markdown(),
-        sweep.to_markdown()
-    );
-    write_text(&out.join("equal_error.md"), &md)?;
-    write_json(&out.join("equal_error.json"), results)?;
+    sweep
+}
+
+/// A scene's lines of error against VPL evaluations: RSM sampling and the one cut at each
+/// sub-sampling, the per-tile cuts a line for each criterion and sharing.
+fn scene_series(s: &SceneResult) -> Vec<Series> {
     let mut series = Vec::new();
-    for s in &results.scenes {
-        let points = |ps: &mut dyn Iterator<Item = &Point>| {
-            ps.map(|p| (p.vpl_evaluations_per_pixel, p.rel_l1))
-                .collect()
-        };
-        for k in SUBSAMPLES {
-            let at = |p: &&Point| p.subsample == k;
-            series.push(Series {
-                name: format!("{} {}^2 RSM sampling, subsample {k}", s.scene, s.rsm_size),
-                points: points(&mut s.rsm.iter().filter(at)),
-            });
-            series.push(Series {
-                name: format!("{} {}^2 quadtree, subsample {k}", s.scene, s.rsm_size),
-                points: points(
-                    &mut s
-                        .comparisons
-                        .iter()
-                        .map(|c| &c.quadtree)
-                        .filter(at)
-                        // the one cut (`ONE_CUT`, "paper"); the per-tile cuts follow
-                        .filter(|p| !p.label.contains(' ')),
-                ),
-            });
-        }
-        // the per-tile cuts (full resolution), a line for each criterion and sharing
-        let mut families: Vec<&str> = Vec::new();
-        for c in &s.comparisons {
-            if let Some((family, _)) = c.quadtree.label.rsplit_once(' ')
-                && !families.contains(&family)
-            {
-                families.push(family);
-            }
-        }
-        for family in families {
-            let of = |p: &&Point| p.label.rsplit_once(' ').is_some_and(|(f, _)| f == family);
-            series.push(Series {
-                name: format!("{} {}^2 per-tile cuts, {family}", s.scene, s.rsm_size),
-                points: points(&mut s.comparisons.iter().map(|c| &c.quadtree).filter(of)),
-            });
+    let points = |ps: &mut dyn Iterator<Item = &Point>| {
+        ps.map(|p| (p.vpl_evaluations_per_pixel, p.rel_l1))
+            .collect()
+    };
+    for k in SUBSAMPLES {
+        let at = |p: &&Point| p.subsample == k;
+        series.push(Series {
+            name: format!("{} {}^2 RSM sampling, subsample {k}", s.scene, s.rsm_size),
+            points: points(&mut s.rsm.iter().filter(at)),
+        });
+        series.push(Series {
+            name: format!("{} {}^2 quadtree, subsample {k}", s.scene, s.rsm_size),
+            points: points(
+                &mut s
+                    .comparisons
+                    .iter()
+                    .map(|c| &c.quadtree)
+                    .filter(at)
+                    // the one cut (`ONE_CUT`, "paper"); the per-tile cuts follow
+                    .filter(|p| !p.label.contains(' ')),
+            ),
+        });
+    }
+    // the per-tile cuts (full resolution), a line for each criterion and sharing
+    let mut families: Vec<&str> = Vec::new();
+    for c in &s.comparisons {
+        if let Some((family, _)) = c.quadtree.label.rsplit_once(' ')
+            && !families.contains(&family)
+        {
+            families.push(family);
         }
     }
-    line_plot(
-        &out.join("equal_error.svg"),
-        &PlotSpec {
-            title: "Indirect light: error against VPL evaluations per pixel",
-            x_label: "VPL evaluations per shaded pixel",
-            y_label: "rel. L1 error of the indirect term",
-            log_x: true,
-            log_y: true,
-        },
-        &series,
-    )?;
-    Ok(())
+    for family in families {
+        let of = |p: &&Point| p.label.rsplit_once(' ').is_some_and(|(f, _)| f == family);
+        series.push(Series {
+            name: format!("{} {}^2 per-tile cuts, {family}", s.scene, s.rsm_size),
+            points: points(&mut s.comparisons.iter().map(|c| &c.quadtree).filter(of)),
+        });
+    }
+    series
 }
 
 /// The name of the per-tile cuts' rows of a criterion and sharing, before their error

@@ -38,25 +38,20 @@
 //! its luminous intensity that over 4 pi, as Bevy lights it; a directional light's illuminance
 //! in lux), so the indirect light is in the same units as Bevy's direct light and is scaled by the
 //! camera's exposure as Bevy's is. The lights are taken in a fixed order (directional, spot, point
-//! lights, each kind by entity) up to the first camera's [`Settings::max_lights`].
+//! lights, each kind by entity) up to the first camera's
+//! [`Settings::max_lights`](quadray_indirect::Settings::max_lights).
 
 mod render;
+mod scene;
 
-use bevy::asset::{AssetEvent, uuid_handle};
-use bevy::camera::Hdr;
-use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
-use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
-use bevy::pbr::StandardMaterial;
+pub use scene::{
+    IndirectLight, IndirectLightSource, quadray_directional, quadray_point, quadray_spot,
+};
+
 use bevy::prelude::*;
-use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
-use bevy::render::extract_resource::{ExtractResource, ExtractResourcePlugin};
-use bevy::render::storage::ShaderBuffer;
-use bevy::shader::Shader;
-use quadray_indirect::scene::{Cone, Intensity, Light, LightKind, Vertex};
-use quadray_indirect::{Method, Scene, Settings};
-use std::sync::Arc;
-
-const GBUFFER_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d11");
+use bevy::render::extract_component::ExtractComponentPlugin;
+use bevy::render::extract_resource::ExtractResourcePlugin;
+use scene::{IndirectLightScene, collect_lights, collect_triangles};
 
 /// Adds [`IndirectLight`] to the cameras that carry it, from the lights marked
 /// [`IndirectLightSource`]. Add it after `DefaultPlugins`; the cameras need deferred rendering
@@ -65,10 +60,6 @@ pub struct IndirectLightPlugin;
 
 impl Plugin for IndirectLightPlugin {
     fn build(&self, app: &mut App) {
-        let _ = app.world_mut().resource_mut::<Assets<Shader>>().insert(
-            &GBUFFER_SHADER,
-            Shader::from_wgsl(include_str!("gbuffer.wgsl"), "quadray/gi_gbuffer.wgsl"),
-        );
         app.add_plugins((
             ExtractComponentPlugin::<IndirectLight>::default(),
             ExtractResourcePlugin::<IndirectLightScene>::default(),
@@ -81,261 +72,5 @@ impl Plugin for IndirectLightPlugin {
                 .after(bevy::camera::visibility::VisibilitySystems::VisibilityPropagate),
         );
         render::build(app);
-    }
-}
-
-/// On a camera: add one bounce of indirect light from the [`IndirectLightSource`] lights (to the
-/// HDR picture, before tone mapping: the camera gets `Hdr` and Bevy's depth and deferred prepasses).
-#[derive(Component, Clone, Debug, ExtractComponent)]
-#[require(DepthPrepass, DeferredPrepass, Hdr)]
-pub struct IndirectLight {
-    /// quadray's light-quadtree settings (RSM size, cut levels, validity thresholds, per-tile
-    /// cuts, indirect shadows, temporal weight, ...); `size` is ignored: the gather runs at the
-    /// camera's size.
-    pub settings: Settings,
-    /// How the indirect light is gathered: per-tile cuts ([`Method::DEFAULT`]), the quadtree's
-    /// one cut, the paper's per-level passes, RSM sampling, or every VPL (the brute force).
-    pub method: Method,
-    /// Clamp of the VPL kernel's distance (world units): 1/r^4 is taken at no less than this.
-    pub r_min: f32,
-    /// `false` keeps what is built but gathers and adds no light (to compare).
-    pub enabled: bool,
-    /// Debug view: the light quadtree's cut over the RSM in the picture's top-left corner, after
-    /// tone mapping (the RSM's flux with every cluster outlined in its level's colour: white
-    /// single VPLs, then red, yellow, green, blue, violet going up), the picture `quadray
-    /// indirect` writes as `*.cut.png`. The per-tile cuts refine this cut tile by tile.
-    pub cut_view: bool,
-    /// Debug output: each frame's indirect radiance (`[f32; 4]` a pixel, row-major, before the
-    /// exposure) copied into this buffer, when it has room.
-    pub debug_indirect: Option<Handle<ShaderBuffer>>,
-}
-
-impl Default for IndirectLight {
-    fn default() -> Self {
-        Self {
-            settings: Settings::DEFAULT,
-            method: Method::DEFAULT,
-            r_min: quadray_indirect::scene::DEFAULT_R_MIN,
-            enabled: true,
-            cut_view: false,
-            debug_indirect: None,
-        }
-    }
-}
-
-/// On a `DirectionalLight`, `PointLight` or `SpotLight`: a light whose first bounce
-/// [`IndirectLight`] cameras add.
-#[derive(Component, Clone, Copy, Debug, Default)]
-pub struct IndirectLightSource;
-
-/// What the render world needs of the main world's scene: its triangles (rebuilt when a mesh,
-/// material or transform changes) and the marked lights.
-#[derive(Resource, Clone, Default, ExtractResource)]
-struct IndirectLightScene {
-    triangles: Arc<Vec<[Vertex; 3]>>,
-    /// Counts the rebuilds of `triangles`.
-    generation: u64,
-    lights: Vec<Light>,
-}
-
-/// A Bevy colour times a strength, as a light's RGB intensity.
-fn coloured(color: Color, strength: f32) -> Intensity {
-    let c = LinearRgba::from(color);
-    Intensity::Native(Vec3::new(c.red, c.green, c.blue) * strength)
-}
-
-/// Bevy's directional light as quadray's: its illuminance along the transform's forward.
-pub fn quadray_directional(light: &DirectionalLight, transform: &GlobalTransform) -> Light {
-    Light {
-        kind: LightKind::Directional {
-            direction: transform.forward().as_vec3(),
-        },
-        intensity: coloured(light.color, light.illuminance),
-    }
-}
-
-/// Bevy's point light as quadray's: luminous intensity (lumens over 4 pi, as Bevy lights it).
-pub fn quadray_point(light: &PointLight, transform: &GlobalTransform) -> Light {
-    Light {
-        kind: LightKind::Point {
-            position: transform.translation(),
-        },
-        intensity: coloured(light.color, light.intensity / (4.0 * std::f32::consts::PI)),
-    }
-}
-
-/// Bevy's spot light as quadray's: luminous intensity (lumens over 4 pi, as Bevy lights a spot)
-/// on the axis, the outer angle as the cone, the fade from the inner angle as its falloff.
-pub fn quadray_spot(light: &SpotLight, transform: &GlobalTransform) -> Light {
-    let cone_deg = light.outer_angle.to_degrees();
-    Light {
-        kind: LightKind::Spot {
-            position: transform.translation(),
-            cone: Cone {
-                direction: transform.forward().as_vec3(),
-                cone_deg,
-                falloff_deg: (light.outer_angle - light.inner_angle)
-                    .to_degrees()
-                    .clamp(0.0, cone_deg),
-            },
-        },
-        intensity: coloured(light.color, light.intensity / (4.0 * std::f32::consts::PI)),
-    }
-}
-
-/// The marked lights of one kind, by entity.
-type Marked<'w, 's, L> =
-    Query<'w, 's, (Entity, &'static L, &'static GlobalTransform), With<IndirectLightSource>>;
-
-fn collect_lights(
-    directional: Marked<DirectionalLight>,
-    spots: Marked<SpotLight>,
-    points: Marked<PointLight>,
-    cameras: Query<(), With<IndirectLight>>,
-    mut scene: ResMut<IndirectLightScene>,
-    mut warned: Local<Option<String>>,
-) {
-    let mut warn = |message: String| {
-        if warned.as_ref() != Some(&message) {
-            warn!("{message}");
-            *warned = Some(message);
-        }
-    };
-    fn sorted<L: Component>(
-        q: &Marked<L>,
-        convert: fn(&L, &GlobalTransform) -> Light,
-    ) -> Vec<(Entity, Light)> {
-        let mut lights: Vec<_> = q.iter().map(|(e, l, t)| (e, convert(l, t))).collect();
-        lights.sort_by_key(|(e, _)| *e);
-        lights
-    }
-    let marked = [
-        sorted(&directional, quadray_directional),
-        sorted(&spots, quadray_spot),
-        sorted(&points, quadray_point),
-    ]
-    .concat();
-    if marked.is_empty() && !cameras.is_empty() {
-        warn(
-            "quadray indirect light: no light has IndirectLightSource; add that component to \
-             the DirectionalLight, PointLight or SpotLight whose bounce the IndirectLight cameras \
-             should show"
-                .into(),
-        );
-    }
-    let mut lights = Vec::new();
-    for (entity, light) in marked {
-        let max = Scene::MAX_CONE_DEG;
-        let checked = light.validate().and_then(|()| match light.kind {
-            LightKind::Spot { cone, .. } if cone.cone_deg > max => Err(format!(
-                "its outer angle {:.1} degrees is over {max} (the RSM sees twice the cone)",
-                cone.cone_deg
-            )),
-            _ => Ok(()),
-        });
-        match checked {
-            Ok(()) => lights.push(light),
-            Err(e) => warn(format!(
-                "quadray indirect light: the IndirectLightSource {} {entity} is skipped: {e}",
-                light.kind_name()
-            )),
-        }
-    }
-    if scene.lights != lights {
-        scene.lights = lights;
-    }
-}
-
-/// The objects whose triangles make the RSM.
-type Objects<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Ref<'static, GlobalTransform>,
-        Ref<'static, Mesh3d>,
-        Option<Ref<'static, MeshMaterial3d<StandardMaterial>>>,
-        Ref<'static, InheritedVisibility>,
-    ),
->;
-
-#[allow(clippy::too_many_arguments)]
-fn collect_triangles(
-    objects: Objects,
-    meshes: Res<Assets<Mesh>>,
-    materials: Res<Assets<StandardMaterial>>,
-    mut mesh_events: MessageReader<AssetEvent<Mesh>>,
-    mut material_events: MessageReader<AssetEvent<StandardMaterial>>,
-    mut removed: RemovedComponents<Mesh3d>,
-    mut scene: ResMut<IndirectLightScene>,
-    mut count: Local<usize>,
-) {
-    let events =
-        mesh_events.read().count() + material_events.read().count() + removed.read().count();
-    let changed = objects.iter().any(|(t, m, mat, v)| {
-        t.is_changed() || m.is_changed() || v.is_changed() || mat.is_some_and(|m| m.is_changed())
-    });
-    if events == 0 && !changed && objects.iter().len() == *count {
-        return;
-    }
-    *count = objects.iter().len();
-    let mut triangles = Vec::new();
-    for (transform, mesh, material, visible) in &objects {
-        let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) else {
-            continue;
-        };
-        let albedo = material
-            .and_then(|m| materials.get(&m.0))
-            .map_or(Vec3::splat(0.5), |m| {
-                let c = LinearRgba::from(m.base_color);
-                Vec3::new(c.red, c.green, c.blue) * (1.0 - m.metallic)
-            });
-        append_triangles(mesh, &transform, albedo.to_array(), &mut triangles);
-    }
-    scene.triangles = Arc::new(triangles);
-    scene.generation += 1;
-}
-
-/// Appends `mesh`'s triangles in world space (a triangle list with positions; face normals where
-/// it has none); other topologies add nothing.
-fn append_triangles(
-    mesh: &Mesh,
-    transform: &GlobalTransform,
-    albedo: [f32; 3],
-    out: &mut Vec<[Vertex; 3]>,
-) {
-    if mesh.primitive_topology() != PrimitiveTopology::TriangleList {
-        return;
-    }
-    let Some(VertexAttributeValues::Float32x3(positions)) =
-        mesh.attribute(Mesh::ATTRIBUTE_POSITION)
-    else {
-        return;
-    };
-    let normals = match mesh.attribute(Mesh::ATTRIBUTE_NORMAL) {
-        Some(VertexAttributeValues::Float32x3(n)) if n.len() == positions.len() => Some(n),
-        _ => None,
-    };
-    let affine = transform.affine();
-    let normal_matrix = Mat3::from(affine.matrix3).inverse().transpose();
-    let vertex = |i: usize, face: Vec3| Vertex {
-        position: affine.transform_point3(Vec3::from(positions[i])).into(),
-        normal: normals
-            .map_or(face, |n| {
-                (normal_matrix * Vec3::from(n[i])).normalize_or_zero()
-            })
-            .into(),
-        albedo,
-    };
-    let corners: Vec<usize> = match mesh.indices() {
-        Some(indices @ (Indices::U16(_) | Indices::U32(_))) => indices.iter().collect(),
-        None => (0..positions.len()).collect(),
-    };
-    for t in corners.chunks_exact(3) {
-        if t.iter().any(|&i| i >= positions.len()) {
-            continue;
-        }
-        let p = [t[0], t[1], t[2]].map(|i| affine.transform_point3(Vec3::from(positions[i])));
-        let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-        out.push([vertex(t[0], face), vertex(t[1], face), vertex(t[2], face)]);
     }
 }

@@ -2,7 +2,8 @@
 //! G-buffer translated from Bevy's, quadray's gather, the additive composite into the view and,
 //! on request, the cut over the RSM drawn into the tone-mapped picture.
 
-use super::{GBUFFER_SHADER, IndirectLight, IndirectLightScene};
+use super::scene::{IndirectLight, IndirectLightScene};
+use bevy::asset::uuid_handle;
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
@@ -24,6 +25,7 @@ use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery
 use bevy::render::storage::GpuShaderBuffer;
 use bevy::render::view::{ExtractedView, ViewTarget};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
+use bevy::shader::Shader;
 use quadray_indirect::occupancy::OccupancyGrid;
 use quadray_indirect::scene::Light;
 use quadray_indirect::{FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, RsmPass, Settings};
@@ -31,11 +33,17 @@ use quadray_indirect::{LightView, ViewMaps, scene::bounds_of};
 use std::num::NonZero;
 use std::sync::{Mutex, PoisonError};
 
+/// Bevy's packed G-buffer translated into quadray's (`gbuffer.wgsl`).
+const GBUFFER_SHADER: Handle<Shader> = uuid_handle!("5c0f3f62-8d0c-4d57-9a43-6f1f4c1f9d11");
 const COUNTS_WGSL: &str = include_str!("counts.wgsl");
 /// The G-buffer translation's uniform: world_from_clip, the eye (xyz), the size (two u32).
 const VIEW_UNIFORM_BYTES: u64 = 64 + 16 + 16;
 
 pub(super) fn build(app: &mut App) {
+    let _ = app.world_mut().resource_mut::<Assets<Shader>>().insert(
+        &GBUFFER_SHADER,
+        Shader::from_wgsl(include_str!("gbuffer.wgsl"), "quadray/gi_gbuffer.wgsl"),
+    );
     let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
         return;
     };
