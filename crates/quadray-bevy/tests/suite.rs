@@ -4,6 +4,7 @@
 
 mod common;
 mod gi;
+mod gi_displaced;
 mod hits;
 mod lifecycle;
 mod pass_cost;
