@@ -132,9 +132,10 @@ fn main() {
         rsm_size: args.rsm_size,
     };
     let mut app = App::new();
-    // the scene loads in a few frames; each frame gathers anew while the light turns (on the
-    // CPU rasteriser about a second a frame at this size)
-    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 60, timed));
+    // the picture 10 frames after Bevy's last pipeline compiled (the scene loads meanwhile);
+    // each frame gathers anew while the light turns (on the CPU rasteriser about a second a
+    // frame at this size)
+    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 10, timed));
     add_default_plugins(&mut app, assets, offscreen);
     app.insert_resource(DefaultOpaqueRendererMethod::deferred())
         .add_plugins(IndirectLightPlugin)
