@@ -30,11 +30,10 @@
 //! composite (`composite.wgsl`). The light's RSM is rasterised from the scene's triangles,
 //! gathered on the CPU from every visible `Mesh3d` whenever a mesh, material or transform
 //! changes: a `StandardMaterial`'s polygons in its base colour (textures are not read), a
-//! [`PyramidMaterial`](crate::PyramidMaterial)'s displaced surface (its height field cut into
-//! triangles, at most [`DISPLACED_TRIANGLES_MAX`] a mesh) in its base colour times its colour
-//! texture (read on the CPU where the image keeps its data; its base colour alone where not);
-//! the same triangles make the occupancy grid of indirect shadows ([`IndirectLightScene`] holds
-//! them). A moving light rebuilds the RSM, the pyramid and the cut, a still light and a moving
+//! [`PyramidMaterial`]'s displaced surface (its height field cut into triangles, at most
+//! [`DISPLACED_TRIANGLES_MAX`] a mesh) in its base colour times its colour texture (read on the
+//! CPU where the image keeps its data; its base colour alone where not); the same triangles make
+//! the occupancy grid of indirect shadows ([`IndirectLightScene`] holds them). A moving light rebuilds the RSM, the pyramid and the cut, a still light and a moving
 //! camera reuse them. Each camera gathers every frame: Bevy's G-buffer changes without the camera moving (a mesh's pipeline
 //! compiled frames after it loaded, render layers switched).
 //!
