@@ -7,10 +7,13 @@ use bevy::app::ScheduleRunnerPlugin;
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
-use bevy::render::render_resource::TextureFormat;
+use bevy::render::render_resource::{PipelineCache, TextureFormat};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
+use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::window::{ExitCondition, PrimaryWindow};
 use bevy::winit::WinitPlugin;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Bevy's asset plugin reading the repository's `assets/<folder>`: under `BEVY_ASSET_ROOT` when
@@ -36,7 +39,8 @@ pub struct Offscreen {
     pub path: String,
     /// The camera's target (made by [`Offscreen::make_target`]).
     pub target: Handle<Image>,
-    /// Frames before the picture is taken (the scene loaded, the pipelines warm).
+    /// Frames before the picture is taken, counted from when Bevy has no pipeline left to compile
+    /// (the scene loaded, the pipelines warm).
     pub warm_up: u32,
     /// Frames to time after the warm-up, before the picture (0: none).
     pub timed: usize,
@@ -92,6 +96,12 @@ pub fn add_default_plugins(app: &mut App, assets: AssetPlugin, offscreen: Option
     .add_plugins(ScheduleRunnerPlugin::run_loop(wait))
     .insert_resource(offscreen)
     .add_systems(Update, save_when_ready);
+    // on a CPU rasteriser Bevy compiles its pipelines for many frames, a material's last
+    let compiling = Compiling::default();
+    app.insert_resource(compiling.clone());
+    app.sub_app_mut(RenderApp)
+        .insert_resource(compiling)
+        .add_systems(Render, note_compiling.in_set(RenderSystems::Cleanup));
     // after the render app exists, which it hands its recorder to
     if timed {
         app.add_plugins(RenderDiagnosticsPlugin);
@@ -108,6 +118,16 @@ pub fn set_title(windows: &mut Query<&mut Window, With<PrimaryWindow>>, title: &
     }
 }
 
+/// Whether Bevy's render world had a pipeline left to compile at the end of its last frame;
+/// shared by both worlds.
+#[derive(Resource, Clone, Default)]
+struct Compiling(Arc<AtomicBool>);
+
+fn note_compiling(pipelines: Res<PipelineCache>, compiling: Res<Compiling>) {
+    let waiting = pipelines.waiting_pipelines().next().is_some();
+    compiling.0.store(waiting, Ordering::Relaxed);
+}
+
 /// Off screen: after the warm-up, times the frames asked for (printing their median and the
 /// medians of quadray's render diagnostics over their last frames), then saves the target and
 /// quits.
@@ -117,7 +137,11 @@ fn save_when_ready(
     mut exit: MessageWriter<AppExit>,
     time: Res<Time<Real>>,
     mut diagnostics: ResMut<DiagnosticsStore>,
+    compiling: Res<Compiling>,
 ) {
+    if offscreen.frames <= offscreen.warm_up && compiling.0.load(Ordering::Relaxed) {
+        offscreen.frames = 0;
+    }
     offscreen.frames += 1;
     let warm_up = offscreen.warm_up;
     if offscreen.frames == warm_up + 1 {

@@ -58,6 +58,38 @@ fn the_gi_program_adds_the_bounce_to_its_headless_picture() {
     assert_eq!(darker, 0, "{darker} pixels darker with the bounce");
 }
 
+/// `--displaced` shows the pyramid material's surfaces (a displaced floor and wall beside a red
+/// wall, lit by a spot) with the bounce: it brightens the picture and darkens nothing, as on the
+/// Cornell box. `--displaced` with `--scene` is refused.
+#[test]
+fn the_gi_program_bounces_off_displaced_surfaces() {
+    let dir =
+        std::env::temp_dir().join(format!("quadray-bevy-gi-displaced-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (lit, unlit) = std::thread::scope(|s| {
+        let lit = s.spawn(|| screenshot(&dir, "bounce", &["--displaced"]));
+        let unlit = s.spawn(|| screenshot(&dir, "no-bounce", &["--displaced", "--no-gi"]));
+        (lit.join().unwrap(), unlit.join().unwrap())
+    });
+    let luma = |p: &image::Rgba<u8>| p.0[..3].iter().map(|&c| u32::from(c)).sum::<u32>();
+    let (mut brighter, mut darker) = (0, 0);
+    for (a, b) in lit.pixels().zip(unlit.pixels()) {
+        brighter += usize::from(luma(a) > luma(b));
+        darker += usize::from(luma(a) < luma(b));
+    }
+    println!(
+        "displaced surfaces: {brighter} of 4096 pixels brighter with the bounce, {darker} darker"
+    );
+    assert!(brighter >= 3500, "only {brighter} of 4096 pixels brighter");
+    assert_eq!(darker, 0, "{darker} pixels darker with the bounce");
+    let run = Command::new(env!("CARGO_BIN_EXE_quadray-bevy-gi"))
+        .args(["--displaced", "--scene", "x.gltf"])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("cannot be used with"));
+}
+
 /// `--scene` renders a glTF of the user's from outside the repository's assets (here the bundled
 /// Cornell box copied elsewhere): the same picture as the bundled one. A flag the program does
 /// not know, and a scene that is not there or not glTF, are refused by name.

@@ -58,8 +58,10 @@ use bevy::render::render_resource::{
 };
 use bevy::render::storage::ShaderBuffer;
 use bevy::shader::{Shader, ShaderDefVal, ShaderRef};
+use quadray_displace::heightmap::HeightMap;
 use quadray_displace::pyramid::Addressing;
 use quadray_displace::{PyramidInfo, TRACE_WGSL};
+use std::sync::Arc;
 
 /// `StandardMaterial` with its parallax replaced by the pyramid trace.
 pub type PyramidMaterial = ExtendedMaterial<StandardMaterial, PyramidExtension>;
@@ -157,7 +159,7 @@ impl PyramidExtension {
         }
     }
 
-    fn addressing(&self) -> Addressing {
+    pub(crate) fn addressing(&self) -> Addressing {
         if self.clamp_to_map {
             Addressing::Clamp
         } else {
@@ -267,16 +269,17 @@ impl From<&PyramidExtension> for PyramidUniform {
     }
 }
 
-/// Each depth map's pyramid image and size, or `None` once the map proved unusable.
+/// Each depth map's pyramid image, size and height field, or `None` once the map proved
+/// unusable (the GI plugin tessellates the height field for its RSM).
 #[derive(Resource, Default)]
-struct Pyramids(HashMap<AssetId<Image>, Option<BuiltPyramid>>);
+pub(crate) struct Pyramids(pub(crate) HashMap<AssetId<Image>, Option<BuiltPyramid>>);
 
-/// The pyramid image and the depth map's width and height in texels.
-type BuiltPyramid = (Handle<Image>, UVec2);
+/// The pyramid image, the depth map's width and height in texels and its height field.
+pub(crate) type BuiltPyramid = (Handle<Image>, UVec2, Arc<HeightMap>);
 
 /// Builds the pyramid of every depth map a material uses once the image is loaded (and again when
 /// it changes), and points the materials at it. An unusable map is logged once, naming the asset.
-fn build_pyramids(
+pub(crate) fn build_pyramids(
     mut image_events: MessageReader<AssetEvent<Image>>,
     mut pyramids: ResMut<Pyramids>,
     mut images: ResMut<Assets<Image>>,
@@ -298,7 +301,7 @@ fn build_pyramids(
                 .as_ref()
                 .map(|p| (p.id(), m.extension.map_size));
             match wanted {
-                Some(Some((handle, size))) => current != Some((handle.id(), *size)),
+                Some(Some((handle, size, _))) => current != Some((handle.id(), *size)),
                 Some(None) => false,
                 None => images.contains(&m.extension.depth_map),
             }
@@ -319,6 +322,7 @@ fn build_pyramids(
                 Some(Ok(map)) => Some((
                     images.add(pyramid_image(&map)),
                     UVec2::new(map.width, map.height),
+                    Arc::new(map),
                 )),
                 Some(Err(e)) => {
                     error!("quadray-bevy: {e}");
@@ -327,7 +331,7 @@ fn build_pyramids(
                 None => None,
             }
         });
-        if let Some((handle, size)) = built {
+        if let Some((handle, size, _)) = built {
             material.extension.pyramid = Some(handle.clone());
             material.extension.map_size = *size;
         }

@@ -37,13 +37,13 @@ const TARGET: [f32; 3] = [0.5, 0.5, 0.0];
 /// What one camera records, read back each frame (the latest kept).
 #[derive(Clone)]
 pub(crate) struct Probe {
-    method: Method,
-    enabled: bool,
-    cut_view: bool,
+    pub(crate) method: Method,
+    pub(crate) enabled: bool,
+    pub(crate) cut_view: bool,
     pub(crate) indirect: Handle<ShaderBuffer>,
     pub(crate) picture: Handle<Image>,
     pub(crate) read_indirect: Arc<Mutex<Option<Vec<u8>>>>,
-    read_picture: Arc<Mutex<Option<Vec<u8>>>>,
+    pub(crate) read_picture: Arc<Mutex<Option<Vec<u8>>>>,
 }
 
 #[derive(Resource)]
@@ -86,24 +86,35 @@ fn setup(
     let probes = setup
         .cases
         .iter()
-        .map(|&(method, enabled, cut_view)| {
-            let mut indirect = ShaderBuffer::with_size((width * height * 16) as usize, default());
-            indirect.buffer_description.usage |= BufferUsages::COPY_SRC | BufferUsages::COPY_DST;
-            let mut target =
-                Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
-            target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-            Probe {
-                method,
-                enabled,
-                cut_view,
-                indirect: buffers.add(indirect),
-                picture: images.add(target),
-                read_indirect: Arc::default(),
-                read_picture: Arc::default(),
-            }
-        })
+        .map(|&case| Probe::new(case, width, height, &mut images, &mut buffers))
         .collect();
     commands.insert_resource(Probes(probes));
+}
+
+impl Probe {
+    /// A `width` x `height` camera's picture and indirect light for `case`, to read back.
+    pub(crate) fn new(
+        (method, enabled, cut_view): Case,
+        width: u32,
+        height: u32,
+        images: &mut Assets<Image>,
+        buffers: &mut Assets<ShaderBuffer>,
+    ) -> Self {
+        let mut indirect = ShaderBuffer::with_size((width * height * 16) as usize, default());
+        indirect.buffer_description.usage |= BufferUsages::COPY_SRC | BufferUsages::COPY_DST;
+        let mut target =
+            Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
+        target.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        Probe {
+            method,
+            enabled,
+            cut_view,
+            indirect: buffers.add(indirect),
+            picture: images.add(target),
+            read_indirect: Arc::default(),
+            read_picture: Arc::default(),
+        }
+    }
 }
 
 /// The glTF's camera (a node of the scene, where a test's own cameras are not), when it appears.
@@ -188,12 +199,18 @@ fn app_of(scene: &'static str, cases: &[Case], settings: Settings, plugin: bool)
         app.add_plugins(RenderDiagnosticsPlugin)
             .add_systems(Startup, setup)
             .add_systems(Update, configure);
-        let compiling = Compiling::default();
-        app.insert_resource(compiling.clone());
-        app.sub_app_mut(RenderApp)
-            .insert_resource(compiling)
-            .add_systems(Render, note_compiling.in_set(RenderSystems::Cleanup));
+        track_compiling(app);
     })
+}
+
+/// Notes in both worlds whether Bevy still compiles a pipeline (what [`compiling`] reads, which
+/// [`gathered`] waits on).
+pub(crate) fn track_compiling(app: &mut App) {
+    let compiling = Compiling::default();
+    app.insert_resource(compiling.clone());
+    app.sub_app_mut(RenderApp)
+        .insert_resource(compiling)
+        .add_systems(Render, note_compiling.in_set(RenderSystems::Cleanup));
 }
 
 pub(crate) fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {

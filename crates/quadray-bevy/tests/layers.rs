@@ -3,13 +3,15 @@
 
 use crate::layering::assert_layered;
 
-/// Every module, by layer, bottom first: the pyramid image and the indirect light's main-world
-/// side, then its render-world side, the plugin that adds both, the material at the root.
+/// Every module, by layer, bottom first: the pyramid image, the material at the root, the
+/// displaced surfaces' triangles and the indirect light's main-world side (which reads the
+/// materials), then its render-world side, and the plugin that adds both.
 const LAYERS: &[&[&str]] = &[
-    &["pyramid_image", "gi::scene"],
+    &["pyramid_image"],
+    &[""],
+    &["gi::displaced", "gi::scene"],
     &["gi::render"],
     &["gi"],
-    &[""],
 ];
 
 #[test]

@@ -4,6 +4,7 @@
 
 mod common;
 mod gi;
+mod gi_displaced;
 mod hits;
 #[path = "../../quadray-indirect/tests/layering.rs"]
 mod layering;

@@ -9,7 +9,10 @@
 //! as for the whole workspace, and what the test build compiled is reused).
 //! `--scene PATH` shows a glTF or GLB scene of your own instead (its camera and its punctual
 //! lights; `assets/scenes/cornell_lights.gltf` has all three kinds); `--gi-lights spot,point`
-//! lets only those kinds give the bounce (default: all three). Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
+//! lets only those kinds give the bounce (default: all three). `--displaced` shows quadray's
+//! displaced surfaces instead: a floor and a wall with `PyramidMaterial` (the tile map; Bevy's
+//! parallax example's map and colours) beside a plain red wall, lit by a spot, the bounce leaving
+//! from the displaced surfaces. Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
 //! [--cut-view] [--method quadtree|quadtree-tiles|rsm|reference]` renders off screen with the
 //! light still and saves the picture. `--frames N` (with `--screenshot`) times N frames with the
 //! light turning and prints their median and Bevy's render diagnostics of the bounce (GPU time of
@@ -21,12 +24,14 @@
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::gltf::GltfAssetLabel;
+use bevy::image::ImageLoaderSettings;
 use bevy::pbr::DefaultOpaqueRendererMethod;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy::world_serialization::WorldAssetRoot;
 use clap::Parser;
 use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
 use quadray_bevy_programs::{Offscreen, add_default_plugins, repository_assets, set_title};
 use quadray_indirect::{Method, Settings, Size};
 use std::path::{Path, PathBuf};
@@ -42,7 +47,7 @@ const METHODS: [Method; 4] = [
 /// The light's turn about the vertical (radians a second).
 const TURN: f32 = 0.25;
 
-/// The glTF file's camera, when it appears.
+/// The scene's camera (the glTF file's, or the displaced scene's), when it appears.
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
 /// What the first frame shows (`--no-gi`, `--method`, `--cut-view`) and at what size (`--size`,
@@ -69,6 +74,11 @@ struct Args {
     /// and spot) turning and giving the bounce (default: the bundled Cornell box).
     #[arg(long, value_name = "PATH.gltf")]
     scene: Option<PathBuf>,
+    /// Show quadray's displaced surfaces instead of the Cornell box: a floor and a wall drawn
+    /// with the pyramid material beside a plain red wall, lit by a spot; the bounce leaves from
+    /// the displaced surfaces (the GI plugin's RSM holds their height fields).
+    #[arg(long, conflicts_with = "scene")]
+    displaced: bool,
     /// Render off screen, save the picture here and exit.
     #[arg(long, value_name = "PNG")]
     screenshot: Option<String>,
@@ -109,18 +119,24 @@ enum GiLight {
 #[derive(Resource)]
 struct GiLights(Vec<GiLight>);
 
-/// The scene file under the asset root.
+/// What is shown: a scene file under the asset root, or the displaced surfaces built here.
 #[derive(Resource, Clone)]
-struct SceneFile(String);
+enum Shows {
+    File(String),
+    Displaced,
+}
 
 fn main() {
     let args = Args::parse();
     let (assets, scene) = match &args.scene {
-        None => (repository_assets(""), SCENE.to_string()),
-        Some(path) => scene_assets(path).unwrap_or_else(|e| {
-            eprintln!("error: --scene {}: {e}", path.display());
-            std::process::exit(2);
-        }),
+        None if args.displaced => (repository_assets(""), Shows::Displaced),
+        None => (repository_assets(""), Shows::File(SCENE.to_string())),
+        Some(path) => scene_assets(path)
+            .map(|(assets, file)| (assets, Shows::File(file)))
+            .unwrap_or_else(|e| {
+                eprintln!("error: --scene {}: {e}", path.display());
+                std::process::exit(2);
+            }),
     };
     let timed = args.frames.unwrap_or(0) as usize;
     let shown = Shown {
@@ -132,15 +148,16 @@ fn main() {
         rsm_size: args.rsm_size,
     };
     let mut app = App::new();
-    // the scene loads in a few frames; each frame gathers anew while the light turns (on the
-    // CPU rasteriser about a second a frame at this size)
-    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 60, timed));
+    // the picture 10 frames after Bevy's last pipeline compiled (the scene loads meanwhile);
+    // each frame gathers anew while the light turns (on the CPU rasteriser about a second a
+    // frame at this size)
+    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 10, timed));
     add_default_plugins(&mut app, assets, offscreen);
     app.insert_resource(DefaultOpaqueRendererMethod::deferred())
-        .add_plugins(IndirectLightPlugin)
+        .add_plugins((IndirectLightPlugin, PyramidDisplacementPlugin))
         .insert_resource(shown)
         .insert_resource(GiLights(args.gi_lights.clone()))
-        .insert_resource(SceneFile(scene))
+        .insert_resource(scene)
         .add_systems(Startup, setup)
         .add_systems(Update, (configure, keys, turn_light, show_title).chain())
         .run();
@@ -172,15 +189,95 @@ fn setup(
     mut images: ResMut<Assets<Image>>,
     offscreen: Option<ResMut<Offscreen>>,
     shown: Res<Shown>,
-    scene: Res<SceneFile>,
+    scene: Res<Shows>,
 ) {
-    commands.spawn(WorldAssetRoot(
-        assets.load(GltfAssetLabel::Scene(0).from_asset(scene.0.clone())),
-    ));
+    match &*scene {
+        Shows::File(file) => {
+            commands.spawn(WorldAssetRoot(
+                assets.load(GltfAssetLabel::Scene(0).from_asset(file.clone())),
+            ));
+        }
+        Shows::Displaced => commands.run_system_cached(displaced_scene),
+    }
     if let Some(mut offscreen) = offscreen {
         let (width, height) = shown.size;
         offscreen.make_target(&mut images, width, height);
     }
+}
+
+/// The displaced surfaces: a 4 x 4 floor with the tile map and a 4 x 4 wall with Bevy's parallax
+/// example's maps (`PyramidMaterial`, self-shadowed), a plain red wall on the left, a spot
+/// light, and a camera where a glTF file's would be (`configure` gives it the bounce).
+fn displaced_scene(
+    mut commands: Commands,
+    assets: Res<AssetServer>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut standard: ResMut<Assets<StandardMaterial>>,
+    mut pyramid: ResMut<Assets<PyramidMaterial>>,
+) {
+    let linear = |s: &mut ImageLoaderSettings| s.is_srgb = false;
+    let mut square = |normal: Vec3| {
+        let plane = Plane3d::new(normal, Vec2::splat(2.0)).mesh().build();
+        meshes.add(
+            plane
+                .with_generated_tangents()
+                .expect("a plane has normals and uvs"),
+        )
+    };
+    let (floor, wall, side) = (square(Vec3::Y), square(Vec3::Z), square(Vec3::X));
+    let mut displaced = |base: StandardMaterial, map: &str, depth_scale: f32| {
+        let map = assets
+            .load_builder()
+            .with_settings(linear)
+            .load(map.to_owned());
+        let mut extension = PyramidExtension::new(map, depth_scale);
+        extension.shadow_strength = 1.0;
+        pyramid.add(PyramidMaterial { base, extension })
+    };
+    let tiles = displaced(
+        StandardMaterial {
+            base_color: Color::srgb(0.85, 0.8, 0.7),
+            perceptual_roughness: 0.8,
+            ..default()
+        },
+        "heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png",
+        0.015,
+    );
+    let stones = displaced(
+        StandardMaterial {
+            base_color_texture: Some(assets.load("heightmaps/bevy_parallax/cube_color.png")),
+            perceptual_roughness: 0.7,
+            ..default()
+        },
+        "heightmaps/bevy_parallax/cube_depth.png",
+        0.03,
+    );
+    commands.spawn((Mesh3d(floor), MeshMaterial3d(tiles), Transform::default()));
+    commands.spawn((
+        Mesh3d(wall),
+        MeshMaterial3d(stones),
+        Transform::from_xyz(0.0, 2.0, -2.0),
+    ));
+    commands.spawn((
+        Mesh3d(side),
+        MeshMaterial3d(standard.add(Color::srgb(0.8, 0.1, 0.08))),
+        Transform::from_xyz(-2.0, 2.0, 0.0),
+    ));
+    commands.spawn((
+        SpotLight {
+            intensity: 2.0e6,
+            outer_angle: 0.7,
+            inner_angle: 0.5,
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_xyz(1.2, 3.4, 1.6).looking_at(Vec3::new(-0.6, 0.0, -1.0), Vec3::Y),
+    ));
+    commands.spawn((
+        Camera3d::default(),
+        Transform::from_xyz(1.2, 1.9, 4.6).looking_at(Vec3::new(-0.2, 1.0, -0.8), Vec3::Y),
+        Projection::default(),
+    ));
 }
 
 /// A light of the three kinds glTF files hold, just loaded.

@@ -71,7 +71,8 @@ fn main() {
     let method = args.method as usize;
     let mut app = App::new();
     let assets = repository_assets("heightmaps/bevy_parallax");
-    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 300, 0));
+    // the picture 30 frames after Bevy's last pipeline compiled (the maps load meanwhile)
+    let offscreen = args.screenshot.map(|path| Offscreen::new(path, 30, 0));
     add_default_plugins(&mut app, assets, offscreen);
     app.add_plugins(PyramidDisplacementPlugin)
         .insert_resource(FirstMethod(method))

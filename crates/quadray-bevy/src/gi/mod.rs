@@ -28,10 +28,15 @@
 //! device (quadray builds on the wgpu Bevy 0.19 uses); the plugin adds only the translation of
 //! Bevy's packed G-buffer (`gbuffer.wgsl`, with Bevy's unpacking functions) and the additive
 //! composite (`composite.wgsl`). The light's RSM is rasterised from the scene's triangles,
-//! gathered on the CPU from every visible `Mesh3d` with a `StandardMaterial` (its base colour;
-//! textures are not read) whenever a mesh, material or transform changes; a moving light rebuilds
-//! the RSM, the pyramid and the cut, a still light and a moving camera reuse them. Each camera
-//! gathers every frame: Bevy's G-buffer changes without the camera moving (a mesh's pipeline
+//! gathered on the CPU from every visible `Mesh3d` whenever a mesh, material or transform
+//! changes: a `StandardMaterial`'s polygons in its base colour (textures are not read), a
+//! [`PyramidMaterial`](crate::PyramidMaterial)'s displaced surface (its height field cut into
+//! triangles, at most [`DISPLACED_TRIANGLES_MAX`] a mesh) in its base colour times its colour
+//! texture (read on the CPU where the image keeps its data; its base colour alone where not); the
+//! same triangles make the occupancy grid of indirect shadows ([`IndirectLightScene`] holds
+//! them). A moving light rebuilds the RSM, the pyramid and the cut, a still light and a moving
+//! camera reuse them. Each camera gathers every frame: Bevy's G-buffer changes without the camera
+//! moving (a mesh's pipeline
 //! compiled frames after it loaded, render layers switched).
 //!
 //! Units: the lights' intensities are Bevy's (a point or spot light's luminous power in lumens,
@@ -41,17 +46,20 @@
 //! lights, each kind by entity) up to the first camera's
 //! [`Settings::max_lights`](quadray_indirect::Settings::max_lights).
 
+mod displaced;
 mod render;
 mod scene;
 
+pub use displaced::DISPLACED_TRIANGLES_MAX;
 pub use scene::{
-    IndirectLight, IndirectLightSource, quadray_directional, quadray_point, quadray_spot,
+    IndirectLight, IndirectLightScene, IndirectLightSource, quadray_directional, quadray_point,
+    quadray_spot,
 };
 
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::extract_resource::ExtractResourcePlugin;
-use scene::{IndirectLightScene, collect_lights, collect_triangles};
+use scene::{collect_lights, collect_triangles};
 
 /// Adds [`IndirectLight`] to the cameras that carry it, from the lights marked
 /// [`IndirectLightSource`]. Add it after `DefaultPlugins`; the cameras need deferred rendering
@@ -69,6 +77,7 @@ impl Plugin for IndirectLightPlugin {
             PostUpdate,
             (collect_triangles, collect_lights)
                 .after(bevy::transform::TransformSystems::Propagate)
+                .after(crate::build_pyramids)
                 .after(bevy::camera::visibility::VisibilitySystems::VisibilityPropagate),
         );
         render::build(app);

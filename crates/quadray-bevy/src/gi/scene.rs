@@ -1,15 +1,19 @@
 //! The main world's side of the plugin: the components a user adds, and the marked lights and the
 //! scene's triangles gathered each frame into [`IndirectLightScene`] for the render world.
 
+use super::displaced::{Albedo, ColourMap, Displacement, append_displaced};
+use crate::{PyramidMaterial, Pyramids};
 use bevy::asset::AssetEvent;
 use bevy::camera::Hdr;
 use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
 use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
 use bevy::pbr::StandardMaterial;
+use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::extract_resource::ExtractResource;
 use bevy::render::storage::ShaderBuffer;
+use quadray_displace::heightmap::HeightMap;
 use quadray_indirect::scene::{Cone, Intensity, Light, LightKind, Vertex};
 use quadray_indirect::{Method, Scene, Settings};
 use std::sync::Arc;
@@ -58,14 +62,29 @@ impl Default for IndirectLight {
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct IndirectLightSource;
 
-/// What the render world needs of the main world's scene: its triangles (rebuilt when a mesh,
-/// material or transform changes) and the marked lights.
+/// The scene the lights' RSMs and the occupancy grid are made of, gathered each time a mesh,
+/// material or transform changes: the triangles of every visible `Mesh3d` in world space (a
+/// `StandardMaterial`'s base colour as their albedo; a `PyramidMaterial`'s displaced surface,
+/// see [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX)), and the marked lights. A
+/// resource of the main world, to read.
 #[derive(Resource, Clone, Default, ExtractResource)]
-pub(super) struct IndirectLightScene {
+pub struct IndirectLightScene {
     pub(super) triangles: Arc<Vec<[Vertex; 3]>>,
     /// Counts the rebuilds of `triangles`.
     pub(super) generation: u64,
     pub(super) lights: Vec<Light>,
+}
+
+impl IndirectLightScene {
+    /// The triangles, in world space, with the normal and albedo the RSM takes.
+    pub fn triangles(&self) -> &[[Vertex; 3]] {
+        &self.triangles
+    }
+
+    /// Counts the times the triangles were gathered anew.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
 }
 
 /// A Bevy colour times a strength, as a light's RGB intensity.
@@ -184,45 +203,191 @@ type Objects<'w, 's> = Query<
         Ref<'static, GlobalTransform>,
         Ref<'static, Mesh3d>,
         Option<Ref<'static, MeshMaterial3d<StandardMaterial>>>,
+        Option<Ref<'static, MeshMaterial3d<PyramidMaterial>>>,
         Ref<'static, InheritedVisibility>,
     ),
 >;
 
-#[allow(clippy::too_many_arguments)]
+/// What the scene's triangles are made from besides the meshes: the materials, the displaced
+/// surfaces' height fields (the displacement plugin's, absent without it) and the colour
+/// textures read on the CPU.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct Sources<'w, 's> {
+    meshes: Res<'w, Assets<Mesh>>,
+    materials: Res<'w, Assets<StandardMaterial>>,
+    displaced: Option<Res<'w, Assets<PyramidMaterial>>>,
+    pyramids: Option<Res<'w, Pyramids>>,
+    images: Res<'w, Assets<Image>>,
+    assets: Res<'w, AssetServer>,
+    mesh_events: MessageReader<'w, 's, AssetEvent<Mesh>>,
+    material_events: MessageReader<'w, 's, AssetEvent<StandardMaterial>>,
+    /// (absent without the displacement plugin)
+    displaced_events: Option<MessageReader<'w, 's, AssetEvent<PyramidMaterial>>>,
+    image_events: MessageReader<'w, 's, AssetEvent<Image>>,
+    /// Each colour texture as the RSM reads it (`None`: not readable on the CPU, warned once).
+    colours: Local<'s, HashMap<AssetId<Image>, Option<Arc<ColourMap>>>>,
+}
+
 pub(super) fn collect_triangles(
     objects: Objects,
-    meshes: Res<Assets<Mesh>>,
-    materials: Res<Assets<StandardMaterial>>,
-    mut mesh_events: MessageReader<AssetEvent<Mesh>>,
-    mut material_events: MessageReader<AssetEvent<StandardMaterial>>,
+    sources: Sources,
     mut removed: RemovedComponents<Mesh3d>,
     mut scene: ResMut<IndirectLightScene>,
     mut count: Local<usize>,
 ) {
-    let events =
-        mesh_events.read().count() + material_events.read().count() + removed.read().count();
-    let changed = objects.iter().any(|(t, m, mat, v)| {
-        t.is_changed() || m.is_changed() || v.is_changed() || mat.is_some_and(|m| m.is_changed())
+    let Sources {
+        meshes,
+        materials,
+        displaced,
+        pyramids,
+        images,
+        assets,
+        mut mesh_events,
+        mut material_events,
+        mut displaced_events,
+        mut image_events,
+        mut colours,
+    } = sources;
+    let displaced = displaced.as_deref();
+    let mut events = mesh_events.read().count()
+        + material_events.read().count()
+        + displaced_events.as_mut().map_or(0, |e| e.read().count())
+        + removed.read().count();
+    for event in image_events.read() {
+        let id = match event {
+            AssetEvent::Added { id }
+            | AssetEvent::Modified { id }
+            | AssetEvent::Removed { id }
+            | AssetEvent::LoadedWithDependencies { id } => *id,
+            AssetEvent::Unused { .. } => continue,
+        };
+        // a colour texture read, or one a displaced material waits for
+        if colours.remove(&id).is_some() || uses_image(displaced, id) {
+            events += 1;
+        }
+    }
+    let changed = objects.iter().any(|(t, m, mat, pyramid, v)| {
+        t.is_changed()
+            || m.is_changed()
+            || v.is_changed()
+            || mat.is_some_and(|m| m.is_changed())
+            || pyramid.is_some_and(|m| m.is_changed())
     });
     if events == 0 && !changed && objects.iter().len() == *count {
         return;
     }
     *count = objects.iter().len();
     let mut triangles = Vec::new();
-    for (transform, mesh, material, visible) in &objects {
+    for (transform, mesh, material, pyramid, visible) in &objects {
         let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) else {
             continue;
         };
+        if let Some(material) = pyramid.and_then(|m| displaced?.get(&m.0)) {
+            let colour = material
+                .base
+                .base_color_texture
+                .as_ref()
+                .and_then(|texture| {
+                    colours
+                        .entry(texture.id())
+                        .or_insert_with(|| read_colours(&images, &assets, texture))
+                        .clone()
+                });
+            let map = pyramids
+                .as_ref()
+                .and_then(|p| p.0.get(&material.extension.depth_map.id()))
+                .and_then(|built| built.as_ref())
+                .filter(|_| material.extension.pyramid.is_some())
+                .map(|(_, _, map)| map.as_ref());
+            append_displaced_mesh(
+                mesh,
+                &transform,
+                material,
+                map,
+                colour.as_deref(),
+                &mut triangles,
+            );
+            continue;
+        }
         let albedo = material
             .and_then(|m| materials.get(&m.0))
-            .map_or(Vec3::splat(0.5), |m| {
-                let c = LinearRgba::from(m.base_color);
-                Vec3::new(c.red, c.green, c.blue) * (1.0 - m.metallic)
-            });
+            .map_or(Vec3::splat(0.5), base_albedo);
         append_triangles(mesh, &transform, albedo.to_array(), &mut triangles);
     }
     scene.triangles = Arc::new(triangles);
     scene.generation += 1;
+}
+
+/// Whether a displaced material uses image `id` as its depth map or colour texture.
+fn uses_image(materials: Option<&Assets<PyramidMaterial>>, id: AssetId<Image>) -> bool {
+    materials.is_some_and(|materials| {
+        materials.iter().any(|(_, m)| {
+            m.extension.depth_map.id() == id
+                || m.base
+                    .base_color_texture
+                    .as_ref()
+                    .is_some_and(|t| t.id() == id)
+        })
+    })
+}
+
+/// A colour texture as the RSM reads it, once loaded; `None` (with a warning naming it) where
+/// it cannot be read on the CPU.
+fn read_colours(
+    images: &Assets<Image>,
+    assets: &AssetServer,
+    texture: &Handle<Image>,
+) -> Option<Arc<ColourMap>> {
+    let image = images.get(texture)?;
+    let read = ColourMap::of_image(image).map(Arc::new);
+    if read.is_none() {
+        let name = assets
+            .get_path(texture.id())
+            .map_or_else(|| format!("{:?}", texture.id()), |p| p.to_string());
+        warn!(
+            "quadray indirect light: the colour texture {name} cannot be read on the CPU (no \
+             CPU-side data, or a format Image::get_color_at does not read): the RSM takes the \
+             displaced surface's base colour alone"
+        );
+    }
+    read
+}
+
+/// A standard material's diffuse albedo: its base colour times 1 - metallic.
+fn base_albedo(m: &StandardMaterial) -> Vec3 {
+    let c = LinearRgba::from(m.base_color);
+    Vec3::new(c.red, c.green, c.blue) * (1.0 - m.metallic)
+}
+
+/// Appends a mesh with a [`PyramidMaterial`]: its displaced surface once the material traces
+/// its depth `map`, before that its polygon (as the material draws it: flat), in the material's
+/// base colour times its colour texture where that was read on the CPU.
+fn append_displaced_mesh(
+    mesh: &Mesh,
+    transform: &GlobalTransform,
+    material: &PyramidMaterial,
+    map: Option<&HeightMap>,
+    colour: Option<&ColourMap>,
+    out: &mut Vec<[Vertex; 3]>,
+) {
+    let albedo = Albedo {
+        base: base_albedo(&material.base),
+        texture: colour,
+        uv_transform: material.base.uv_transform,
+    };
+    let flat = HeightMap {
+        width: 1,
+        height: 1,
+        depth: vec![0.0],
+    };
+    let displacement = Displacement {
+        map: map.unwrap_or(&flat),
+        depth_scale: material.extension.depth_scale,
+        addressing: material.extension.addressing(),
+    };
+    if !append_displaced(mesh, transform, &displacement, &albedo, out) {
+        append_triangles(mesh, transform, albedo.base.to_array(), out);
+    }
 }
 
 /// Appends `mesh`'s triangles in world space (a triangle list with positions; face normals where
