@@ -393,7 +393,7 @@ mod tests {
     #[cfg(feature = "cli")]
     #[test]
     fn every_setting_comes_back_through_its_flags() {
-        use quadray_core::settings::{flags_at_default, from_args};
+        use quadray_core::settings::assert_flags_round_trip;
         let every = Settings {
             method: Method::Relief,
             view_angle_deg: 60.5,
@@ -409,19 +409,13 @@ mod tests {
             show_iterations: true,
         };
         assert!(every.validate().is_ok());
-        let args = every.to_args();
-        let defaults = Settings::DEFAULT.to_args();
-        assert_eq!(
-            flags_at_default::<Settings>(&args, &defaults),
-            Vec::<String>::new(),
-            "{args:?}"
-        );
         let shown = Method::ALL.into_iter().flat_map(|m| [m.shown(), m.timed()]);
-        for s in [every, Settings::DEFAULT].into_iter().chain(shown) {
-            let args = s.to_args();
-            let parsed = from_args::<Settings>(&args).unwrap_or_else(|e| panic!("{args:?}: {e}"));
-            assert_eq!(parsed, s, "{args:?}");
-        }
+        assert_flags_round_trip(
+            every,
+            std::iter::once(Settings::DEFAULT).chain(shown),
+            &Settings::DEFAULT.to_args(),
+            Settings::to_args,
+        );
     }
 
     #[test]

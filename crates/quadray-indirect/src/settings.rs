@@ -757,7 +757,7 @@ mod tests {
     #[cfg(feature = "cli")]
     #[test]
     fn every_setting_comes_back_through_its_flags() {
-        use quadray_core::settings::{flags_at_default, from_args};
+        use quadray_core::settings::assert_flags_round_trip;
         let every = Settings {
             size: Size::new(96, 64),
             rsm_size: 256,
@@ -784,18 +784,12 @@ mod tests {
             tile_share: 0.0,
         };
         assert!(every.validate().is_ok());
-        let args = every.to_args();
-        let defaults = Settings::DEFAULT.to_args();
-        assert_eq!(
-            flags_at_default::<Settings>(&args, &defaults),
-            Vec::<String>::new(),
-            "{args:?}"
+        assert_flags_round_trip(
+            every,
+            [Settings::DEFAULT, Settings::DEFAULT.resolved()],
+            &Settings::DEFAULT.to_args(),
+            Settings::to_args,
         );
-        for s in [every, Settings::DEFAULT, Settings::DEFAULT.resolved()] {
-            let args = s.to_args();
-            let parsed = from_args::<Settings>(&args).unwrap_or_else(|e| panic!("{args:?}: {e}"));
-            assert_eq!(parsed, s, "{args:?}");
-        }
     }
 
     /// Each refusal names the parameter and its declared range.

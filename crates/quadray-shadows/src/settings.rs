@@ -274,7 +274,7 @@ mod tests {
     #[cfg(feature = "cli")]
     #[test]
     fn every_setting_comes_back_through_its_flags() {
-        use quadray_core::settings::{flags_at_default, from_args};
+        use quadray_core::settings::assert_flags_round_trip;
         let every = Settings {
             scheme: SchemeChoice::Volume,
             nth: Nth::Fixed(6.5),
@@ -284,18 +284,12 @@ mod tests {
             check: true,
         };
         assert!(every.validate().is_ok());
-        let args = every.to_args();
-        let defaults = Settings::DEFAULT.to_args();
-        assert_eq!(
-            flags_at_default::<Settings>(&args, &defaults),
-            Vec::<String>::new(),
-            "{args:?}"
+        assert_flags_round_trip(
+            every,
+            [Settings::DEFAULT],
+            &Settings::DEFAULT.to_args(),
+            Settings::to_args,
         );
-        for s in [every, Settings::DEFAULT] {
-            let args = s.to_args();
-            let parsed = from_args::<Settings>(&args).unwrap_or_else(|e| panic!("{args:?}: {e}"));
-            assert_eq!(parsed, s, "{args:?}");
-        }
     }
 
     #[test]

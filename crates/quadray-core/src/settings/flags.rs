@@ -101,6 +101,31 @@ pub fn flags_at_default<S: Args>(args: &[String], defaults: &[String]) -> Vec<St
         .collect()
 }
 
+/// The check each settings type's tests make of its flags (`to_args`: its `Settings::to_args`):
+/// `every`, a value with each field off its default, writes no flag at its default (`defaults`:
+/// the default settings' flags), and `every` and each of `others` parse back from their flags to
+/// themselves. Panics naming the flags where not.
+pub fn assert_flags_round_trip<S>(
+    every: S,
+    others: impl IntoIterator<Item = S>,
+    defaults: &[String],
+    to_args: impl Fn(&S) -> Vec<String>,
+) where
+    S: Args + FromArgMatches + PartialEq + std::fmt::Debug,
+{
+    let args = to_args(&every);
+    assert_eq!(
+        flags_at_default::<S>(&args, defaults),
+        Vec::<String>::new(),
+        "{args:?}"
+    );
+    for s in std::iter::once(every).chain(others) {
+        let args = to_args(&s);
+        let parsed = from_args::<S>(&args).unwrap_or_else(|e| panic!("{args:?}: {e}"));
+        assert_eq!(parsed, s, "{args:?}");
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
