@@ -173,11 +173,16 @@ pub fn render_demo(
         let path = out.join(format!("{scene}.png"));
         files.push(lights_picture(gpu, size, scene, &path)?);
     }
-    for scene in ["visibility-shelf", "visibility-storeys"] {
+    for scene in [
+        "visibility-shelf",
+        "visibility-storeys",
+        "visibility-pillars",
+        "courtyard",
+    ] {
         progress(&format!(
             "{scene}: indirect shadows on a scene nobody tuned on"
         ));
-        let path = out.join(format!("{scene}.png"));
+        let path = out.join(format!("{scene}-shadows.png"));
         files.push(held_apart_picture(gpu, size, scene, &path)?);
     }
     Ok(files)
