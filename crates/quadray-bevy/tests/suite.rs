@@ -14,3 +14,4 @@ mod pass_cost;
 mod prepass;
 mod self_shadow;
 mod shadows;
+mod validation;
