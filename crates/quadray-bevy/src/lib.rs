@@ -11,26 +11,31 @@
 //! use bevy::prelude::*;
 //! use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
 //!
+//! fn main() {
+//!     App::new()
+//!         .add_plugins((DefaultPlugins, PyramidDisplacementPlugin))
+//!         .add_systems(Startup, setup)
+//!         .run();
+//! }
+//!
 //! fn setup(
 //!     mut commands: Commands,
 //!     assets: Res<AssetServer>,
 //!     mut meshes: ResMut<Assets<Mesh>>,
 //!     mut materials: ResMut<Assets<PyramidMaterial>>,
 //! ) {
+//!     // the trace needs uvs and tangents
 //!     let mesh = Mesh::from(Cuboid::default()).with_generated_tangents().unwrap();
 //!     commands.spawn((
 //!         Mesh3d(meshes.add(mesh)),
 //!         MeshMaterial3d(materials.add(PyramidMaterial {
+//!             // no depth_map here: the extension takes it
 //!             base: StandardMaterial::from(assets.load::<Image>("cube_color.png")),
+//!             // the depth map and the depth scale Bevy's parallax takes
 //!             extension: PyramidExtension::new(assets.load("cube_depth.png"), 0.09),
 //!         })),
 //!     ));
 //! }
-//!
-//! App::new()
-//!     .add_plugins((DefaultPlugins, PyramidDisplacementPlugin))
-//!     .add_systems(Startup, setup)
-//!     .run();
 //! ```
 //!
 //! The depth map is the image a Bevy user already has for `StandardMaterial::depth_map` (0 at the

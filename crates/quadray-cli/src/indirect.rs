@@ -3,10 +3,12 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
+use glam::Vec3;
 use quadray_bench::indirect::run::{RunOptions, run};
 use quadray_core::image_out::EXPOSURE;
 use quadray_core::write_json;
 use quadray_gpu::Gpu;
+use quadray_indirect::scene::Light;
 use quadray_indirect::{Method, Scene, Settings};
 use std::path::{Path, PathBuf};
 
@@ -58,17 +60,33 @@ pub struct IndirectArgs {
     /// Camera target X,Y,Z instead of the scene file's.
     #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
     camera_target: Option<[f32; 3]>,
-    /// The first light's position X,Y,Z instead of the scene file's (a point or spot light).
-    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
-    light_position: Option<[f32; 3]>,
-    /// The first light's direction X,Y,Z instead of the scene file's (a spot's axis, the sun's
-    /// direction).
-    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
-    light_direction: Option<[f32; 3]>,
+    /// A light's position, `[N:]X,Y,Z`, instead of the scene file's (a point or spot light; N
+    /// counts the scene's lights from 1, the first by default; once per light).
+    #[arg(long, value_parser = parse_light_vec3, allow_hyphen_values = true)]
+    light_position: Vec<NumberedVec3>,
+    /// A light's direction, `[N:]X,Y,Z`, instead of the scene file's (a spot's axis, the sun's
+    /// direction; N as for --light-position).
+    #[arg(long, value_parser = parse_light_vec3, allow_hyphen_values = true)]
+    light_direction: Vec<NumberedVec3>,
     #[arg(long)]
     out: PathBuf,
     #[arg(long)]
     stats: Option<PathBuf>,
+}
+
+/// A light's number (from 1) and a vector.
+type NumberedVec3 = (usize, [f32; 3]);
+
+/// `[N:]X,Y,Z`: a light's number (1 when left out) and a vector.
+fn parse_light_vec3(s: &str) -> Result<NumberedVec3, String> {
+    let (number, v) = match s.split_once(':') {
+        Some((n, v)) => match n.trim().parse::<usize>() {
+            Ok(n) if n >= 1 => (n, v),
+            _ => return Err(format!("`{n}` is not a light's number (1, 2, ...)")),
+        },
+        None => (1, s),
+    };
+    Ok((number, quadray_core::parse_vec3(v)?))
 }
 
 /// `picture.png` -> `picture.SUFFIX.png`.
@@ -89,23 +107,25 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     }
     set(&mut scene.camera.position, args.camera_position);
     set(&mut scene.camera.target, args.camera_target);
-    let first = &mut scene.lights[0];
-    if let Some(p) = args.light_position
-        && !first.place(p.into())
-    {
-        anyhow::bail!(
-            "--light-position: the scene's first light is a {}",
-            first.describe()
-        );
-    }
-    if let Some(d) = args.light_direction
-        && !first.aim(d.into())
-    {
-        anyhow::bail!(
-            "--light-direction: the scene's first light is a {}",
-            first.describe()
-        );
-    }
+    let lights = &mut scene.lights;
+    let mut move_lights =
+        |flag: &str, given: &[NumberedVec3], apply: fn(&mut Light, Vec3) -> bool| {
+            let count = lights.len();
+            for &(number, v) in given {
+                let light = lights.get_mut(number - 1).with_context(|| {
+                    format!("{flag} {number}:...: the scene has {count} light(s)")
+                })?;
+                if !apply(light, v.into()) {
+                    anyhow::bail!(
+                        "{flag}: the scene's light {number} is a {}",
+                        light.describe()
+                    );
+                }
+            }
+            Ok(())
+        };
+    move_lights("--light-position", &args.light_position, Light::place)?;
+    move_lights("--light-direction", &args.light_direction, Light::aim)?;
     scene
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;

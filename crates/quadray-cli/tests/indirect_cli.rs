@@ -184,7 +184,7 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
     std::fs::write(&scene, "r_min = 0.05\n[camera]\nposition = [0, 0, 1]\n").unwrap();
     let courtyard = assets().join("scenes/courtyard.toml");
     let courtyard = courtyard.to_str().unwrap();
-    let cases: [(Vec<&str>, &str); 14] = [
+    let cases: [(Vec<&str>, &str); 16] = [
         (vec!["--scene", scene.to_str().unwrap()], "bad.toml"),
         (vec!["--scene", "/nonexistent/scene.toml"], "scene.toml"),
         (vec!["--rsm-size", "100"], "power of two"),
@@ -198,7 +198,15 @@ fn bad_scenes_and_parameters_are_refused_with_a_reason() {
         // the sun has no position to move
         (
             vec!["--scene", courtyard, "--light-position", "1,2,3"],
-            "--light-position: the scene's first light is a directional light along",
+            "--light-position: the scene's light 1 is a directional light along",
+        ),
+        (
+            vec!["--scene", courtyard, "--light-direction", "2:0,-1,0"],
+            "--light-direction 2:...: the scene has 1 light(s)",
+        ),
+        (
+            vec!["--light-position", "0:1,2,3"],
+            "`0` is not a light's number",
         ),
         (
             vec!["--tile-capacity", "0"],

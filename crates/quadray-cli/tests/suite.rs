@@ -14,6 +14,7 @@ mod indirect_cli;
 mod layering;
 mod layers;
 mod raytrace_cli;
+mod readme_snippets;
 mod scene_cli;
 mod slurm;
 mod tiles_cli;

@@ -8,6 +8,18 @@
 //! (`examples/displaced_quad.rs` is a whole program). quadray's own [`Renderer`] is built the
 //! same way.
 //!
+//! ```no_run
+//! # use quadray_displace::pyramid::Addressing;
+//! # use quadray_displace::{HeightPyramid, PyramidKind, TRACE_WGSL, heightmap::HeightMap};
+//! # fn build(device: wgpu::Device, queue: wgpu::Queue, map: HeightMap) -> (quadray_displace::PyramidInfo, String) {
+//! # const MY_SHADER: &str = "";
+//! let pyramid = HeightPyramid::build_gpu(&device, &queue, &map, PyramidKind::Point);
+//! let info = pyramid.info(Addressing::Wrap);          // upload it; bind pyramid.view() as texture_2d<f32>
+//! let source = format!("{TRACE_WGSL}\n{MY_SHADER}");  // MY_SHADER calls pyramid_trace, pyramid_lit
+//! # (info, source)
+//! # }
+//! ```
+//!
 //! Data flows one way: [`heightmap`] (load) -> [`pyramid`] (build) -> [`gpu`] (trace and shade)
 //! -> [`accuracy`] (measure against [`reference`](mod@reference) on the CPU's own
 //! [`primary_rays`]).

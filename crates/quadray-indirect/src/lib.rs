@@ -16,7 +16,32 @@
 //! To add the bounce to your own wgpu renderer, record the passes into your encoder:
 //! [`RsmPass`] (or your own [`RsmViews`]) -> [`LightQuadtree`] (build, cut) -> [`Gather`] into your
 //! [`GBufferViews`] -> [`OutputPass`] into your texture, all configured by one [`Settings`].
-//! `examples/gi_gbuffer.rs` is a whole program doing that.
+//! `examples/gi_gbuffer.rs` is a whole program doing that; its heart:
+//!
+//! ```no_run
+//! # use quadray_indirect::scene::Light;
+//! # use quadray_indirect::{GBufferViews, Gather, IndirectError, LightQuadtree, LightView};
+//! # use quadray_indirect::{Method, RsmPass, Settings, ViewMaps};
+//! # #[allow(clippy::too_many_arguments)]
+//! # fn record(
+//! #     device: wgpu::Device, queue: wgpu::Queue, mut encoder: wgpu::CommandEncoder,
+//! #     s: Settings, sun: Light, scene_bounds: (glam::Vec3, glam::Vec3), r_min: f32,
+//! #     [position, normal, albedo]: [&wgpu::TextureView; 3], vertices: wgpu::Buffer, vertex_count: u32,
+//! # ) -> Result<(), IndirectError> {
+//! let light = LightView::of_light(&sun, scene_bounds); // a spot or the sun: one view, a point light six
+//! let rsm = RsmPass::new(&device, s.rsm_size);
+//! rsm.set_light(&queue, &light[0]);
+//! let quadtree = LightQuadtree::new(&device, &queue, s.rsm_size, s.cluster, rsm.views());
+//! let maps = [ViewMaps { rsm: rsm.views(), quadtree: &quadtree }];
+//! let gather = Gather::new(&device, &s, &maps, GBufferViews { position, normal, albedo })?;
+//! gather.set_lights(&queue, &light, r_min);
+//! rsm.record(&mut encoder, vertices.slice(..), vertex_count, None);
+//! quadtree.record_build(&mut encoder, None);
+//! quadtree.record_cut(&mut encoder, None);
+//! gather.record_indirect(&mut encoder, Method::DEFAULT, &[&quadtree], None); // per-tile cuts
+//! # Ok(())
+//! # }
+//! ```
 
 #![warn(missing_docs)]
 

@@ -19,25 +19,22 @@
 //! `examples/hst_scene.rs`):
 //!
 //! ```
-//! use glam::Vec3;
-//! use quadray_shadows::{Camera, Light, Material, Nth, Scene, SchemeChoice, Settings, Size};
-//!
-//! let camera = Camera { position: Vec3::new(0.0, 2.0, 4.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
-//! let mut scene = Scene::new("doc", camera);
+//! # use glam::Vec3;
+//! # use quadray_shadows::{Camera, Light, Material, Nth, Scene, SchemeChoice, Settings, Size};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! # let (position, target) = (Vec3::new(0.0, 2.0, 4.0), Vec3::ZERO);
+//! # let positions = [[-2.0, 0.0, -2.0], [-2.0, 0.0, 2.0], [2.0, 0.0, 2.0], [2.0, 0.0, -2.0]].map(Vec3::from_array);
+//! # let triangle_indices = [0, 1, 2, 0, 2, 3];
+//! let mut scene = Scene::new("mine", Camera { position, target, up: Vec3::Y, fov_y_deg: 45.0 });
 //! let grey = scene.add_material(Material::matte(Vec3::splat(0.7)));
-//! scene.add_light(Light::white(Vec3::new(1.0, 4.0, 2.0), 0.8));
-//! let floor = [[-2.0, 0.0, -2.0], [-2.0, 0.0, 2.0], [2.0, 0.0, 2.0], [2.0, 0.0, -2.0]];
-//! let corners = floor.map(|p| scene.add_vertex(Vec3::from_array(p)));
-//! scene.add_face(corners.to_vec(), grey).unwrap();
-//! let settings = Settings {
-//!     scheme: SchemeChoice::Hst,
-//!     nth: Nth::Fixed(8.0),
-//!     size: Size::new(32, 24),
-//!     depth: 2,
-//!     ..Settings::DEFAULT
-//! };
-//! let (image, report) = quadray_shadows::run(scene, &settings, &|| {}).unwrap();
-//! assert_eq!((image.width, report.polygons), (32, 1));
+//! scene.add_light(Light::white(Vec3::new(2.0, 4.0, 2.5), 0.6));
+//! scene.add_mesh(&positions, &triangle_indices, grey)?;
+//! let settings = Settings { scheme: SchemeChoice::Hst, nth: Nth::Auto, size: Size::new(320, 240),
+//!                           ..Settings::DEFAULT };
+//! let (image, report) = quadray_shadows::run(scene, &settings, &|| {})?;
+//! # assert_eq!((image.width, report.polygons), (320, 2));
+//! # Ok(())
+//! # }
 //! ```
 //!
 //! Where this departs from the paper, and why:

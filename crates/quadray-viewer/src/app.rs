@@ -168,17 +168,19 @@ impl State {
     /// the camera after its first frame.
     fn prepare(&mut self, args: &Args, scripted: bool) {
         if self.technique == Technique::Indirect && self.indirect.is_none() {
-            self.indirect = Some(IndirectView::new(
+            let mut view = IndirectView::new(
                 self.gpu,
                 args.scene.clone(),
                 args.indirect_method,
                 args.show,
                 args.rsm_size,
-            ));
+            );
+            view.light = args.light as usize - 1;
+            self.indirect = Some(view);
         }
         if scripted && self.frames_drawn > 0 {
             match (self.technique, &mut self.indirect) {
-                (Technique::Indirect, Some(view)) => view.spin(args.spin),
+                (Technique::Indirect, Some(view)) => view.spin(args.spin, args.light_spin),
                 _ => self.displace.settings.azimuth_deg += args.spin,
             }
         }
@@ -380,7 +382,8 @@ fn indirect_panel(ui: &mut egui::Ui, view: &mut IndirectView, frame_ms: f32) {
         ui.colored_label(egui::Color32::LIGHT_RED, e);
     }
     ui.small(
-        "Drag: look. Right drag: aim the light. W/A/S/D, Q/E, wheel: move. L: animate light. \
+        "Drag: look. Right drag: aim (or move) the selected light. W/A/S/D, Q/E, wheel: move. \
+         L: animate the selected light. \
          P: screenshot.",
     );
 }

@@ -55,6 +55,13 @@ pub struct Args {
     /// Scripted run: turn the camera by this many degrees each frame.
     #[arg(long, default_value_t = 0.0)]
     pub spin: f32,
+    /// Indirect light: the light that right drags, L and --light-spin move (from 1).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    pub light: u32,
+    /// Scripted run: turn that light by this many degrees each frame (a spot's or the sun's aim
+    /// about the vertical; a point light about the scene's middle).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub light_spin: f32,
     /// Scripted run: draw this many frames, save --screenshot, and exit.
     #[arg(long)]
     pub frames: Option<u32>,

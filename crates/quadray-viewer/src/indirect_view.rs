@@ -1,5 +1,5 @@
 //! The indirect-light panel: scene, method and every parameter of the light quadtree, a fly camera
-//! and a spot light that can be dragged or animated. Frames come from `quadray_indirect::Renderer`
+//! and the scene's lights, each of which can be dragged or animated. Frames come from `quadray_indirect::Renderer`
 //! and are tone-mapped by the same code as `quadray indirect`, so the screenshot's command line
 //! renders the same picture headless. A frame is rendered only when something changed.
 
@@ -67,48 +67,89 @@ fn yaw_pitch(d: Vec3) -> (f32, f32) {
     )
 }
 
-/// The camera and light as the viewer moves them; the loaded scene keeps the originals.
+/// The camera and lights as the viewer moves them; the loaded scene keeps the originals.
 struct Pose {
     eye: Vec3,
     yaw: f32,
     pitch: f32,
-    light_yaw: f32,
-    light_pitch: f32,
+    lights: Vec<LightPose>,
     /// Angle of the animated light around its dragged direction.
     light_phase: f32,
+}
+
+/// Where a light aims (a spot, the sun) or stands (a point light).
+enum LightPose {
+    Aim { yaw: f32, pitch: f32 },
+    Place(Vec3),
 }
 
 impl Pose {
     fn of(scene: &Scene) -> Self {
         let eye = scene.camera.position;
         let (yaw, pitch) = yaw_pitch(scene.camera.target - eye);
-        // a point light has no aim to drag: its yaw and pitch stay unused
-        let (light_yaw, light_pitch) =
-            yaw_pitch(scene.lights[0].direction().unwrap_or(Vec3::NEG_Y));
+        let lights = scene
+            .lights
+            .iter()
+            .map(|light| match (light.direction(), light.position()) {
+                (Some(d), _) => {
+                    let (yaw, pitch) = yaw_pitch(d);
+                    LightPose::Aim { yaw, pitch }
+                }
+                (None, p) => LightPose::Place(p.expect("a light without an aim has a position")),
+            })
+            .collect();
         Self {
             eye,
             yaw,
             pitch,
-            light_yaw,
-            light_pitch,
+            lights,
             light_phase: 0.0,
         }
     }
 
-    /// The scene with this pose's camera and light.
-    fn apply(&self, base: &Scene, animated: bool) -> Scene {
+    /// The scene with this pose's camera and lights; `animated`: the light of that number
+    /// circles its dragged direction (or position).
+    fn apply(&self, base: &Scene, animated: Option<usize>) -> Scene {
         let mut scene = base.clone();
         scene.camera.position = self.eye;
         scene.camera.target = self.eye + direction(self.yaw, self.pitch);
-        let mut light = direction(self.light_yaw, self.light_pitch);
-        if animated {
-            // circle 15 degrees around the dragged direction
-            let axis =
-                Quat::from_axis_angle(light, self.light_phase) * light.any_orthonormal_vector();
-            light = Quat::from_axis_angle(axis, 15f32.to_radians()) * light;
+        for (i, (light, pose)) in scene.lights.iter_mut().zip(&self.lights).enumerate() {
+            let phase = Some(i) == animated;
+            match *pose {
+                LightPose::Aim { yaw, pitch } => {
+                    let mut aim = direction(yaw, pitch);
+                    if phase {
+                        // circle 15 degrees around the dragged direction
+                        let axis = Quat::from_axis_angle(aim, self.light_phase)
+                            * aim.any_orthonormal_vector();
+                        aim = Quat::from_axis_angle(axis, 15f32.to_radians()) * aim;
+                    }
+                    light.aim(aim);
+                }
+                LightPose::Place(position) => {
+                    let circle = if phase {
+                        let (sin, cos) = self.light_phase.sin_cos();
+                        0.05 * base.extent() * Vec3::new(cos, 0.0, sin)
+                    } else {
+                        Vec3::ZERO
+                    };
+                    light.place(position + circle);
+                }
+            }
         }
-        scene.lights[0].aim(light);
         scene
+    }
+
+    /// Turns the light of that number by `degrees` about the vertical: a spot's or the sun's aim,
+    /// a point light's position about the scene's middle.
+    fn turn_light(&mut self, light: usize, degrees: f32, middle: Vec3) {
+        match &mut self.lights[light] {
+            LightPose::Aim { yaw, .. } => *yaw += degrees,
+            LightPose::Place(position) => {
+                *position =
+                    middle + Quat::from_rotation_y(-degrees.to_radians()) * (*position - middle);
+            }
+        }
     }
 }
 
@@ -123,6 +164,9 @@ pub struct IndirectView {
     pub method: Method,
     pub show: Show,
     pub exposure: f32,
+    /// The light that right drags, scripted turns and the animation move (an index into the
+    /// scene's lights; the last one where the scene has fewer).
+    pub light: usize,
     pub animate_light: bool,
     /// The camera moved: shade again with the light's buffers reused.
     redraw: bool,
@@ -170,6 +214,7 @@ impl IndirectView {
             method,
             show,
             exposure: 1.0,
+            light: 0,
             animate_light: false,
             redraw: true,
             rebuild: true,
@@ -229,10 +274,11 @@ impl IndirectView {
             let path = &self.scenes[self.scene];
             let scene = Scene::load(path)?;
             let pose = Pose::of(&scene);
+            self.light = self.light.min(scene.lights.len() - 1);
             self.loaded = Some((self.scene, scene, pose));
         }
         let (_, base, pose) = self.loaded.as_ref().expect("loaded above");
-        let scene = pose.apply(base, self.animate_light);
+        let scene = pose.apply(base, self.animated());
         self.settings.validate().map_err(anyhow::Error::msg)?;
         let same_sizes = |r: &Renderer| {
             let s = r.settings();
@@ -302,8 +348,24 @@ impl IndirectView {
     /// The `quadray indirect` command that renders this view headless.
     pub fn command_line(&self, out: &Path) -> Option<String> {
         let (index, base, pose) = self.loaded.as_ref()?;
-        let scene = pose.apply(base, self.animate_light);
+        let scene = pose.apply(base, self.animated());
         let v = |p: [f32; 3]| format!("{},{},{}", p[0], p[1], p[2]);
+        let several = scene.lights.len() > 1;
+        let lights = scene.lights.iter().enumerate().flat_map(|(i, light)| {
+            let number = if several {
+                format!("{}:", i + 1)
+            } else {
+                String::new()
+            };
+            let position = light.position().map(|p| (p, "position"));
+            let direction = light.direction().map(|d| (d, "direction"));
+            [position, direction]
+                .into_iter()
+                .flatten()
+                .map(move |(vector, what)| {
+                    format!("--light-{what} {number}{}", v(vector.to_array()))
+                })
+        });
         let words = [
             "quadray indirect --scene".to_string(),
             shell_word(&self.scenes[*index]),
@@ -316,16 +378,7 @@ impl IndirectView {
             format!("--camera-position {}", v(scene.camera.position.to_array())),
             format!("--camera-target {}", v(scene.camera.target.to_array())),
         ])
-        .chain(
-            scene.lights[0]
-                .position()
-                .map(|p| format!("--light-position {}", v(p.to_array()))),
-        )
-        .chain(
-            scene.lights[0]
-                .direction()
-                .map(|d| format!("--light-direction {}", v(d.to_array()))),
-        )
+        .chain(lights)
         .chain(["--frames 1 --out".into(), shell_word(out)]);
         Some(words.collect::<Vec<_>>().join(" "))
     }
@@ -348,12 +401,22 @@ impl IndirectView {
         Ok(cmd)
     }
 
-    /// Turns the camera by `degrees` (scripted runs).
-    pub fn spin(&mut self, degrees: f32) {
-        if let Some((_, _, pose)) = &mut self.loaded {
+    /// Turns the camera by `degrees` and the selected light by `light_degrees` (scripted runs).
+    pub fn spin(&mut self, degrees: f32, light_degrees: f32) {
+        if let Some((_, base, pose)) = &mut self.loaded {
             pose.yaw += degrees;
             self.redraw = true;
+            if light_degrees != 0.0 {
+                let (lo, hi) = base.bounds();
+                pose.turn_light(self.light, light_degrees, (lo + hi) / 2.0);
+                self.rebuild = true;
+            }
         }
+    }
+
+    /// The light the animation circles, when it is on.
+    fn animated(&self) -> Option<usize> {
+        self.animate_light.then_some(self.light)
     }
 
     /// The control panel; marks what a change invalidates.
@@ -363,6 +426,12 @@ impl IndirectView {
         choice_box(ui, "scene", &mut self.scene, &scenes, |i| {
             scene_name(&self.scenes[i])
         });
+        if let Some((_, base, _)) = &self.loaded {
+            let lights: Vec<usize> = (0..base.lights.len()).collect();
+            choice_box(ui, "light (right drag, L)", &mut self.light, &lights, |i| {
+                format!("{}: {}", i + 1, base.lights[i].kind_name())
+            });
+        }
         choice_box(ui, "method", &mut self.method, &Method::ALL, |m| {
             m.name().into()
         });
@@ -485,7 +554,8 @@ impl IndirectView {
         }
     }
 
-    /// Look with the left button, aim the light with the right, move with the wheel.
+    /// Look with the left button, aim the selected light with the right (a point light moves
+    /// over the ground plane), move with the wheel.
     pub fn handle_pointer(&mut self, response: &egui::Response, ui: &egui::Ui) {
         let Some((_, base, pose)) = &mut self.loaded else {
             return;
@@ -498,8 +568,17 @@ impl IndirectView {
         }
         if response.dragged_by(egui::PointerButton::Secondary) {
             let d = response.drag_delta();
-            pose.light_yaw += d.x * 0.3;
-            pose.light_pitch = (pose.light_pitch - d.y * 0.3).clamp(-89.9, 89.9);
+            match &mut pose.lights[self.light] {
+                LightPose::Aim { yaw, pitch } => {
+                    *yaw += d.x * 0.3;
+                    *pitch = (*pitch - d.y * 0.3).clamp(-89.9, 89.9);
+                }
+                LightPose::Place(position) => {
+                    let forward = direction(pose.yaw, 0.0);
+                    let right = forward.cross(Vec3::Y);
+                    *position += (right * d.x - forward * d.y) * 0.002 * base.extent();
+                }
+            }
             self.rebuild = true;
         }
         if response.hovered() {

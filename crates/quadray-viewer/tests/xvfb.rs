@@ -219,12 +219,36 @@ fn viewer_screenshots_match_their_headless_command_lines() {
     );
     assert!(!command.contains("--resample"), "{command}");
 
-    // indirect light through `quadray view`: the camera turns 5 degrees a frame
-    screenshot_matches_replay(
+    // indirect light through `quadray view` on a scene of three lights: the camera turns 5
+    // degrees a frame and the second light 30; the command line moves every light by number
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes/cornell_lights.gltf");
+    let command = screenshot_matches_replay(
         &x,
         &quadray(),
-        "view --technique indirect --rsm-size 32 --spin 5 --frames 3",
+        &format!(
+            "view --technique indirect --scene {} --rsm-size 32 --spin 5 --light 2 \
+             --light-spin 30 --frames 3",
+            scene.display()
+        ),
         &dir.join("indirect.png"),
         (96, 72),
     );
+    let loaded = quadray_indirect::Scene::load(&scene).unwrap();
+    let second = &loaded.lights[1];
+    let given = |flag: &str| {
+        let word = command.split(&format!("--light-{flag} 2:")).nth(1)?;
+        let v = quadray_core::parse_vec3(word.split_whitespace().next()?).unwrap();
+        Some(glam::Vec3::from(v))
+    };
+    let moved = match (second.position(), second.direction()) {
+        (Some(p), None) => given("position").unwrap().distance(p),
+        (_, Some(d)) => given("direction")
+            .unwrap()
+            .normalize()
+            .distance(d.normalize()),
+        (None, None) => unreachable!("a light has a position or a direction"),
+    };
+    assert!(moved > 0.1, "light 2 moved {moved} in `{command}`");
+    assert!(command.contains("--light-direction 3:"), "{command}");
 }

@@ -11,17 +11,22 @@
 //! use bevy::prelude::*;
 //! use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
 //!
-//! fn setup(mut commands: Commands) {
-//!     commands.spawn((SpotLight::default(), IndirectLightSource, Transform::default()));
-//!     commands.spawn((Camera3d::default(), Msaa::Off, IndirectLight::default()));
+//! fn main() {
+//!     App::new()
+//!         // the gather reads the deferred G-buffer: StandardMaterials render deferred
+//!         .insert_resource(DefaultOpaqueRendererMethod::deferred())
+//!         .add_plugins((DefaultPlugins, IndirectLightPlugin))
+//!         .add_systems(Startup, setup)
+//!         .run();
 //! }
 //!
-//! App::new()
-//!     // the gather reads the deferred G-buffer: StandardMaterials render deferred
-//!     .insert_resource(DefaultOpaqueRendererMethod::deferred())
-//!     .add_plugins((DefaultPlugins, IndirectLightPlugin))
-//!     .add_systems(Startup, setup)
-//!     .run();
+//! fn setup(mut commands: Commands) {
+//!     // any DirectionalLight, PointLight or SpotLight marked gives the bounce
+//!     let above = Transform::from_xyz(0.0, 3.0, 0.0).looking_at(Vec3::ZERO, Vec3::Z);
+//!     commands.spawn((SpotLight::default(), IndirectLightSource, above));
+//!     // the settings and the method; MSAA off, as deferred rendering needs
+//!     commands.spawn((Camera3d::default(), Msaa::Off, IndirectLight::default()));
+//! }
 //! ```
 //!
 //! The passes are `quadray_indirect`'s own, recorded into Bevy's command encoder on Bevy's
