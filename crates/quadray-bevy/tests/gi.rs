@@ -19,10 +19,10 @@ use bevy::render::render_resource::{BufferUsages, PipelineCache, TextureFormat, 
 use bevy::render::storage::ShaderBuffer;
 use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::world_serialization::WorldAssetRoot;
-use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource, ViewPasses};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{Method, Renderer, Scene, Settings};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use crate::common::ASSETS;
@@ -199,18 +199,18 @@ fn app_of(scene: &'static str, cases: &[Case], settings: Settings, plugin: bool)
         app.add_plugins(RenderDiagnosticsPlugin)
             .add_systems(Startup, setup)
             .add_systems(Update, configure);
-        track_compiling(app);
+        track_render_world(app);
     })
 }
 
-/// Notes in both worlds whether Bevy still compiles a pipeline (what [`compiling`] reads, which
-/// [`gathered`] waits on).
-pub(crate) fn track_compiling(app: &mut App) {
-    let compiling = Compiling::default();
-    app.insert_resource(compiling.clone());
+/// Notes in both worlds what Bevy's render world holds at the end of each frame (what
+/// [`compiling`], which [`gathered`] waits on, and [`cameras_with_passes`] read).
+pub(crate) fn track_render_world(app: &mut App) {
+    let notes = RenderWorldNotes::default();
+    app.insert_resource(notes.clone());
     app.sub_app_mut(RenderApp)
-        .insert_resource(compiling)
-        .add_systems(Render, note_compiling.in_set(RenderSystems::Cleanup));
+        .insert_resource(notes)
+        .add_systems(Render, take_notes.in_set(RenderSystems::Cleanup));
 }
 
 pub(crate) fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
@@ -220,21 +220,37 @@ pub(crate) fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// Whether Bevy's render world had a pipeline left to compile at the end of its last frame (a
-/// mesh drawn with it is missing from the picture until then); shared by both worlds.
+/// What Bevy's render world held at the end of its last frame, shared by both worlds (the render
+/// world runs on its own thread): whether a pipeline was left to compile (a mesh drawn with it is
+/// missing from the picture until then), and how many cameras held the plugin's passes.
 #[derive(Resource, Clone, Default)]
-struct Compiling(Arc<AtomicBool>);
+struct RenderWorldNotes(Arc<(AtomicBool, AtomicUsize)>);
 
-fn note_compiling(pipelines: Res<PipelineCache>, compiling: Res<Compiling>) {
+fn take_notes(
+    pipelines: Res<PipelineCache>,
+    passes: Query<(), With<ViewPasses>>,
+    notes: Res<RenderWorldNotes>,
+) {
     let waiting = pipelines.waiting_pipelines().next().is_some();
-    compiling.0.store(waiting, Ordering::Relaxed);
+    notes.0.0.store(waiting, Ordering::Relaxed);
+    notes.0.1.store(passes.iter().count(), Ordering::Relaxed);
 }
 
 /// Whether Bevy still compiles a pipeline, as its last rendered frame saw it.
 pub(crate) fn compiling(app: &App) -> bool {
     app.world()
-        .resource::<Compiling>()
+        .resource::<RenderWorldNotes>()
         .0
+        .0
+        .load(Ordering::Relaxed)
+}
+
+/// The cameras that held the plugin's passes in Bevy's render world in its last rendered frame.
+pub(crate) fn cameras_with_passes(app: &App) -> usize {
+    app.world()
+        .resource::<RenderWorldNotes>()
+        .0
+        .1
         .load(Ordering::Relaxed)
 }
 

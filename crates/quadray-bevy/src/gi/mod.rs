@@ -45,12 +45,16 @@
 //! camera's exposure as Bevy's is. The lights are taken in a fixed order (directional, spot, point
 //! lights, each kind by entity) up to the first camera's
 //! [`Settings::max_lights`](quadray_indirect::Settings::max_lights).
+//!
+//! A camera that loses [`IndirectLight`], or is despawned or no longer rendered, frees its passes
+//! ([`ViewPasses`]); the lights' maps are freed when no rendered camera has [`IndirectLight`].
 
 mod displaced;
 mod render;
 mod scene;
 
 pub use displaced::DISPLACED_TRIANGLES_MAX;
+pub use render::ViewPasses;
 pub use scene::{
     IndirectLight, IndirectLightScene, IndirectLightSource, quadray_directional, quadray_point,
     quadray_spot,

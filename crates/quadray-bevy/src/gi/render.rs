@@ -52,7 +52,7 @@ pub(super) fn build(app: &mut App) {
         .add_systems(RenderStartup, init_pipelines)
         .add_systems(
             Render,
-            (prepare_light, prepare_views)
+            (drop_unused_views, prepare_light, prepare_views)
                 .chain()
                 .in_set(RenderSystems::PrepareBindGroups),
         )
@@ -332,17 +332,35 @@ impl LightPasses {
     }
 }
 
+/// A render-world camera whose passes [`drop_unused_views`] frees.
+type Unused = (
+    With<ViewPasses>,
+    Or<(Without<IndirectLight>, Without<ExtractedCamera>)>,
+);
+
+/// Frees the passes of a camera that lost [`IndirectLight`] or is no longer rendered (inactive,
+/// or its target at zero size): Bevy keeps a render-world camera from frame to frame, and its
+/// passes with it. A despawned camera's go with its render-world entity.
+fn drop_unused_views(mut commands: Commands, unused: Query<Entity, Unused>) {
+    for entity in &unused {
+        commands.entity(entity).remove::<ViewPasses>();
+    }
+}
+
 fn prepare_light(
     scene: Option<Res<IndirectLightScene>>,
-    cameras: Query<&IndirectLight>,
+    cameras: Query<&IndirectLight, With<ExtractedCamera>>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     mut state: ResMut<LightState>,
     mut warned: Local<Option<String>>,
 ) {
-    let (Some(scene), Some(camera)) = (scene, cameras.iter().next()) else {
+    let Some(camera) = cameras.iter().next() else {
+        // no camera gathers: the lights' maps are freed, and made anew for the next one
+        state.0 = None;
         return;
     };
+    let Some(scene) = scene else { return };
     let device = device.wgpu_device();
     let settings = &camera.settings;
     // the light's passes are sized by the settings: refuse what the gather would refuse
@@ -432,10 +450,11 @@ fn prepare_light(
     l.max_lights = settings.max_lights;
 }
 
-/// A camera's side: quadray's G-buffer (translated from Bevy's), its gather, composite and cut
-/// view.
+/// In Bevy's render world, on a camera that gathers: its side of the plugin, quadray's G-buffer
+/// (translated from Bevy's), its gather, composite and cut view. Made for the camera's size and
+/// format, and removed with its [`IndirectLight`] (or when the camera is not rendered).
 #[derive(Component)]
-pub(super) struct ViewPasses {
+pub struct ViewPasses {
     settings: Settings,
     /// The light's maps the gather reads ([`LightPasses::maps_generation`]).
     maps_generation: u64,
@@ -612,6 +631,8 @@ fn prepare_views(
     mut pipelines: ResMut<Pipelines>,
     mut warned: Local<HashMap<Entity, String>>,
 ) {
+    // (a camera that comes back after it went away warns again)
+    warned.retain(|entity, _| views.contains(*entity));
     let Some(l) = light.0.as_ref() else { return };
     let device = device.wgpu_device();
     for (entity, gi, view, camera, target, prepass, passes) in &mut views {
