@@ -23,6 +23,7 @@ use bevy::render::render_resource::{
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::storage::GpuShaderBuffer;
+use bevy::render::sync_world::MainEntity;
 use bevy::render::view::{ExtractedView, ViewTarget};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 use bevy::shader::Shader;
@@ -769,6 +770,7 @@ fn indirect_light_pass(
         &ViewTarget,
         &ViewPrepassTextures,
         &IndirectLight,
+        &MainEntity,
     )>,
     mut light: ResMut<LightState>,
     pipelines: Res<Pipelines>,
@@ -776,7 +778,7 @@ fn indirect_light_pass(
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
     mut ctx: RenderContext,
 ) {
-    let (passes, target, prepass, gi) = view.into_inner();
+    let (passes, target, prepass, gi, camera) = view.into_inner();
     let Some(l) = light.0.as_mut().filter(|_| gi.enabled) else {
         return;
     };
@@ -824,12 +826,14 @@ fn indirect_light_pass(
         }
     };
     drop(cached);
-    // Bevy's diagnostics (with its RenderDiagnosticsPlugin): GPU time of the light's passes,
-    // the gather and the composite, the cut's size and the gather's work per shaded pixel
+    // Bevy's diagnostics (with its RenderDiagnosticsPlugin), under the camera's own path: GPU
+    // time of the light's passes, the gather and the composite, the gather's work per shaded
+    // pixel; and the lights' cut's size, shared
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let encoder = ctx.command_encoder();
-    let whole = diagnostics.time_span(encoder, "quadray_gi");
+    let camera_path = camera_diagnostics(camera.id());
+    let whole = diagnostics.time_span(encoder, camera_path.clone());
     if l.stale {
         let span = diagnostics.time_span(encoder, "light");
         for view in &l.views {
@@ -888,14 +892,17 @@ fn indirect_light_pass(
         let cut = l.views[0].quadtree.cut_count().slice(0..4);
         diagnostics.record_u32(encoder, &cut, "quadray_gi/cut_clusters");
         let evaluations = passes.means.slice(0..4);
-        diagnostics.record_f32(
-            encoder,
-            &evaluations,
-            "quadray_gi/vpl_evaluations_per_pixel",
-        );
+        let path = format!("{camera_path}/vpl_evaluations_per_pixel");
+        diagnostics.record_f32(encoder, &evaluations, path);
         let fetches = passes.means.slice(4..8);
-        diagnostics.record_f32(encoder, &fetches, "quadray_gi/texel_fetches_per_pixel");
+        let path = format!("{camera_path}/texel_fetches_per_pixel");
+        diagnostics.record_f32(encoder, &fetches, path);
     }
+}
+
+/// The diagnostics' path of `camera`'s passes and counts, below Bevy's `render/`.
+pub(super) fn camera_diagnostics(camera: Entity) -> String {
+    format!("quadray_gi/camera_{camera}")
 }
 
 /// The value behind `mutex`, also after a panic elsewhere (every value here is whole).
