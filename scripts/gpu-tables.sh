@@ -177,7 +177,7 @@ fi
 
 # (the summary needs python3; the stats files alone hold every figure)
 python3 - "$out" <<'EOF' || echo "no summary.md: python3 failed or is missing" >&2
-import json, pathlib, sys
+import json, pathlib, re, sys
 out = pathlib.Path(sys.argv[1])
 adapter, date = (out / "adapter.txt").read_text().split("\n")[:2]
 lines = [f"# GPU tables on {adapter}, {date}", ""]
@@ -213,7 +213,9 @@ if bevy:
                 values["frame"] = float(line.split()[2])
             elif ": median " in line:
                 path, rest = line.split(": median ")
-                values[path.removeprefix("render/quadray_gi").strip("/")] = float(rest.split()[0].rstrip("ms"))
+                # one camera: its path's part (render/quadray_gi/camera_{entity}/...) dropped
+                key = re.sub(r"^camera_[^/]+/?", "", path.removeprefix("render/quadray_gi").strip("/"))
+                values[key] = float(rest.split()[0].rstrip("ms"))
         cell = lambda k: f"{values[k]:.3f}" if k in values else "-"
         lines.append(f"| {f.stem} | {cell('frame')} | {cell('elapsed_gpu')} | {cell('light/elapsed_gpu')} | "
                      f"{cell('gather/elapsed_gpu')} | {cell('composite/elapsed_gpu')} | "

@@ -9,7 +9,7 @@ use bevy::camera::visibility::RenderLayers;
 use bevy::camera::{Hdr, RenderTarget};
 use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::diagnostic::DiagnosticsStore;
+use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
 use bevy::gltf::GltfAssetLabel;
 use bevy::pbr::DefaultOpaqueRendererMethod;
 use bevy::prelude::*;
@@ -19,10 +19,12 @@ use bevy::render::render_resource::{BufferUsages, PipelineCache, TextureFormat, 
 use bevy::render::storage::ShaderBuffer;
 use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::world_serialization::WorldAssetRoot;
-use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+use quadray_bevy::gi::{
+    IndirectLight, IndirectLightPlugin, IndirectLightSource, ViewPasses, camera_diagnostic_path,
+};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{Method, Renderer, Scene, Settings};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use crate::common::ASSETS;
@@ -199,18 +201,18 @@ fn app_of(scene: &'static str, cases: &[Case], settings: Settings, plugin: bool)
         app.add_plugins(RenderDiagnosticsPlugin)
             .add_systems(Startup, setup)
             .add_systems(Update, configure);
-        track_compiling(app);
+        track_render_world(app);
     })
 }
 
-/// Notes in both worlds whether Bevy still compiles a pipeline (what [`compiling`] reads, which
-/// [`gathered`] waits on).
-pub(crate) fn track_compiling(app: &mut App) {
-    let compiling = Compiling::default();
-    app.insert_resource(compiling.clone());
+/// Notes in both worlds what Bevy's render world holds at the end of each frame (what
+/// [`compiling`], which [`gathered`] waits on, and [`cameras_with_passes`] read).
+pub(crate) fn track_render_world(app: &mut App) {
+    let notes = RenderWorldNotes::default();
+    app.insert_resource(notes.clone());
     app.sub_app_mut(RenderApp)
-        .insert_resource(compiling)
-        .add_systems(Render, note_compiling.in_set(RenderSystems::Cleanup));
+        .insert_resource(notes)
+        .add_systems(Render, take_notes.in_set(RenderSystems::Cleanup));
 }
 
 pub(crate) fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
@@ -220,21 +222,37 @@ pub(crate) fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// Whether Bevy's render world had a pipeline left to compile at the end of its last frame (a
-/// mesh drawn with it is missing from the picture until then); shared by both worlds.
+/// What Bevy's render world held at the end of its last frame, shared by both worlds (the render
+/// world runs on its own thread): whether a pipeline was left to compile (a mesh drawn with it is
+/// missing from the picture until then), and how many cameras held the plugin's passes.
 #[derive(Resource, Clone, Default)]
-struct Compiling(Arc<AtomicBool>);
+struct RenderWorldNotes(Arc<(AtomicBool, AtomicUsize)>);
 
-fn note_compiling(pipelines: Res<PipelineCache>, compiling: Res<Compiling>) {
+fn take_notes(
+    pipelines: Res<PipelineCache>,
+    passes: Query<(), With<ViewPasses>>,
+    notes: Res<RenderWorldNotes>,
+) {
     let waiting = pipelines.waiting_pipelines().next().is_some();
-    compiling.0.store(waiting, Ordering::Relaxed);
+    notes.0.0.store(waiting, Ordering::Relaxed);
+    notes.0.1.store(passes.iter().count(), Ordering::Relaxed);
 }
 
 /// Whether Bevy still compiles a pipeline, as its last rendered frame saw it.
 pub(crate) fn compiling(app: &App) -> bool {
     app.world()
-        .resource::<Compiling>()
+        .resource::<RenderWorldNotes>()
         .0
+        .0
+        .load(Ordering::Relaxed)
+}
+
+/// The cameras that held the plugin's passes in Bevy's render world in its last rendered frame.
+pub(crate) fn cameras_with_passes(app: &App) -> usize {
+    app.world()
+        .resource::<RenderWorldNotes>()
+        .0
+        .1
         .load(Ordering::Relaxed)
 }
 
@@ -339,34 +357,65 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
     let reference = in_candela(reference_frame.indirect);
     let quadtree = in_candela(quadtree_frame.indirect);
 
-    // the counts in Bevy's diagnostics are quadray's: the cut's clusters, and each camera's VPL
-    // evaluations per shaded pixel (every camera records under the same paths, so the history
-    // holds the brute force's and the quadtree's)
+    // the counts in Bevy's diagnostics are quadray's: the cut's clusters (the lights', shared),
+    // and under each camera's own path its VPL evaluations and texel fetches per shaded pixel,
+    // its method's in quadray's renderer (the same view and settings), within 1%; a camera with
+    // the bounce off reports none
     let store = app.world().resource::<DiagnosticsStore>();
-    let history = |name: &str| -> Vec<f64> {
-        let path = format!("render/quadray_gi/{name}");
-        store
-            .iter()
-            .find(|d| d.path().as_str() == path)
-            .map(|d| d.values().copied().collect())
-            .unwrap_or_default()
-    };
-    let cut = history("cut_clusters");
+    let cut: Vec<f64> = store
+        .get(&DiagnosticPath::const_new("render/quadray_gi/cut_clusters"))
+        .map(|d| d.values().copied().collect())
+        .unwrap_or_default();
     println!("clusters in the cut: plugin {cut:?}, quadray {clusters}");
     assert!(!cut.is_empty() && cut.iter().all(|&c| c == f64::from(clusters)));
-    let evaluations = history("vpl_evaluations_per_pixel");
-    for (method, counts) in [
-        ("reference", reference_frame.counts),
-        ("quadtree", quadtree_frame.counts),
-    ] {
-        let expected = counts.vpl_evaluations_per_pixel();
-        println!("VPL evaluations per pixel, {method}: quadray {expected:.2}");
-        assert!(
-            evaluations
-                .iter()
-                .any(|&e| (e - expected).abs() <= 0.01 * expected),
-            "{method}: {expected} not among the plugin's {evaluations:?}"
+    let world = app.world_mut();
+    let cameras: Vec<(Entity, IndirectLight)> = world
+        .query::<(Entity, &IndirectLight)>()
+        .iter(world)
+        .map(|(e, gi)| (e, gi.clone()))
+        .collect();
+    let store = app.world().resource::<DiagnosticsStore>();
+    for p in &probes {
+        let (camera, _) = cameras
+            .iter()
+            .find(|(_, gi)| gi.debug_indirect.as_ref() == Some(&p.indirect))
+            .unwrap();
+        let reported = |name| {
+            let path = camera_diagnostic_path(*camera, name);
+            (store.get(&path).and_then(|d| d.value()), path)
+        };
+        let case = format!(
+            "{} (bounce {}, cut view {})",
+            p.method.name(),
+            p.enabled,
+            p.cut_view
         );
+        let counts = match p.method {
+            Method::Reference => &reference_frame.counts,
+            Method::Quadtree => &quadtree_frame.counts,
+            Method::QuadtreeTiles => &default_frame.counts,
+            other => panic!("no quadray frame of {other:?}"),
+        };
+        for (name, expected) in [
+            (
+                "vpl_evaluations_per_pixel",
+                counts.vpl_evaluations_per_pixel(),
+            ),
+            ("texel_fetches_per_pixel", counts.texel_fetches_per_pixel()),
+        ] {
+            let (plugin, path) = reported(name);
+            if !p.enabled {
+                println!("{name}, {case}: plugin {plugin:?}");
+                assert_eq!(plugin, None, "{case}: {path:?}");
+                continue;
+            }
+            println!("{name}, {case}: plugin {plugin:?}, quadray {expected:.2}");
+            let plugin = plugin.unwrap_or_else(|| panic!("{case}: no {path:?}"));
+            assert!(
+                (plugin - expected).abs() <= 0.01 * expected,
+                "{case}: {name} {plugin} against quadray's {expected}"
+            );
+        }
     }
 
     // (a) the two renderers' brute force agree

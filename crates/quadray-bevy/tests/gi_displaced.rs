@@ -6,7 +6,7 @@
 //! the low level only where the raised part bounces light.
 
 use crate::common::{MAPS, headless_app, height_map, unit_plane};
-use crate::gi::{Probe, Probes, compiling, gathered, track_compiling};
+use crate::gi::{Probe, Probes, compiling, gathered, track_render_world};
 use bevy::camera::RenderTarget;
 use bevy::camera::ScalingMode;
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -487,7 +487,7 @@ fn bounce(scenes: &[(Floor, View)]) -> Vec<Vec<[f32; 3]>> {
     let mut app = headless_app(|app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .add_plugins((PyramidDisplacementPlugin, IndirectLightPlugin));
-        track_compiling(app);
+        track_render_world(app);
     });
     let world = app.world_mut();
     let (plane, wall) = {

@@ -50,17 +50,30 @@
 //! camera's exposure as Bevy's is. The lights are taken in a fixed order (directional, spot, point
 //! lights, each kind by entity) up to the first camera's
 //! [`Settings::max_lights`](quadray_indirect::Settings::max_lights).
+//!
+//! With Bevy's `RenderDiagnosticsPlugin`, each camera reports to Bevy's `DiagnosticsStore` under
+//! its own path, `render/quadray_gi/camera_{entity}` (its main-world entity as Bevy prints it,
+//! [`camera_diagnostic_path`]): `elapsed_gpu` and `elapsed_cpu` of its passes and of their parts
+//! `light` (the lights' RSMs, pyramids and cuts, in the frames that rebuild them, under the
+//! camera that records them), `gather` and `composite`; `vpl_evaluations_per_pixel` and
+//! `texel_fetches_per_pixel`, its gather's work per shaded pixel. The lights' cut is every
+//! camera's: its size is `render/quadray_gi/cut_clusters`.
+//!
+//! A camera that loses [`IndirectLight`], or is despawned or no longer rendered, frees its passes
+//! ([`ViewPasses`]); the lights' maps are freed when no rendered camera has [`IndirectLight`].
 
 mod displaced;
 mod render;
 mod scene;
 
 pub use displaced::DISPLACED_TRIANGLES_MAX;
+pub use render::ViewPasses;
 pub use scene::{
     IndirectLight, IndirectLightScene, IndirectLightSource, quadray_directional, quadray_point,
     quadray_spot,
 };
 
+use bevy::diagnostic::DiagnosticPath;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::extract_resource::ExtractResourcePlugin;
@@ -87,4 +100,14 @@ impl Plugin for IndirectLightPlugin {
         );
         render::build(app);
     }
+}
+
+/// The path in Bevy's `DiagnosticsStore` of `camera`'s diagnostic `name`: `elapsed_gpu`,
+/// `gather/elapsed_gpu`, `vpl_evaluations_per_pixel`, ... (the module's documentation lists
+/// them), reported with Bevy's `RenderDiagnosticsPlugin`.
+pub fn camera_diagnostic_path(camera: Entity, name: &str) -> DiagnosticPath {
+    DiagnosticPath::new(format!(
+        "render/{}/{name}",
+        render::camera_diagnostics(camera)
+    ))
 }

@@ -23,6 +23,7 @@ use bevy::render::render_resource::{
 };
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::storage::GpuShaderBuffer;
+use bevy::render::sync_world::MainEntity;
 use bevy::render::view::{ExtractedView, ViewTarget};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 use bevy::shader::Shader;
@@ -52,7 +53,7 @@ pub(super) fn build(app: &mut App) {
         .add_systems(RenderStartup, init_pipelines)
         .add_systems(
             Render,
-            (prepare_light, prepare_views)
+            (drop_unused_views, prepare_light, prepare_views)
                 .chain()
                 .in_set(RenderSystems::PrepareBindGroups),
         )
@@ -332,17 +333,35 @@ impl LightPasses {
     }
 }
 
+/// A render-world camera whose passes [`drop_unused_views`] frees.
+type Unused = (
+    With<ViewPasses>,
+    Or<(Without<IndirectLight>, Without<ExtractedCamera>)>,
+);
+
+/// Frees the passes of a camera that lost [`IndirectLight`] or is no longer rendered (inactive,
+/// or its target at zero size): Bevy keeps a render-world camera from frame to frame, and its
+/// passes with it. A despawned camera's go with its render-world entity.
+fn drop_unused_views(mut commands: Commands, unused: Query<Entity, Unused>) {
+    for entity in &unused {
+        commands.entity(entity).remove::<ViewPasses>();
+    }
+}
+
 fn prepare_light(
     scene: Option<Res<IndirectLightScene>>,
-    cameras: Query<&IndirectLight>,
+    cameras: Query<&IndirectLight, With<ExtractedCamera>>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     mut state: ResMut<LightState>,
     mut warned: Local<Option<String>>,
 ) {
-    let (Some(scene), Some(camera)) = (scene, cameras.iter().next()) else {
+    let Some(camera) = cameras.iter().next() else {
+        // no camera gathers: the lights' maps are freed, and made anew for the next one
+        state.0 = None;
         return;
     };
+    let Some(scene) = scene else { return };
     let device = device.wgpu_device();
     let settings = &camera.settings;
     // the light's passes are sized by the settings: refuse what the gather would refuse
@@ -432,10 +451,11 @@ fn prepare_light(
     l.max_lights = settings.max_lights;
 }
 
-/// A camera's side: quadray's G-buffer (translated from Bevy's), its gather, composite and cut
-/// view.
+/// In Bevy's render world, on a camera that gathers: its side of the plugin, quadray's G-buffer
+/// (translated from Bevy's), its gather, composite and cut view. Made for the camera's size and
+/// format, and removed with its [`IndirectLight`] (or when the camera is not rendered).
 #[derive(Component)]
-pub(super) struct ViewPasses {
+pub struct ViewPasses {
     settings: Settings,
     /// The light's maps the gather reads ([`LightPasses::maps_generation`]).
     maps_generation: u64,
@@ -612,6 +632,8 @@ fn prepare_views(
     mut pipelines: ResMut<Pipelines>,
     mut warned: Local<HashMap<Entity, String>>,
 ) {
+    // (a camera that comes back after it went away warns again)
+    warned.retain(|entity, _| views.contains(*entity));
     let Some(l) = light.0.as_ref() else { return };
     let device = device.wgpu_device();
     for (entity, gi, view, camera, target, prepass, passes) in &mut views {
@@ -748,6 +770,7 @@ fn indirect_light_pass(
         &ViewTarget,
         &ViewPrepassTextures,
         &IndirectLight,
+        &MainEntity,
     )>,
     mut light: ResMut<LightState>,
     pipelines: Res<Pipelines>,
@@ -755,7 +778,7 @@ fn indirect_light_pass(
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
     mut ctx: RenderContext,
 ) {
-    let (passes, target, prepass, gi) = view.into_inner();
+    let (passes, target, prepass, gi, camera) = view.into_inner();
     let Some(l) = light.0.as_mut().filter(|_| gi.enabled) else {
         return;
     };
@@ -803,12 +826,14 @@ fn indirect_light_pass(
         }
     };
     drop(cached);
-    // Bevy's diagnostics (with its RenderDiagnosticsPlugin): GPU time of the light's passes,
-    // the gather and the composite, the cut's size and the gather's work per shaded pixel
+    // Bevy's diagnostics (with its RenderDiagnosticsPlugin), under the camera's own path: GPU
+    // time of the light's passes, the gather and the composite, the gather's work per shaded
+    // pixel; and the lights' cut's size, shared
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let encoder = ctx.command_encoder();
-    let whole = diagnostics.time_span(encoder, "quadray_gi");
+    let camera_path = camera_diagnostics(camera.id());
+    let whole = diagnostics.time_span(encoder, camera_path.clone());
     if l.stale {
         let span = diagnostics.time_span(encoder, "light");
         for view in &l.views {
@@ -867,14 +892,17 @@ fn indirect_light_pass(
         let cut = l.views[0].quadtree.cut_count().slice(0..4);
         diagnostics.record_u32(encoder, &cut, "quadray_gi/cut_clusters");
         let evaluations = passes.means.slice(0..4);
-        diagnostics.record_f32(
-            encoder,
-            &evaluations,
-            "quadray_gi/vpl_evaluations_per_pixel",
-        );
+        let path = format!("{camera_path}/vpl_evaluations_per_pixel");
+        diagnostics.record_f32(encoder, &evaluations, path);
         let fetches = passes.means.slice(4..8);
-        diagnostics.record_f32(encoder, &fetches, "quadray_gi/texel_fetches_per_pixel");
+        let path = format!("{camera_path}/texel_fetches_per_pixel");
+        diagnostics.record_f32(encoder, &fetches, path);
     }
+}
+
+/// The diagnostics' path of `camera`'s passes and counts, below Bevy's `render/`.
+pub(super) fn camera_diagnostics(camera: Entity) -> String {
+    format!("quadray_gi/camera_{camera}")
 }
 
 /// The value behind `mutex`, also after a panic elsewhere (every value here is whole).
