@@ -340,6 +340,7 @@ mod tests {
                         shadow_steps: steps,
                         shadow_thickness: thickness,
                         shadow_grid,
+                        shadow_grid_levels: 1,
                         temporal_weight: temporal,
                         tile_error,
                         tile_criterion,

@@ -4,7 +4,11 @@
 //! ([`OccupancyGrid::visible`]) is the CPU twin of `wgsl/occupancy.wgsl`'s `grid_visibility`; both
 //! start and end two cells off the surfaces along their normals, so that a surface never hides
 //! its own points. The bits are stored a brick of [`BRICK`] cells to a word, so that a walk
-//! fetches a word a brick it passes through, not a cell (an empty brick is a zero word).
+//! fetches a word a brick it passes through, not a cell (an empty brick is a zero word). A grid
+//! of two levels ([`OccupancyGrid::two_level`]) also holds, for each set cell, which of its
+//! [`SUBCELLS`]^3 sub-cells a triangle overlaps: the walk crosses the set cells sub-cell by
+//! sub-cell, so an opening is narrowed by a sub-cell, not a cell, on each side, at the cost of
+//! the cells in empty space.
 
 use crate::scene::Vertex;
 use glam::{IVec3, UVec3, Vec3};
@@ -29,30 +33,93 @@ pub const HEADER_WORDS: usize = 8;
 /// The grid's dimensions are multiples of it.
 pub const BRICK: UVec3 = UVec3::new(4, 4, 2);
 
+/// Sub-cells along each side of a set cell in a grid of two levels: a cell's 4x4x4 sub-cells
+/// take two words, each a brick of 4x4x2 ([`BRICK`]) sub-cells.
+pub const SUBCELLS: u32 = 4;
+
+/// Words a set cell's sub-cells take in a grid of two levels.
+pub const MASK_WORDS: usize = 2;
+
 /// What a walk between two points found, and the words it fetched.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Walk {
     /// Visible, blocked, or `None`: a moved end lies in a set cell.
     pub visible: Option<bool>,
-    /// Words fetched: one each time the walk enters a brick it has not just read.
+    /// Words fetched: one each time the walk enters a brick it has not just read (and in a
+    /// grid of two levels, one for where a brick's sub-cells start, the first time the walk
+    /// enters a set cell of the brick, and one each time it enters a half of a set cell's
+    /// sub-cells it has not just read).
     pub fetches: u32,
-    /// Cells tested (what a grid of a word a cell would have fetched).
+    /// Cells and sub-cells tested (what a grid of a word a cell would have fetched).
     pub cells: u32,
 }
 
-/// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell.
+/// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell; in a grid of
+/// two levels, with the same for the [`SUBCELLS`]^3 sub-cells of each set cell.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OccupancyGrid {
     dims: UVec3,
     origin: Vec3,
     cell: f32,
     bits: Vec<u32>,
+    /// Two levels: per brick, the index of the sub-cells of its first set cell (the set cells
+    /// before it counted); then [`MASK_WORDS`] a set cell, in the order of the bricks and bits.
+    sub: Option<SubCells>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct SubCells {
+    first: Vec<u32>,
+    masks: Vec<u32>,
 }
 
 impl OccupancyGrid {
     /// The grid of `triangles` with `cells` cells along the longest side of their bounds, and a
     /// margin of [`END_OFFSET_CELLS`] + 1 cells all round (so a moved end stays inside).
     pub fn of_triangles(triangles: &[[Vertex; 3]], cells: u32) -> Self {
+        Self::one_level(triangles, cells).0
+    }
+
+    /// [`Self::of_triangles`] (`levels` 1) or [`Self::two_level`] (more):
+    /// [`crate::Settings::shadow_grid_levels`].
+    pub fn with_levels(triangles: &[[Vertex; 3]], cells: u32, levels: u32) -> Self {
+        if levels > 1 {
+            Self::two_level(triangles, cells)
+        } else {
+            Self::of_triangles(triangles, cells)
+        }
+    }
+
+    /// [`Self::of_triangles`] with each set cell's [`SUBCELLS`]^3 sub-cells: a cell stays set
+    /// where a triangle overlaps one of its sub-cells. Takes a word a brick and [`MASK_WORDS`]
+    /// words a set cell beyond the grid's bits ([`crate::Settings::MAX_TWO_LEVEL_SHADOW_GRID`]
+    /// bounds it).
+    pub fn two_level(triangles: &[[Vertex; 3]], cells: u32) -> Self {
+        let (mut grid, in_grid) = Self::one_level(triangles, cells);
+        let mut masks = std::collections::HashMap::<usize, [u32; MASK_WORDS]>::new();
+        for t in &in_grid {
+            grid.add_subcells(*t, &mut masks);
+        }
+        // a cell whose sub-cells no triangle overlaps (it touched the cell's margin) is clear
+        grid.bits.fill(0);
+        let mut cells: Vec<(usize, [u32; MASK_WORDS])> = masks.into_iter().collect();
+        cells.sort_unstable_by_key(|&(index, _)| index);
+        for &(index, _) in &cells {
+            grid.bits[index / 32] |= 1 << (index % 32);
+        }
+        let mut first = Vec::with_capacity(grid.bits.len());
+        let mut count = 0;
+        for w in &grid.bits {
+            first.push(count);
+            count += w.count_ones();
+        }
+        let masks = cells.into_iter().flat_map(|(_, m)| m).collect();
+        grid.sub = Some(SubCells { first, masks });
+        grid
+    }
+
+    /// The grid of one level, and its triangles in grid units.
+    fn one_level(triangles: &[[Vertex; 3]], cells: u32) -> (Self, Vec<[Vec3; 3]>) {
         let (lo, hi) =
             crate::scene::bounds_of(triangles.iter().flatten().map(|v| Vec3::from(v.position)));
         let (lo, hi) = if lo.cmple(hi).all() {
@@ -70,11 +137,21 @@ impl OccupancyGrid {
             origin,
             cell,
             bits: vec![0; bricks.element_product() as usize],
+            sub: None,
         };
-        for t in triangles {
-            grid.add_triangle(t.map(|v| (Vec3::from(v.position) - origin) / cell));
+        let in_grid: Vec<[Vec3; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|v| (Vec3::from(v.position) - origin) / cell))
+            .collect();
+        for t in &in_grid {
+            grid.add_triangle(*t);
         }
-        grid
+        (grid, in_grid)
+    }
+
+    /// Whether the grid has two levels ([`Self::two_level`]).
+    pub fn is_two_level(&self) -> bool {
+        self.sub.is_some()
     }
 
     /// Cells along x, y and z.
@@ -98,6 +175,14 @@ impl OccupancyGrid {
         self.bits.iter().map(|w| w.count_ones()).sum()
     }
 
+    /// Whether sub-cell `s` (in sub-cell units, [`SUBCELLS`] a cell) holds a piece of a
+    /// triangle: its cell's, in a grid of one level.
+    pub fn subcell_occupied(&self, s: IVec3) -> bool {
+        let mut reader = WordReader::new(self);
+        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+        reader.occupied(c) && (self.sub.is_none() || reader.sub_occupied(s))
+    }
+
     /// Whether the segment from `x` (a receiver, normal `n`) to `xp` (a VPL or cluster, normal
     /// `np`, of any length: a cluster's mean normal is shorter) crosses no set cell, its ends
     /// moved [`END_OFFSET_CELLS`] off their surfaces (an end whose normal is shorter than 0.1
@@ -112,12 +197,7 @@ impl OccupancyGrid {
     /// [`Self::visible`] with the words the walk fetched, as the GPU's walk counts them: the
     /// word last read is kept, so a brick costs one fetch however many of its cells are crossed.
     pub fn walk(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Walk {
-        let mut reader = WordReader {
-            grid: self,
-            word: None,
-            fetches: 0,
-            cells: 0,
-        };
+        let mut reader = WordReader::new(self);
         let visible = self.walk_cells(x, n, xp, np, &mut reader);
         Walk {
             visible,
@@ -139,20 +219,47 @@ impl OccupancyGrid {
         let d = b - a;
         let mut c = a.floor().as_ivec3();
         let end = b.floor().as_ivec3();
-        if reader.occupied(c) || reader.occupied(end) {
+        // the end first: the walk goes on from the start's word
+        if reader.occupied_at(b) || reader.occupied_at(a) {
             return None;
         }
         let step = IVec3::new(sign(d.x), sign(d.y), sign(d.z));
         let t_delta = Vec3::new(inverse(d.x), inverse(d.y), inverse(d.z));
         // the segment parameter of the clearance at each end
         let clearance = END_CLEARANCE_CELLS / d.length().max(1e-6);
+        let blocked_at = |entered: f32| clearance < entered && entered < 1.0 - clearance;
         let mut t_max = Vec3::new(
             first_crossing(a.x, d.x),
             first_crossing(a.y, d.y),
             first_crossing(a.z, d.z),
         );
-        // a segment crosses at most one cell a face it passes: the bound of the walk
-        for _ in 0..=self.dims.x + self.dims.y + self.dims.z {
+        // one loop, over the cells and, with two levels, the sub-cells of the set ones: lavapipe
+        // caps the loop iterations of a shader invocation, the gather's sums and walks together,
+        // and a loop nested here used up that cap even in the one-level walk, which never ran it
+        let mut sub = if self.sub.is_some() && reader.occupied(c) {
+            Some(SubWalk::new(c, a, d, 0.0))
+        } else {
+            None
+        };
+        let cells = self.dims.x + self.dims.y + self.dims.z + 1;
+        let bound = if self.sub.is_some() {
+            cells * (3 * SUBCELLS + 1)
+        } else {
+            cells
+        };
+        for _ in 0..bound {
+            if let Some(w) = &mut sub {
+                if w.entered <= 1.0 {
+                    if reader.sub_occupied(w.s) {
+                        return blocked_at(w.entered.max(0.0)).then_some(false);
+                    }
+                    if w.step() {
+                        continue;
+                    }
+                }
+                // past the cell or the segment's end
+                sub = None;
+            }
             if c == end {
                 break;
             }
@@ -173,27 +280,36 @@ impl OccupancyGrid {
                 c = end;
             }
             if reader.occupied(c) {
-                return (clearance < entered && entered < 1.0 - clearance).then_some(false);
+                if self.sub.is_none() {
+                    return blocked_at(entered).then_some(false);
+                }
+                sub = Some(SubWalk::new(c, a, d, entered));
             }
         }
         Some(true)
     }
 
-    /// The grid as the gather reads it: [`HEADER_WORDS`] words (the dimensions, a pad, the
+    /// The grid as the gather reads it: [`HEADER_WORDS`] words (the dimensions, the levels, the
     /// origin and the cell's side as `f32` bits), then a word a [`BRICK`], brick (x, y, z) at
-    /// word `x + bricks.x * (y + bricks.y * z)`.
+    /// word `x + bricks.x * (y + bricks.y * z)`; with two levels then a word a brick, the index
+    /// of its first set cell's sub-cells, and [`MASK_WORDS`] words a set cell, its sub-cell
+    /// (x, y, z) in word `z / 2` at bit `x + 4 * (y + 4 * (z % 2))`.
     pub fn gpu_words(&self) -> Vec<u32> {
         let mut words = vec![
             self.dims.x,
             self.dims.y,
             self.dims.z,
-            0,
+            if self.sub.is_some() { 2 } else { 1 },
             self.origin.x.to_bits(),
             self.origin.y.to_bits(),
             self.origin.z.to_bits(),
             self.cell.to_bits(),
         ];
         words.extend_from_slice(&self.bits);
+        if let Some(sub) = &self.sub {
+            words.extend_from_slice(&sub.first);
+            words.extend_from_slice(&sub.masks);
+        }
         words
     }
 
@@ -216,6 +332,46 @@ impl OccupancyGrid {
         let (b, l) = (c / BRICK, c % BRICK);
         let word = b.x + bricks.x * (b.y + bricks.y * b.z);
         Some((word as usize, l.x + BRICK.x * (l.y + BRICK.y * l.z)))
+    }
+
+    /// Sets, in `masks` (by the cell's bit index), every sub-cell of a set cell that the
+    /// triangle (in grid units) overlaps.
+    fn add_subcells(
+        &self,
+        t: [Vec3; 3],
+        masks: &mut std::collections::HashMap<usize, [u32; MASK_WORDS]>,
+    ) {
+        if !t.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        let k = SUBCELLS as f32;
+        let top = self.dims.as_ivec3() * SUBCELLS as i32 - 1;
+        let lo = (t[0].min(t[1]).min(t[2]) * k)
+            .floor()
+            .as_ivec3()
+            .max(IVec3::ZERO);
+        let hi = (t[0].max(t[1]).max(t[2]) * k).floor().as_ivec3().min(top);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let s = IVec3::new(x, y, z);
+                    let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+                    let (word, bit) = self.index(c).expect("clamped to the grid");
+                    if self.bits[word] >> bit & 1 == 0 {
+                        continue;
+                    }
+                    // the cell's box's rule (a plane at a face in, one at the next out):
+                    // the sub-cells at the cell's faces end where the cell's box does
+                    let low = s.as_vec3() / k - Vec3::splat(1e-5);
+                    let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
+                    if triangle_overlaps_box(t, (low + high) * 0.5, (high - low) * 0.5) {
+                        let mask = masks.entry(word * 32 + bit as usize).or_default();
+                        let (w, b) = sub_bit((s - c * SUBCELLS as i32).as_uvec3());
+                        mask[w] |= 1 << b;
+                    }
+                }
+            }
+        }
     }
 
     /// Sets every cell the triangle (in grid units) overlaps. A cell is the half-open
@@ -247,15 +403,77 @@ impl OccupancyGrid {
     }
 }
 
+/// Sub-cell `l` (0..[`SUBCELLS`] each) of a cell: its word among the cell's [`MASK_WORDS`], and
+/// its bit.
+fn sub_bit(l: UVec3) -> (usize, u32) {
+    ((l.z / 2) as usize, l.x + 4 * (l.y + 4 * (l.z % 2)))
+}
+
 /// A walk's reads of the grid: the last word fetched, how many were, and the cells tested.
 struct WordReader<'a> {
     grid: &'a OccupancyGrid,
     word: Option<(usize, u32)>,
+    /// The held brick's first sub-cells, once read.
+    first: Option<u32>,
+    /// The last word of sub-cells fetched.
+    sub_word: Option<(usize, u32)>,
     fetches: u32,
     cells: u32,
 }
 
 impl WordReader<'_> {
+    fn new(grid: &OccupancyGrid) -> WordReader<'_> {
+        WordReader {
+            grid,
+            word: None,
+            first: None,
+            sub_word: None,
+            fetches: 0,
+            cells: 0,
+        }
+    }
+
+    /// Whether the point `p` (grid units) lies in a set cell, and with two levels in a set
+    /// sub-cell of it.
+    fn occupied_at(&mut self, p: Vec3) -> bool {
+        self.occupied(p.floor().as_ivec3())
+            && (self.grid.sub.is_none()
+                || self.sub_occupied((p * SUBCELLS as f32).floor().as_ivec3()))
+    }
+
+    /// Whether sub-cell `s` (sub-cell units) is set, its cell being set (the word of the cell
+    /// held).
+    fn sub_occupied(&mut self, s: IVec3) -> bool {
+        self.cells += 1;
+        let sub = self.grid.sub.as_ref().expect("a grid of two levels");
+        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+        let (index, bit) = self.grid.index(c).expect("a set cell is in the grid");
+        let (held, bits) = self.word.expect("the cell's word is held");
+        debug_assert_eq!(held, index);
+        let first = match self.first {
+            Some(first) => first,
+            None => {
+                self.fetches += 1;
+                let first = sub.first[index];
+                self.first = Some(first);
+                first
+            }
+        };
+        let rank = first + (bits & ((1u32 << bit) - 1)).count_ones();
+        let (w, b) = sub_bit((s - c * SUBCELLS as i32).as_uvec3());
+        let word = rank as usize * MASK_WORDS + w;
+        let mask = match self.sub_word {
+            Some((held, mask)) if held == word => mask,
+            _ => {
+                self.fetches += 1;
+                let mask = sub.masks[word];
+                self.sub_word = Some((word, mask));
+                mask
+            }
+        };
+        mask >> b & 1 == 1
+    }
+
     fn occupied(&mut self, c: IVec3) -> bool {
         self.cells += 1;
         let Some((index, bit)) = self.grid.index(c) else {
@@ -267,10 +485,74 @@ impl WordReader<'_> {
                 self.fetches += 1;
                 let bits = self.grid.bits[index];
                 self.word = Some((index, bits));
+                self.first = None;
                 bits
             }
         };
         bits >> bit & 1 == 1
+    }
+}
+
+/// A walk's way through the sub-cells of a set cell: the sub-cell it is in, the parameter where
+/// it entered it, and the DDA's state.
+struct SubWalk {
+    s: IVec3,
+    entered: f32,
+    lo: IVec3,
+    hi: IVec3,
+    step: IVec3,
+    t_max: Vec3,
+    t_delta: Vec3,
+}
+
+impl SubWalk {
+    /// The segment from `a` along `d` (grid units) entering set cell `c` at parameter `entered`.
+    fn new(c: IVec3, a: Vec3, d: Vec3, entered: f32) -> Self {
+        let k = SUBCELLS as f32;
+        let (a, d) = (a * k, d * k);
+        let lo = c * SUBCELLS as i32;
+        let hi = lo + (SUBCELLS as i32 - 1);
+        // the sub-cell entered, kept in the cell against rounding
+        let s = (a + d * entered).floor().as_ivec3().clamp(lo, hi);
+        let face = |s: i32, a: f32, d: f32| {
+            if d > 0.0 {
+                (s as f32 + 1.0 - a) / d
+            } else if d < 0.0 {
+                (s as f32 - a) / d
+            } else {
+                f32::INFINITY
+            }
+        };
+        Self {
+            s,
+            entered,
+            lo,
+            hi,
+            step: IVec3::new(sign(d.x), sign(d.y), sign(d.z)),
+            t_max: Vec3::new(
+                face(s.x, a.x, d.x),
+                face(s.y, a.y, d.y),
+                face(s.z, a.z, d.z),
+            ),
+            t_delta: Vec3::new(inverse(d.x), inverse(d.y), inverse(d.z)),
+        }
+    }
+
+    /// Steps to the next sub-cell: whether it lies in the cell.
+    fn step(&mut self) -> bool {
+        let t = &mut self.t_max;
+        self.entered = t.min_element();
+        if t.x <= t.y && t.x <= t.z {
+            self.s.x += self.step.x;
+            t.x += self.t_delta.x;
+        } else if t.y <= t.z {
+            self.s.y += self.step.y;
+            t.y += self.t_delta.y;
+        } else {
+            self.s.z += self.step.z;
+            t.z += self.t_delta.z;
+        }
+        self.s.cmpge(self.lo).all() && self.s.cmple(self.hi).all()
     }
 }
 
@@ -438,6 +720,76 @@ mod tests {
         let set: u32 = words[HEADER_WORDS..].iter().map(|w| w.count_ones()).sum();
         assert_eq!(set, grid.occupied_count());
         assert!(set > 16 * 16, "the floor alone covers 16 x 16 cells: {set}");
+    }
+
+    /// A wall at x = 0.5 over the whole unit square with a slit 0.04 wide at z = 0.5, standing
+    /// on a floor: narrower than a cell pair at 32 cells, four sub-cells wide.
+    fn wall_with_a_slit() -> Vec<[Vertex; 3]> {
+        let mut t = floor_and_wall(0.0)[..2].to_vec();
+        for (z0, z1) in [(0.0, 0.48), (0.52, 1.0)] {
+            t.extend(quad([
+                [0.5, 0.0, z0],
+                [0.5, 1.0, z0],
+                [0.5, 1.0, z1],
+                [0.5, 0.0, z1],
+            ]));
+        }
+        t
+    }
+
+    #[test]
+    fn two_levels_keep_a_slit_open_that_one_level_closes() {
+        let t = wall_with_a_slit();
+        let (one, two) = (
+            OccupancyGrid::of_triangles(&t, 32),
+            OccupancyGrid::two_level(&t, 32),
+        );
+        let up = Vec3::Y;
+        let at = |z: f32, x: f32| Vec3::new(x, 0.3, z);
+        // through the slit and through the wall beside it
+        let slit = (at(0.5, 0.2), at(0.5, 0.8));
+        let wall = (at(0.3, 0.2), at(0.3, 0.8));
+        assert_eq!(
+            one.visible(slit.0, up, slit.1, up),
+            Some(false),
+            "closed at one level"
+        );
+        assert_eq!(
+            two.visible(slit.0, up, slit.1, up),
+            Some(true),
+            "open at two"
+        );
+        assert_eq!(
+            two.visible(wall.0, up, wall.1, up),
+            Some(false),
+            "the wall blocks"
+        );
+        // a plane on a sub-cell's face sets the sub-cells above it only: the slit's edges at
+        // z = 0.48 and 0.52 (sub-cells 61.44 and 66.56) leave sub-cells 62 to 65 free
+        let column = |z: i32| two.subcell_occupied(IVec3::new(64 + 12, 40, z + 12));
+        let free: Vec<i32> = (58..70).filter(|&z| !column(z)).collect();
+        assert_eq!(free, vec![62, 63, 64, 65], "sub-cells of the slit");
+        // the same set cells (each with a set sub-cell), two more words each
+        assert_eq!(two.occupied_count(), one.occupied_count());
+        let extra = two.gpu_words().len() - one.gpu_words().len();
+        assert_eq!(
+            extra,
+            one.bits.len() + MASK_WORDS * one.occupied_count() as usize
+        );
+        // in empty space the walk costs what one level's does; it crosses the wall's set
+        // cells sub-cell by sub-cell, fetching their words
+        let left = (Vec3::new(0.1, 0.5, 0.2), Vec3::new(0.4, 0.6, 0.8));
+        let (a, b) = (
+            one.walk(left.0, up, left.1, up),
+            two.walk(left.0, up, left.1, up),
+        );
+        assert_eq!((a.visible, b.visible), (Some(true), Some(true)));
+        assert_eq!(a.fetches, b.fetches, "empty space");
+        let (a, b) = (
+            one.walk(slit.0, up, slit.1, up),
+            two.walk(slit.0, up, slit.1, up),
+        );
+        assert!(b.fetches > a.fetches && b.cells > a.cells, "{a:?} {b:?}");
     }
 
     #[test]

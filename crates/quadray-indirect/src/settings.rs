@@ -456,6 +456,16 @@ pub struct Settings {
         value_parser = Settings::SHADOW_GRID.parser(),
     ))]
     pub shadow_grid: u32,
+    /// Levels of the occupancy grid (--shadow-grid): 1, a bit a cell; 2, also a bit for each of
+    /// the 4x4x4 sub-cells of every set cell, walked where the walk meets a set cell, so that an
+    /// opening is narrowed by a sub-cell on each side rather than by a cell (two words a set
+    /// cell; at most 128 cells with 2 levels).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.shadow_grid_levels,
+        value_parser = Settings::SHADOW_GRID_LEVELS.parser(),
+    ))]
+    pub shadow_grid_levels: u32,
     /// Weight of each frame's indirect light in a running average over frames (1: off), every
     /// method but the brute force: damps the cut's popping under a moving light (see
     /// BENCHMARKS.md). Reprojected through the camera's motion (points the last frame did not
@@ -519,6 +529,7 @@ impl Settings {
         shadow_steps: 8,
         shadow_thickness: 0.03,
         shadow_grid: 64,
+        shadow_grid_levels: 1,
         temporal_weight: 1.0,
         tile_error: None,
         tile_criterion: TileCriterion::Estimate,
@@ -545,6 +556,11 @@ impl Settings {
     pub const SHADOW_THICKNESS: Limits<f32> = Limits::above(0.0, 1.0);
     /// [`Settings::shadow_grid`]: 512 cells a side take 17 MB.
     pub const SHADOW_GRID: Limits<u32> = Limits::closed(0, 512);
+    /// [`Settings::shadow_grid_levels`].
+    pub const SHADOW_GRID_LEVELS: Limits<u32> = Limits::closed(1, 2);
+    /// The most cells of [`Settings::shadow_grid`] with 2 levels: a grid whose every cell is
+    /// set takes 2 words a cell, 135^3 cells with the margins, 20 MB.
+    pub const MAX_TWO_LEVEL_SHADOW_GRID: u32 = 128;
     /// [`Settings::temporal_weight`].
     pub const TEMPORAL_WEIGHT: Limits<f32> = Limits::above(0.0, 1.0);
     /// [`Settings::tile_error`].
@@ -687,6 +703,16 @@ impl Settings {
         Self::SHADOW_STEPS.check("shadow steps", s.shadow_steps)?;
         Self::SHADOW_THICKNESS.check("shadow thickness", s.shadow_thickness)?;
         Self::SHADOW_GRID.check("shadow grid", s.shadow_grid)?;
+        Self::SHADOW_GRID_LEVELS.check("shadow grid levels", s.shadow_grid_levels)?;
+        if s.shadow_grid_levels > 1 && s.shadow_grid > Self::MAX_TWO_LEVEL_SHADOW_GRID {
+            return Err(format!(
+                "shadow grid {} with {} levels must be at most {} cells (its sub-cells take two \
+                 words a set cell)",
+                s.shadow_grid,
+                s.shadow_grid_levels,
+                Self::MAX_TWO_LEVEL_SHADOW_GRID
+            ));
+        }
         Self::TEMPORAL_WEIGHT.check("temporal weight", s.temporal_weight)?;
         if let Some(error) = s.tile_error {
             Self::TILE_ERROR.check("tile error", error)?;
@@ -777,6 +803,7 @@ mod tests {
             shadow_steps: 5,
             shadow_thickness: 0.1,
             shadow_grid: 0,
+            shadow_grid_levels: 2,
             temporal_weight: 0.67,
             tile_error: Some(0.01),
             tile_criterion: TileCriterion::Bound,
@@ -853,6 +880,23 @@ mod tests {
                 },
                 "tile capacity 2048",
                 Settings::TILE_CAPACITY.to_string(),
+            ),
+            (
+                Settings {
+                    shadow_grid_levels: 3,
+                    ..ok.clone()
+                },
+                "shadow grid levels 3",
+                Settings::SHADOW_GRID_LEVELS.to_string(),
+            ),
+            (
+                Settings {
+                    shadow_grid: 256,
+                    shadow_grid_levels: 2,
+                    ..ok.clone()
+                },
+                "shadow grid 256 with 2 levels must be at most 128 cells",
+                "(its sub-cells take two words a set cell)".to_string(),
             ),
             (
                 Settings {

@@ -288,10 +288,11 @@ struct LightPasses {
     /// The RSMs, pyramids and cuts are to be recorded again (a light or the scene changed).
     stale: bool,
     /// The scene's occupancy grid that indirect shadows walk, at the first camera's
-    /// [`Settings::shadow_grid`] cells (none without indirect shadows, or at 0 cells: the
-    /// gathers march the depth maps), and how many times it was made.
+    /// [`Settings::shadow_grid`] cells and [`Settings::shadow_grid_levels`] (none without
+    /// indirect shadows, or at 0 cells: the gathers march the depth maps), and how many times
+    /// it was made.
     occupancy: Option<OccupancyGrid>,
-    occupancy_cells: u32,
+    occupancy_cells: (u32, u32),
     occupancy_generation: u64,
 }
 
@@ -385,7 +386,7 @@ fn prepare_light(
         light_views: Vec::new(),
         stale: true,
         occupancy: None,
-        occupancy_cells: 0,
+        occupancy_cells: (0, 0),
         occupancy_generation: 0,
     });
     let cluster = settings.cluster;
@@ -400,11 +401,13 @@ fn prepare_light(
     } else {
         0
     };
-    if l.generation != scene.generation || l.occupancy_cells != cells {
+    let levels = settings.shadow_grid_levels;
+    if l.generation != scene.generation || l.occupancy_cells != (cells, levels) {
         // (rebuilt with every change of the scene: a few milliseconds for thousands of
         // triangles at 64 cells)
-        l.occupancy = (cells > 0).then(|| OccupancyGrid::of_triangles(&scene.triangles, cells));
-        l.occupancy_cells = cells;
+        l.occupancy =
+            (cells > 0).then(|| OccupancyGrid::with_levels(&scene.triangles, cells, levels));
+        l.occupancy_cells = (cells, levels);
         l.occupancy_generation += 1;
     }
     if l.generation != scene.generation {

@@ -4,7 +4,7 @@
 //! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
 //! shared struct's size and field offsets against these.
 
-use crate::occupancy::{BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS};
+use crate::occupancy::{BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS, SUBCELLS};
 pub(crate) use crate::settings::{
     CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, TILE, TILE_FRONTIER,
 };
@@ -59,7 +59,8 @@ pub(crate) fn prelude() -> String {
          const OCCUPANCY_HEADER: u32 = {}u;\n\
          const OCCUPANCY_END_OFFSET: f32 = {END_OFFSET_CELLS:?};\n\
          const OCCUPANCY_END_CLEARANCE: f32 = {END_CLEARANCE_CELLS:?};\n\
-         const OCCUPANCY_BRICK = vec3<u32>({}u, {}u, {}u);\n",
+         const OCCUPANCY_BRICK = vec3<u32>({}u, {}u, {}u);\n\
+         const OCCUPANCY_SUBCELLS: u32 = {SUBCELLS}u;\n",
         std::f32::consts::PI,
         OutputTerm::Indirect as u32,
         OutputTerm::Direct as u32,

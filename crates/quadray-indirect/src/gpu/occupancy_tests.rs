@@ -1,6 +1,7 @@
 //! The occupancy grid's walk on the GPU (`wgsl/occupancy.wgsl`, `grid_visibility`) against its CPU
 //! twin ([`OccupancyGrid::walk`]) on segments between random points of the leak scene's
-//! surfaces: the same answers from the same word fetches.
+//! surfaces, through a grid of one level and one of two: the same answers from the same word
+//! fetches.
 
 use super::contract::{
     bind_group, compute_pipeline, layout, pipeline_layout, shader_module, storage_buffer,
@@ -29,6 +30,7 @@ struct Segment { x: vec4<f32>, n: vec4<f32>, xp: vec4<f32>, np: vec4<f32> }
 @group(0) @binding(1) var<storage, read> segments: array<Segment>;
 @group(0) @binding(2) var<storage, read_write> seen: array<vec2<u32>>;
 fn occupancy_dims() -> vec3<u32> { return vec3<u32>(grid[0], grid[1], grid[2]); }
+fn occupancy_levels() -> u32 { return grid[3]; }
 fn occupancy_origin() -> vec3<f32> { return bitcast<vec3<f32>>(vec3<u32>(grid[4], grid[5], grid[6])); }
 fn occupancy_cell() -> f32 { return bitcast<f32>(grid[7]); }
 fn occupancy_word(i: u32) -> u32 { return grid[OCCUPANCY_HEADER + i]; }
@@ -42,8 +44,12 @@ if (id.x < arrayLength(&segments)) {
 }
 ";
 
-/// Each segment's `grid_visibility` (visible, blocked, `None` unknown) and its fetches.
-fn walks_on_the_gpu(grid: &OccupancyGrid, segments: &[Segment]) -> Vec<(Option<bool>, u32)> {
+/// Each segment's `grid_visibility` (visible, blocked, `None` unknown) and its fetches, for each
+/// grid.
+fn walks_on_the_gpu(
+    grids: &[OccupancyGrid],
+    segments: &[Segment],
+) -> Vec<Vec<(Option<bool>, u32)>> {
     let gpu = quadray_gpu::Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     let d = &gpu.device;
     let group_layout = layout(
@@ -64,28 +70,31 @@ fn walks_on_the_gpu(grid: &OccupancyGrid, segments: &[Segment]) -> Vec<(Option<b
             usage: wgpu::BufferUsages::STORAGE,
         })
     };
-    let words = buffer("grid", bytemuck::cast_slice(&grid.gpu_words()));
     let input = buffer("segments", bytemuck::cast_slice(segments));
-    let output = storage_buffer(d, "seen", segments.len() as u64 * 8);
-    let group = bind_group(
-        d,
-        "grid walks",
-        &group_layout,
-        vec![whole(&words), whole(&input), whole(&output)],
-    );
-    let mut encoder = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((segments.len() as u32).div_ceil(64), 1, 1);
-    }
-    gpu.queue.submit([encoder.finish()]);
-    let bytes = quadray_gpu::read_buffer(&gpu, &output).unwrap();
-    bytemuck::pod_collect_to_vec::<u8, [u32; 2]>(&bytes)
-        .into_iter()
-        .map(|[verdict, fetches]| ((verdict != 2).then_some(verdict == 1), fetches))
-        .collect()
+    let walk = |grid: &OccupancyGrid| {
+        let words = buffer("grid", bytemuck::cast_slice(&grid.gpu_words()));
+        let output = storage_buffer(d, "seen", segments.len() as u64 * 8);
+        let group = bind_group(
+            d,
+            "grid walks",
+            &group_layout,
+            vec![whole(&words), whole(&input), whole(&output)],
+        );
+        let mut encoder = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups((segments.len() as u32).div_ceil(64), 1, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        let bytes = quadray_gpu::read_buffer(&gpu, &output).unwrap();
+        bytemuck::pod_collect_to_vec::<u8, [u32; 2]>(&bytes)
+            .into_iter()
+            .map(|[verdict, fetches]| ((verdict != 2).then_some(verdict == 1), fetches))
+            .collect()
+    };
+    grids.iter().map(walk).collect()
 }
 
 /// Segments between random points of random triangles (with their normals); every fifth ends
@@ -120,44 +129,55 @@ fn segments(scene: &Scene, count: usize) -> Vec<Segment> {
 #[test]
 fn the_gpu_walks_the_grid_as_the_cpu_does() {
     let scene = Scene::load(&scenes_dir().join("leak.toml")).unwrap();
-    let grid = OccupancyGrid::of_triangles(&scene.triangles, 48);
     let cases = segments(&scene, 4096);
-    let gpu = walks_on_the_gpu(&grid, &cases);
-    let cpu: Vec<Walk> = cases
-        .iter()
-        .map(|s| {
-            let v = |a: [f32; 4]| Vec3::from_slice(&a[..3]);
-            grid.walk(v(s.x), v(s.n), v(s.xp), v(s.np))
-        })
-        .collect();
-    let count = |answer| cpu.iter().filter(|w| w.visible == answer).count();
-    let (visible, unknown) = (count(Some(true)), count(None));
-    let differ = cpu
-        .iter()
-        .zip(&gpu)
-        .filter(|(a, b)| (a.visible, a.fetches) != **b)
-        .count();
-    let fetches: u32 = cpu.iter().map(|w| w.fetches).sum();
-    let cells: u32 = cpu.iter().map(|w| w.cells).sum();
-    println!(
-        "of {} segments on the CPU {visible} visible, {unknown} unknown; the GPU differs on \
-         {differ} (answer or fetches); {fetches} words fetched for {cells} cells tested",
-        cases.len()
-    );
-    // a word a brick: a walk crossing several cells of a brick reads it once
-    assert!(
-        fetches * 2 <= cells,
-        "{fetches} words fetched for {cells} cells"
-    );
-    // (points on the boxes' thin edges start inside the box beside them)
-    assert!(unknown < cases.len() / 2, "{unknown} unknown");
-    // both answers are common (a tenth of the segments are visible: most join points on
-    // the boxes' outer faces or in the other room), so that a walk that always says one of
-    // them fails
-    assert!(
-        (cases.len() / 20..cases.len() * 19 / 20).contains(&visible),
-        "{visible}"
-    );
-    // a tie at a cell's corner may go either way in floating point
-    assert!(differ * 1000 <= cases.len(), "{differ} differ");
+    let grids = [1, 2].map(|levels| OccupancyGrid::with_levels(&scene.triangles, 48, levels));
+    let gpu = walks_on_the_gpu(&grids, &cases);
+    for (grid, gpu) in grids.iter().zip(gpu) {
+        let levels = if grid.is_two_level() { 2 } else { 1 };
+        let cpu: Vec<Walk> = cases
+            .iter()
+            .map(|s| {
+                let v = |a: [f32; 4]| Vec3::from_slice(&a[..3]);
+                grid.walk(v(s.x), v(s.n), v(s.xp), v(s.np))
+            })
+            .collect();
+        let count = |answer| cpu.iter().filter(|w| w.visible == answer).count();
+        let (visible, unknown) = (count(Some(true)), count(None));
+        let differ = cpu
+            .iter()
+            .zip(&gpu)
+            .filter(|(a, b)| (a.visible, a.fetches) != **b)
+            .count();
+        let fetches: u32 = cpu.iter().map(|w| w.fetches).sum();
+        let cells: u32 = cpu.iter().map(|w| w.cells).sum();
+        println!(
+            "{levels} levels: of {} segments on the CPU {visible} visible, {unknown} unknown; \
+             the GPU differs on {differ} (answer or fetches); {fetches} words fetched for \
+             {cells} cells tested",
+            cases.len()
+        );
+        // a word a brick (and a half of a set cell's sub-cells): a walk crossing several
+        // cells of a word reads it once
+        assert!(
+            fetches * 2 <= cells,
+            "{levels} levels: {fetches} words fetched for {cells} cells"
+        );
+        // (points on the boxes' thin edges start inside the box beside them)
+        assert!(
+            unknown < cases.len() / 2,
+            "{levels} levels: {unknown} unknown"
+        );
+        // both answers are common (a tenth of the segments are visible: most join points on
+        // the boxes' outer faces or in the other room), so that a walk that always says one of
+        // them fails
+        assert!(
+            (cases.len() / 20..cases.len() * 19 / 20).contains(&visible),
+            "{levels} levels: {visible}"
+        );
+        // a tie at a cell's corner may go either way in floating point
+        assert!(
+            differ * 1000 <= cases.len(),
+            "{levels} levels: {differ} differ"
+        );
+    }
 }

@@ -83,7 +83,11 @@ impl<'g> Renderer<'g> {
                 .collect();
             let mut gather = Gather::new(d, &settings, &maps, gbuffer.views())?;
             if settings.indirect_shadows && settings.shadow_grid > 0 {
-                let grid = OccupancyGrid::of_triangles(&scene.triangles, settings.shadow_grid);
+                let grid = OccupancyGrid::with_levels(
+                    &scene.triangles,
+                    settings.shadow_grid,
+                    settings.shadow_grid_levels,
+                );
                 gather.set_occupancy(d, q, &grid, gbuffer.views());
             }
             let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {

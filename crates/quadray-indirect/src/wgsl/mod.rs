@@ -84,8 +84,9 @@ pub const CUT_VIEW: &str = include_str!("cut_view.wgsl");
 /// Visibility through the scene's occupancy grid, `grid_visibility(x, n, xp, np)` (indirect
 /// shadows): a 3D DDA from a receiver to a cluster, each end moved two cells off its surface;
 /// the CPU's twin is [`crate::occupancy::OccupancyGrid::visible`]. Needs [`NODE`] (the fetch
-/// counter). Accessors: `fn occupancy_dims() -> vec3<u32>`, `fn occupancy_origin() -> vec3<f32>`,
-/// `fn occupancy_cell() -> f32`, `fn occupancy_word(i: u32) -> u32`.
+/// counter). Accessors: `fn occupancy_dims() -> vec3<u32>`, `fn occupancy_levels() -> u32`,
+/// `fn occupancy_origin() -> vec3<f32>`, `fn occupancy_cell() -> f32`,
+/// `fn occupancy_word(i: u32) -> u32`.
 pub const OCCUPANCY: &str = include_str!("occupancy.wgsl");
 
 #[cfg(test)]
@@ -115,6 +116,7 @@ fn tile_sample(q: u32) -> u32 { return 0u; }
 ";
     const OCCUPANCY_ACCESSORS: &str = "
 fn occupancy_dims() -> vec3<u32> { return vec3<u32>(0u); }
+fn occupancy_levels() -> u32 { return 1u; }
 fn occupancy_origin() -> vec3<f32> { return vec3<f32>(0.0); }
 fn occupancy_cell() -> f32 { return 1.0; }
 fn occupancy_word(i: u32) -> u32 { return 0u; }

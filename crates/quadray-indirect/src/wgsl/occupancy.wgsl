@@ -1,18 +1,28 @@
 // The scene's occupancy grid walked between a receiver and a cluster (indirect shadows): the
 // twin of the CPU's `OccupancyGrid::walk` (src/occupancy.rs), step for step and fetch for fetch.
 // Accessors: `occupancy_dims() -> vec3<u32>` (zero: no grid; multiples of OCCUPANCY_BRICK),
+// `occupancy_levels() -> u32` (1, or 2 with each set cell's sub-cells after the bits),
 // `occupancy_origin() -> vec3<f32>`, `occupancy_cell() -> f32` and `occupancy_word(i: u32) -> u32`
 // (a word a brick of OCCUPANCY_BRICK cells, brick (x, y, z) at word x + bricks.x * (y + bricks.y
 // * z), its cell (x, y, z) at bit x + 4 * (y + 4 * z)).
 
 // (OCCUPANCY_END_OFFSET, the cells a segment's ends are moved off their surfaces along the
 // normals, OCCUPANCY_END_CLEARANCE, the cells from an end within which a set cell leaves the walk
-// undecided, and OCCUPANCY_BRICK come from the prelude)
+// undecided, OCCUPANCY_BRICK and OCCUPANCY_SUBCELLS come from the prelude)
 
-// Whether cell `c` is set (outside the grid: no). `held` is the walk's last word read (x: its
-// index + 1, 0 before the first; y: its bits): a brick costs one fetch however many of its
-// cells the walk crosses.
-fn occupied(c: vec3<i32>, held: ptr<function, vec2<u32>>) -> bool {
+// A walk's reads of the grid: the last word read (its index + 1, 0 before the first; its bits),
+// the held brick's first sub-cells (+ 1, 0 until read) and the last word of sub-cells read (its
+// index + 1; its bits). A brick costs one fetch however many of its cells the walk crosses.
+struct OccupancyHeld {
+    word: u32,
+    bits: u32,
+    first: u32,
+    sub_word: u32,
+    sub_bits: u32,
+}
+
+// Whether cell `c` is set (outside the grid: no).
+fn occupied(c: vec3<i32>, held: ptr<function, OccupancyHeld>) -> bool {
     let d = occupancy_dims();
     if (any(c < vec3<i32>(0)) || any(vec3<u32>(c) >= d)) {
         return false;
@@ -21,12 +31,48 @@ fn occupied(c: vec3<i32>, held: ptr<function, vec2<u32>>) -> bool {
     let b = vec3<u32>(c) / OCCUPANCY_BRICK;
     let l = vec3<u32>(c) % OCCUPANCY_BRICK;
     let word = b.x + bricks.x * (b.y + bricks.y * b.z);
-    if ((*held).x != word + 1u) {
+    if ((*held).word != word + 1u) {
         fetches++;
-        *held = vec2<u32>(word + 1u, occupancy_word(word));
+        (*held).word = word + 1u;
+        (*held).bits = occupancy_word(word);
+        (*held).first = 0u;
     }
     let bit = l.x + OCCUPANCY_BRICK.x * (l.y + OCCUPANCY_BRICK.y * l.z);
-    return (((*held).y >> bit) & 1u) == 1u;
+    return (((*held).bits >> bit) & 1u) == 1u;
+}
+
+// Whether sub-cell `s` (sub-cell units) of a grid of two levels is set, its cell being set and
+// its cell's word held: the sub-cells of a brick's set cells follow a word a brick, the index of
+// its first set cell's, two words a set cell, sub-cell (x, y, z) in word z / 2 at bit
+// x + 4 * (y + 4 * (z % 2)).
+fn sub_occupied(s: vec3<i32>, held: ptr<function, OccupancyHeld>) -> bool {
+    let bricks = occupancy_dims() / OCCUPANCY_BRICK;
+    let count = bricks.x * bricks.y * bricks.z;
+    let c = vec3<u32>(s) / OCCUPANCY_SUBCELLS;
+    let l = vec3<u32>(s) % OCCUPANCY_SUBCELLS;
+    if ((*held).first == 0u) {
+        fetches++;
+        (*held).first = occupancy_word(count + (*held).word - 1u) + 1u;
+    }
+    let lc = c % OCCUPANCY_BRICK;
+    let bit = lc.x + OCCUPANCY_BRICK.x * (lc.y + OCCUPANCY_BRICK.y * lc.z);
+    let rank = (*held).first - 1u + countOneBits((*held).bits & ((1u << bit) - 1u));
+    let word = 2u * count + 2u * rank + l.z / 2u;
+    if ((*held).sub_word != word + 1u) {
+        fetches++;
+        (*held).sub_word = word + 1u;
+        (*held).sub_bits = occupancy_word(word);
+    }
+    let b = l.x + 4u * (l.y + 4u * (l.z % 2u));
+    return (((*held).sub_bits >> b) & 1u) == 1u;
+}
+
+// Whether the point `p` (grid units) lies in a set cell, and with two levels in a set sub-cell.
+fn occupied_at(p: vec3<f32>, held: ptr<function, OccupancyHeld>) -> bool {
+    if (!occupied(vec3<i32>(floor(p)), held)) {
+        return false;
+    }
+    return occupancy_levels() == 1u || sub_occupied(vec3<i32>(floor(p * f32(OCCUPANCY_SUBCELLS))), held);
 }
 
 // A segment's end in grid units, moved off its surface (an end whose normal is shorter than 0.1
@@ -59,18 +105,83 @@ const GRID_BLOCKED = 0u;
 const GRID_VISIBLE = 1u;
 const GRID_UNKNOWN = 2u;
 
+// The sub-cell face the segment from `a` moving `d` (sub-cell units) crosses next from sub-cell
+// `s`.
+fn occupancy_face(s: i32, a: f32, d: f32) -> f32 {
+    if (d > 0.0) {
+        return (f32(s) + 1.0 - a) / d;
+    }
+    if (d < 0.0) {
+        return (f32(s) - a) / d;
+    }
+    return 3.0e38;
+}
+
+// A walk's way through the sub-cells of a set cell: the sub-cell it is in, the parameter where
+// it entered it, and the DDA's state.
+struct SubWalk {
+    s: vec3<i32>,
+    entered: f32,
+    lo: vec3<i32>,
+    hi: vec3<i32>,
+    step: vec3<i32>,
+    t_max: vec3<f32>,
+    t_delta: vec3<f32>,
+}
+
+// The segment from `a_cells` along `d_cells` (grid units) entering set cell `c` at parameter
+// `entered`.
+fn sub_walk(c: vec3<i32>, a_cells: vec3<f32>, d_cells: vec3<f32>, entered: f32) -> SubWalk {
+    let k = f32(OCCUPANCY_SUBCELLS);
+    let a = a_cells * k;
+    let d = d_cells * k;
+    let lo = c * i32(OCCUPANCY_SUBCELLS);
+    let hi = lo + vec3<i32>(i32(OCCUPANCY_SUBCELLS) - 1);
+    // the sub-cell entered, kept in the cell against rounding
+    let s = clamp(vec3<i32>(floor(a + d * entered)), lo, hi);
+    return SubWalk(
+        s,
+        entered,
+        lo,
+        hi,
+        vec3<i32>(sign(d)),
+        vec3<f32>(occupancy_face(s.x, a.x, d.x), occupancy_face(s.y, a.y, d.y), occupancy_face(s.z, a.z, d.z)),
+        vec3<f32>(occupancy_inverse(d.x), occupancy_inverse(d.y), occupancy_inverse(d.z)),
+    );
+}
+
+// Steps to the next sub-cell: whether it lies in the cell.
+fn sub_step(w: ptr<function, SubWalk>) -> bool {
+    let t = (*w).t_max;
+    (*w).entered = min(t.x, min(t.y, t.z));
+    if (t.x <= t.y && t.x <= t.z) {
+        (*w).s.x += (*w).step.x;
+        (*w).t_max.x += (*w).t_delta.x;
+    } else if (t.y <= t.z) {
+        (*w).s.y += (*w).step.y;
+        (*w).t_max.y += (*w).t_delta.y;
+    } else {
+        (*w).s.z += (*w).step.z;
+        (*w).t_max.z += (*w).t_delta.z;
+    }
+    return all((*w).s >= (*w).lo) && all((*w).s <= (*w).hi);
+}
+
 // The segment from `x` (a receiver, normal `n`) to `xp` (a cluster, normal `np`) through the
-// grid: a 3D DDA over the cells it passes through, bounded by the grid's dimensions.
+// grid: a 3D DDA over the cells it passes through, bounded by the grid's dimensions, and with two
+// levels over the sub-cells of the set cells among them.
 fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> u32 {
     let a = occupancy_end(x, n);
     let b = occupancy_end(xp, np);
     let d = b - a;
     var c = vec3<i32>(floor(a));
     let end = vec3<i32>(floor(b));
-    var held = vec2<u32>(0u);
-    if (occupied(c, &held) || occupied(end, &held)) {
+    var held = OccupancyHeld(0u, 0u, 0u, 0u, 0u);
+    // the end first: the walk goes on from the start's word
+    if (occupied_at(b, &held) || occupied_at(a, &held)) {
         return GRID_UNKNOWN;
     }
+    let two_levels = occupancy_levels() == 2u;
     let step = vec3<i32>(sign(d));
     let t_delta = vec3<f32>(occupancy_inverse(d.x), occupancy_inverse(d.y), occupancy_inverse(d.z));
     // the segment parameter of the clearance at each end
@@ -80,9 +191,32 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
         occupancy_first_crossing(a.y, d.y),
         occupancy_first_crossing(a.z, d.z),
     );
+    // one loop, over the cells and, with two levels, the sub-cells of the set ones: lavapipe
+    // caps the loop iterations of an invocation, the gather's sums and walks together, and a
+    // loop nested here used up that cap even in the one-level walk, which never ran it
+    var in_sub = false;
+    var w: SubWalk;
+    if (two_levels && occupied(c, &held)) {
+        in_sub = true;
+        w = sub_walk(c, a, d, 0.0);
+    }
     let dims = occupancy_dims();
-    let bound = dims.x + dims.y + dims.z;
-    for (var i = 0u; i <= bound; i++) {
+    let cells = dims.x + dims.y + dims.z + 1u;
+    let bound = select(cells, cells * (3u * OCCUPANCY_SUBCELLS + 1u), two_levels);
+    for (var i = 0u; i < bound; i++) {
+        if (in_sub) {
+            if (w.entered <= 1.0) {
+                if (sub_occupied(w.s, &held)) {
+                    let at = max(w.entered, 0.0);
+                    return select(GRID_UNKNOWN, GRID_BLOCKED, clearance < at && at < 1.0 - clearance);
+                }
+                if (sub_step(&w)) {
+                    continue;
+                }
+            }
+            // past the cell or the segment's end
+            in_sub = false;
+        }
         if (all(c == end)) {
             break;
         }
@@ -102,7 +236,11 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
             c = end;
         }
         if (occupied(c, &held)) {
-            return select(GRID_UNKNOWN, GRID_BLOCKED, clearance < entered && entered < 1.0 - clearance);
+            if (!two_levels) {
+                return select(GRID_UNKNOWN, GRID_BLOCKED, clearance < entered && entered < 1.0 - clearance);
+            }
+            in_sub = true;
+            w = sub_walk(c, a, d, entered);
         }
     }
     return GRID_VISIBLE;

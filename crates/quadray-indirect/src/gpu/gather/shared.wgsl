@@ -121,6 +121,10 @@ fn occupancy_dims() -> vec3<u32> {
     return vec3<u32>(occupancy_load(0u), occupancy_load(1u), occupancy_load(2u));
 }
 
+fn occupancy_levels() -> u32 {
+    return occupancy_load(3u);
+}
+
 fn occupancy_origin() -> vec3<f32> {
     return bitcast<vec3<f32>>(vec3<u32>(occupancy_load(4u), occupancy_load(5u), occupancy_load(6u)));
 }
