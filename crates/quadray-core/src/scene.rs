@@ -68,9 +68,14 @@
 //! tree (required; its aspect ratio is ignored, the image size decides), and every
 //! `KHR_lights_punctual` light: point, spot and directional (`range` is ignored). Their
 //! intensities are [`Intensity::Photometric`]: colour times intensity.
+//!
+//! [`SceneDescription::to_gltf`] writes a scene as one `.gltf` that this reader reads back as the
+//! same scene: every object's triangles in world coordinates with matte materials, the camera,
+//! and every light as a `KHR_lights_punctual` light (see its docs for what changes form).
 
 mod read_gltf;
 mod read_toml;
+mod write_gltf;
 
 use crate::FileError;
 use crate::mesh::Model;
@@ -298,6 +303,42 @@ pub enum Shape {
     Polygons(Vec<Vec<Vec3>>),
 }
 
+impl Shape {
+    /// The faces of a box seen from outside, each four corners (numbered as in
+    /// [`Shape::box_corner`]) counter-clockwise: top (+y), bottom, front (+z), back, left (-x),
+    /// right. The one cut of a box into faces, so that a box written to glTF is the box a
+    /// technique builds.
+    pub const BOX_FACES: [[usize; 4]; 6] = [
+        [6, 7, 3, 2],
+        [0, 1, 5, 4],
+        [4, 5, 7, 6],
+        [1, 0, 2, 3],
+        [0, 4, 6, 2],
+        [5, 1, 3, 7],
+    ];
+
+    /// Corner `i` of the box from `min` to `max`: bits 0, 1, 2 of `i` pick `max` in x, y, z.
+    pub fn box_corner(min: Vec3, max: Vec3, i: usize) -> Vec3 {
+        let picks = glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0);
+        Vec3::select(picks, max, min)
+    }
+
+    /// The corners of [`Shape::BOX_FACES`] of the box from `min` to `max`.
+    pub fn box_faces(min: Vec3, max: Vec3) -> [[Vec3; 4]; 6] {
+        Self::BOX_FACES.map(|face| face.map(|i| Self::box_corner(min, max, i)))
+    }
+
+    /// The unit normal of a planar polygon (Newell's, so the winding decides the side: vertices
+    /// counter-clockwise seen from where it points); zero for a polygon of no area.
+    pub fn polygon_normal(polygon: &[Vec3]) -> Vec3 {
+        let n = polygon.len();
+        (0..n)
+            .map(|i| polygon[i].cross(polygon[(i + 1) % n]))
+            .sum::<Vec3>()
+            .normalize_or_zero()
+    }
+}
+
 /// Uniform scale, then a turn about +y, then a translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
@@ -344,6 +385,7 @@ impl SceneDescription {
         Self::from_toml(&text, path)
     }
 
+
     /// `technique`'s own settings from its table (its defaults where the file has none); a key
     /// the technique does not know is an error that names the table.
     pub fn technique_settings<T: serde::de::DeserializeOwned + Default>(
@@ -357,6 +399,48 @@ impl SceneDescription {
                 .try_into()
                 .map_err(|e| format!("[{technique}]: {}", e.to_string().trim())),
         }
+    }
+
+    /// The scene as a glTF 2.0 file's text (JSON, its one buffer embedded as a base64 `data:`
+    /// URI, so the file stands alone), which [`SceneDescription::load`] reads back as this scene:
+    ///
+    /// - every object a node with one mesh, its triangles in world coordinates (the transform
+    ///   applied: boxes cut as [`Shape::box_faces`], polygons into fans, zero-area triangles left
+    ///   out) with normals, and texture coordinates where a mesh's material has a texture;
+    /// - materials matte (metallic 0, roughness 1): a named material's `diffuse`, or a mesh
+    ///   file's base colour, texture and emission, as the base colour (clamped to [0, 1] as glTF
+    ///   requires); the Whitted fields (specular, reflect, transmit, ior) are left out;
+    /// - the camera a node looking down its -z with its +y up: `target` becomes the point one
+    ///   unit ahead and `up` is made square to the view (the same view); no aspect ratio (the
+    ///   picture's decides), `znear` a thousandth of the scene's extent;
+    /// - every light a `KHR_lights_punctual` light on a node (a spot and the sun shining down its
+    ///   -z), its intensity photometric as the reader takes it: [`Intensity::Photometric`] as
+    ///   it is, [`Intensity::Native`] read as radiometric and times [`LUMENS_PER_WATT`] (so
+    ///   [`Intensity::radiometric`] gives the same back); colour times intensity, the brightest
+    ///   channel 1 in the colour; a spot's `cone_deg` the outer angle and `cone_deg -
+    ///   falloff_deg` the inner one (glTF wants inner < outer: a zero falloff is written one
+    ///   float step wide);
+    /// - each technique's settings in the scene's `extras`.
+    ///
+    /// A builtin mesh is a technique's, which the scene does not hold: replace it by its mesh
+    /// first (quadray indirect's `builtins_as_meshes`), or it is an error.
+    pub fn to_gltf(&self) -> Result<String, String> {
+        write_gltf::write(self)
+    }
+
+    /// Writes [`SceneDescription::to_gltf`] to `path` (a `.gltf`), creating its folder.
+    pub fn save_gltf(&self, path: &Path) -> Result<(), FileError> {
+        let gltf_extension = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
+        if !gltf_extension {
+            return Err(FileError::new(
+                path,
+                "a scene is written as a .gltf (JSON, the buffer embedded)",
+            ));
+        }
+        let text = self.to_gltf().map_err(|e| FileError::new(path, e))?;
+        crate::write_text(path, &text)
     }
 
     /// Parses TOML scene text. `path` names the scene in errors, its directory is where mesh
