@@ -65,7 +65,8 @@
 //!
 //! A `.gltf` or `.glb` scene gives one object (every mesh of the shown scene, placed by its node
 //! transforms, with its materials' base colours), the first perspective camera met in the node
-//! tree (required; its aspect ratio is ignored, the image size decides), and every
+//! tree (required, but [`SceneDescription::load_framing`] makes one that frames the meshes; its
+//! aspect ratio is ignored, the image size decides), and every
 //! `KHR_lights_punctual` light: point, spot and directional (`range` is ignored). Their
 //! intensities are [`Intensity::Photometric`]: colour times intensity.
 //!
@@ -379,12 +380,24 @@ impl SceneDescription {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         if matches!(extension.as_deref(), Some("gltf" | "glb")) {
-            return read_gltf::load(path);
+            return read_gltf::load(path, false).map(|(scene, _)| scene);
         }
         let text = std::fs::read_to_string(path).map_err(|e| FileError::new(path, e))?;
         Self::from_toml(&text, path)
     }
 
+    /// As [`SceneDescription::load`], but a glTF scene without a camera is given
+    /// [`Camera::framing`] its meshes instead of being refused; `true` with a camera so made.
+    /// (For a viewer of any glTF file; a renderer's scene names its view.)
+    pub fn load_framing(path: &Path) -> Result<(Self, bool), FileError> {
+        let gltf = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+        if gltf {
+            return read_gltf::load(path, true);
+        }
+        Ok((Self::load(path)?, false))
+    }
 
     /// `technique`'s own settings from its table (its defaults where the file has none); a key
     /// the technique does not know is an error that names the table.
@@ -459,6 +472,23 @@ fn stem(path: &Path) -> String {
 
 /// Checks what holds for every scene, whatever file it came from.
 impl Camera {
+    /// [`Camera::framing`]'s field of view.
+    pub const FRAMING_FOV_Y_DEG: f32 = 45.0;
+
+    /// A camera that sees all of `bounds` (min, max): looking at their middle along -z with +y
+    /// up, from as far as puts their enclosing sphere inside [`Camera::FRAMING_FOV_Y_DEG`].
+    pub fn framing((min, max): (Vec3, Vec3)) -> Self {
+        let centre = min.midpoint(max);
+        let radius = (0.5 * min.distance(max)).max(1e-3);
+        let half_fov = (0.5 * Self::FRAMING_FOV_Y_DEG).to_radians();
+        Self {
+            position: centre + Vec3::Z * (radius / half_fov.sin()),
+            target: centre,
+            up: Vec3::Y,
+            fov_y_deg: Self::FRAMING_FOV_Y_DEG,
+        }
+    }
+
     /// [`Camera::fov_y_deg`]: a picture needs some, a pinhole cannot reach 180.
     pub const FOV_Y: crate::settings::Limits<f32> = crate::settings::Limits::above(0.0, 179.0);
 
