@@ -92,7 +92,7 @@ fn the_gi_program_bounces_off_displaced_surfaces() {
 
 /// `--scene` renders a glTF of the user's from outside the repository's assets (here the bundled
 /// Cornell box copied elsewhere): the same picture as the bundled one. A flag the program does
-/// not know, and a scene that is not there or not glTF, are refused by name.
+/// not know, and a scene that is not there, not glTF or malformed, are refused by name.
 #[test]
 fn the_gi_program_renders_a_users_gltf_and_refuses_what_it_cannot_use() {
     let dir = std::env::temp_dir().join(format!("quadray-bevy-gi-scene-{}", std::process::id()));
@@ -137,6 +137,11 @@ fn the_gi_program_renders_a_users_gltf_and_refuses_what_it_cannot_use() {
         &["--scene", "room.obj"],
         "--scene room.obj: not a glTF scene (.gltf or .glb)",
     );
+    let recursive = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../assets/malformed/gltf2/RecursiveNodes/RecursiveNodes.gltf"
+    );
+    refused(&["--scene", recursive], "RecursiveNodes.gltf: node");
     refused(&["--size", "0x64"], "--size");
     refused(&["--frames", "5"], "--screenshot");
     refused(

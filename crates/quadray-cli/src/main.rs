@@ -5,6 +5,7 @@ mod displace;
 mod indirect;
 mod merge;
 mod raytrace;
+mod scene;
 mod smoke;
 mod tiles;
 
@@ -38,6 +39,8 @@ enum Command {
     Tiles(merge::TilesArgs),
     /// One-bounce indirect light from a light quadtree, its baselines and reference.
     Indirect(indirect::IndirectArgs),
+    /// Scene files: `quadray scene export IN OUT.gltf` writes a scene as glTF.
+    Scene(scene::SceneArgs),
     /// Every GPU pass of every technique at a tiny size, one at a time, each waited for within
     /// the bound: one line a pass, or the error naming where it stopped (a new GPU's first check).
     Smoke(smoke::SmokeArgs),
@@ -149,6 +152,7 @@ fn main() -> Result<()> {
             what: Bench::Shadows { quick, out },
         } => raytrace::bench(quick, &out)?,
         Command::Indirect(args) => indirect::run_indirect(args)?,
+        Command::Scene(args) => scene::run(args)?,
         Command::Smoke(args) => smoke::run(args)?,
         Command::Demo { out, size } => {
             if !(16..=4096).contains(&size) {

@@ -10,7 +10,7 @@ const LAYERS: &[&[&str]] = &[
     &["spinner"],
     &["tiles"],
     &["raytrace"],
-    &["merge", "displace", "indirect", "smoke"],
+    &["merge", "displace", "indirect", "scene", "smoke"],
     &[""],
 ];
 

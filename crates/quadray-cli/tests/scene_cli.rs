@@ -1,10 +1,11 @@
 //! One scene format for `quadray indirect` and `quadray raytrace`: the bundled glTF scene renders
 //! in both (as the TOML Cornell box in `quadray indirect`; lit, shadowed, red left and green
-//! right in `quadray raytrace`), and bad scene files are refused with the file named.
+//! right in `quadray raytrace`), and bad scene files are refused with the file named. `quadray
+//! scene export` writes the bundled glTF twins of the TOML scenes, which render as the TOML.
 
 use crate::common;
 
-use common::{assets, quadray_ok, quadray_refuses, scratch};
+use common::{assets, quadray_ok, quadray_refuses, read_json, scratch};
 use std::path::Path;
 
 fn rgb(path: &Path) -> image::RgbImage {
@@ -196,4 +197,134 @@ fn a_dim_gltf_light_is_reported_with_the_exposure_that_shows_it() {
         stderr.contains("weak against the ambient light"),
         "{stderr}"
     );
+}
+
+/// The bundled glTF twins of the sunlit courtyard and the lamplit room are what `quadray scene
+/// export` writes from their TOML today, byte for byte.
+#[test]
+fn the_bundled_gltf_twins_are_their_toml_exported() {
+    let dir = scratch("scene-export");
+    for name in ["courtyard", "lamplit_room"] {
+        let (toml, gltf) = (
+            dir.join(format!("{name}.toml")),
+            dir.join(format!("{name}.gltf")),
+        );
+        let scenes = assets().join("scenes");
+        // the TOML names no file, so it exports the same from any folder
+        std::fs::copy(scenes.join(format!("{name}.toml")), &toml).unwrap();
+        quadray_ok(&[
+            "scene",
+            "export",
+            toml.to_str().unwrap(),
+            gltf.to_str().unwrap(),
+        ]);
+        let bundled = std::fs::read(scenes.join(format!("{name}.gltf"))).unwrap();
+        assert!(
+            std::fs::read(&gltf).unwrap() == bundled,
+            "assets/scenes/{name}.gltf is not `quadray scene export` of {name}.toml: export it again"
+        );
+    }
+}
+
+/// `quadray indirect` renders the exported courtyard as its TOML: the same pictures (direct,
+/// indirect, combined) to one 8-bit step, and the same work per pixel and error against the
+/// brute force. (The point-lit room is held as `Scene`s equal in quadray-indirect's tests: its
+/// 18 light views cost seconds here.)
+#[test]
+fn indirect_renders_the_exported_courtyard_as_its_toml() {
+    let dir = scratch("scene-export-indirect");
+    let scenes = assets().join("scenes");
+    let render = |file: &str| {
+        // courtyard.toml.png, courtyard.gltf.png: one picture each
+        let (out, stats) = (
+            dir.join(format!("{file}.png")),
+            dir.join(format!("{file}.json")),
+        );
+        quadray_ok(&[
+            "indirect",
+            "--scene",
+            scenes.join(file).to_str().unwrap(),
+            "--size",
+            "32x32",
+            "--rsm-size",
+            "16",
+            "--frames",
+            "0",
+            "--reference",
+            "--out",
+            out.to_str().unwrap(),
+            "--stats",
+            stats.to_str().unwrap(),
+        ]);
+        (out, read_json(&stats))
+    };
+    let (toml, toml_stats) = render("courtyard.toml");
+    let (gltf, gltf_stats) = render("courtyard.gltf");
+    for suffix in ["", ".direct", ".indirect"] {
+        let picture = |p: &Path| {
+            let stem = p.file_stem().unwrap().to_string_lossy();
+            rgb(&p.with_file_name(format!("{stem}{suffix}.png")))
+        };
+        let (a, b) = (picture(&toml), picture(&gltf));
+        let (mean, large) = quadray_core::image_out::channel_difference(a.as_raw(), b.as_raw(), 1);
+        assert!(
+            mean < 0.01 && large == 0.0,
+            "courtyard{suffix}: mean {mean}, {large} off by > 1"
+        );
+    }
+    let figure = |stats: &serde_json::Value, path: &str| {
+        stats
+            .pointer(path)
+            .and_then(|v| v.as_f64())
+            .unwrap_or_else(|| panic!("{path}"))
+    };
+    for path in [
+        "/vpl_evaluations_per_pixel",
+        "/texel_fetches_per_pixel",
+        "/error/rel_l1",
+        "/error/rmse",
+    ] {
+        let (a, b) = (figure(&toml_stats, path), figure(&gltf_stats, path));
+        assert!(
+            (a - b).abs() <= 1e-4 * a.abs(),
+            "{path}: {a} from the TOML, {b} from the glTF"
+        );
+    }
+}
+
+/// `quadray scene export` refuses a missing scene, a file it cannot write (not a .gltf) and a
+/// builtin mesh no technique has, each with the file named.
+#[test]
+fn scene_export_refuses_bad_input_naming_the_file() {
+    let dir = scratch("scene-export-bad");
+    let unknown = dir.join("unknown.toml");
+    let courtyard = std::fs::read_to_string(assets().join("scenes/courtyard.toml")).unwrap();
+    std::fs::write(
+        &unknown,
+        format!("{courtyard}\n[[objects]]\nbuiltin = \"sponza\"\n"),
+    )
+    .unwrap();
+    let courtyard = assets().join("scenes/courtyard.toml");
+    let (missing, glb, out) = (
+        dir.join("missing.toml"),
+        dir.join("x.glb"),
+        dir.join("x.gltf"),
+    );
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    for (scene, out, needle) in [
+        (path(&missing), path(&out), "missing.toml".to_string()),
+        (
+            path(&courtyard),
+            path(&glb),
+            "x.glb: a scene is written as a .gltf".into(),
+        ),
+        (
+            path(&unknown),
+            path(&out),
+            "unknown.toml: object 11: unknown builtin `sponza`".into(),
+        ),
+    ] {
+        quadray_refuses(&["scene", "export", &scene, &out], &needle);
+    }
+    assert!(!out.exists() && !glb.exists());
 }

@@ -65,12 +65,18 @@
 //!
 //! A `.gltf` or `.glb` scene gives one object (every mesh of the shown scene, placed by its node
 //! transforms, with its materials' base colours), the first perspective camera met in the node
-//! tree (required; its aspect ratio is ignored, the image size decides), and every
+//! tree (required, but [`SceneDescription::load_framing`] makes one that frames the meshes; its
+//! aspect ratio is ignored, the image size decides), and every
 //! `KHR_lights_punctual` light: point, spot and directional (`range` is ignored). Their
 //! intensities are [`Intensity::Photometric`]: colour times intensity.
+//!
+//! [`SceneDescription::to_gltf`] writes a scene as one `.gltf` that this reader reads back as the
+//! same scene: every object's triangles in world coordinates with matte materials, the camera,
+//! and every light as a `KHR_lights_punctual` light (see its docs for what changes form).
 
 mod read_gltf;
 mod read_toml;
+mod write_gltf;
 
 use crate::FileError;
 use crate::mesh::Model;
@@ -298,6 +304,42 @@ pub enum Shape {
     Polygons(Vec<Vec<Vec3>>),
 }
 
+impl Shape {
+    /// The faces of a box seen from outside, each four corners (numbered as in
+    /// [`Shape::box_corner`]) counter-clockwise: top (+y), bottom, front (+z), back, left (-x),
+    /// right. The one cut of a box into faces, so that a box written to glTF is the box a
+    /// technique builds.
+    pub const BOX_FACES: [[usize; 4]; 6] = [
+        [6, 7, 3, 2],
+        [0, 1, 5, 4],
+        [4, 5, 7, 6],
+        [1, 0, 2, 3],
+        [0, 4, 6, 2],
+        [5, 1, 3, 7],
+    ];
+
+    /// Corner `i` of the box from `min` to `max`: bits 0, 1, 2 of `i` pick `max` in x, y, z.
+    pub fn box_corner(min: Vec3, max: Vec3, i: usize) -> Vec3 {
+        let picks = glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0);
+        Vec3::select(picks, max, min)
+    }
+
+    /// The corners of [`Shape::BOX_FACES`] of the box from `min` to `max`.
+    pub fn box_faces(min: Vec3, max: Vec3) -> [[Vec3; 4]; 6] {
+        Self::BOX_FACES.map(|face| face.map(|i| Self::box_corner(min, max, i)))
+    }
+
+    /// The unit normal of a planar polygon (Newell's, so the winding decides the side: vertices
+    /// counter-clockwise seen from where it points); zero for a polygon of no area.
+    pub fn polygon_normal(polygon: &[Vec3]) -> Vec3 {
+        let n = polygon.len();
+        (0..n)
+            .map(|i| polygon[i].cross(polygon[(i + 1) % n]))
+            .sum::<Vec3>()
+            .normalize_or_zero()
+    }
+}
+
 /// Uniform scale, then a turn about +y, then a translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
@@ -338,10 +380,23 @@ impl SceneDescription {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         if matches!(extension.as_deref(), Some("gltf" | "glb")) {
-            return read_gltf::load(path);
+            return read_gltf::load(path, false).map(|(scene, _)| scene);
         }
         let text = std::fs::read_to_string(path).map_err(|e| FileError::new(path, e))?;
         Self::from_toml(&text, path)
+    }
+
+    /// As [`SceneDescription::load`], but a glTF scene without a camera is given
+    /// [`Camera::framing`] its meshes instead of being refused; `true` with a camera so made.
+    /// (For a viewer of any glTF file; a renderer's scene names its view.)
+    pub fn load_framing(path: &Path) -> Result<(Self, bool), FileError> {
+        let gltf = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+        if gltf {
+            return read_gltf::load(path, true);
+        }
+        Ok((Self::load(path)?, false))
     }
 
     /// `technique`'s own settings from its table (its defaults where the file has none); a key
@@ -357,6 +412,48 @@ impl SceneDescription {
                 .try_into()
                 .map_err(|e| format!("[{technique}]: {}", e.to_string().trim())),
         }
+    }
+
+    /// The scene as a glTF 2.0 file's text (JSON, its one buffer embedded as a base64 `data:`
+    /// URI, so the file stands alone), which [`SceneDescription::load`] reads back as this scene:
+    ///
+    /// - every object a node with one mesh, its triangles in world coordinates (the transform
+    ///   applied: boxes cut as [`Shape::box_faces`], polygons into fans, zero-area triangles left
+    ///   out) with normals, and texture coordinates where a mesh's material has a texture;
+    /// - materials matte (metallic 0, roughness 1): a named material's `diffuse`, or a mesh
+    ///   file's base colour, texture and emission, as the base colour (clamped to [0, 1] as glTF
+    ///   requires); the Whitted fields (specular, reflect, transmit, ior) are left out;
+    /// - the camera a node looking down its -z with its +y up: `target` becomes the point one
+    ///   unit ahead and `up` is made square to the view (the same view); no aspect ratio (the
+    ///   picture's decides), `znear` a thousandth of the scene's extent;
+    /// - every light a `KHR_lights_punctual` light on a node (a spot and the sun shining down its
+    ///   -z), its intensity photometric as the reader takes it: [`Intensity::Photometric`] as
+    ///   it is, [`Intensity::Native`] read as radiometric and times [`LUMENS_PER_WATT`] (so
+    ///   [`Intensity::radiometric`] gives the same back); colour times intensity, the brightest
+    ///   channel 1 in the colour; a spot's `cone_deg` the outer angle and `cone_deg -
+    ///   falloff_deg` the inner one (glTF wants inner < outer: a zero falloff is written one
+    ///   float step wide);
+    /// - each technique's settings in the scene's `extras`.
+    ///
+    /// A builtin mesh is a technique's, which the scene does not hold: replace it by its mesh
+    /// first (quadray indirect's `builtins_as_meshes`), or it is an error.
+    pub fn to_gltf(&self) -> Result<String, String> {
+        write_gltf::write(self)
+    }
+
+    /// Writes [`SceneDescription::to_gltf`] to `path` (a `.gltf`), creating its folder.
+    pub fn save_gltf(&self, path: &Path) -> Result<(), FileError> {
+        let gltf_extension = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
+        if !gltf_extension {
+            return Err(FileError::new(
+                path,
+                "a scene is written as a .gltf (JSON, the buffer embedded)",
+            ));
+        }
+        let text = self.to_gltf().map_err(|e| FileError::new(path, e))?;
+        crate::write_text(path, &text)
     }
 
     /// Parses TOML scene text. `path` names the scene in errors, its directory is where mesh
@@ -375,6 +472,23 @@ fn stem(path: &Path) -> String {
 
 /// Checks what holds for every scene, whatever file it came from.
 impl Camera {
+    /// [`Camera::framing`]'s field of view.
+    pub const FRAMING_FOV_Y_DEG: f32 = 45.0;
+
+    /// A camera that sees all of `bounds` (min, max): looking at their middle along -z with +y
+    /// up, from as far as puts their enclosing sphere inside [`Camera::FRAMING_FOV_Y_DEG`].
+    pub fn framing((min, max): (Vec3, Vec3)) -> Self {
+        let centre = min.midpoint(max);
+        let radius = (0.5 * min.distance(max)).max(1e-3);
+        let half_fov = (0.5 * Self::FRAMING_FOV_Y_DEG).to_radians();
+        Self {
+            position: centre + Vec3::Z * (radius / half_fov.sin()),
+            target: centre,
+            up: Vec3::Y,
+            fov_y_deg: Self::FRAMING_FOV_Y_DEG,
+        }
+    }
+
     /// [`Camera::fov_y_deg`]: a picture needs some, a pinhole cannot reach 180.
     pub const FOV_Y: crate::settings::Limits<f32> = crate::settings::Limits::above(0.0, 179.0);
 

@@ -20,7 +20,12 @@ const LAYERS: &[&[&str]] = &[
     &["geom", "geom::bvh", "settings", "settings::flags"],
     &["image_out"],
     &["mesh", "mesh::obj", "mesh::ply", "mesh::gltf"],
-    &["scene", "scene::read_gltf", "scene::read_toml"],
+    &[
+        "scene",
+        "scene::read_gltf",
+        "scene::read_toml",
+        "scene::write_gltf",
+    ],
     &[""],
 ];
 

@@ -1,5 +1,5 @@
 //! The scene description: every bundled scene file, the two older TOML spellings against the
-//! canonical one, the bundled glTF scene, and bad input (malformed glTF, no camera, transforms
+//! canonical one, the bundled glTF scene, a glTF file without a camera framed, and bad input (malformed glTF, no camera, transforms
 //! that overflow, bad values) refused with the file named, never a panic.
 
 use glam::Vec3;
@@ -28,9 +28,11 @@ fn every_bundled_scene_file_loads() {
         ("cornell_lights.gltf", 3, 1, 1, 0),
         ("cornell_obj.toml", 1, 1, 1, 0),
         ("cornell_spot.gltf", 1, 1, 1, 0),
+        ("courtyard.gltf", 1, 0, 1, 0),
         ("courtyard.toml", 1, 0, 11, 4),
         ("example-gi.toml", 1, 1, 10, 10),
         ("example-hst.toml", 2, 0, 5, 4),
+        ("lamplit_room.gltf", 3, 0, 1, 0),
         ("lamplit_room.toml", 3, 0, 14, 4),
         ("leak.toml", 1, 1, 9, 2),
         ("shadows-buddha.toml", 3, 0, 2, 1),
@@ -190,6 +192,37 @@ fn the_bundled_gltf_scene_has_the_camera_and_spot_of_cornell_toml() {
     assert_eq!(model.triangle_count(), 30);
     let (lo, hi) = model.bounds();
     assert!(lo.abs_diff_eq(Vec3::ZERO, 1e-6) && hi.abs_diff_eq(Vec3::ONE, 1e-6));
+}
+
+/// A glTF file without a camera (the Blender Cornell box) is refused as a scene, and on request
+/// framed: the camera looks at the meshes' middle and sees every corner of their bounds; a file
+/// with a camera keeps its own.
+#[test]
+fn a_gltf_scene_without_a_camera_is_framed_on_request() {
+    let glb = asset("meshes/cornell_box_gltf/cornell-box.glb");
+    let err = refused(&glb);
+    assert!(err.contains("cornell-box.glb: no camera"), "{err}");
+    let (scene, framed) = SceneDescription::load_framing(&glb).unwrap();
+    assert!(framed);
+    let Shape::Mesh { model, .. } = &scene.objects[0].shape else {
+        panic!("a glTF scene is one mesh object");
+    };
+    let (lo, hi) = model.bounds();
+    let c = scene.camera;
+    let axis = (c.target - c.position).normalize();
+    assert!(axis.abs_diff_eq(Vec3::NEG_Z, 1e-6) && c.target.abs_diff_eq(lo.midpoint(hi), 1e-6));
+    for i in 0..8 {
+        let corner = Shape::box_corner(lo, hi, i);
+        let degrees = axis.angle_between(corner - c.position).to_degrees();
+        assert!(
+            degrees < 0.5 * c.fov_y_deg,
+            "corner {corner}: {degrees} deg off the axis"
+        );
+    }
+    let bundled = asset("scenes/cornell_spot.gltf");
+    let (own, framed) = SceneDescription::load_framing(&bundled).unwrap();
+    assert!(!framed);
+    assert_eq!(own.camera, SceneDescription::load(&bundled).unwrap().camera);
 }
 
 /// The bundled glTF scene's JSON, changed by `edit`, written to `dir/name`.

@@ -3,6 +3,7 @@
 //! `cargo test --release -p quadray-core --test suite -- mesh::`.
 
 mod common;
+mod gltf_export;
 #[path = "../../quadray-indirect/tests/layering.rs"]
 mod layering;
 mod layers;

@@ -287,10 +287,7 @@ fn polygon_triangles(polygons: &[Vec<Vec3>]) -> Vec<[Vertex; 3]> {
     let mut out = Vec::new();
     for polygon in polygons {
         let n = polygon.len();
-        let normal = (0..n)
-            .map(|i| polygon[i].cross(polygon[(i + 1) % n]))
-            .sum::<Vec3>()
-            .normalize_or_zero();
+        let normal = Shape::polygon_normal(polygon);
         if normal == Vec3::ZERO {
             continue;
         }
@@ -304,6 +301,61 @@ fn polygon_triangles(polygons: &[Vec<Vec3>]) -> Vec<[Vertex; 3]> {
         }
     }
     out
+}
+
+/// Builtin mesh `name` as a mesh file's model: its triangles, one mesh for each run of triangles
+/// of one albedo (in their order), a material for each albedo (named `NAME N`, white's the
+/// default last).
+pub fn builtin_model(name: &str) -> Result<Model, String> {
+    let mut model = Model::default();
+    for triangle in builtin_triangles(name)? {
+        let albedo = Vec3::from(triangle[0].albedo);
+        let material = match model.materials.iter().position(|m| m.base_color == albedo) {
+            Some(m) => m,
+            None => {
+                model.materials.push(quadray_core::mesh::Material {
+                    name: format!("{name} {}", model.materials.len()),
+                    base_color: albedo,
+                    ..Default::default()
+                });
+                model.materials.len() - 1
+            }
+        };
+        if model.meshes.last().is_none_or(|m| m.material != material) {
+            model.meshes.push(quadray_core::mesh::Mesh {
+                name: format!("{name}/{}", model.meshes.len()),
+                positions: Vec::new(),
+                normals: Vec::new(),
+                uvs: None,
+                indices: Vec::new(),
+                material,
+            });
+        }
+        let mesh = model.meshes.last_mut().expect("pushed above");
+        let first = mesh.positions.len() as u32;
+        mesh.positions
+            .extend(triangle.map(|v| Vec3::from(v.position)));
+        mesh.normals.extend(triangle.map(|v| Vec3::from(v.normal)));
+        mesh.indices.push([first, first + 1, first + 2]);
+    }
+    model.materials.push(Default::default());
+    Ok(model)
+}
+
+/// `scene` with every builtin mesh replaced by its [`builtin_model`], placed and coloured as
+/// before: a scene that holds all of its geometry, as writing it to glTF needs.
+pub fn builtins_as_meshes(scene: &SceneDescription) -> Result<SceneDescription, String> {
+    let mut scene = scene.clone();
+    for (i, object) in scene.objects.iter_mut().enumerate() {
+        if let Shape::Builtin(name) = &object.shape {
+            let model = builtin_model(name).map_err(|e| format!("object {i}: {e}"))?;
+            object.shape = Shape::Mesh {
+                path: PathBuf::from(name),
+                model: Box::new(model),
+            };
+        }
+    }
+    Ok(scene)
 }
 
 /// One object's triangles in world space, with its material's albedo when it has one.

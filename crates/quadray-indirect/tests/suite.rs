@@ -3,6 +3,7 @@
 //! `cargo test --release -p quadray-indirect --test suite -- counts::`.
 
 mod counts;
+mod gltf_export;
 mod gpu;
 mod layering;
 mod layers;

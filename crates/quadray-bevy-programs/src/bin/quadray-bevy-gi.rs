@@ -7,9 +7,11 @@
 //!
 //! `cargo run --release --bin quadray-bevy-gi` (`--bin`, not `-p`: Cargo then resolves features
 //! as for the whole workspace, and what the test build compiled is reused).
-//! `--scene PATH` shows a glTF or GLB scene of your own instead (its camera and its punctual
-//! lights; `assets/scenes/cornell_lights.gltf` has all three kinds); `--gi-lights spot,point`
-//! lets only those kinds give the bounce (default: all three). `--displaced` shows quadray's
+//! `--scene PATH` shows a glTF or GLB scene of your own instead (its camera, or one that frames
+//! its meshes from +z where it has none, and its punctual lights;
+//! `assets/scenes/cornell_lights.gltf` has all three kinds); `--gi-lights spot,point`
+//! lets only those kinds give the bounce (default: all three); `--shadows` turns on Bevy's shadow
+//! maps for its lights (Bevy's glTF loader leaves them off). `--displaced` shows quadray's
 //! displaced surfaces instead: a floor and a wall with `PyramidMaterial` (the tile map; Bevy's
 //! parallax example's map and colours) beside a plain red wall, lit by a spot, the bounce leaving
 //! from the displaced surfaces. Without a display: `... --bin quadray-bevy-gi -- --screenshot out.png [--no-gi]
@@ -70,8 +72,9 @@ struct Shown {
     about = "One bounce of indirect light from quadray's light quadtree in a Bevy app"
 )]
 struct Args {
-    /// A glTF or GLB scene of your own: its camera, and its punctual lights (directional, point
-    /// and spot) turning and giving the bounce (default: the bundled Cornell box).
+    /// A glTF or GLB scene of your own: its camera (or one framing its meshes from +z), and its
+    /// punctual lights (directional, point and spot) turning and giving the bounce (default: the
+    /// bundled Cornell box).
     #[arg(long, value_name = "PATH.gltf")]
     scene: Option<PathBuf>,
     /// Show quadray's displaced surfaces instead of the Cornell box: a floor and a wall drawn
@@ -105,6 +108,10 @@ struct Args {
     /// the scene directly only).
     #[arg(long, value_delimiter = ',', default_values = ["directional", "point", "spot"])]
     gi_lights: Vec<GiLight>,
+    /// Bevy's shadow maps on the scene file's lights, which Bevy's glTF loader leaves off: the
+    /// direct light's shade, where the bounce is all the light there is (a sunlit scene's).
+    #[arg(long, conflicts_with = "displaced")]
+    shadows: bool,
 }
 
 /// A kind of light `--gi-lights` names.
@@ -115,14 +122,19 @@ enum GiLight {
     Spot,
 }
 
-/// The kinds of light marked as the bounce's sources.
+/// The kinds of light marked as the bounce's sources, and whether the file's lights cast
+/// Bevy's shadows (`--shadows`).
 #[derive(Resource)]
-struct GiLights(Vec<GiLight>);
+struct GiLights {
+    kinds: Vec<GiLight>,
+    shadows: bool,
+}
 
-/// What is shown: a scene file under the asset root, or the displaced surfaces built here.
+/// What is shown: a scene file under the asset root (with the camera that frames it when it has
+/// none), or the displaced surfaces built here.
 #[derive(Resource, Clone)]
 enum Shows {
-    File(String),
+    File(String, Option<quadray_core::scene::Camera>),
     Displaced,
 }
 
@@ -130,9 +142,9 @@ fn main() {
     let args = Args::parse();
     let (assets, scene) = match &args.scene {
         None if args.displaced => (repository_assets(""), Shows::Displaced),
-        None => (repository_assets(""), Shows::File(SCENE.to_string())),
+        None => (repository_assets(""), Shows::File(SCENE.to_string(), None)),
         Some(path) => scene_assets(path)
-            .map(|(assets, file)| (assets, Shows::File(file)))
+            .map(|(assets, file, framing)| (assets, Shows::File(file, framing)))
             .unwrap_or_else(|e| {
                 eprintln!("error: --scene {}: {e}", path.display());
                 std::process::exit(2);
@@ -156,16 +168,22 @@ fn main() {
     app.insert_resource(DefaultOpaqueRendererMethod::deferred())
         .add_plugins((IndirectLightPlugin, PyramidDisplacementPlugin))
         .insert_resource(shown)
-        .insert_resource(GiLights(args.gi_lights.clone()))
+        .insert_resource(GiLights {
+            kinds: args.gi_lights.clone(),
+            shadows: args.shadows,
+        })
         .insert_resource(scene)
         .add_systems(Startup, setup)
         .add_systems(Update, (configure, keys, turn_light, show_title).chain())
         .run();
 }
 
-/// Bevy's asset plugin reading the folder of a scene file of the user's, and the file's name
-/// under it: a glTF or GLB file that exists.
-fn scene_assets(path: &Path) -> Result<(AssetPlugin, String), String> {
+/// Bevy's asset plugin reading the folder of a scene file of the user's, the file's name under
+/// it, and a camera framing its meshes where it has none: a glTF or GLB file that exists and
+/// that quadray's reader reads (so that a bad file is an error here, not a black picture).
+fn scene_assets(
+    path: &Path,
+) -> Result<(AssetPlugin, String, Option<quadray_core::scene::Camera>), String> {
     let gltf = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
@@ -173,6 +191,9 @@ fn scene_assets(path: &Path) -> Result<(AssetPlugin, String), String> {
         return Err("not a glTF scene (.gltf or .glb)".into());
     }
     let path = std::fs::canonicalize(path).map_err(|e| format!("cannot read it: {e}"))?;
+    let (scene, framed) =
+        quadray_core::scene::SceneDescription::load_framing(&path).map_err(|e| e.reason)?;
+    let framing = framed.then_some(scene.camera);
     let (Some(folder), Some(name)) = (path.parent(), path.file_name()) else {
         return Err("not a file".into());
     };
@@ -180,7 +201,7 @@ fn scene_assets(path: &Path) -> Result<(AssetPlugin, String), String> {
         file_path: folder.to_string_lossy().into_owned(),
         ..default()
     };
-    Ok((assets, name.to_string_lossy().into_owned()))
+    Ok((assets, name.to_string_lossy().into_owned(), framing))
 }
 
 fn setup(
@@ -192,10 +213,21 @@ fn setup(
     scene: Res<Shows>,
 ) {
     match &*scene {
-        Shows::File(file) => {
+        Shows::File(file, framing) => {
             commands.spawn(WorldAssetRoot(
                 assets.load(GltfAssetLabel::Scene(0).from_asset(file.clone())),
             ));
+            // where the file's camera would be (`configure` gives it the bounce)
+            if let Some(c) = framing {
+                commands.spawn((
+                    Camera3d::default(),
+                    Transform::from_translation(c.position).looking_at(c.target, c.up),
+                    Projection::Perspective(PerspectiveProjection {
+                        fov: c.fov_y_deg.to_radians(),
+                        ..default()
+                    }),
+                ));
+            }
         }
         Shows::Displaced => commands.run_system_cached(displaced_scene),
     }
@@ -280,6 +312,14 @@ fn displaced_scene(
     ));
 }
 
+/// A light of the three kinds glTF files hold: one of the three is there.
+type FileLight = (
+    Entity,
+    Option<&'static mut DirectionalLight>,
+    Option<&'static mut PointLight>,
+    Option<&'static mut SpotLight>,
+);
+
 /// A light of the three kinds glTF files hold, just loaded.
 type NewLight = (
     Or<(Added<SpotLight>, Added<PointLight>, Added<DirectionalLight>)>,
@@ -288,23 +328,35 @@ type NewLight = (
 
 /// A camera where the file's is (that one turned off) gets the bounce (deferred, no MSAA, by
 /// default a 128^2 RSM: interactive on a CPU rasteriser too); the file's lights of the kinds
-/// `--gi-lights` names are marked as its sources. A refused RSM size is Bevy's log's warning, as for any app.
+/// `--gi-lights` names are marked as its sources, and with `--shadows` every light casts
+/// Bevy's shadows. A refused RSM size is Bevy's log's warning, as for any app.
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Transform, &Projection), FileCamera>,
-    lights: Query<(Entity, Has<DirectionalLight>, Has<PointLight>), NewLight>,
+    mut lights: Query<FileLight, NewLight>,
     gi_lights: Res<GiLights>,
     offscreen: Option<Res<Offscreen>>,
     shown: Res<Shown>,
 ) {
-    for (light, directional, point) in &lights {
-        let kind = match (directional, point) {
-            (true, _) => GiLight::Directional,
-            (_, true) => GiLight::Point,
+    for (light, directional, point, spot) in &mut lights {
+        let kind = match (&directional, &point) {
+            (Some(_), _) => GiLight::Directional,
+            (_, Some(_)) => GiLight::Point,
             _ => GiLight::Spot,
         };
-        if gi_lights.0.contains(&kind) {
+        if gi_lights.kinds.contains(&kind) {
             commands.entity(light).insert(IndirectLightSource);
+        }
+        if gi_lights.shadows {
+            if let Some(mut l) = directional {
+                l.shadow_maps_enabled = true;
+            }
+            if let Some(mut l) = point {
+                l.shadow_maps_enabled = true;
+            }
+            if let Some(mut l) = spot {
+                l.shadow_maps_enabled = true;
+            }
         }
     }
     for (file_camera, transform, projection) in &cameras {

@@ -13,7 +13,9 @@ use gltf::json::extensions::scene::khr_lights_punctual::Type;
 use gltf::json::validation::Checked;
 use std::path::Path;
 
-pub(super) fn load(path: &Path) -> Result<SceneDescription, FileError> {
+/// The scene, and whether its camera was made by [`Camera::framing`] (with `frame`, where the
+/// file has none; without, that is an error).
+pub(super) fn load(path: &Path, frame: bool) -> Result<(SceneDescription, bool), FileError> {
     let model = load_model(path).map_err(|e| mesh_error(path, e))?;
     let document = document(path).map_err(|e| mesh_error(path, e))?;
     let json = document.as_json();
@@ -53,13 +55,18 @@ pub(super) fn load(path: &Path) -> Result<SceneDescription, FileError> {
         Ok(())
     })
     .map_err(|e| mesh_error(path, e))?;
-    let camera = camera.ok_or_else(|| {
-        FileError::new(
-            path,
-            "no camera: the scene needs a node with a perspective camera",
-        )
-    })?;
-    Ok(SceneDescription {
+    let framed = camera.is_none() && frame;
+    let camera = match camera {
+        Some(camera) => camera,
+        None if frame => Camera::framing(model.bounds()),
+        None => {
+            return Err(FileError::new(
+                path,
+                "no camera: the scene needs a node with a perspective camera",
+            ));
+        }
+    };
+    let scene = SceneDescription {
         name: stem(path),
         camera,
         lights,
@@ -73,7 +80,8 @@ pub(super) fn load(path: &Path) -> Result<SceneDescription, FileError> {
             material: None,
         }],
         techniques: scene_extras(json).map_err(|why| FileError::new(path, why))?,
-    })
+    };
+    Ok((scene, framed))
 }
 
 /// Each technique's own settings from the default scene's `extras` (`{"indirect": {"r_min":

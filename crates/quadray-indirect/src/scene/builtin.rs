@@ -3,6 +3,7 @@
 
 use super::Vertex;
 use glam::{Mat4, Vec3};
+use quadray_core::scene::Shape;
 
 const WHITE: [f32; 3] = [0.73, 0.73, 0.73];
 const RED: [f32; 3] = [0.63, 0.065, 0.05];
@@ -38,25 +39,14 @@ fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2
     [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
 }
 
-/// Corner `i` of the box spanned by `lo` and `hi`: bits 0, 1, 2 of `i` pick `hi` in x, y, z.
-fn box_corner(lo: Vec3, hi: Vec3, i: usize) -> Vec3 {
-    let pick = |bit: usize, lo: f32, hi: f32| if i & bit == 0 { lo } else { hi };
-    Vec3::new(
-        pick(1, lo.x, hi.x),
-        pick(2, lo.y, hi.y),
-        pick(4, lo.z, hi.z),
-    )
-}
+// The faces of a box seen from outside (the scene model's, in quad order).
+const TOP: [usize; 4] = Shape::BOX_FACES[0];
+const FRONT: [usize; 4] = Shape::BOX_FACES[2]; // +z
+const BACK: [usize; 4] = Shape::BOX_FACES[3]; // -z
+const LEFT: [usize; 4] = Shape::BOX_FACES[4]; // -x
+const RIGHT: [usize; 4] = Shape::BOX_FACES[5]; // +x
 
-// The faces of a box seen from outside, as corners of `box_corner` in quad order.
-const TOP: [usize; 4] = [6, 7, 3, 2];
-const BOTTOM: [usize; 4] = [0, 1, 5, 4];
-const FRONT: [usize; 4] = [4, 5, 7, 6]; // +z
-const BACK: [usize; 4] = [1, 0, 2, 3]; // -z
-const LEFT: [usize; 4] = [0, 4, 6, 2]; // -x
-const RIGHT: [usize; 4] = [5, 1, 3, 7]; // +x
-
-/// The two triangles of each face, the face's corners numbered as in [`box_corner`].
+/// The two triangles of each face, the face's corners numbered as in [`Shape::box_corner`].
 fn box_faces(corners: [Vec3; 8], faces: &[([usize; 4], [f32; 3])]) -> Vec<[Vertex; 3]> {
     faces
         .iter()
@@ -68,7 +58,7 @@ fn box_faces(corners: [Vec3; 8], faces: &[([usize; 4], [f32; 3])]) -> Vec<[Verte
 
 /// The unit room [0,1]^3 open towards +z: red wall at x = 0, green at x = 1.
 fn cornell_room() -> Vec<[Vertex; 3]> {
-    let corners = std::array::from_fn(|i| box_corner(Vec3::ZERO, Vec3::ONE, i));
+    let corners = std::array::from_fn(|i| Shape::box_corner(Vec3::ZERO, Vec3::ONE, i));
     // seen from inside
     let floor = [4, 5, 1, 0];
     let ceiling = [2, 3, 7, 6];
@@ -99,20 +89,20 @@ fn block(centre: Vec3, side: f32, height: f32, turn_deg: f32) -> Vec<[Vertex; 3]
     let r = Mat4::from_translation(centre) * Mat4::from_rotation_y(turn_deg.to_radians());
     let h = side * 0.5;
     let (lo, hi) = (Vec3::new(-h, 0.0, -h), Vec3::new(h, height, h));
-    let corners = std::array::from_fn(|i| r.transform_point3(box_corner(lo, hi, i)));
+    let corners = std::array::from_fn(|i| r.transform_point3(Shape::box_corner(lo, hi, i)));
     box_faces(
         corners,
         &[TOP, FRONT, RIGHT, BACK, LEFT].map(|f| (f, WHITE)),
     )
 }
 
-/// An axis-aligned box, faces outwards.
+/// An axis-aligned box, faces outwards (the scene model's faces, which a box written to glTF
+/// has too).
 pub(super) fn cuboid(lo: Vec3, hi: Vec3, albedo: [f32; 3]) -> Vec<[Vertex; 3]> {
-    let corners = std::array::from_fn(|i| box_corner(lo, hi, i));
-    box_faces(
-        corners,
-        &[TOP, BOTTOM, FRONT, BACK, LEFT, RIGHT].map(|f| (f, albedo)),
-    )
+    Shape::box_faces(lo, hi)
+        .into_iter()
+        .flat_map(|[a, b, c, d]| quad(a, b, c, d, albedo))
+        .collect()
 }
 
 /// A vertical cylinder (no caps) with smooth normals, `segments` around and `rings` high.
