@@ -199,12 +199,12 @@ fn a_dim_gltf_light_is_reported_with_the_exposure_that_shows_it() {
     );
 }
 
-/// The bundled glTF twins of the sunlit courtyard and the lamplit room are what `quadray scene
-/// export` writes from their TOML today, byte for byte.
+/// The bundled glTF twins of the sunlit courtyard, the lamplit room and the two rooms joined by a
+/// door are what `quadray scene export` writes from their TOML today, byte for byte.
 #[test]
 fn the_bundled_gltf_twins_are_their_toml_exported() {
     let dir = scratch("scene-export");
-    for name in ["courtyard", "lamplit_room"] {
+    for name in ["courtyard", "lamplit_room", "visibility-door"] {
         let (toml, gltf) = (
             dir.join(format!("{name}.toml")),
             dir.join(format!("{name}.gltf")),

@@ -40,6 +40,7 @@ fn every_bundled_scene_file_loads() {
         ("shadows-cornell.toml", 3, 0, 1, 0),
         ("shadows-demo.toml", 2, 0, 4, 3),
         ("visibility-corridor.toml", 1, 1, 10, 3),
+        ("visibility-door.gltf", 1, 1, 1, 0),
         ("visibility-door.toml", 1, 1, 11, 4),
         ("visibility-gap.toml", 1, 1, 7, 3),
         ("visibility-pillars.toml", 1, 1, 11, 3),
