@@ -621,7 +621,11 @@ fn plugin_s_indirect_shadows_are_quadray_s() {
             );
             // quadray's to 1%, far from quadray's without shadows; on the Cornell box also from
             // the march's (behind the door the march is as close to the grid as the plugin)
-            let against = if scene == SCENE { plain.min(march) } else { plain };
+            let against = if scene == SCENE {
+                plain.min(march)
+            } else {
+                plain
+            };
             assert!(
                 plugin <= 0.01 && plugin <= 0.25 * against,
                 "{scene}: {plugin} {plain} {march}"
