@@ -2,7 +2,7 @@
 //! geometry, the public passes take whatever textures they are given): the frame ends, a bad
 //! texel acts exactly as an empty one, and nothing non-finite reaches any pixel.
 
-use quadray_gpu::{Gpu, read_buffer, read_texture_f32, texture_2d, texture_2d_with_data};
+use quadray_gpu::{Gpu, read_buffer, read_texture_f32, texture_2d};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{
     FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass, OutputTerm,
@@ -78,76 +78,117 @@ fn clean_inputs(gpu: &Gpu, scene: &Scene) -> (Texels, Texels) {
     (gbuffer, rsm)
 }
 
-/// One frame of `method` through the public passes on the caller's `gbuffer` and `rsm`: the
-/// indirect light (rgb) and the combined radiance the output pass writes (rgb).
-fn frame(
-    gpu: &Gpu,
-    scene: &Scene,
-    gbuffer: &Texels,
-    rsm: &Texels,
-    method: Method,
-) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let s = settings();
-    let size = (s.size.width, s.size.height);
-    let upload = |texels: &Texels, size| {
-        texels.each_ref().map(|t| {
-            texture_2d_with_data(d, q, "input", size, FLOAT_FORMAT, bytemuck::cast_slice(t))
-                .create_view(&Default::default())
-        })
-    };
-    let [g_pos, g_normal, g_albedo] = upload(gbuffer, size);
-    let [flux, position, normal] = upload(rsm, (s.rsm_size, s.rsm_size));
-    let rsm_views = RsmViews {
-        flux: &flux,
-        position: &position,
-        normal: &normal,
-    };
-    let gbuffer_views = GBufferViews {
-        position: &g_pos,
-        normal: &g_normal,
-        albedo: &g_albedo,
-    };
-    let quadtree = LightQuadtree::new(d, q, s.rsm_size, s.cluster, rsm_views);
-    let maps = [ViewMaps {
-        rsm: rsm_views,
-        quadtree: &quadtree,
-    }];
-    let gather = Gather::new(d, &s, &maps, gbuffer_views).unwrap();
-    gather.set_lights(q, &LightView::of_scene(scene, 1), scene.r_min);
-    let aspect = size.0 as f32 / size.1 as f32;
-    gather.set_camera(q, scene.camera_view_proj(aspect), scene.camera.position);
-    let output = texture_2d(
-        d,
-        "output",
-        size,
-        FLOAT_FORMAT,
-        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-    );
-    let output_pass = OutputPass::new(d, FLOAT_FORMAT, OutputTerm::Combined).unwrap();
-    let mut encoder = d.create_command_encoder(&Default::default());
-    quadtree.record_build(&mut encoder, None);
-    quadtree.record_cut(&mut encoder, None);
-    gather.record_indirect(&mut encoder, method, &[&quadtree], None);
-    gather.record_direct(&mut encoder, None);
-    output_pass.record(
-        d,
-        &mut encoder,
-        &gather,
-        &output.create_view(&Default::default()),
-    );
-    gpu.submit(format!("{method} on bad inputs"), encoder.finish());
-    // the waits are bounded: a frame that never ends fails here
-    let indirect: Vec<[f32; 4]> =
-        bytemuck::pod_collect_to_vec(&read_buffer(gpu, gather.indirect()).unwrap());
-    let combined = read_texture_f32(gpu, &output, 0, 4).unwrap();
-    (
-        indirect.iter().map(|p| [p[0], p[1], p[2]]).collect(),
-        combined
-            .chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect(),
-    )
+/// The public passes on input textures of the caller's (a G-buffer and an RSM), made once for
+/// every frame of a test: their pipelines are the costliest part of a frame on lavapipe.
+struct Passes {
+    gbuffer: [wgpu::Texture; 3],
+    rsm: [wgpu::Texture; 3],
+    quadtree: LightQuadtree,
+    gather: Gather,
+    output: wgpu::Texture,
+    output_pass: OutputPass,
+}
+
+impl Passes {
+    fn new(gpu: &Gpu, scene: &Scene) -> Self {
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let s = settings();
+        let size = (s.size.width, s.size.height);
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+        let inputs = |size| [0, 1, 2].map(|_| texture_2d(d, "input", size, FLOAT_FORMAT, usage));
+        let (gbuffer, rsm) = (inputs(size), inputs((s.rsm_size, s.rsm_size)));
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let ([g_pos, g_normal, g_albedo], [flux, position, normal]) =
+            (gbuffer.each_ref().map(view), rsm.each_ref().map(view));
+        let rsm_views = RsmViews {
+            flux: &flux,
+            position: &position,
+            normal: &normal,
+        };
+        let gbuffer_views = GBufferViews {
+            position: &g_pos,
+            normal: &g_normal,
+            albedo: &g_albedo,
+        };
+        let quadtree = LightQuadtree::new(d, q, s.rsm_size, s.cluster, rsm_views);
+        let maps = [ViewMaps {
+            rsm: rsm_views,
+            quadtree: &quadtree,
+        }];
+        let gather = Gather::new(d, &s, &maps, gbuffer_views).unwrap();
+        gather.set_lights(q, &LightView::of_scene(scene, 1), scene.r_min);
+        let aspect = size.0 as f32 / size.1 as f32;
+        gather.set_camera(q, scene.camera_view_proj(aspect), scene.camera.position);
+        let output = texture_2d(
+            d,
+            "output",
+            size,
+            FLOAT_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
+        let output_pass = OutputPass::new(d, FLOAT_FORMAT, OutputTerm::Combined).unwrap();
+        Self {
+            gbuffer,
+            rsm,
+            quadtree,
+            gather,
+            output,
+            output_pass,
+        }
+    }
+
+    /// One frame of `method` on the caller's `gbuffer` and `rsm`: the indirect light (rgb) and
+    /// the combined radiance the output pass writes (rgb).
+    fn frame(
+        &self,
+        gpu: &Gpu,
+        gbuffer: &Texels,
+        rsm: &Texels,
+        method: Method,
+    ) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+        let d = &gpu.device;
+        for (texture, texels) in self
+            .gbuffer
+            .iter()
+            .chain(&self.rsm)
+            .zip(gbuffer.iter().chain(rsm))
+        {
+            gpu.queue.write_texture(
+                texture.as_image_copy(),
+                bytemuck::cast_slice(texels),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(texture.width() * 16),
+                    rows_per_image: None,
+                },
+                texture.size(),
+            );
+        }
+        let mut encoder = d.create_command_encoder(&Default::default());
+        self.quadtree.record_build(&mut encoder, None);
+        self.quadtree.record_cut(&mut encoder, None);
+        self.gather
+            .record_indirect(&mut encoder, method, &[&self.quadtree], None);
+        self.gather.record_direct(&mut encoder, None);
+        self.output_pass.record(
+            d,
+            &mut encoder,
+            &self.gather,
+            &self.output.create_view(&Default::default()),
+        );
+        gpu.submit(format!("{method} on bad inputs"), encoder.finish());
+        // the waits are bounded: a frame that never ends fails here
+        let indirect: Vec<[f32; 4]> =
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, self.gather.indirect()).unwrap());
+        let combined = read_texture_f32(gpu, &self.output, 0, 4).unwrap();
+        (
+            indirect.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+            combined
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
+        )
+    }
 }
 
 /// Pixels with a non-finite channel.
@@ -209,10 +250,11 @@ fn bad_g_buffer_texels_act_as_empty_ones_and_change_no_other_pixel() {
         .map(|&(x, y, ..)| (y * width + x) as usize)
         .collect();
     let tile_of = |i: usize| (i as u32 % width / 8, i as u32 / width / 8);
+    let passes = Passes::new(&gpu, &scene);
     for method in Method::ALL {
-        let (clean_indirect, clean_combined) = frame(&gpu, &scene, &gbuffer, &rsm, method);
-        let (indirect, combined) = frame(&gpu, &scene, &bad, &rsm, method);
-        let (empty_indirect, empty_combined) = frame(&gpu, &scene, &cleared, &rsm, method);
+        let (clean_indirect, clean_combined) = passes.frame(&gpu, &gbuffer, &rsm, method);
+        let (indirect, combined) = passes.frame(&gpu, &bad, &rsm, method);
+        let (empty_indirect, empty_combined) = passes.frame(&gpu, &cleared, &rsm, method);
         let changed = differing(&indirect, &clean_indirect);
         let elsewhere: Vec<usize> = match method {
             Method::QuadtreeTiles => changed
@@ -280,10 +322,11 @@ fn bad_rsm_texels_act_as_empty_ones() {
             texture[i] = [0.0; 4];
         }
     }
+    let passes = Passes::new(&gpu, &scene);
     for method in Method::ALL {
-        let (indirect, combined) = frame(&gpu, &scene, &gbuffer, &bad, method);
-        let (empty_indirect, _) = frame(&gpu, &scene, &gbuffer, &cleared, method);
-        let (clean_indirect, _) = frame(&gpu, &scene, &gbuffer, &rsm, method);
+        let (indirect, combined) = passes.frame(&gpu, &gbuffer, &bad, method);
+        let (empty_indirect, _) = passes.frame(&gpu, &gbuffer, &cleared, method);
+        let (clean_indirect, _) = passes.frame(&gpu, &gbuffer, &rsm, method);
         let error = compare(&indirect, &clean_indirect);
         println!(
             "{method}: {} of {} lit RSM texels bad: {} non-finite pixels, rel L1 {:.2e} against the clean RSM",
