@@ -67,6 +67,9 @@ struct Setup {
     settings: Settings,
     /// The cameras' eye and target; `None`: the file camera's place.
     view: Option<([f32; 3], [f32; 3])>,
+    /// The kind of light marked as the bounce's source (`spot`, `point`, `directional`);
+    /// `None`: every light.
+    marked_kind: Option<&'static str>,
 }
 
 /// Method, bounce on, cut view on.
@@ -131,11 +134,14 @@ impl Probe {
 /// The glTF's camera (a node of the scene, where a test's own cameras are not), when it appears.
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>, With<ChildOf>);
 
-/// Bevy's lights of the three kinds, not yet marked.
-type Unmarked = (
-    Or<(With<SpotLight>, With<PointLight>, With<DirectionalLight>)>,
-    Without<IndirectLightSource>,
+/// Bevy's lights of the three kinds: whether marked, whether a spot, whether a point light.
+type Lights<'a> = (
+    Entity,
+    Has<IndirectLightSource>,
+    Has<SpotLight>,
+    Has<PointLight>,
 );
+type AnyLight = Or<(With<SpotLight>, With<PointLight>, With<DirectionalLight>)>;
 
 /// Once the glTF's camera and lights exist: one camera per case with the file's projection (once:
 /// a glTF spawned later keeps the probes' cameras), and the file's lights marked as the bounce's
@@ -143,14 +149,23 @@ type Unmarked = (
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Projection, &Transform), FileCamera>,
-    lights: Query<Entity, Unmarked>,
+    lights: Query<Lights, AnyLight>,
     probes: Res<Probes>,
     setup: Res<Setup>,
     mut spawned: Local<bool>,
 ) {
-    for light in &lights {
+    for (light, marked, spot, point) in &lights {
+        let kind = match (spot, point) {
+            (true, _) => "spot",
+            (_, true) => "point",
+            _ => "directional",
+        };
         // (a test may despawn the light this frame)
-        commands.entity(light).try_insert(IndirectLightSource);
+        match (setup.marked_kind.is_none_or(|k| k == kind), marked) {
+            (true, false) => _ = commands.entity(light).try_insert(IndirectLightSource),
+            (false, true) => _ = commands.entity(light).try_remove::<IndirectLightSource>(),
+            _ => {}
+        }
     }
     for (entity, projection, file_place) in &cameras {
         // the file's camera: replaced by the probes'
@@ -219,6 +234,7 @@ fn app_of(
                 cases: cases.to_vec(),
                 settings,
                 view,
+                marked_kind: None,
             });
         if plugin {
             app.add_plugins(IndirectLightPlugin);
@@ -355,13 +371,19 @@ fn quadray_renderer_from<'g>(
     settings: Settings,
     view: Option<([f32; 3], [f32; 3])>,
 ) -> (Scene, Renderer<'g>) {
+    let scene = scene_from(file, view);
+    let renderer = Renderer::new(gpu, &scene, settings).unwrap();
+    (scene, renderer)
+}
+
+/// quadray's scene of `file` seen from `view` (`None`: the file's camera).
+fn scene_from(file: &str, view: Option<([f32; 3], [f32; 3])>) -> Scene {
     let mut scene = Scene::load(&std::path::Path::new(ASSETS).join(file)).unwrap();
     if let Some((eye, target)) = view {
         scene.camera.position = eye.into();
         scene.camera.target = target.into();
     }
-    let renderer = Renderer::new(gpu, &scene, settings).unwrap();
-    (scene, renderer)
+    scene
 }
 
 /// quadray's radiance in the plugin's units: candela (Bevy's) where quadray's are W/sr (cd / 683).
@@ -547,9 +569,10 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
     );
 }
 
-/// The sun, a point light and a spot from the same glTF file, each marked: the plugin's brute
-/// force over their RSMs (the sun's orthographic, the point light's six cube faces) is quadray's
-/// own over the same file, and its default method is as close to it as quadray's is to its own.
+/// The sun, a point light and a spot from the same glTF file, all three marked and then each
+/// alone: the plugin's brute force over their RSMs (the sun's orthographic, the point light's six
+/// cube faces) is quadray's own over the same file, and its default method is as close to it as
+/// quadray's is to its own.
 #[test]
 #[ignore = "run under the validation layer by validation::every_pass_passes_the_layer, in a child process"]
 fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
@@ -558,27 +581,51 @@ fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
         (Method::DEFAULT, true, false),
     ];
     let mut app = app(LIGHTS_SCENE, &cases);
-    let (_, indirect) = gathered(&mut app);
+    let (probes, indirect) = gathered(&mut app);
     let gpu = quadray_gpu::Gpu::new().expect("an adapter (scripts/setup.sh installs lavapipe)");
-    let (scene, mut renderer) = quadray_renderer(&gpu, LIGHTS_SCENE);
+    let scene = scene_from(LIGHTS_SCENE, CORNELL_VIEW);
     let kinds: Vec<_> = scene.lights.iter().map(|l| l.kind_name()).collect();
     assert_eq!(kinds, ["spot", "point", "directional"]);
-    assert_eq!(renderer.view_count(), 8);
-    let reference = in_candela(renderer.render_frame(Method::Reference).unwrap().indirect);
-    let agreement = compare(&indirect[0], &reference);
-    println!("three lights: plugin brute force against quadray's: {agreement:?}");
-    assert!(agreement.rel_l1 <= 0.05, "{agreement:?}");
-    let default = in_candela(renderer.render_frame(Method::DEFAULT).unwrap().indirect);
-    let quadray_error = compare(&default, &reference).rel_l1;
-    let plugin_error = compare(&indirect[1], &indirect[0]).rel_l1;
-    println!(
-        "three lights: default method against brute force: plugin {plugin_error:.4}, quadray \
-         {quadray_error:.4}"
-    );
-    assert!(
-        plugin_error <= 1.5 * quadray_error.max(1e-3),
-        "{plugin_error} vs {quadray_error}"
-    );
+    let check = |what: &str, indirect: &[Vec<[f32; 3]>], kind: Option<&str>| {
+        let mut lit = scene.clone();
+        lit.lights
+            .retain(|l| kind.is_none_or(|k| l.kind_name() == k));
+        let mut renderer = Renderer::new(&gpu, &lit, Settings::sized(SIZE, SIZE, RSM)).unwrap();
+        let views = [("spot", 1), ("point", 6), ("directional", 1)];
+        let expected: usize = views
+            .iter()
+            .filter(|v| kind.is_none_or(|k| k == v.0))
+            .map(|v| v.1)
+            .sum();
+        assert_eq!(renderer.view_count(), expected, "{what}");
+        let reference = in_candela(renderer.render_frame(Method::Reference).unwrap().indirect);
+        let agreement = compare(&indirect[0], &reference);
+        let default = in_candela(renderer.render_frame(Method::DEFAULT).unwrap().indirect);
+        let quadray_error = compare(&default, &reference).rel_l1;
+        let plugin_error = compare(&indirect[1], &indirect[0]).rel_l1;
+        println!(
+            "{what}: plugin brute force against quadray's: {agreement:?}; default method against \
+             brute force: plugin {plugin_error:.4}, quadray {quadray_error:.4}"
+        );
+        assert!(agreement.rel_l1 <= 0.05, "{what}: {agreement:?}");
+        assert!(
+            plugin_error <= 1.5 * quadray_error.max(1e-3),
+            "{what}: {plugin_error} vs {quadray_error}"
+        );
+    };
+    check("three lights", &indirect, None);
+    // each kind alone, in the same app: the others' marks taken off
+    for kind in ["spot", "point", "directional"] {
+        app.world_mut().resource_mut::<Setup>().marked_kind = Some(kind);
+        for _ in 0..10 {
+            app.update();
+        }
+        let alone: Vec<_> = probes
+            .iter()
+            .map(|p| floats(p.read_indirect.lock().unwrap().as_ref().unwrap()))
+            .collect();
+        check(&format!("the {kind} light alone"), &alone, Some(kind));
+    }
 }
 
 /// Indirect shadows in the plugin walk the occupancy grid of the scene's triangles as quadray's
