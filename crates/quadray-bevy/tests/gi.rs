@@ -617,9 +617,24 @@ fn plugin_gathers_the_sun_a_point_light_and_a_spot_as_quadray_does() {
     // each kind alone, in the same app: the others' marks taken off
     for kind in ["spot", "point", "directional"] {
         app.world_mut().resource_mut::<Setup>().marked_kind = Some(kind);
-        for _ in 0..10 {
+        // until the brute force's read-back has changed and then held still for two frames
+        let read = || floats(probes[0].read_indirect.lock().unwrap().as_ref().unwrap());
+        let before = read();
+        let (mut last, mut still) = (before.clone(), 0);
+        for _ in 0..30 {
             app.update();
+            let now = read();
+            still = if now == last && now != before {
+                still + 1
+            } else {
+                0
+            };
+            last = now;
+            if still == 2 {
+                break;
+            }
         }
+        assert_eq!(still, 2, "the {kind} light alone: the bounce never settled");
         let alone: Vec<_> = probes
             .iter()
             .map(|p| floats(p.read_indirect.lock().unwrap().as_ref().unwrap()))

@@ -2,6 +2,7 @@
 //! a doctest in one of the workspace's crates (`cargo test --doc` compiles them all; the lines
 //! that set up what a snippet takes for granted are hidden from the docs with `# `).
 
+use crate::layering::rust_files;
 use std::path::{Path, PathBuf};
 
 fn workspace() -> PathBuf {
@@ -48,17 +49,6 @@ fn doctests(source: &str) -> Vec<String> {
     tests
 }
 
-fn rust_sources(dir: &Path, into: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_sources(&path, into);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            into.push(path);
-        }
-    }
-}
-
 #[test]
 fn every_readme_snippet_is_a_compiled_doctest() {
     let root = workspace();
@@ -68,7 +58,7 @@ fn every_readme_snippet_is_a_compiled_doctest() {
     for krate in std::fs::read_dir(root.join("crates")).unwrap() {
         let src = krate.unwrap().path().join("src");
         if src.is_dir() {
-            rust_sources(&src, &mut sources);
+            rust_files(&src, &mut sources);
         }
     }
     let doctests: Vec<String> = sources
