@@ -298,6 +298,7 @@ mod tests {
                 f(Settings::TILE_SHARE, 0.0, 1000.0),
                 u(Settings::MAX_LIGHTS),
                 u(Settings::SHADOW_GRID),
+                u(Settings::TILE_DEBLOCK),
             ),
         )
             .prop_map(
@@ -311,6 +312,7 @@ mod tests {
                         tile_share,
                         max_lights,
                         shadow_grid,
+                        tile_deblock,
                     ),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
@@ -346,6 +348,7 @@ mod tests {
                         tile_criterion,
                         tile_capacity,
                         tile_share,
+                        tile_deblock,
                     }
                 },
             )
@@ -393,6 +396,7 @@ mod tests {
                 Settings::TILE_CAPACITY.to_string(),
             ),
             ("--tile-share", "-1", Settings::TILE_SHARE.to_string()),
+            ("--tile-deblock", "4", Settings::TILE_DEBLOCK.to_string()),
             ("--validity", "global", validities.join(", ")),
         ] {
             // `=` so that a negative value reaches the flag's parser rather than clap's.

@@ -47,6 +47,7 @@
 
 pub mod baselines;
 pub mod blockiness;
+pub mod deblock;
 mod frame;
 pub mod gpu;
 pub mod occupancy;

@@ -13,6 +13,9 @@ use std::fmt;
 
 /// Side of a tile of receivers that shares one per-tile cut (the gather's workgroup).
 pub(crate) const TILE: u32 = 8;
+/// Two receivers lie on one surface only where their normals' dot exceeds this (upsampling,
+/// corner sharing, deblocking).
+pub(crate) const NORMAL_AGREEMENT: f32 = 0.9;
 /// Nodes a tile's frontier holds in workgroup memory (per-tile cuts, two levels of it): the
 /// most a tile's list may hold ([`Settings::tile_capacity`]).
 pub(crate) const TILE_FRONTIER: u32 = 1024;
@@ -507,6 +510,16 @@ pub struct Settings {
         value_parser = Settings::TILE_SHARE.parser(),
     ))]
     pub tile_share: f32,
+    /// quadtree-tiles: pixels on either side of each tile boundary over which a step in the
+    /// indirect light that the neighbours' slopes do not explain is spread, where those pixels
+    /// lie on one surface (neighbouring tiles' cuts differ, so their light steps where the truth
+    /// is smooth; 0: off).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.tile_deblock,
+        value_parser = Settings::TILE_DEBLOCK.parser(),
+    ))]
+    pub tile_deblock: u32,
 }
 
 impl Default for Settings {
@@ -535,6 +548,7 @@ impl Settings {
         tile_criterion: TileCriterion::Estimate,
         tile_capacity: None,
         tile_share: 2.0,
+        tile_deblock: 3,
     };
 
     /// Either side of [`Settings::size`].
@@ -569,6 +583,9 @@ impl Settings {
     pub const TILE_CAPACITY: Limits<u32> = Limits::closed(1, TILE_FRONTIER);
     /// [`Settings::tile_share`].
     pub const TILE_SHARE: Limits<f32> = Limits::closed(0.0, 1000.0).interactive(0.0, 8.0);
+    /// [`Settings::tile_deblock`]: a boundary's pixels and the one beyond on either side stay
+    /// within its two tiles, so that no two boundaries share a pixel.
+    pub const TILE_DEBLOCK: Limits<u32> = Limits::closed(0, TILE / 2 - 1);
 
     /// Bytes the per-tile cuts' lists may take, a storage buffer every adapter binds.
     pub const MAX_TILE_LIST_BYTES: u64 = 128 << 20;
@@ -721,6 +738,7 @@ impl Settings {
             Self::TILE_CAPACITY.check("tile capacity", capacity)?;
         }
         Self::TILE_SHARE.check("tile share", s.tile_share)?;
+        Self::TILE_DEBLOCK.check("tile deblock", s.tile_deblock)?;
         let bytes = s.tile_list_bytes();
         if bytes > Self::MAX_TILE_LIST_BYTES {
             return Err(format!(
@@ -809,6 +827,7 @@ mod tests {
             tile_criterion: TileCriterion::Bound,
             tile_capacity: Some(64),
             tile_share: 0.0,
+            tile_deblock: 1,
         };
         assert!(every.validate().is_ok());
         assert_flags_round_trip(

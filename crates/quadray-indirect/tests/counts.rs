@@ -149,6 +149,13 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
             r_min: scene.r_min,
         });
         let (mut evaluations, mut fetches, mut bounds) = (0, 3 * pixels, 0);
+        // the deblocking filter: on each line across a boundary not too near the picture's
+        // edge, its window's G-buffer texels and light
+        let r = s.tile_deblock;
+        let boundaries = |along: u32| (8..).step_by(8).take_while(|b| b + r < along).count();
+        let windows = boundaries(s.size.width) as u64 * u64::from(s.size.height)
+            + boundaries(s.size.height) as u64 * u64::from(s.size.width);
+        fetches += windows * u64::from(2 * r + 2) * 4;
         let tiles_x = s.size.width.div_ceil(8);
         for (tile, ((cut, &reported), twin)) in cuts.iter().zip(&estimates).zip(&twin).enumerate() {
             let (tx, ty) = (tile as u32 % tiles_x, tile as u32 / tiles_x);

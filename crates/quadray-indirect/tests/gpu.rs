@@ -280,8 +280,10 @@ fn per_tile_cuts_converge_to_the_brute_force_as_their_error_bound_shrinks() {
                 Settings {
                     tile_error: Some(tile_error),
                     tile_criterion,
-                    // every pixel sums its own list (the corners' interpolation is not exact)
+                    // every pixel sums its own list (the corners' interpolation is not exact),
+                    // and the light stays as the lists sum it
                     tile_share: 0.0,
+                    tile_deblock: 0,
                     ..settings(32)
                 },
             );
@@ -429,6 +431,8 @@ fn shared_far_clusters_are_exact_at_tile_corners_and_cut_evaluations() {
             Settings {
                 tile_criterion: TileCriterion::Estimate,
                 tile_share,
+                // the light as the corners and the lists give it
+                tile_deblock: 0,
                 ..sized()
             },
         );

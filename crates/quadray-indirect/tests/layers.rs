@@ -14,7 +14,7 @@ const LAYERS: &[&[&str]] = &[
     &["scene", "scene::builtin"],
     &["occupancy"],
     &["baselines"],
-    &["reference", "picture", "blockiness"],
+    &["reference", "picture", "blockiness", "deblock"],
     &["tile_cut"],
     &["gpu::contract"],
     &["wgsl"],

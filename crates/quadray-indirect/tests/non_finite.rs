@@ -250,6 +250,12 @@ fn bad_g_buffer_texels_act_as_empty_ones_and_change_no_other_pixel() {
         .map(|&(x, y, ..)| (y * width + x) as usize)
         .collect();
     let tile_of = |i: usize| (i as u32 % width / 8, i as u32 / width / 8);
+    // a tile shares its list, and the deblocking filter reaches half a tile past it
+    let shared_with = |b: usize, i: usize| {
+        let ((tx, ty), (x, y)) = (tile_of(b), (i as u32 % width, i as u32 / width));
+        let near = |t: u32, v: u32| (t * 8).saturating_sub(4) <= v && v < t * 8 + 12;
+        near(tx, x) && near(ty, y)
+    };
     let passes = Passes::new(&gpu, &scene);
     for method in Method::ALL {
         let (clean_indirect, clean_combined) = passes.frame(&gpu, &gbuffer, &rsm, method);
@@ -260,7 +266,7 @@ fn bad_g_buffer_texels_act_as_empty_ones_and_change_no_other_pixel() {
             Method::QuadtreeTiles => changed
                 .iter()
                 .copied()
-                .filter(|&i| bad_pixels.iter().all(|&b| tile_of(b) != tile_of(i)))
+                .filter(|&i| bad_pixels.iter().all(|&b| !shared_with(b, i)))
                 .collect(),
             _ => changed
                 .iter()

@@ -3,6 +3,7 @@
 //! within `TIE` of its threshold), where f32 sums in another order may decide the other way.
 
 use quadray_gpu::Gpu;
+use quadray_indirect::deblock::deblock;
 use quadray_indirect::tile_cut::{TileInput, tile_cuts};
 use quadray_indirect::{CutNode, Method, Renderer, Scene, Settings, TileCriterion};
 use std::collections::BTreeSet;
@@ -123,5 +124,43 @@ fn gpu_tile_cuts_equal_the_cpu_twin() {
             c.tied,
             c.lit
         );
+    }
+}
+
+/// The deblocking filter on the GPU against its CPU twin (`quadray_indirect::deblock`): the
+/// per-tile cuts' light without it, filtered on the CPU, is the light with it, and the filter
+/// changes the light at many boundaries.
+#[test]
+fn gpu_deblocking_equals_the_cpu_twin() {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let scene = Scene::load(&quadray_indirect::scene::scenes_dir().join("leak.toml")).unwrap();
+    // 72 x 56: the last column and row of tiles have a boundary too near the edge to filter
+    let frame = |tile_deblock| {
+        let settings = Settings {
+            indirect_shadows: true,
+            tile_deblock,
+            ..Settings::sized(76, 60, 32)
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+        let frame = r.render_frame(Method::QuadtreeTiles).unwrap();
+        (frame, r.read_receivers().unwrap())
+    };
+    let (plain, receivers) = frame(0);
+    {
+        let radius = Settings::DEFAULT.tile_deblock;
+        let (filtered, _) = frame(radius);
+        let mut twin = plain.indirect.clone();
+        deblock(&mut twin, &receivers, plain.width as usize, radius as usize);
+        let scale = twin.iter().flatten().fold(0.0f32, |m, v| m.max(v.abs()));
+        let far = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+            a.iter()
+                .zip(b)
+                .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > 1e-5 * scale))
+                .count()
+        };
+        let changed = far(&plain.indirect, &twin);
+        println!("radius {radius}: {changed} pixels changed");
+        assert!(changed > 200, "radius {radius}: {changed} pixels changed");
+        assert_eq!(far(&filtered.indirect, &twin), 0, "radius {radius}");
     }
 }

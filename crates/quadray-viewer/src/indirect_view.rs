@@ -525,6 +525,11 @@ impl IndirectView {
             Settings::TILE_SHARE,
             "shared beyond, tile extents (quadtree-tiles, 0: off)",
         ));
+        ui.add(limits_slider(
+            &mut s.tile_deblock,
+            Settings::TILE_DEBLOCK,
+            "deblocking, pixels each side (quadtree-tiles, 0: off)",
+        ));
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
         ui.checkbox(&mut s.indirect_shadows, "indirect shadows (quadtree)");

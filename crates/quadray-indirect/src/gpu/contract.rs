@@ -145,6 +145,7 @@ pub(crate) struct ShadeUniform {
     pub tiles_x: u32,
     pub tile_estimate: u32,
     pub tile_share: f32,
+    pub tile_deblock: u32,
 }
 
 /// WGSL `LightTerms`: the gather's per-view values (the kernel's clamp, the lengths that scale

@@ -61,7 +61,8 @@ fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
                 tile_start,
                 tiles_x,
                 tile_estimate,
-                tile_share
+                tile_share,
+                tile_deblock
             ]
         ),
         shared!(

@@ -255,6 +255,9 @@ impl Gather {
                     (Method::Reference, None) => self.brute_force.record(&mut pass, res),
                 }
             }
+            if method == Method::QuadtreeTiles {
+                self.tiles.record_deblock(&mut pass, res);
+            }
             if filtered && upsampled.is_none() {
                 self.temporal.record_blend(&mut pass, res);
             }

@@ -17,7 +17,7 @@ use crate::gpu::light::LightView;
 use crate::gpu::quadtree::LightQuadtree;
 use crate::gpu::rsm::RsmViews;
 use crate::occupancy::OccupancyGrid;
-use crate::settings::{Settings, TileCriterion};
+use crate::settings::{NORMAL_AGREEMENT, Settings, TileCriterion};
 use crate::wgsl;
 use wgpu::util::DeviceExt;
 
@@ -46,7 +46,7 @@ fn shade_uniform(s: &Settings) -> ShadeUniform {
         subsample: s.subsample,
         low_width,
         low_height,
-        normal_agreement: 0.9,
+        normal_agreement: NORMAL_AGREEMENT,
         shadow_steps: s.march_steps(),
         temporal_weight: s.temporal_weight,
         tile_error: s.tile_error_or_default(),
@@ -55,6 +55,7 @@ fn shade_uniform(s: &Settings) -> ShadeUniform {
         tiles_x: s.tiles().0,
         tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
         tile_share: s.tile_share,
+        tile_deblock: s.tile_deblock,
     }
 }
 

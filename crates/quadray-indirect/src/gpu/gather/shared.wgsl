@@ -26,6 +26,9 @@ struct Shade {
     // per-tile cuts: nodes farther than this times the tile's receivers' diagonal are gathered
     // at the tile's corners and interpolated (0: every pixel evaluates every node)
     tile_share: f32,
+    // per-tile cuts: pixels on either side of a tile boundary its unexplained step is spread
+    // over (0: none; deblock.wgsl)
+    tile_deblock: u32,
 }
 
 // Per light view, with the light: the kernel's clamp, the lengths that scale with the scene and

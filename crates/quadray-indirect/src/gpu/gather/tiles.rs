@@ -1,16 +1,22 @@
 //! Per-tile cuts ([`Method::QuadtreeTiles`]): one workgroup a tile of 8x8 pixels refines
 //! its own cut of the light quadtree against a bound of each node's contribution, then its pixels
-//! sum it. The tiles' lists are this pass's own group 3.
+//! sum it, and the light's steps at the tiles' boundaries are smoothed where the pixels lie on
+//! one surface (`deblock.wgsl`). The tiles' lists are this pass's own group 3.
 
 use super::resources::Resources;
 #[cfg(doc)]
 use crate::Method;
-use crate::gpu::contract::{bind_group, layout, storage_buffer, storage_entry, whole};
+use crate::gpu::contract::{bind_group, dispatch_2d, layout, storage_buffer, storage_entry, whole};
 use crate::wgsl;
 use std::sync::OnceLock;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 3] = [wgsl::BOUND, wgsl::TILE_RULE, include_str!("tiles.wgsl")];
+pub(crate) const WGSL: [&str; 4] = [
+    wgsl::BOUND,
+    wgsl::TILE_RULE,
+    include_str!("tiles.wgsl"),
+    include_str!("deblock.wgsl"),
+];
 
 /// The per-tile cuts' lists and their bind group (group 3).
 struct TileLists {
@@ -24,6 +30,8 @@ struct TileLists {
 
 pub(crate) struct Tiles {
     pipeline: wgpu::ComputePipeline,
+    /// The deblocking filter across the columns' boundaries, then across the rows'.
+    deblock: [wgpu::ComputePipeline; 2],
     lists_layout: wgpu::BindGroupLayout,
     /// Allocated by the first frame (up to [`crate::Settings::MAX_TILE_LIST_BYTES`]), so that
     /// the other methods pay nothing for them.
@@ -42,15 +50,16 @@ impl Tiles {
                 storage_entry::<[u32; 4]>(1, false),
             ],
         );
-        let [pipeline] = res.pipelines(
+        let [pipeline, columns, rows] = res.pipelines(
             device,
             "gather tiles",
             &WGSL,
-            ["indirect_tiles"],
+            ["indirect_tiles", "deblock_columns", "deblock_rows"],
             &[&lists_layout],
         );
         Self {
             pipeline,
+            deblock: [columns, rows],
             lists_layout,
             lists: OnceLock::new(),
             device: device.clone(),
@@ -78,6 +87,25 @@ impl Tiles {
         pass.set_pipeline(&self.pipeline);
         res.bind_dispatch(pass, 0, 0);
         pass.dispatch_workgroups(tx, ty, 1);
+    }
+
+    /// Records the deblocking filter over the light every view's tiles summed, where
+    /// [`crate::Settings::tile_deblock`] asks for it: one invocation a boundary and line of
+    /// pixels, the columns' boundaries first. Needs the lists' group that [`Tiles::record`] set.
+    pub fn record_deblock(&self, pass: &mut wgpu::ComputePass, res: &Resources) {
+        let s = res.settings();
+        if s.tile_deblock == 0 {
+            return;
+        }
+        let (tx, ty) = s.tiles();
+        res.bind_dispatch(pass, 0, 0);
+        let lines = [(tx - 1, s.size.height), (ty - 1, s.size.width)];
+        for (pipeline, (boundaries, lines)) in self.deblock.iter().zip(lines) {
+            if boundaries > 0 {
+                pass.set_pipeline(pipeline);
+                dispatch_2d(pass, boundaries, lines);
+            }
+        }
     }
 
     /// The last per-tile cuts, `None` before the first frame: per tile, its node indices
