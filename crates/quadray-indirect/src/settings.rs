@@ -463,7 +463,7 @@ pub struct Settings {
     /// the 4x4x4 sub-cells of every set cell, walked where the walk meets a set cell, so that an
     /// opening is narrowed by a sub-cell on each side rather than by a cell (two words a set
     /// cell; at most 128 cells with 2 levels). Two by default: on the visibility scenes tuned on,
-    /// the FLIP to the truth 0.084 -> 0.056 (corridor) and 0.020 -> 0.016 (gap) for 11-20% more
+    /// the FLIP to the truth 0.084 -> 0.056 (corridor) and 0.020 -> 0.016 (gap) for 10-20% more
     /// fetches, and the deblocking filter (--tile-deblock) takes the tile structure the sharper
     /// visibility gives (BENCHMARKS.md).
     #[cfg_attr(feature = "cli", arg(
