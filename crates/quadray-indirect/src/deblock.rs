@@ -10,14 +10,16 @@
 use crate::frame::Receiver;
 use crate::settings::{NORMAL_AGREEMENT, TILE};
 
-/// An unexplained step larger than the light beside it is the light's own edge: kept.
-const LIMIT: f32 = 1.0;
+/// An unexplained step larger than the light beside it is the light's own edge: kept (the
+/// shader's `DEBLOCK_LIMIT`, in its prelude).
+pub(crate) const LIMIT: f32 = 1.0;
 /// Two neighbours lie on one surface where their normals agree ([`NORMAL_AGREEMENT`]) and the
 /// step between them leaves their plane by at most this sine (a silhouette's steps along the
-/// view ray).
-const PLANE: f32 = 0.2;
-/// Albedo below this leaves a channel's light as it is (no irradiance to recover).
-const ALBEDO: f32 = 1e-4;
+/// view ray; `DEBLOCK_PLANE`).
+pub(crate) const PLANE: f32 = 0.2;
+/// Albedo below this leaves a channel's light as it is (no irradiance to recover;
+/// `DEBLOCK_ALBEDO`).
+pub(crate) const ALBEDO: f32 = 1e-4;
 
 /// Filters `radiance` (a `width`-wide picture's indirect light, rows top down) over
 /// `receivers` (its G-buffer: `None` where it sees no geometry) with `radius` pixels each side

@@ -4,6 +4,7 @@
 //! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
 //! shared struct's size and field offsets against these.
 
+use crate::deblock::{ALBEDO as DEBLOCK_ALBEDO, LIMIT as DEBLOCK_LIMIT, PLANE as DEBLOCK_PLANE};
 use crate::occupancy::{BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS, SUBCELLS};
 pub(crate) use crate::settings::{
     CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, TILE, TILE_FRONTIER,
@@ -60,7 +61,10 @@ pub(crate) fn prelude() -> String {
          const OCCUPANCY_END_OFFSET: f32 = {END_OFFSET_CELLS:?};\n\
          const OCCUPANCY_END_CLEARANCE: f32 = {END_CLEARANCE_CELLS:?};\n\
          const OCCUPANCY_BRICK = vec3<u32>({}u, {}u, {}u);\n\
-         const OCCUPANCY_SUBCELLS: u32 = {SUBCELLS}u;\n",
+         const OCCUPANCY_SUBCELLS: u32 = {SUBCELLS}u;\n\
+         const DEBLOCK_LIMIT: f32 = {DEBLOCK_LIMIT:?};\n\
+         const DEBLOCK_PLANE: f32 = {DEBLOCK_PLANE:?};\n\
+         const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};\n",
         std::f32::consts::PI,
         OutputTerm::Indirect as u32,
         OutputTerm::Direct as u32,
@@ -449,6 +453,9 @@ mod tests {
             format!("const EMPTY_BOX: f32 = {EMPTY_BOX:?};"),
             format!("const CONE_SLACK: f32 = {CONE_SLACK:?};"),
             format!("const SPLIT_BINS: u32 = {SPLIT_BINS}u;"),
+            format!("const DEBLOCK_LIMIT: f32 = {DEBLOCK_LIMIT:?};"),
+            format!("const DEBLOCK_PLANE: f32 = {DEBLOCK_PLANE:?};"),
+            format!("const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};"),
         ] {
             assert!(prelude.contains(&line), "{line}");
         }

@@ -7,13 +7,10 @@
 // their detail. Boundaries' windows do not overlap (`Settings::TILE_DEBLOCK`), so that each
 // invocation filters its own in place. The CPU's twin is `deblock.rs`.
 
-// An unexplained step larger than the light beside it is the light's own edge: kept.
-const DEBLOCK_LIMIT: f32 = 1.0;
-// Two neighbours lie on one surface where their normals agree and the step between them leaves
-// their plane by at most this sine (a silhouette's steps along the view ray).
-const DEBLOCK_PLANE: f32 = 0.2;
-// Albedo below this leaves a channel's light as it is (no irradiance to recover).
-const DEBLOCK_ALBEDO: f32 = 1e-4;
+// DEBLOCK_LIMIT (an unexplained step larger than this times the light beside it is the light's
+// own edge: kept), DEBLOCK_PLANE (the sine by which a step between two neighbours on one surface
+// may leave their plane) and DEBLOCK_ALBEDO (below it a channel's light is left as it is) come
+// from the prelude, the twin's constants.
 
 fn one_surface(a: Receiver, b: Receiver) -> bool {
     let d = b.x - a.x;
