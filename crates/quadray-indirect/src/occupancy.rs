@@ -50,8 +50,12 @@ pub struct Walk {
     /// enters a set cell of the brick, and one each time it enters a half of a set cell's
     /// sub-cells it has not just read).
     pub fetches: u32,
-    /// Cells and sub-cells tested (what a grid of a word a cell would have fetched).
+    /// Cells and sub-cells the segment crossed up to the answer (what a grid of a word a cell
+    /// would have fetched).
     pub cells: u32,
+    /// Steps of the walk's loop: a cell, a sub-cell, or an empty brick crossed in one step
+    /// (its work on a GPU, beside the fetches).
+    pub steps: u32,
 }
 
 /// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell; in a grid of
@@ -189,7 +193,8 @@ impl OccupancyGrid {
     /// stays); `None` where a moved end lies in a set cell (another surface within two cells
     /// of it: in a corner, under a box) or the walk enters a set cell within
     /// [`END_CLEARANCE_CELLS`] of an end, which the grid cannot judge. Visits the cells the
-    /// segment passes through, in order (a 3D DDA).
+    /// segment passes through, in order (a 3D DDA), and crosses a brick whose word is zero in
+    /// one step.
     pub fn visible(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Option<bool> {
         self.walk(x, n, xp, np).visible
     }
@@ -203,6 +208,7 @@ impl OccupancyGrid {
             visible,
             fetches: reader.fetches,
             cells: reader.cells,
+            steps: reader.steps,
         }
     }
 
@@ -248,6 +254,7 @@ impl OccupancyGrid {
             cells
         };
         for _ in 0..bound {
+            reader.steps += 1;
             if let Some(w) = &mut sub {
                 if w.entered <= 1.0 {
                     if reader.sub_occupied(w.s) {
@@ -264,8 +271,46 @@ impl OccupancyGrid {
                 break;
             }
             // the parameter where the walk enters its next cell
-            let entered = t_max.min_element();
-            if t_max.x <= t_max.y && t_max.x <= t_max.z {
+            let mut entered = t_max.min_element();
+            if reader.in_empty_brick(c) {
+                // an empty brick: on to the cell where the segment leaves it, in one step
+                let lo = c.div_euclid(BRICK.as_ivec3()) * BRICK.as_ivec3();
+                let hi = lo + BRICK.as_ivec3();
+                let leaving = |i: usize| {
+                    let face = if step[i] > 0 { hi[i] } else { lo[i] };
+                    face_at(face as f32, a[i], d[i])
+                };
+                let exit = Vec3::new(leaving(0), leaving(1), leaving(2));
+                entered = exit.min_element();
+                if entered > 1.0 {
+                    // the end's cell is in the brick
+                    break;
+                }
+                // the cell across the face it leaves by (ties as the DDA's), kept beside the
+                // brick against rounding
+                let mut next = (a + d * entered).floor().as_ivec3().clamp(lo, hi - 1);
+                let axis = if exit.x <= exit.y && exit.x <= exit.z {
+                    0
+                } else if exit.y <= exit.z {
+                    1
+                } else {
+                    2
+                };
+                next[axis] = if step[axis] > 0 {
+                    hi[axis]
+                } else {
+                    lo[axis] - 1
+                };
+                // the cells a walk of a cell a step would have tested on the way
+                reader.cells += (next - c).abs().element_sum().max(1) as u32 - 1;
+                c = next;
+                let next_face = (c + step.max(IVec3::ZERO)).as_vec3();
+                t_max = Vec3::new(
+                    face_at(next_face.x, a.x, d.x),
+                    face_at(next_face.y, a.y, d.y),
+                    face_at(next_face.z, a.z, d.z),
+                );
+            } else if t_max.x <= t_max.y && t_max.x <= t_max.z {
                 c.x += step.x;
                 t_max.x += t_delta.x;
             } else if t_max.y <= t_max.z {
@@ -419,6 +464,7 @@ struct WordReader<'a> {
     sub_word: Option<(usize, u32)>,
     fetches: u32,
     cells: u32,
+    steps: u32,
 }
 
 impl WordReader<'_> {
@@ -430,6 +476,7 @@ impl WordReader<'_> {
             sub_word: None,
             fetches: 0,
             cells: 0,
+            steps: 0,
         }
     }
 
@@ -472,6 +519,13 @@ impl WordReader<'_> {
             }
         };
         mask >> b & 1 == 1
+    }
+
+    /// Whether the word of cell `c`'s brick is held and zero: no cell of the brick is set.
+    fn in_empty_brick(&self, c: IVec3) -> bool {
+        self.grid
+            .index(c)
+            .is_some_and(|(index, _)| self.word == Some((index, 0)))
     }
 
     fn occupied(&mut self, c: IVec3) -> bool {
@@ -576,6 +630,15 @@ fn inverse(d: f32) -> f32 {
     }
 }
 
+/// The segment parameter at which it reaches the plane `face` of an axis, from `a` moving `d`.
+fn face_at(face: f32, a: f32, d: f32) -> f32 {
+    if d == 0.0 {
+        f32::INFINITY
+    } else {
+        (face - a) / d
+    }
+}
+
 /// The segment parameter at which it first crosses a face of the axis, from `a` moving `d`.
 fn first_crossing(a: f32, d: f32) -> f32 {
     if d > 0.0 {
@@ -664,6 +727,22 @@ mod tests {
         // starts in a set cell
         let corner = grid.visible(Vec3::new(0.51, 0.0, 0.5), up, right, up);
         assert_eq!(corner, None, "at the wall's foot");
+    }
+
+    #[test]
+    fn a_walk_crosses_an_empty_brick_in_one_step() {
+        for levels in [1, 2] {
+            let grid = OccupancyGrid::with_levels(&floor_and_wall(0.5), 32, levels);
+            // above the floor and left of the wall, through empty bricks only
+            let (from, to) = (Vec3::new(0.02, 0.3, 0.4), Vec3::new(0.45, 0.4, 0.5));
+            let free = grid.walk(from, Vec3::ZERO, to, Vec3::ZERO);
+            assert_eq!(free.visible, Some(true), "{levels} levels");
+            // a brick spans 4 cells along x and y and 2 along z
+            assert!(free.steps * 2 <= free.cells, "{levels} levels: {free:?}");
+            // on through the wall: blocked
+            let across = grid.walk(from, Vec3::ZERO, to + Vec3::X * 0.5, Vec3::ZERO);
+            assert_eq!(across.visible, Some(false), "{levels} levels");
+        }
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The occupancy grid's walk on the GPU (`wgsl/occupancy.wgsl`, `grid_visibility`) against its CPU
 //! twin ([`OccupancyGrid::walk`]) on segments between random points of the leak scene's
 //! surfaces, through a grid of one level and one of two: the same answers from the same word
-//! fetches.
+//! fetches in the same steps.
 
 use super::contract::{
     bind_group, compute_pipeline, layout, pipeline_layout, shader_module, storage_buffer,
@@ -28,7 +28,7 @@ const ENTRY: &str = "
 struct Segment { x: vec4<f32>, n: vec4<f32>, xp: vec4<f32>, np: vec4<f32> }
 @group(0) @binding(0) var<storage, read> grid: array<u32>;
 @group(0) @binding(1) var<storage, read> segments: array<Segment>;
-@group(0) @binding(2) var<storage, read_write> seen: array<vec2<u32>>;
+@group(0) @binding(2) var<storage, read_write> seen: array<vec3<u32>>;
 fn occupancy_dims() -> vec3<u32> { return vec3<u32>(grid[0], grid[1], grid[2]); }
 fn occupancy_levels() -> u32 { return grid[3]; }
 fn occupancy_origin() -> vec3<f32> { return bitcast<vec3<f32>>(vec3<u32>(grid[4], grid[5], grid[6])); }
@@ -39,17 +39,17 @@ fn walk(@builtin(global_invocation_id) id: vec3<u32>) {
 if (id.x < arrayLength(&segments)) {
     let s = segments[id.x];
     let verdict = grid_visibility(s.x.xyz, s.n.xyz, s.xp.xyz, s.np.xyz);
-    seen[id.x] = vec2<u32>(verdict, fetches);
+    seen[id.x] = vec3<u32>(verdict, fetches, walk_steps);
 }
 }
 ";
 
-/// Each segment's `grid_visibility` (visible, blocked, `None` unknown) and its fetches, for each
-/// grid.
+/// Each segment's `grid_visibility` (visible, blocked, `None` unknown), its fetches and its
+/// loop's steps, for each grid.
 fn walks_on_the_gpu(
     grids: &[OccupancyGrid],
     segments: &[Segment],
-) -> Vec<Vec<(Option<bool>, u32)>> {
+) -> Vec<Vec<(Option<bool>, u32, u32)>> {
     let gpu = quadray_gpu::Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     let d = &gpu.device;
     let group_layout = layout(
@@ -58,7 +58,7 @@ fn walks_on_the_gpu(
         &[
             storage_entry::<[u32; HEADER_WORDS + 1]>(0, true),
             storage_entry::<Segment>(1, true),
-            storage_entry::<[u32; 2]>(2, false),
+            storage_entry::<[u32; 4]>(2, false),
         ],
     );
     let module = shader_module(d, "grid walks", &[wgsl::NODE, wgsl::OCCUPANCY, ENTRY]);
@@ -73,7 +73,7 @@ fn walks_on_the_gpu(
     let input = buffer("segments", bytemuck::cast_slice(segments));
     let walk = |grid: &OccupancyGrid| {
         let words = buffer("grid", bytemuck::cast_slice(&grid.gpu_words()));
-        let output = storage_buffer(d, "seen", segments.len() as u64 * 8);
+        let output = storage_buffer(d, "seen", segments.len() as u64 * 16);
         let group = bind_group(
             d,
             "grid walks",
@@ -89,9 +89,11 @@ fn walks_on_the_gpu(
         }
         gpu.queue.submit([encoder.finish()]);
         let bytes = quadray_gpu::read_buffer(&gpu, &output).unwrap();
-        bytemuck::pod_collect_to_vec::<u8, [u32; 2]>(&bytes)
+        bytemuck::pod_collect_to_vec::<u8, [u32; 4]>(&bytes)
             .into_iter()
-            .map(|[verdict, fetches]| ((verdict != 2).then_some(verdict == 1), fetches))
+            .map(|[verdict, fetches, steps, _]| {
+                ((verdict != 2).then_some(verdict == 1), fetches, steps)
+            })
             .collect()
     };
     grids.iter().map(walk).collect()
@@ -146,14 +148,15 @@ fn the_gpu_walks_the_grid_as_the_cpu_does() {
         let differ = cpu
             .iter()
             .zip(&gpu)
-            .filter(|(a, b)| (a.visible, a.fetches) != **b)
+            .filter(|(a, b)| (a.visible, a.fetches, a.steps) != **b)
             .count();
         let fetches: u32 = cpu.iter().map(|w| w.fetches).sum();
         let cells: u32 = cpu.iter().map(|w| w.cells).sum();
+        let steps: u32 = cpu.iter().map(|w| w.steps).sum();
         println!(
             "{levels} levels: of {} segments on the CPU {visible} visible, {unknown} unknown; \
-             the GPU differs on {differ} (answer or fetches); {fetches} words fetched for \
-             {cells} cells tested",
+             the GPU differs on {differ} (answer, fetches or steps); {fetches} words fetched \
+             and {steps} steps for {cells} cells crossed",
             cases.len()
         );
         // a word a brick (and a half of a set cell's sub-cells): a walk crossing several

@@ -21,16 +21,36 @@ struct OccupancyHeld {
     sub_bits: u32,
 }
 
-// Whether cell `c` is set (outside the grid: no).
-fn occupied(c: vec3<i32>, held: ptr<function, OccupancyHeld>) -> bool {
+// The walks' loop steps (a cell, a sub-cell, or an empty brick crossed in one step), as the CPU
+// twin counts them (`Walk::steps`).
+var<private> walk_steps: u32;
+
+const OUTSIDE_GRID = 0xffffffffu;
+
+// The index of the word of cell `c`'s brick (OUTSIDE_GRID outside the grid).
+fn brick_word(c: vec3<i32>) -> u32 {
     let d = occupancy_dims();
     if (any(c < vec3<i32>(0)) || any(vec3<u32>(c) >= d)) {
-        return false;
+        return OUTSIDE_GRID;
     }
     let bricks = d / OCCUPANCY_BRICK;
     let b = vec3<u32>(c) / OCCUPANCY_BRICK;
+    return b.x + bricks.x * (b.y + bricks.y * b.z);
+}
+
+// Whether the walk holds cell `c`'s brick's word and it is zero: no cell of the brick is set.
+fn in_empty_brick(c: vec3<i32>, held: OccupancyHeld) -> bool {
+    let word = brick_word(c);
+    return word != OUTSIDE_GRID && held.word == word + 1u && held.bits == 0u;
+}
+
+// Whether cell `c` is set (outside the grid: no).
+fn occupied(c: vec3<i32>, held: ptr<function, OccupancyHeld>) -> bool {
+    let word = brick_word(c);
+    if (word == OUTSIDE_GRID) {
+        return false;
+    }
     let l = vec3<u32>(c) % OCCUPANCY_BRICK;
-    let word = b.x + bricks.x * (b.y + bricks.y * b.z);
     if ((*held).word != word + 1u) {
         fetches++;
         (*held).word = word + 1u;
@@ -85,6 +105,11 @@ fn occupancy_end(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 
 fn occupancy_inverse(d: f32) -> f32 {
     return select(1.0 / abs(d), 3.0e38, d == 0.0);
+}
+
+// The segment parameter where the segment from `a` moving `d` (one axis) reaches `face`.
+fn occupancy_face_at(face: f32, a: f32, d: f32) -> f32 {
+    return select((face - a) / d, 3.0e38, d == 0.0);
 }
 
 fn occupancy_first_crossing(a: f32, d: f32) -> f32 {
@@ -168,8 +193,8 @@ fn sub_step(w: ptr<function, SubWalk>) -> bool {
 }
 
 // The segment from `x` (a receiver, normal `n`) to `xp` (a cluster, normal `np`) through the
-// grid: a 3D DDA over the cells it passes through, bounded by the grid's dimensions, and with two
-// levels over the sub-cells of the set cells among them.
+// grid: a 3D DDA over the cells it passes through, bounded by the grid's dimensions, crossing an
+// empty brick in one step, and with two levels over the sub-cells of the set cells among them.
 fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> u32 {
     let a = occupancy_end(x, n);
     let b = occupancy_end(xp, np);
@@ -204,6 +229,7 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
     let cells = dims.x + dims.y + dims.z + 1u;
     let bound = select(cells, cells * (3u * OCCUPANCY_SUBCELLS + 1u), two_levels);
     for (var i = 0u; i < bound; i++) {
+        walk_steps++;
         if (in_sub) {
             if (w.entered <= 1.0) {
                 if (sub_occupied(w.s, &held)) {
@@ -221,8 +247,38 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
             break;
         }
         // the parameter where the walk enters its next cell
-        let entered = min(t_max.x, min(t_max.y, t_max.z));
-        if (t_max.x <= t_max.y && t_max.x <= t_max.z) {
+        var entered = min(t_max.x, min(t_max.y, t_max.z));
+        if (in_empty_brick(c, held)) {
+            // an empty brick: on to the cell where the segment leaves it, in one step
+            let lo = c / vec3<i32>(OCCUPANCY_BRICK) * vec3<i32>(OCCUPANCY_BRICK);
+            let hi = lo + vec3<i32>(OCCUPANCY_BRICK);
+            let exit = vec3<f32>(
+                occupancy_face_at(f32(select(lo.x, hi.x, step.x > 0)), a.x, d.x),
+                occupancy_face_at(f32(select(lo.y, hi.y, step.y > 0)), a.y, d.y),
+                occupancy_face_at(f32(select(lo.z, hi.z, step.z > 0)), a.z, d.z),
+            );
+            entered = min(exit.x, min(exit.y, exit.z));
+            if (entered > 1.0) {
+                // the end's cell is in the brick
+                break;
+            }
+            // the cell across the face it leaves by (ties as the DDA's), kept beside the brick
+            // against rounding
+            c = clamp(vec3<i32>(floor(a + d * entered)), lo, hi - vec3<i32>(1));
+            if (exit.x <= exit.y && exit.x <= exit.z) {
+                c.x = select(lo.x - 1, hi.x, step.x > 0);
+            } else if (exit.y <= exit.z) {
+                c.y = select(lo.y - 1, hi.y, step.y > 0);
+            } else {
+                c.z = select(lo.z - 1, hi.z, step.z > 0);
+            }
+            let next_face = vec3<f32>(c + max(step, vec3<i32>(0)));
+            t_max = vec3<f32>(
+                occupancy_face_at(next_face.x, a.x, d.x),
+                occupancy_face_at(next_face.y, a.y, d.y),
+                occupancy_face_at(next_face.z, a.z, d.z),
+            );
+        } else if (t_max.x <= t_max.y && t_max.x <= t_max.z) {
             c.x += step.x;
             t_max.x += t_delta.x;
         } else if (t_max.y <= t_max.z) {
