@@ -64,6 +64,7 @@ fn bounds_on_the_gpu(cases: &[BoundCase]) -> Vec<f32> {
         &pipeline_layout(d, &[&group_layout]),
         &module,
         "bound_cases",
+        &[],
     );
     let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("bound cases"),

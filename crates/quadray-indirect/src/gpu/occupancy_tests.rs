@@ -62,7 +62,13 @@ fn walks_on_the_gpu(
         ],
     );
     let module = shader_module(d, "grid walks", &[wgsl::NODE, wgsl::OCCUPANCY, ENTRY]);
-    let pipeline = compute_pipeline(d, &pipeline_layout(d, &[&group_layout]), &module, "walk");
+    let pipeline = compute_pipeline(
+        d,
+        &pipeline_layout(d, &[&group_layout]),
+        &module,
+        "walk",
+        &[],
+    );
     let buffer = |label, contents: &[u8]| {
         d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),

@@ -1,8 +1,8 @@
 //! The output pass: the gather's radiance written into the caller's texture.
 
 use super::contract::{
-    OutputTerm, bind_group, compute_pass, dispatch_2d, layout, pipeline_layout, shader_module,
-    storage_entry, whole,
+    OutputTerm, bind_group, compute_pass, compute_pipeline, dispatch_2d, layout, pipeline_layout,
+    shader_module, storage_entry, whole,
 };
 use super::gather::Gather;
 use crate::IndirectError;
@@ -64,17 +64,13 @@ impl OutputPass {
         );
         let [source] = sources(name);
         let module = shader_module(device, "output", &[&source]);
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("output"),
-            layout: Some(&pipeline_layout(device, &[&group_layout])),
-            module: &module,
-            entry_point: Some("write_output"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &[("TERM", f64::from(term as u32))],
-                ..Default::default()
-            },
-            cache: None,
-        });
+        let pipeline = compute_pipeline(
+            device,
+            &pipeline_layout(device, &[&group_layout]),
+            &module,
+            "write_output",
+            &[("TERM", f64::from(term as u32))],
+        );
         Ok(Self {
             pipeline,
             group_layout,

@@ -84,7 +84,7 @@ impl LightQuadtree {
         );
         let module = shader_module(device, "quadtree", &SOURCES);
         let pipelines = pipeline_layout(device, &[&group_layout, &level_layout]);
-        let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry);
+        let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry, &[]);
         let node_size = size_of::<GpuNode>() as u64;
         let params = uniform_buffer::<ClusterUniform>(device, "cluster settings");
         let nodes = storage_buffer(device, "nodes", node_count(rsm_size) * node_size);

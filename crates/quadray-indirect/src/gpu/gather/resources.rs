@@ -411,7 +411,12 @@ impl Resources {
         .chain(own_groups.iter().copied())
         .collect();
         let layout = pipeline_layout(device, &groups);
-        entries.map(|entry| compute_pipeline(device, &layout, &module, entry))
+        // the pipeline constant SHADOWS (shared.wgsl)
+        let shadows = [(
+            "SHADOWS",
+            f64::from(u8::from(self.settings.march_steps() > 0)),
+        )];
+        entries.map(|entry| compute_pipeline(device, &layout, &module, entry, &shadows))
     }
 
     /// Binds light view `view`'s group and the frame's.

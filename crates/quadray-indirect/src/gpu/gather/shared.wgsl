@@ -2,6 +2,11 @@
 // light, camera and per-dispatch uniforms, the RSM, quadtree and G-buffer, the outputs, and the
 // helpers every pass shares.
 
+// Whether the gather tests indirect shadows (shade.shadow_steps > 0): a pipeline constant, so
+// that a gather without them compiles no visibility test at all. A walk inlined in a summing
+// loop, even one that never runs, made that loop 4-11 times slower on lavapipe.
+override SHADOWS: bool;
+
 // The gather's settings, written once.
 struct Shade {
     sample_count: u32,
@@ -145,7 +150,7 @@ fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
     let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
     // (branches, not `||`: the visibility test's loops must not run without shadows, as
     // lavapipe counts their iterations towards the summing loop's cap)
-    if (shade.shadow_steps > 0u && any(e != vec3<f32>(0.0))) {
+    if (SHADOWS && any(e != vec3<f32>(0.0))) {
         if (!visible(r.x, r.n, node.pos.xyz, node.normal.xyz)) {
             return vec3<f32>(0.0);
         }

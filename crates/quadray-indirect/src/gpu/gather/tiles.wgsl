@@ -436,17 +436,28 @@ fn pixel_sum(local: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_c
         }
         irradiance += max(vec3<f32>(0.0), r.n * v);
     }
+    if (SHADOWS && !corner_seen) {
+        // (a loop of its own: a walk inlined in the loop below made it twice as slow on
+        // lavapipe where it never ran)
+        for (var i = 0u; i < listed; i++) {
+            let entry = frontier[0][i];
+            if ((entry & SHARED) == 0u || !on_patch) {
+                fetches++;
+                irradiance += node_irradiance(nodes[entry & ~SHARED], r);
+            }
+        }
+        return irradiance;
+    }
     for (var i = 0u; i < listed; i++) {
         let entry = frontier[0][i];
         if ((entry & SHARED) == 0u || !on_patch) {
             fetches++;
             let node = nodes[entry & ~SHARED];
+            var seen = 1.0;
             if (corner_seen) {
-                let seen = vec4<f32>((vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u)) & vec4<u32>(1u));
-                irradiance += dot(seen_weights, seen) * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
-            } else {
-                irradiance += node_irradiance(node, r);
+                seen = dot(seen_weights, vec4<f32>((vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u)) & vec4<u32>(1u)));
             }
+            irradiance += seen * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
         }
     }
     return irradiance;
@@ -478,7 +489,7 @@ fn indirect_tiles(
     storageBarrier();
     let listed = atomicLoad(&list_len);
     let corners_covered = all_corners_covered();
-    let corner_shadows = shade.shadow_steps > 0u && corners_covered;
+    let corner_shadows = SHADOWS && corners_covered;
     let sharing = shade.tile_share > 0.0 && corners_covered;
     let shared_nodes = list_for_gather(local, tile, listed, groups, sharing, corner_shadows);
     var corner_vectors: array<mat3x3<f32>, 4>;
