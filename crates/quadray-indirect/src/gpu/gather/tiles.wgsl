@@ -64,15 +64,22 @@ fn tile_sample(q: u32) -> u32 {
     return atomicLoad(&quadrant_pixel[q]);
 }
 
-// Indirect shadows per tile: bit c set where the point `p` (a node's mean) is visible from the
-// tile's corner receiver c (`visible`, shared.wgsl); a pixel on the corners' surface weighs each
-// of its tile's nodes by the corners' visibility interpolated, so that a tile marches four
-// shadow rays a node instead of one a pixel.
+// Indirect shadows per tile: bit c + 4 set where the node at `p` (its mean, mean normal `np`)
+// faces the tile's corner receiver c, and then bit c where the corner sees it (`visible`,
+// shared.wgsl); a pixel on the corners' surface weighs each of its tile's nodes by the
+// visibility of the corners the node faces, interpolated, so that a tile marches at most four
+// shadow rays a node instead of one a pixel. (A corner behind the node's plane gets no light
+// from it and no ray: 12-22% fewer fetches on the visibility scenes, the same pictures or
+// better. Skipping the corners whose plane the node is behind too made the door scene's
+// shadows blocky, 0.87 -> 1.35.)
 fn corner_visibility(p: vec3<f32>, np: vec3<f32>) -> u32 {
     var seen = 0u;
     for (var c = 0u; c < 4u; c++) {
-        if (visible(tile_x[CORNERS[c]], tile_n[CORNERS[c]], p, np)) {
-            seen |= 1u << c;
+        if (dot(np, tile_x[CORNERS[c]] - p) > 0.0) {
+            seen |= 1u << (c + 4u);
+            if (visible(tile_x[CORNERS[c]], tile_n[CORNERS[c]], p, np)) {
+                seen |= 1u << c;
+            }
         }
     }
     return seen;
@@ -378,7 +385,8 @@ fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat
         if ((entry & SHARED) != 0u) {
             fetches++;
             let node = nodes[entry & ~SHARED];
-            // (evaluated either way, as a pixel's own sum does before its shadow test)
+            // (evaluated either way, as a pixel's own sum does before its shadow test; a corner
+            // the node does not face had no ray, and gets no light from it)
             let seen = !corner_shadows || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
             v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, terms.r_min) * f32(seen);
         }
@@ -455,7 +463,12 @@ fn pixel_sum(local: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_c
             let node = nodes[entry & ~SHARED];
             var seen = 1.0;
             if (corner_seen) {
-                seen = dot(seen_weights, vec4<f32>((vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u)) & vec4<u32>(1u)));
+                let bits = vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u);
+                let lit = seen_weights * vec4<f32>((bits >> vec4<u32>(4u)) & vec4<u32>(1u));
+                let lit_total = lit.x + lit.y + lit.z + lit.w;
+                if (lit_total > 0.0) {
+                    seen = dot(lit, vec4<f32>(bits & vec4<u32>(1u))) / lit_total;
+                }
             }
             irradiance += seen * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
         }
