@@ -466,6 +466,8 @@ fn pixel_sum(local: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_c
                 let bits = vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u);
                 let lit = seen_weights * vec4<f32>((bits >> vec4<u32>(4u)) & vec4<u32>(1u));
                 let lit_total = lit.x + lit.y + lit.z + lit.w;
+                // (no corner on the pixel's surface faces the node: the node lies nearly in
+                // that surface's plane, and its little light there counts as seen)
                 if (lit_total > 0.0) {
                     seen = dot(lit, vec4<f32>(bits & vec4<u32>(1u))) / lit_total;
                 }
