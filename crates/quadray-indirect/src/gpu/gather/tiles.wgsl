@@ -69,7 +69,7 @@ fn tile_sample(q: u32) -> u32 {
 // shared.wgsl); a pixel on the corners' surface weighs each of its tile's nodes by the
 // visibility of the corners the node faces, interpolated, so that a tile marches at most four
 // shadow rays a node instead of one a pixel. (A corner behind the node's plane gets no light
-// from it and no ray: 12-22% fewer fetches on the visibility scenes, the same pictures or
+// from it and no ray: 1-22% fewer fetches on the visibility scenes, the same pictures or
 // better. Skipping the corners whose plane the node is behind too made the door scene's
 // shadows blocky, 0.87 -> 1.35.)
 fn corner_visibility(p: vec3<f32>, np: vec3<f32>) -> u32 {
