@@ -299,6 +299,7 @@ mod tests {
                 u(Settings::MAX_LIGHTS),
                 u(Settings::SHADOW_GRID),
                 u(Settings::TILE_DEBLOCK),
+                f(Settings::TILE_SHADOW_ANGLE, 0.0, 100.0),
             ),
         )
             .prop_map(
@@ -313,6 +314,7 @@ mod tests {
                         max_lights,
                         shadow_grid,
                         tile_deblock,
+                        tile_shadow_angle,
                     ),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
@@ -348,6 +350,7 @@ mod tests {
                         tile_criterion,
                         tile_capacity,
                         tile_share,
+                        tile_shadow_angle,
                         tile_deblock,
                     }
                 },
@@ -397,6 +400,11 @@ mod tests {
             ),
             ("--tile-share", "-1", Settings::TILE_SHARE.to_string()),
             ("--tile-deblock", "4", Settings::TILE_DEBLOCK.to_string()),
+            (
+                "--tile-shadow-angle",
+                "-1",
+                Settings::TILE_SHADOW_ANGLE.to_string(),
+            ),
             ("--validity", "global", validities.join(", ")),
         ] {
             // `=` so that a negative value reaches the flag's parser rather than clap's.

@@ -533,6 +533,14 @@ impl IndirectView {
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
         ui.checkbox(&mut s.indirect_shadows, "indirect shadows (quadtree)");
+        ui.add_enabled(
+            s.indirect_shadows,
+            limits_slider(
+                &mut s.tile_shadow_angle,
+                Settings::TILE_SHADOW_ANGLE,
+                "shadow rays shared within, box over distance (quadtree-tiles, 0: off)",
+            ),
+        );
         let mut temporal = s.temporal_weight < 1.0;
         ui.checkbox(&mut temporal, "temporal filter (reprojected)");
         s.temporal_weight = if temporal {

@@ -7,7 +7,7 @@
 use crate::deblock::{ALBEDO as DEBLOCK_ALBEDO, LIMIT as DEBLOCK_LIMIT, PLANE as DEBLOCK_PLANE};
 use crate::occupancy::{BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS, SUBCELLS};
 pub(crate) use crate::settings::{
-    CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, TILE, TILE_FRONTIER,
+    CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, TILE, TILE_ENTRY_INDEX_BITS, TILE_FRONTIER,
 };
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -47,6 +47,7 @@ pub(crate) fn prelude() -> String {
          const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;\n\
          const MAX_LEVELS: u32 = {MAX_LEVELS}u;\n\
          const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;\n\
+         const TILE_ENTRY_INDEX_BITS: u32 = {TILE_ENTRY_INDEX_BITS}u;\n\
          const TILE: u32 = {TILE}u;\n\
          const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};\n\
          const EMPTY_BOX: f32 = {EMPTY_BOX:?};\n\
@@ -150,6 +151,7 @@ pub(crate) struct ShadeUniform {
     pub tile_estimate: u32,
     pub tile_share: f32,
     pub tile_deblock: u32,
+    pub tile_shadow_angle: f32,
 }
 
 /// WGSL `LightTerms`: the gather's per-view values (the kernel's clamp, the lengths that scale
@@ -452,6 +454,7 @@ mod tests {
             format!("const LEVEL_SLICE: u32 = {LEVEL_SLICE}u;"),
             format!("const MAX_LEVELS: u32 = {MAX_LEVELS}u;"),
             format!("const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;"),
+            format!("const TILE_ENTRY_INDEX_BITS: u32 = {TILE_ENTRY_INDEX_BITS}u;"),
             format!("const TILE: u32 = {TILE}u;"),
             format!("const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};"),
             format!("const EMPTY_BOX: f32 = {EMPTY_BOX:?};"),

@@ -13,7 +13,7 @@ use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts}
 use crate::occupancy::OccupancyGrid;
 use crate::picture::{cut_view, cut_view_zoom};
 use crate::scene::Scene;
-use crate::settings::{ClusterSettings, Method, Settings, TILE};
+use crate::settings::{ClusterSettings, Method, Settings, TILE, TILE_ENTRY_INDEX_BITS};
 use quadray_core::image_out::Rgba8Image;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
 use std::collections::BTreeMap;
@@ -489,7 +489,11 @@ impl<'g> Renderer<'g> {
             .enumerate()
             .map(|(tile, size)| {
                 let list = &lists[tile * capacity..][..size[0] as usize];
-                list.iter().map(|&i| CutNode::at(s.rsm_size, i)).collect()
+                list.iter()
+                    .map(|&entry| {
+                        CutNode::at(s.rsm_size, entry & ((1 << TILE_ENTRY_INDEX_BITS) - 1))
+                    })
+                    .collect()
             })
             .collect())
     }

@@ -62,7 +62,8 @@ fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
                 tiles_x,
                 tile_estimate,
                 tile_share,
-                tile_deblock
+                tile_deblock,
+                tile_shadow_angle
             ]
         ),
         shared!(

@@ -56,6 +56,7 @@ fn shade_uniform(s: &Settings) -> ShadeUniform {
         tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
         tile_share: s.tile_share,
         tile_deblock: s.tile_deblock,
+        tile_shadow_angle: s.tile_shadow_angle,
     }
 }
 

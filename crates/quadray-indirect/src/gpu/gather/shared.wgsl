@@ -34,6 +34,10 @@ struct Shade {
     // per-tile cuts: pixels on either side of a tile boundary its unexplained step is spread
     // over (0: none; deblock.wgsl)
     tile_deblock: u32,
+    // per-tile cuts with indirect shadows: a cluster takes the visibility of its highest valid
+    // ancestor whose box's diagonal is at most this times its distance from the tile's
+    // receivers (0: each its own; tiles.wgsl)
+    tile_shadow_angle: f32,
 }
 
 // Per light view, with the light: the kernel's clamp, the lengths that scale with the scene and

@@ -20,11 +20,16 @@ pub(crate) const WGSL: [&str; 4] = [
 
 /// The per-tile cuts' lists and their bind group (group 3).
 struct TileLists {
-    /// Per tile, the per-tile cut's node indices (`tile_capacity` slots a tile).
+    /// Per tile, the per-tile cut's entries (`tile_capacity` slots a tile): a node's index in
+    /// the low [`crate::settings::TILE_ENTRY_INDEX_BITS`], with indirect shadows its visibility
+    /// target's slot above.
     cuts: wgpu::Buffer,
     /// Per tile, the nodes its list holds, the splits refused for want of room, the nodes whose
     /// error it estimated and the VPL evaluations that took (four `u32`).
     sizes: wgpu::Buffer,
+    /// With indirect shadows, per tile the nodes its shadow rays go to (`tile_capacity` slots a
+    /// tile; one word without shadows). Only the shader reads it.
+    _targets: wgpu::Buffer,
     group: wgpu::BindGroup,
 }
 
@@ -48,6 +53,7 @@ impl Tiles {
             &[
                 storage_entry::<u32>(0, false),
                 storage_entry::<[u32; 4]>(1, false),
+                storage_entry::<u32>(2, false),
             ],
         );
         let [pipeline, columns, rows] = res.pipelines(
@@ -75,13 +81,24 @@ impl Tiles {
             let cuts = storage_buffer(&self.device, "per-tile cuts", s.tile_list_bytes());
             let tiles = u64::from(tx) * u64::from(ty);
             let sizes = storage_buffer(&self.device, "per-tile cut sizes", tiles * 16);
+            let target_bytes = if s.march_steps() > 0 {
+                s.tile_list_bytes()
+            } else {
+                4
+            };
+            let targets = storage_buffer(&self.device, "per-tile shadow targets", target_bytes);
             let group = bind_group(
                 &self.device,
                 "per-tile cuts",
                 &self.lists_layout,
-                vec![whole(&cuts), whole(&sizes)],
+                vec![whole(&cuts), whole(&sizes), whole(&targets)],
             );
-            TileLists { cuts, sizes, group }
+            TileLists {
+                cuts,
+                sizes,
+                _targets: targets,
+                group,
+            }
         });
         pass.set_bind_group(3, &lists.group, &[]);
         pass.set_pipeline(&self.pipeline);

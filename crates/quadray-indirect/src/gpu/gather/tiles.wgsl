@@ -6,11 +6,14 @@
 // that holds a barrier, and each loop around a barrier counts to a workgroup-uniform bound.
 
 // Group 3, this pass's own: the per-tile cuts' lists (allocated by the first frame that draws
-// them): each tile's node indices (`tile_capacity` slots a tile), and per tile the nodes it
-// holds, the splits refused for want of room, the nodes whose error it estimated and the VPL
-// evaluations that took
+// them): each tile's entries (`tile_capacity` slots a tile: a node's index, with indirect
+// shadows its visibility target's slot, see ENTRY_INDEX), per tile the nodes it holds, the
+// splits refused for want of room, the nodes whose error it estimated and the VPL evaluations
+// that took, and with indirect shadows each tile's visibility targets (`tile_capacity` slots a
+// tile: the node whose mean the tile's shadow rays go to)
 @group(3) @binding(0) var<storage, read_write> tile_cuts: array<u32>;
 @group(3) @binding(1) var<storage, read_write> tile_sizes: array<vec4<u32>>;
+@group(3) @binding(2) var<storage, read_write> tile_targets: array<u32>;
 
 // the tile's receivers: position (EMPTY_BOX where none) and normal
 var<workgroup> tile_x: array<vec3<f32>, TILE_PIXELS>;
@@ -50,6 +53,17 @@ var<workgroup> stray: array<atomic<u32>, 3>;
 const SHARED: u32 = 0x80000000u;
 var<workgroup> shared_count: atomic<u32>;
 var<workgroup> shared_total: u32;
+// Indirect shadows share their rays among a tile's clusters: a listed node whose ancestor is
+// valid (one surface) and small seen from the tile's receivers (`tile_shadow_angle`) takes that
+// ancestor's visibility, so that a tile walks once to each such ancestor's mean rather than to
+// each of its listed descendants (BENCHMARKS.md: 2.5-5x fewer walks on the tuned visibility
+// scenes, the same FLIP within 3%). A frontier's or a list's entry is the node's index
+// (ENTRY_INDEX, TILE_ENTRY_INDEX_BITS of them), and once an ancestor or the node itself
+// became a target, ENTRY_TARGETED and the target's slot; the targets' nodes are in
+// `tile_targets`, their visibility from the corners in `verdicts` once refinement is done.
+const ENTRY_INDEX: u32 = (1u << TILE_ENTRY_INDEX_BITS) - 1u;
+const ENTRY_TARGETED: u32 = 0x80000000u;
+var<workgroup> target_count: atomic<u32>;
 
 // The accessors of wgsl/tile_rule.wgsl.
 fn tile_position(p: u32) -> vec3<f32> {
@@ -62,27 +76,6 @@ fn tile_normal(p: u32) -> vec3<f32> {
 
 fn tile_sample(q: u32) -> u32 {
     return atomicLoad(&quadrant_pixel[q]);
-}
-
-// Indirect shadows per tile: bit c + 4 set where the node at `p` (its mean, mean normal `np`)
-// faces the tile's corner receiver c, and then bit c where the corner sees it (`visible`,
-// shared.wgsl); a pixel on the corners' surface weighs each of its tile's nodes by the
-// visibility of the corners the node faces, interpolated, so that a tile marches at most four
-// shadow rays a node instead of one a pixel. (A corner behind the node's plane gets no light
-// from it and no ray: 1-22% fewer fetches on the visibility scenes, the same pictures or
-// better. Skipping the corners whose plane the node is behind too made the door scene's
-// shadows blocky, 0.87 -> 1.35.)
-fn corner_visibility(p: vec3<f32>, np: vec3<f32>) -> u32 {
-    var seen = 0u;
-    for (var c = 0u; c < 4u; c++) {
-        if (dot(np, tile_x[CORNERS[c]] - p) > 0.0) {
-            seen |= 1u << (c + 4u);
-            if (visible(tile_x[CORNERS[c]], tile_n[CORNERS[c]], p, np)) {
-                seen |= 1u << c;
-            }
-        }
-    }
-    return seen;
 }
 
 // Stores every thread's counts: those outside the picture's with the tile's first pixel.
@@ -145,6 +138,7 @@ fn load_tile(pixel: vec2<u32>, inside: bool, local: u32) -> Receiver {
     if (local == 0u) {
         atomicStore(&frontier_len[1], 0u);
         atomicStore(&list_len, 0u);
+        atomicStore(&target_count, 0u);
         atomicStore(&refused, 0u);
         atomicStore(&estimated_nodes, 0u);
         atomicStore(&estimate_evaluations, 0u);
@@ -230,7 +224,7 @@ fn refine(local: u32, tile: u32, g: TileGroups, threshold: f32) {
         let level = root - step;
         let current = step & 1u;
         let count = atomicLoad(&frontier_len[current]);
-        judge_level(local, level, current, count, g, threshold);
+        judge_level(local, tile, level, current, count, g, threshold);
         workgroupBarrier();
         if (local == 0u) {
             grant_splits();
@@ -253,11 +247,12 @@ fn refine(local: u32, tile: u32, g: TileGroups, threshold: f32) {
 
 // A level's verdicts: empty, listed (under the threshold by its bound, or by its estimated error
 // where the estimate decides), or the node's split bin.
-fn judge_level(local: u32, level: u32, current: u32, count: u32, g: TileGroups, threshold: f32) {
+fn judge_level(local: u32, tile: u32, level: u32, current: u32, count: u32, g: TileGroups, threshold: f32) {
     let size = level_size(params, level);
     let offset = level_offset(params, level);
     for (var i = local; i < count; i += TILE_PIXELS) {
-        let index = frontier[current][i];
+        let entry = frontier[current][i];
+        let index = entry & ENTRY_INDEX;
         fetches++;
         let node = nodes[index];
         var verdict = VERDICT_LIST;
@@ -267,6 +262,11 @@ fn judge_level(local: u32, level: u32, current: u32, count: u32, g: TileGroups, 
         } else if (level > 0u) {
             fetches++;
             let b = bounds[index];
+            if (SHADOWS && (entry & ENTRY_TARGETED) == 0u && is_shadow_target(node, b, g)) {
+                let slot = atomicAdd(&target_count, 1u);
+                tile_targets[tile * shade.tile_capacity + slot] = index;
+                frontier[current][i] = entry | ENTRY_TARGETED | (slot << TILE_ENTRY_INDEX_BITS);
+            }
             var excess = tile_bound(node, b, g, terms.r_min);
             if (excess > threshold && estimate_decides(shade.tile_estimate == 1u, level, shade.tile_start, threshold, b, terms.r_min)) {
                 let before = evaluations;
@@ -282,6 +282,16 @@ fn judge_level(local: u32, level: u32, current: u32, count: u32, g: TileGroups, 
         }
         atomicOr(&verdicts[i / 4u], verdict << (8u * (i % 4u)));
     }
+}
+
+// Whether a node (not empty) is its listed descendants' visibility target: valid, and its box's
+// diagonal at most `tile_shadow_angle` times its distance from the receivers' box.
+fn is_shadow_target(node: Node, b: NodeBounds, g: TileGroups) -> bool {
+    let lo = min(g.lo[0], g.lo[1]);
+    let hi = max(g.hi[0], g.hi[1]);
+    let gap = max(vec3<f32>(0.0), max(b.lo.xyz - hi, lo - b.hi.xyz));
+    return node.normal.w > 0.5 && shade.tile_shadow_angle > 0.0
+        && length(b.hi.xyz - b.lo.xyz) <= shade.tile_shadow_angle * length(gap);
 }
 
 // The bins above the cutoff all fit and have their room reserved here; the cutoff bin's nodes
@@ -313,7 +323,8 @@ fn apply_verdicts(local: u32, tile: u32, level: u32, current: u32, count: u32) {
         if (verdict == VERDICT_EMPTY) {
             continue;
         }
-        let index = frontier[current][i];
+        let entry = frontier[current][i];
+        let index = entry & ENTRY_INDEX;
         var split = verdict > cutoff;
         if (verdict == cutoff && cutoff > 0u) {
             split = atomicAdd(&reserved, 3u) + 3u <= shade.tile_capacity;
@@ -330,17 +341,18 @@ fn apply_verdicts(local: u32, tile: u32, level: u32, current: u32, count: u32) {
             let slot = atomicAdd(&frontier_len[next], 4u);
             for (var c = 0u; c < 4u; c++) {
                 let child = xy * 2u + vec2<u32>(c & 1u, c >> 1u);
-                frontier[next][slot + c] = node_index(params, level - 1u, child);
+                frontier[next][slot + c] = node_index(params, level - 1u, child) | (entry & ~ENTRY_INDEX);
             }
         } else {
-            tile_cuts[tile * shade.tile_capacity + atomicAdd(&list_len, 1u)] = index;
+            tile_cuts[tile * shade.tile_capacity + atomicAdd(&list_len, 1u)] = entry;
         }
     }
 }
 
 // Phase 4: the list copied once into workgroup memory (the frontier's, free now), far nodes
-// marked to be shared, with indirect shadows each node's visibility from the tile's corners;
-// how many nodes are shared. Every invocation calls it.
+// marked to be shared; with indirect shadows every listed node without a target its own, each
+// target's visibility from the tile's corners (`corner_visibility`), and per node its target's
+// slot and visibility; how many nodes are shared. Every invocation calls it.
 fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: bool, corner_shadows: bool) -> u32 {
     let base = tile * shade.tile_capacity;
     let lo = min(g.lo[0], g.lo[1]);
@@ -351,11 +363,15 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
     workgroupBarrier();
     for (var i = local; i < listed; i += TILE_PIXELS) {
         fetches++;
-        var index = tile_cuts[base + i];
-        if (corner_shadows) {
-            fetches++;
-            let node = nodes[index];
-            frontier[1][i] = corner_visibility(node.pos.xyz, node.normal.xyz);
+        let entry = tile_cuts[base + i];
+        var index = entry & ENTRY_INDEX;
+        if (SHADOWS) {
+            var slot = (entry & ~ENTRY_TARGETED) >> TILE_ENTRY_INDEX_BITS;
+            if ((entry & ENTRY_TARGETED) == 0u) {
+                slot = atomicAdd(&target_count, 1u);
+                tile_targets[base + slot] = index;
+            }
+            frontier[1][i] = slot;
         }
         if (sharing) {
             fetches++;
@@ -366,11 +382,49 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
         }
         frontier[0][i] = index;
     }
+    if (SHADOWS) {
+        // (the targets' nodes in storage, the verdicts cleared by refinement's last step)
+        storageBarrier();
+        if (corner_shadows) {
+            corner_visibility(local, base, atomicLoad(&target_count));
+        }
+        workgroupBarrier();
+        for (var i = local; i < listed; i += TILE_PIXELS) {
+            let slot = frontier[1][i];
+            frontier[1][i] = (slot << 8u) | ((atomicLoad(&verdicts[slot / 4u]) >> (8u * (slot % 4u))) & 255u);
+        }
+    }
     workgroupBarrier();
     if (local == 0u) {
         shared_total = atomicLoad(&shared_count);
     }
     return workgroupUniformLoad(&shared_total);
+}
+
+// Indirect shadows per tile: each target's byte of `verdicts`, bit c + 4 set where the target
+// (its mean, mean normal) faces the tile's corner receiver c, and then bit c where the corner
+// sees it (`visible`, shared.wgsl), one invocation a target and corner; a pixel on the corners'
+// surface weighs each of its tile's nodes by its target's visibility from the corners the target
+// faces, interpolated, so that a tile walks at most four shadow rays a target instead of one a
+// pixel and node. (A corner behind the target's plane gets no light from it and no ray: 1-22%
+// fewer fetches on the visibility scenes, the same pictures or better. Skipping the corners
+// whose plane the target is behind too made the door scene's shadows blocky, 0.87 -> 1.35.)
+fn corner_visibility(local: u32, base: u32, targets: u32) {
+    for (var k = local; k < 4u * targets; k += TILE_PIXELS) {
+        let slot = k / 4u;
+        let c = k % 4u;
+        fetches++;
+        let node = nodes[tile_targets[base + slot]];
+        let x = tile_x[CORNERS[c]];
+        var seen = 0u;
+        if (dot(node.normal.xyz, x - node.pos.xyz) > 0.0) {
+            seen = 1u << (c + 4u);
+            if (visible(x, tile_n[CORNERS[c]], node.pos.xyz, node.normal.xyz)) {
+                seen |= 1u << c;
+            }
+        }
+        atomicOr(&verdicts[slot / 4u], seen << (8u * (slot % 4u)));
+    }
 }
 
 // Phase 4, then: the shared nodes' vector irradiance at each corner receiver (with indirect
@@ -413,8 +467,8 @@ fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat
 // Phase 5: a covered pixel's sum of its tile's list. Where the pixel lies on the corners'
 // bilinear patch it takes the shared nodes interpolated from `corner_vectors` (else, across a
 // depth edge, it evaluates them too), and with shadows the visibility of the corners on its own
-// surface (none: it marches its own shadow rays).
-fn pixel_sum(local: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_covered: bool, corner_shadows: bool, corner_vectors: array<mat3x3<f32>, 4>) -> vec3<f32> {
+// surface (none: it walks to each target its lit nodes have, once a target).
+fn pixel_sum(local: u32, tile: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_covered: bool, corner_shadows: bool, corner_vectors: array<mat3x3<f32>, 4>) -> vec3<f32> {
     let t = vec2<f32>(f32(local % TILE), f32(local / TILE)) / f32(TILE - 1u);
     let w = vec4<f32>((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);
     var on_patch = false;
@@ -446,12 +500,32 @@ fn pixel_sum(local: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_c
     }
     if (SHADOWS && !corner_seen) {
         // (a loop of its own: a walk inlined in the loop below made it twice as slow on
-        // lavapipe where it never ran)
+        // lavapipe where it never ran.) The targets walked to and those seen, a bit a slot.
+        var walked: array<u32, TILE_FRONTIER / 32u>;
+        var seen: array<u32, TILE_FRONTIER / 32u>;
+        let base = tile * shade.tile_capacity;
         for (var i = 0u; i < listed; i++) {
             let entry = frontier[0][i];
             if ((entry & SHARED) == 0u || !on_patch) {
                 fetches++;
-                irradiance += node_irradiance(nodes[entry & ~SHARED], r);
+                let node = nodes[entry & ~SHARED];
+                let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
+                if (any(e != vec3<f32>(0.0))) {
+                    let slot = frontier[1][i] >> 8u;
+                    let word = slot / 32u;
+                    let bit = 1u << (slot % 32u);
+                    if ((walked[word] & bit) == 0u) {
+                        walked[word] |= bit;
+                        fetches++;
+                        let t = nodes[tile_targets[base + slot]];
+                        if (visible(r.x, r.n, t.pos.xyz, t.normal.xyz)) {
+                            seen[word] |= bit;
+                        }
+                    }
+                    if ((seen[word] & bit) != 0u) {
+                        irradiance += e;
+                    }
+                }
             }
         }
         return irradiance;
@@ -463,7 +537,7 @@ fn pixel_sum(local: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_c
             let node = nodes[entry & ~SHARED];
             var seen = 1.0;
             if (corner_seen) {
-                let bits = vec4<u32>(frontier[1][i]) >> vec4<u32>(0u, 1u, 2u, 3u);
+                let bits = vec4<u32>(frontier[1][i] & 255u) >> vec4<u32>(0u, 1u, 2u, 3u);
                 let lit = seen_weights * vec4<f32>((bits >> vec4<u32>(4u)) & vec4<u32>(1u));
                 let lit_total = lit.x + lit.y + lit.z + lit.w;
                 // (no corner on the pixel's surface faces the node: the node lies nearly in
@@ -513,7 +587,7 @@ fn indirect_tiles(
     }
     var irradiance = vec3<f32>(0.0);
     if (r.covered) {
-        irradiance = pixel_sum(local, r, listed, shared_nodes > 0u, corners_covered, corner_shadows, corner_vectors);
+        irradiance = pixel_sum(local, tile, r, listed, shared_nodes > 0u, corners_covered, corner_shadows, corner_vectors);
     }
     if (inside) {
         add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * irradiance, 0.0));
