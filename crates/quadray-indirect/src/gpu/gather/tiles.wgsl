@@ -28,6 +28,9 @@ var<workgroup> reduce_e: array<vec4<f32>, TILE_PIXELS>;
 // per quadrant of the tile, its first covered pixel (TILE_PIXELS: none): the estimate's
 // sample pixels
 var<workgroup> quadrant_pixel: array<atomic<u32>, 4>;
+// per corner of the tile, its shadow anchor: the covered pixel nearest it (the corner itself
+// where covered), as its squared distance in pixels << 8 | the pixel
+var<workgroup> anchor_key: array<atomic<u32>, 4>;
 // the nodes of the level being refined and of the next (pyramid indices)
 var<workgroup> frontier: array<array<u32, TILE_FRONTIER>, 2>;
 var<workgroup> frontier_len: array<atomic<u32>, 2>;
@@ -125,6 +128,7 @@ fn load_tile(pixel: vec2<u32>, inside: bool, local: u32) -> Receiver {
     tile_n[local] = r.n;
     if (local < 4u) {
         atomicStore(&quadrant_pixel[local], TILE_PIXELS);
+        atomicStore(&anchor_key[local], 0xffffffffu);
     }
     if (local < 3u) {
         atomicStore(&stray[local], 0u);
@@ -146,13 +150,19 @@ fn load_tile(pixel: vec2<u32>, inside: bool, local: u32) -> Receiver {
     return r;
 }
 
-// Phase 1: the receivers' box (left in reduce_lo[0], reduce_hi[0]) and each quadrant's sample
-// pixel; whether the tile has no receiver. Every invocation calls it.
+// Phase 1: the receivers' box (left in reduce_lo[0], reduce_hi[0]), each quadrant's sample
+// pixel and each corner's shadow anchor; whether the tile has no receiver. Every invocation
+// calls it.
 fn tile_is_empty(local: u32, r: Receiver) -> bool {
     // (its first barrier also publishes load_tile's stores before the atomicMin below)
     reduce_receivers(local, r, r.covered);
     if (r.covered) {
         atomicMin(&quadrant_pixel[(local % TILE) / (TILE / 2u) + 2u * (local / (TILE_PIXELS / 2u))], local);
+        let p = vec2<i32>(i32(local % TILE), i32(local / TILE));
+        for (var c = 0u; c < 4u; c++) {
+            let d = p - vec2<i32>(i32(CORNERS[c] % TILE), i32(CORNERS[c] / TILE));
+            atomicMin(&anchor_key[c], (u32(dot(d, d)) << 8u) | local);
+        }
     }
     return workgroupUniformLoad(&reduce_n[0]).w == 0.0;
 }
@@ -353,7 +363,7 @@ fn apply_verdicts(local: u32, tile: u32, level: u32, current: u32, count: u32) {
 // marked to be shared; with indirect shadows every listed node without a target its own, each
 // target's visibility from the tile's corners (`corner_visibility`), and per node its target's
 // slot and visibility; how many nodes are shared. Every invocation calls it.
-fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: bool, corner_shadows: bool) -> u32 {
+fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: bool) -> u32 {
     let base = tile * shade.tile_capacity;
     let lo = min(g.lo[0], g.lo[1]);
     let hi = max(g.hi[0], g.hi[1]);
@@ -385,9 +395,7 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
     if (SHADOWS) {
         // (the targets' nodes in storage, the verdicts cleared by refinement's last step)
         storageBarrier();
-        if (corner_shadows) {
-            corner_visibility(local, base, atomicLoad(&target_count));
-        }
+        corner_visibility(local, base, atomicLoad(&target_count));
         workgroupBarrier();
         for (var i = local; i < listed; i += TILE_PIXELS) {
             let slot = frontier[1][i];
@@ -402,24 +410,26 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
 }
 
 // Indirect shadows per tile: each target's byte of `verdicts`, bit c + 4 set where the target
-// (its mean, mean normal) faces the tile's corner receiver c, and then bit c where the corner
-// sees it (`visible`, shared.wgsl), one invocation a target and corner; a pixel on the corners'
-// surface weighs each of its tile's nodes by its target's visibility from the corners the target
-// faces, interpolated, so that a tile walks at most four shadow rays a target instead of one a
-// pixel and node. (A corner behind the target's plane gets no light from it and no ray: 1-22%
-// fewer fetches on the visibility scenes, the same pictures or better. Skipping the corners
-// whose plane the target is behind too made the door scene's shadows blocky, 0.87 -> 1.35.)
+// (its mean, mean normal) faces the receiver of corner c's anchor (`shadow_anchor`), and then
+// bit c where that receiver sees it (`visible`, shared.wgsl), one invocation a target and
+// corner; a pixel on an anchor's surface weighs each of its tile's nodes by its target's
+// visibility from the anchors the target faces, interpolated, so that a tile walks at most four
+// shadow rays a target instead of one a pixel and node. (An anchor behind the target's plane
+// gets no light from it and no ray: 1-22% fewer fetches on the visibility scenes, the same
+// pictures or better. Skipping the anchors whose plane the target is behind too made the door
+// scene's shadows blocky, 0.87 -> 1.35.)
 fn corner_visibility(local: u32, base: u32, targets: u32) {
     for (var k = local; k < 4u * targets; k += TILE_PIXELS) {
         let slot = k / 4u;
         let c = k % 4u;
         fetches++;
         let node = nodes[tile_targets[base + slot]];
-        let x = tile_x[CORNERS[c]];
+        let a = shadow_anchor(c);
+        let x = tile_x[a];
         var seen = 0u;
         if (dot(node.normal.xyz, x - node.pos.xyz) > 0.0) {
             seen = 1u << (c + 4u);
-            if (visible(x, tile_n[CORNERS[c]], node.pos.xyz, node.normal.xyz)) {
+            if (visible(x, tile_n[a], node.pos.xyz, node.normal.xyz)) {
                 seen |= 1u << c;
             }
         }
@@ -427,11 +437,20 @@ fn corner_visibility(local: u32, base: u32, targets: u32) {
     }
 }
 
+// The pixel that stands for corner c in the shadow rays: the covered pixel nearest the corner
+// (phase 1 found it), so that a tile at the picture's silhouette or with a hole at a corner
+// still tests from four receivers instead of every pixel walking alone. (With the corners alone,
+// the 4-6% of pixels that walked alone took 40-45% of the shadowed gather's time on the leak,
+// storeys and gap scenes.)
+fn shadow_anchor(c: u32) -> u32 {
+    return atomicLoad(&anchor_key[c]) & 255u;
+}
+
 // Phase 4, then: the shared nodes' vector irradiance at each corner receiver (with indirect
 // shadows, those the corner sees): a quarter of the workgroup per corner, each thread a share of
 // the nodes, then summed per corner (one colour channel in each of the reduction arrays). Every
 // invocation calls it.
-fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat3x3<f32>, 4> {
+fn gather_at_corners(local: u32, listed: u32) -> array<mat3x3<f32>, 4> {
     let x = tile_x[CORNERS[local % 4u]];
     var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var i = local / 4u; i < listed; i += TILE_PIXELS / 4u) {
@@ -441,7 +460,7 @@ fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat
             let node = nodes[entry & ~SHARED];
             // (evaluated either way, as a pixel's own sum does before its shadow test; a corner
             // the node does not face had no ray, and gets no light from it)
-            let seen = !corner_shadows || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
+            let seen = !SHADOWS || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
             v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, terms.r_min) * f32(seen);
         }
     }
@@ -466,9 +485,9 @@ fn gather_at_corners(local: u32, listed: u32, corner_shadows: bool) -> array<mat
 
 // Phase 5: a covered pixel's sum of its tile's list. Where the pixel lies on the corners'
 // bilinear patch it takes the shared nodes interpolated from `corner_vectors` (else, across a
-// depth edge, it evaluates them too), and with shadows the visibility of the corners on its own
+// depth edge, it evaluates them too), and with shadows the visibility of the anchors on its own
 // surface (none: it walks to each target its lit nodes have, once a target).
-fn pixel_sum(local: u32, tile: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_covered: bool, corner_shadows: bool, corner_vectors: array<mat3x3<f32>, 4>) -> vec3<f32> {
+fn pixel_sum(local: u32, tile: u32, r: Receiver, listed: u32, shared_nodes: bool, corners_covered: bool, corner_vectors: array<mat3x3<f32>, 4>) -> vec3<f32> {
     let t = vec2<f32>(f32(local % TILE), f32(local / TILE)) / f32(TILE - 1u);
     let w = vec4<f32>((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);
     var on_patch = false;
@@ -476,19 +495,23 @@ fn pixel_sum(local: u32, tile: u32, r: Receiver, listed: u32, shared_nodes: bool
     if (corners_covered) {
         var x = vec3<f32>(0.0);
         for (var c = 0u; c < 4u; c++) {
-            let corner = CORNERS[c];
-            x += w[c] * tile_x[corner];
-            let same_surface = dot(tile_n[corner], r.n) > shade.normal_agreement
-                && abs(dot(r.x - tile_x[corner], tile_n[corner])) < terms.plane_agreement;
-            seen_weights[c] = select(0.0, max(w[c], 1e-3), same_surface);
+            x += w[c] * tile_x[CORNERS[c]];
         }
         on_patch = distance(x, r.x) <= terms.plane_agreement;
+    }
+    if (SHADOWS) {
+        for (var c = 0u; c < 4u; c++) {
+            let a = shadow_anchor(c);
+            let same_surface = dot(tile_n[a], r.n) > shade.normal_agreement
+                && abs(dot(r.x - tile_x[a], tile_n[a])) < terms.plane_agreement;
+            seen_weights[c] = select(0.0, max(w[c], 1e-3), same_surface);
+        }
         if (on_patch) {
             seen_weights = w;
         }
     }
     let seen_total = seen_weights.x + seen_weights.y + seen_weights.z + seen_weights.w;
-    let corner_seen = corner_shadows && seen_total > 0.0;
+    let corner_seen = SHADOWS && seen_total > 0.0;
     seen_weights /= max(seen_total, 1e-6);
     var irradiance = vec3<f32>(0.0);
     if (shared_nodes && on_patch) {
@@ -578,16 +601,15 @@ fn indirect_tiles(
     storageBarrier();
     let listed = atomicLoad(&list_len);
     let corners_covered = all_corners_covered();
-    let corner_shadows = SHADOWS && corners_covered;
     let sharing = shade.tile_share > 0.0 && corners_covered;
-    let shared_nodes = list_for_gather(local, tile, listed, groups, sharing, corner_shadows);
+    let shared_nodes = list_for_gather(local, tile, listed, groups, sharing);
     var corner_vectors: array<mat3x3<f32>, 4>;
     if (shared_nodes > 0u) {
-        corner_vectors = gather_at_corners(local, listed, corner_shadows);
+        corner_vectors = gather_at_corners(local, listed);
     }
     var irradiance = vec3<f32>(0.0);
     if (r.covered) {
-        irradiance = pixel_sum(local, tile, r, listed, shared_nodes > 0u, corners_covered, corner_shadows, corner_vectors);
+        irradiance = pixel_sum(local, tile, r, listed, shared_nodes > 0u, corners_covered, corner_vectors);
     }
     if (inside) {
         add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * irradiance, 0.0));
