@@ -59,8 +59,8 @@ var<workgroup> shared_total: u32;
 // Indirect shadows share their rays among a tile's clusters: a listed node whose ancestor is
 // valid (one surface) and small seen from the tile's receivers (`tile_shadow_angle`) takes that
 // ancestor's visibility, so that a tile walks once to each such ancestor's mean rather than to
-// each of its listed descendants (BENCHMARKS.md: 2.5-5x fewer walks on the tuned visibility
-// scenes, the same FLIP within 3%). A frontier's or a list's entry is the node's index
+// each of its listed descendants (BENCHMARKS.md: 19-26% fewer fetches on the tuned visibility
+// scenes and the leak scene, their FLIP within 3%). A frontier's or a list's entry is the node's index
 // (ENTRY_INDEX, TILE_ENTRY_INDEX_BITS of them), and once an ancestor or the node itself
 // became a target, ENTRY_TARGETED and the target's slot; the targets' nodes are in
 // `tile_targets`, their visibility from the corners in `verdicts` once refinement is done.
