@@ -506,7 +506,8 @@ pub struct Settings {
     pub tile_criterion: TileCriterion,
     /// quadtree-tiles: the most clusters a tile's cut holds; past it refinement stops (counted
     /// as [`crate::WorkCounts::refused_splits`]). The lists take 4 bytes a node and tile of GPU
-    /// memory, at most [`Self::MAX_TILE_LIST_BYTES`]; default: 1024, less where the picture's
+    /// memory (8 with --indirect-shadows, for the shadow rays' targets), each buffer at most
+    /// [`Self::MAX_TILE_LIST_BYTES`]; default: 1024, less where the picture's
     /// lists would take over [`Self::DEFAULT_TILE_LIST_BYTES`] (256 at 1920x1080).
     #[cfg_attr(feature = "cli", arg(long, value_parser = Settings::TILE_CAPACITY.parser()))]
     pub tile_capacity: Option<u32>,
