@@ -524,8 +524,9 @@ pub struct Settings {
     /// quadtree-tiles with --indirect-shadows: a cluster takes the visibility of its highest
     /// ancestor that is valid (one surface) and whose box's diagonal is at most this times its
     /// distance from the tile's pixels, so that a tile walks once to that ancestor's mean rather
-    /// than to each of its listed clusters (0: each cluster its own). At 0.3, 2.5-5x fewer walks
-    /// on the visibility scenes tuned on, their FLIP within 3% (BENCHMARKS.md).
+    /// than to each of its listed clusters (0: each cluster its own). At 0.3, 19-26% fewer
+    /// fetches on the visibility scenes tuned on and the leak scene, their FLIP within 3%
+    /// (BENCHMARKS.md).
     #[cfg_attr(feature = "cli", arg(
         long,
         default_value_t = Settings::DEFAULT.tile_shadow_angle,
