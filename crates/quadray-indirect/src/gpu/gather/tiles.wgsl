@@ -65,6 +65,7 @@ var<workgroup> shared_total: u32;
 // became a target, ENTRY_TARGETED and the target's slot; the targets' nodes are in
 // `tile_targets`, their visibility from the corners in `verdicts` once refinement is done.
 const ENTRY_INDEX: u32 = (1u << TILE_ENTRY_INDEX_BITS) - 1u;
+// (SHARED's bit: the gather's copy of the list is marked only once the entries are read)
 const ENTRY_TARGETED: u32 = 0x80000000u;
 var<workgroup> target_count: atomic<u32>;
 
@@ -439,9 +440,9 @@ fn corner_visibility(local: u32, base: u32, targets: u32) {
 
 // The pixel that stands for corner c in the shadow rays: the covered pixel nearest the corner
 // (phase 1 found it), so that a tile at the picture's silhouette or with a hole at a corner
-// still tests from four receivers instead of every pixel walking alone. (With the corners alone,
-// the 4-6% of pixels that walked alone took 40-45% of the shadowed gather's time on the leak,
-// storeys and gap scenes.)
+// still tests from four receivers instead of every pixel walking alone. (With them the shadowed
+// gather takes 0.55-0.62x the time of the corners alone on the leak, storeys and gap scenes,
+// though only 4-6% of the pixels walked alone: BENCHMARKS.md.)
 fn shadow_anchor(c: u32) -> u32 {
     return atomicLoad(&anchor_key[c]) & 255u;
 }
