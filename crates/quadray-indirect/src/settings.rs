@@ -37,6 +37,13 @@ pub(crate) const EMPTY_BOX: f32 = 1e30;
 /// Widens a normal cone's half-angle (radians) past f32's rounding in acos near 1, so that the
 /// cone still holds every VPL normal.
 pub(crate) const CONE_SLACK: f32 = 1e-3;
+/// Indirect shadows, per-tile cuts: a node of several surfaces (not valid) becomes its listed
+/// descendants' visibility target at this part of [`Settings::tile_shadow_angle`] (its mean lies
+/// off its surfaces, so it stands in for them from farther away only). Chosen on the tuned
+/// visibility scenes (BENCHMARKS.md): 0 (valid nodes only) walked 10.9, 7.9 and 5.1 rays a pixel
+/// on the door, corridor and gap scenes, 0.5 walks 8.4, 4.9 and 4.8 at the same FLIP and
+/// blockiness, 1 walks 6.4, 2.7 and 4.3 but took the gap's blockiness to 1.21 and its FLIP up 4%.
+pub(crate) const MIXED_TARGET_ANGLE: f32 = 0.5;
 /// Per-tile cuts order a level's splits by bins of powers of two of how far a node's bound
 /// exceeds the threshold, the highest first.
 pub(crate) const SPLIT_BINS: u32 = 16;
@@ -522,9 +529,9 @@ pub struct Settings {
     ))]
     pub tile_share: f32,
     /// quadtree-tiles with --indirect-shadows: a cluster takes the visibility of its highest
-    /// ancestor that is valid (one surface) and whose box's diagonal is at most this times its
-    /// distance from the tile's pixels, so that a tile walks once to that ancestor's mean rather
-    /// than to each of its listed clusters (0: each cluster its own). At 0.3, 19-26% fewer
+    /// ancestor whose box's diagonal is at most this times its distance from the tile's pixels
+    /// (half this for an ancestor of several surfaces), so that a tile walks once to that
+    /// ancestor's mean rather than to each of its listed clusters (0: each cluster its own). At 0.3, 19-26% fewer
     /// fetches on the visibility scenes tuned on and the leak scene, their FLIP within 3%
     /// (BENCHMARKS.md).
     #[cfg_attr(feature = "cli", arg(

@@ -96,7 +96,7 @@ fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
         ..Settings::sized(128, 128, 64)
     };
     // (and the per-tile cuts' fetches with shared shadow rays at most this part of those with
-    // each cluster walked to alone: measured 0.72 and 0.96)
+    // each cluster walked to alone: measured 0.69 and 0.95)
     for (file, readme_flip, shared_fetches) in [("leak.toml", 9.2, 0.8), ("cornell.toml", 3.7, 1.0)]
     {
         let scene = Scene::load(&scenes_dir().join(file)).unwrap();

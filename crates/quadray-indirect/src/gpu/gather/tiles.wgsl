@@ -57,10 +57,9 @@ const SHARED: u32 = 0x80000000u;
 var<workgroup> shared_count: atomic<u32>;
 var<workgroup> shared_total: u32;
 // Indirect shadows share their rays among a tile's clusters: a listed node whose ancestor is
-// valid (one surface) and small seen from the tile's receivers (`tile_shadow_angle`) takes that
+// small seen from the tile's receivers (`tile_shadow_angle`, `is_shadow_target`) takes that
 // ancestor's visibility, so that a tile walks once to each such ancestor's mean rather than to
-// each of its listed descendants (BENCHMARKS.md: 19-26% fewer fetches on the tuned visibility
-// scenes and the leak scene, their FLIP within 3%). A frontier's or a list's entry is the node's index
+// each of its listed descendants (BENCHMARKS.md). A frontier's or a list's entry is the node's index
 // (ENTRY_INDEX, TILE_ENTRY_INDEX_BITS of them), and once an ancestor or the node itself
 // became a target, ENTRY_TARGETED and the target's slot; the targets' nodes are in
 // `tile_targets`, their visibility from the corners in `verdicts` once refinement is done.
@@ -300,14 +299,15 @@ fn judge_level(local: u32, tile: u32, level: u32, current: u32, count: u32, g: T
     }
 }
 
-// Whether a node (not empty) is its listed descendants' visibility target: valid, and its box's
-// diagonal at most `tile_shadow_angle` times its distance from the receivers' box.
+// Whether a node (not empty) is its listed descendants' visibility target: its box's diagonal at
+// most `tile_shadow_angle` times its distance from the receivers' box, MIXED_TARGET_ANGLE of
+// that where the node is not valid (several surfaces).
 fn is_shadow_target(node: Node, b: NodeBounds, g: TileGroups) -> bool {
     let lo = min(g.lo[0], g.lo[1]);
     let hi = max(g.hi[0], g.hi[1]);
     let gap = max(vec3<f32>(0.0), max(b.lo.xyz - hi, lo - b.hi.xyz));
-    return node.normal.w > 0.5 && shade.tile_shadow_angle > 0.0
-        && length(b.hi.xyz - b.lo.xyz) <= shade.tile_shadow_angle * length(gap);
+    let angle = shade.tile_shadow_angle * select(MIXED_TARGET_ANGLE, 1.0, node.normal.w > 0.5);
+    return angle > 0.0 && length(b.hi.xyz - b.lo.xyz) <= angle * length(gap);
 }
 
 // The bins above the cutoff all fit and have their room reserved here; the cutoff bin's nodes
