@@ -531,9 +531,10 @@ pub struct Settings {
     /// quadtree-tiles with --indirect-shadows: a cluster takes the visibility of its highest
     /// ancestor whose box's diagonal is at most this times its distance from the tile's pixels
     /// (half this for an ancestor of several surfaces), so that a tile walks once to that
-    /// ancestor's mean rather than to each of its listed clusters (0: each cluster its own). At 0.3, 19-26% fewer
-    /// fetches on the visibility scenes tuned on and the leak scene, their FLIP within 3%
-    /// (BENCHMARKS.md).
+    /// ancestor's mean rather than to each of its listed clusters (0: each cluster its own).
+    /// Chosen on the visibility scenes tuned on: from 0.15 to 0.6 their FLIP stays within 2% of
+    /// 0.3's and the fetches fall with the angle (BENCHMARKS.md, "Indirect shadows on scenes nobody
+    /// tuned on").
     #[cfg_attr(feature = "cli", arg(
         long,
         default_value_t = Settings::DEFAULT.tile_shadow_angle,

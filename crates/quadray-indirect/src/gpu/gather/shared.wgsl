@@ -34,9 +34,10 @@ struct Shade {
     // per-tile cuts: pixels on either side of a tile boundary its unexplained step is spread
     // over (0: none; deblock.wgsl)
     tile_deblock: u32,
-    // per-tile cuts with indirect shadows: a cluster takes the visibility of its highest valid
+    // per-tile cuts with indirect shadows: a cluster takes the visibility of its highest
     // ancestor whose box's diagonal is at most this times its distance from the tile's
-    // receivers (0: each its own; tiles.wgsl)
+    // receivers, MIXED_TARGET_ANGLE of it for an ancestor of several surfaces (0: each its own;
+    // tiles.wgsl)
     tile_shadow_angle: f32,
 }
 
