@@ -423,7 +423,8 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
 // shadow rays a target instead of one a pixel and node. (An anchor behind the target's plane
 // gets no light from it and no ray: 1-22% fewer fetches on the visibility scenes, the same
 // pictures or better. Skipping the anchors whose plane the target is behind too made the door
-// scene's shadows blocky, 0.87 -> 1.35.)
+// scene's shadows blocky, 0.87 -> 1.35; a target behind every anchor's plane walks none:
+// BENCHMARKS.md.)
 fn corner_visibility(local: u32, base: u32, targets: u32) {
     for (var k = local; k < 4u * targets; k += TILE_PIXELS) {
         let slot = k / 4u;
@@ -435,12 +436,25 @@ fn corner_visibility(local: u32, base: u32, targets: u32) {
         var seen = 0u;
         if (dot(node.normal.xyz, x - node.pos.xyz) > 0.0) {
             seen = 1u << (c + 4u);
-            if (visible(x, tile_n[a], node.pos.xyz, node.normal.xyz)) {
+            if (!behind_every_anchor(node.pos.xyz) && visible(x, tile_n[a], node.pos.xyz, node.normal.xyz)) {
                 seen |= 1u << c;
             }
         }
         atomicOr(&verdicts[slot / 4u], seen << (8u * (slot % 4u)));
     }
+}
+
+// Whether `p` lies behind the plane of every corner's anchor by more than the plane agreement:
+// the receivers on the anchors' surfaces get no light from it, and a ray from an anchor would
+// pass through the anchor's own surface, so it counts as hidden without one.
+fn behind_every_anchor(p: vec3<f32>) -> bool {
+    for (var c = 0u; c < 4u; c++) {
+        let a = shadow_anchor(c);
+        if (dot(tile_n[a], p - tile_x[a]) >= -terms.plane_agreement) {
+            return false;
+        }
+    }
+    return true;
 }
 
 // The pixel that stands for corner c in the shadow rays: the covered pixel nearest the corner
