@@ -84,9 +84,9 @@ fn assert_shadows_help(what: &str, plain: &Frame, shadowed: &Frame, truth: &[[f3
 /// tested from the tiles' corners. At the README's setting (128x128, a 64^2 RSM; per-tile cuts
 /// with the estimate criterion, far clusters shared at 2) the picture's mean FLIP to the truth
 /// falls READMEx or more with the one cut and the per-tile cuts (lavapipe, 2026-11-28, the
-/// grid's two levels, shared shadow rays: leak 10.3x and 9.5x, Cornell box 4.0x and 3.7x); the bounds leave 10% for
-/// other adapters. With the depth maps marched alone (`shadow_grid` 0) the leak scene's ratios
-/// are 4.5x and 4.9x and fail, and so do one level's (leak 8.1x and 7.9x).
+/// grid's two levels, shared shadow rays: leak 10.3x and 9.5x, Cornell box 4.0x and 3.7x); the
+/// bounds leave 10% for other adapters. With the depth maps marched alone (`shadow_grid` 0) the
+/// leak scene's ratios are 4.5x and 4.9x and fail, and so do one level's (leak 8.1x and 7.9x).
 #[test]
 fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
