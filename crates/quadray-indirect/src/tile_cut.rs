@@ -527,7 +527,10 @@ fn cone_box_cos_bound(axis: Vec3, half_cos: f32, lo: Vec3, hi: Vec3) -> f32 {
     let z_max = axis.dot(centre) + axis.abs().dot(half);
     let half_sin = (1.0 - half_cos * half_cos).max(0.0).sqrt();
     if z_max <= 0.0 {
-        return half_sin;
+        let x_max = tx.dot(centre).abs() + tx.abs().dot(half);
+        let y_max = ty.dot(centre).abs() + ty.abs().dot(half);
+        let c = z_max / Vec3::new(x_max, y_max, z_max).length().max(1e-30);
+        return (c * half_cos + (1.0 - c * c).max(0.0).sqrt() * half_sin).max(0.0);
     }
     let x_min = (tx.dot(centre).abs() - tx.abs().dot(half)).max(0.0);
     let y_min = (ty.dot(centre).abs() - ty.abs().dot(half)).max(0.0);
@@ -556,4 +559,62 @@ fn node_bound(
     let cos_vpl = cone_box_cos_bound(node.normal, node.lo.w, d_lo, d_hi);
     let cos_receiver = cone_box_cos_bound(receiver_axis, receiver_cos, -d_hi, -d_lo);
     luminance(flux) * cos_vpl * cos_receiver / (PI * d2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cone_box_cos_bound;
+    use glam::Vec3;
+    use proptest::prelude::*;
+
+    fn unit() -> impl Strategy<Value = Vec3> {
+        (-1f32..1.0, -1f32..1.0, -1f32..1.0)
+            .prop_filter_map("too short", |(x, y, z)| Vec3::new(x, y, z).try_normalize())
+    }
+
+    fn point() -> impl Strategy<Value = Vec3> {
+        (-4f32..4.0, -4f32..4.0, -4f32..4.0).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(4096))]
+
+        /// No normal of the cone and direction of the box has a cosine above the bound, on
+        /// either side of the axis's plane.
+        #[test]
+        fn cone_box_cos_bound_bounds_every_normal_and_direction(
+            axis in unit(),
+            half_angle in 0f32..1.6,
+            corner in point(),
+            size in (0f32..3.0, 0f32..3.0, 0f32..3.0),
+            at in (0f32..=1.0, 0f32..=1.0, 0f32..=1.0),
+            tilt in 0f32..=1.0,
+            side in unit(),
+        ) {
+            let (lo, hi) = (corner, corner + Vec3::new(size.0, size.1, size.2));
+            let d = lo + (hi - lo) * Vec3::new(at.0, at.1, at.2);
+            prop_assume!(d.length() > 1e-3);
+            let perpendicular = (side - axis * side.dot(axis)).try_normalize();
+            prop_assume!(perpendicular.is_some());
+            let angle = half_angle * tilt;
+            let normal = axis * angle.cos() + perpendicular.unwrap() * angle.sin();
+            let bound = cone_box_cos_bound(axis, half_angle.cos(), lo, hi);
+            prop_assert!(normal.dot(d.normalize()).max(0.0) <= bound + 1e-5);
+        }
+    }
+
+    /// Behind the axis's plane the bound falls with the angle: a narrow cone sees nothing of a
+    /// box straight behind it and grazes one beside its plane (the cone's half-angle sine).
+    #[test]
+    fn behind_the_plane_the_bound_falls_with_the_angle() {
+        let half_cos = 10f32.to_radians().cos();
+        let behind = Vec3::new(-0.1, -0.1, -5.0)..Vec3::new(0.1, 0.1, -4.0);
+        assert_eq!(
+            cone_box_cos_bound(Vec3::Z, half_cos, behind.start, behind.end),
+            0.0
+        );
+        let grazing = Vec3::new(10.0, -0.1, -0.01)..Vec3::new(11.0, 0.1, 0.0);
+        let bound = cone_box_cos_bound(Vec3::Z, half_cos, grazing.start, grazing.end);
+        assert!((bound - 10f32.to_radians().sin()).abs() < 1e-3, "{bound}");
+    }
 }

@@ -97,7 +97,7 @@ fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
         ..Settings::sized(128, 128, 64)
     };
     // (and the per-tile cuts' fetches with shared shadow rays at most this part of those with
-    // each cluster walked to alone: measured 0.80 and 0.95)
+    // each cluster walked to alone: measured 0.78 and 0.95)
     for (file, readme_flip, shared_fetches) in
         [("leak.toml", 9.5, 0.85), ("cornell.toml", 3.7, 1.0)]
     {
@@ -198,8 +198,8 @@ fn lone_pixels_are_shadowed_as_the_anchored_ones() {
 /// A tile walks no shadow ray to a target that lies behind the plane of every one of its
 /// anchors: the receivers on those surfaces get no light from it. Seen from the dark room, the
 /// leak scene's partition faces away from every VPL (all in the lit room, behind it), and the
-/// per-tile cuts with shadows fetch 1.1% more than without (the targets' nodes); with every
-/// target that faces an anchor walked to, 7.9% more (lavapipe, 32x32).
+/// per-tile cuts with shadows fetch 0.6% more than without (the targets' nodes); with every
+/// target that faces an anchor walked to, 3.7% more (lavapipe, 32x32).
 #[test]
 fn targets_behind_every_anchor_get_no_shadow_ray() {
     let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
@@ -218,7 +218,7 @@ fn targets_behind_every_anchor_get_no_shadow_ray() {
     let (fetches, fetches_shadowed) = (plain.counts.texel_fetches, with.counts.texel_fetches);
     println!("partition: fetches {fetches} -> {fetches_shadowed} with shadows");
     assert!(
-        fetches_shadowed as f64 <= 1.03 * fetches as f64,
+        fetches_shadowed as f64 <= 1.02 * fetches as f64,
         "{fetches} -> {fetches_shadowed}"
     );
     assert_eq!(plain.indirect, with.indirect);

@@ -7,8 +7,8 @@
 
 // A bound of max(0, dot(n, normalize(d))) over unit n within `half_cos` of `axis` and d in the
 // box [lo, hi]: the box turned into a frame whose z is the axis (the box of the turned box), the
-// least angle of its directions from z bounded from its z_max and its least |x|, |y| (Lightcuts),
-// less the cone's half-angle.
+// least angle of its directions from z bounded from its z_max and its least |x|, |y| (Lightcuts)
+// or, for a box behind the axis's plane, its largest |x|, |y|; less the cone's half-angle.
 fn cone_box_cos_bound(axis: vec3<f32>, half_cos: f32, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
     if (half_cos <= 0.0) {
         return 1.0;
@@ -22,8 +22,12 @@ fn cone_box_cos_bound(axis: vec3<f32>, half_cos: f32, lo: vec3<f32>, hi: vec3<f3
     let z_max = dot(axis, centre) + dot(abs(axis), half);
     let half_sin = sqrt(max(0.0, 1.0 - half_cos * half_cos));
     if (z_max <= 0.0) {
-        // every direction at least 90 degrees from the axis
-        return half_sin;
+        // every direction at least 90 degrees from the axis: z / |d| is highest where z is and the
+        // lateral reach widest, so its cosine from the axis is at most that corner's
+        let x_max = abs(dot(tx, centre)) + dot(abs(tx), half);
+        let y_max = abs(dot(ty, centre)) + dot(abs(ty), half);
+        let c = z_max / max(length(vec3<f32>(x_max, y_max, z_max)), 1e-30);
+        return max(0.0, c * half_cos + sqrt(max(0.0, 1.0 - c * c)) * half_sin);
     }
     let x_min = max(0.0, abs(dot(tx, centre)) - dot(abs(tx), half));
     let y_min = max(0.0, abs(dot(ty, centre)) - dot(abs(ty), half));
