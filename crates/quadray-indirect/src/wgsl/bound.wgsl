@@ -22,8 +22,8 @@ fn cone_box_cos_bound(axis: vec3<f32>, half_cos: f32, lo: vec3<f32>, hi: vec3<f3
     let z_max = dot(axis, centre) + dot(abs(axis), half);
     let half_sin = sqrt(max(0.0, 1.0 - half_cos * half_cos));
     if (z_max <= 0.0) {
-        // every direction at least 90 degrees from the axis: z / |d| is highest where z is and the
-        // lateral reach widest, so its cosine from the axis is at most that corner's
+        // every direction at least 90 degrees from the axis: z / |d| (z <= 0) is highest at the
+        // box's highest z with its widest lateral reach, so no direction is nearer the axis
         let x_max = abs(dot(tx, centre)) + dot(abs(tx), half);
         let y_max = abs(dot(ty, centre)) + dot(abs(ty), half);
         let c = z_max / max(length(vec3<f32>(x_max, y_max, z_max)), 1e-30);
