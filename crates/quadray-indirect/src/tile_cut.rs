@@ -14,7 +14,7 @@ use crate::settings::Method;
 use crate::settings::{
     CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, Settings, TILE, TileCriterion,
 };
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec2, Vec3, Vec4};
 use std::f32::consts::PI;
 
 /// A decision whose quantity lies within this fraction of its threshold is a tie.
@@ -525,20 +525,19 @@ fn cone_box_cos_bound(axis: Vec3, half_cos: f32, lo: Vec3, hi: Vec3) -> f32 {
     let tx = axis.cross(helper).normalize();
     let ty = axis.cross(tx);
     let z_max = axis.dot(centre) + axis.abs().dot(half);
-    let half_sin = (1.0 - half_cos * half_cos).max(0.0).sqrt();
-    if z_max <= 0.0 {
-        let x_max = tx.dot(centre).abs() + tx.abs().dot(half);
-        let y_max = ty.dot(centre).abs() + ty.abs().dot(half);
-        let c = z_max / Vec3::new(x_max, y_max, z_max).length().max(1e-30);
-        return (c * half_cos + (1.0 - c * c).max(0.0).sqrt() * half_sin).max(0.0);
-    }
-    let x_min = (tx.dot(centre).abs() - tx.abs().dot(half)).max(0.0);
-    let y_min = (ty.dot(centre).abs() - ty.abs().dot(half)).max(0.0);
-    let least_cos = z_max / (x_min * x_min + y_min * y_min + z_max * z_max).sqrt();
+    let lateral = Vec2::new(tx.dot(centre), ty.dot(centre)).abs();
+    let spread = Vec2::new(tx.abs().dot(half), ty.abs().dot(half));
+    let reach = if z_max <= 0.0 {
+        lateral + spread
+    } else {
+        (lateral - spread).max(Vec2::ZERO)
+    };
+    let least_cos = z_max / reach.extend(z_max).length().max(1e-30);
     if least_cos >= half_cos {
         return 1.0;
     }
-    least_cos * half_cos + (1.0 - least_cos * least_cos).max(0.0).sqrt() * half_sin
+    let half_sin = (1.0 - half_cos * half_cos).max(0.0).sqrt();
+    (least_cos * half_cos + (1.0 - least_cos * least_cos).max(0.0).sqrt() * half_sin).max(0.0)
 }
 
 /// A bound of the luminance of the irradiance a node gives any receiver in the box [lo, hi]

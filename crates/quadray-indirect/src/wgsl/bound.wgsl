@@ -7,8 +7,8 @@
 
 // A bound of max(0, dot(n, normalize(d))) over unit n within `half_cos` of `axis` and d in the
 // box [lo, hi]: the box turned into a frame whose z is the axis (the box of the turned box), the
-// least angle of its directions from z bounded from its z_max and its least |x|, |y| (Lightcuts)
-// or, for a box behind the axis's plane, its largest |x|, |y|; less the cone's half-angle.
+// least angle of its directions from z bounded from its z_max and its least |x|, |y| (Lightcuts;
+// behind the axis's plane its largest), less the cone's half-angle.
 fn cone_box_cos_bound(axis: vec3<f32>, half_cos: f32, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
     if (half_cos <= 0.0) {
         return 1.0;
@@ -20,23 +20,18 @@ fn cone_box_cos_bound(axis: vec3<f32>, half_cos: f32, lo: vec3<f32>, hi: vec3<f3
     let tx = normalize(cross(axis, helper));
     let ty = cross(axis, tx);
     let z_max = dot(axis, centre) + dot(abs(axis), half);
-    let half_sin = sqrt(max(0.0, 1.0 - half_cos * half_cos));
-    if (z_max <= 0.0) {
-        // every direction at least 90 degrees from the axis: z / |d| (z <= 0) is highest at the
-        // box's highest z with its widest lateral reach, so no direction is nearer the axis
-        let x_max = abs(dot(tx, centre)) + dot(abs(tx), half);
-        let y_max = abs(dot(ty, centre)) + dot(abs(ty), half);
-        let c = z_max / max(length(vec3<f32>(x_max, y_max, z_max)), 1e-30);
-        return max(0.0, c * half_cos + sqrt(max(0.0, 1.0 - c * c)) * half_sin);
-    }
-    let x_min = max(0.0, abs(dot(tx, centre)) - dot(abs(tx), half));
-    let y_min = max(0.0, abs(dot(ty, centre)) - dot(abs(ty), half));
-    let least_cos = z_max / sqrt(x_min * x_min + y_min * y_min + z_max * z_max);
+    let lateral = abs(vec2<f32>(dot(tx, centre), dot(ty, centre)));
+    let spread = vec2<f32>(dot(abs(tx), half), dot(abs(ty), half));
+    // z / |d| is highest at the box's highest z and, in front of the axis's plane, its least
+    // lateral reach; behind it (every direction at least 90 degrees from the axis) its widest
+    let reach = select(max(vec2<f32>(0.0), lateral - spread), lateral + spread, z_max <= 0.0);
+    let least_cos = z_max / max(length(vec3<f32>(reach, z_max)), 1e-30);
     if (least_cos >= half_cos) {
         return 1.0;
     }
     // cos(least angle - half-angle)
-    return least_cos * half_cos + sqrt(max(0.0, 1.0 - least_cos * least_cos)) * half_sin;
+    let half_sin = sqrt(max(0.0, 1.0 - half_cos * half_cos));
+    return max(0.0, least_cos * half_cos + sqrt(max(0.0, 1.0 - least_cos * least_cos)) * half_sin);
 }
 
 // A bound of the luminance of the irradiance a node of flux `flux` (`node`: its box and normal
