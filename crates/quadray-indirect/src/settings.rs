@@ -44,6 +44,12 @@ pub(crate) const CONE_SLACK: f32 = 1e-3;
 /// on the door, corridor and gap scenes, 0.5 walks 8.4, 4.9 and 4.8 at the same FLIP and
 /// blockiness, 1 walks 6.4, 2.7 and 4.3 but took the gap's blockiness to 1.21 and its FLIP up 4%.
 pub(crate) const MIXED_TARGET_ANGLE: f32 = 0.5;
+/// Per-tile cuts: a tile whose coarse estimate is zero (its sample pixels get nothing from the
+/// start level's nodes) takes this share of the start level's bounds at its receivers as its
+/// estimate, instead of a threshold of zero that split every node that might light it to the
+/// list's capacity (a quarter to a third of the listed nodes on the door, gap, shelf and leak
+/// scenes, the same pictures to 4 digits of FLIP; BENCHMARKS.md).
+pub(crate) const ZERO_ESTIMATE_SHARE: f32 = 0.1;
 /// Per-tile cuts order a level's splits by bins of powers of two of how far a node's bound
 /// exceeds the threshold, the highest first.
 pub(crate) const SPLIT_BINS: u32 = 16;

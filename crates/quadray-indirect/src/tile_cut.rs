@@ -13,6 +13,7 @@ use crate::reference::vpl_kernel;
 use crate::settings::Method;
 use crate::settings::{
     CONE_SLACK, EMPTY_BOX, NEAR_FIELD_SIZE, SPLIT_BINS, Settings, TILE, TileCriterion,
+    ZERO_ESTIMATE_SHARE,
 };
 use glam::{DVec3, Vec2, Vec3, Vec4};
 use std::f32::consts::PI;
@@ -56,6 +57,9 @@ pub struct TileCut {
     pub estimated: u32,
     /// The VPL evaluations the estimates took.
     pub estimate_evaluations: u32,
+    /// Whether the tile's coarse estimate was zero, its threshold taken from the start level's
+    /// bounds ([`ZERO_ESTIMATE_SHARE`]).
+    pub zero_estimate: bool,
     /// Nodes whose split, near field, nearest receiver or sharing was a tie ([`TIE`]).
     pub ties: Vec<CutNode>,
 }
@@ -278,13 +282,16 @@ impl<'a> Tile<'a> {
         g
     }
 
-    /// Phase 2: the threshold, `tile_error` of the mean of the sample pixels' coarse estimates
-    /// (each thread's share of the start level's nodes summed as the shader's threads do).
-    fn threshold(&self) -> f32 {
+    /// Phase 2: the threshold, `tile_error` of the mean of the sample pixels' coarse estimates,
+    /// or where that is zero of [`ZERO_ESTIMATE_SHARE`] of the start level's nodes' bounds at
+    /// the tile's receivers (each thread's share of the start level's nodes summed as the
+    /// shader's threads do).
+    fn threshold(&self, g: &Groups) -> (f32, bool) {
         let (s, r_min) = self.params();
         let start = s.tile_start_level();
         let side = s.rsm_size >> start;
         let mut shares = [Vec4::ZERO; TILE_PIXELS];
+        let mut bounded = [0.0; TILE_PIXELS];
         for i in 0..side * side {
             let node = self.node(CutNode {
                 level: start,
@@ -298,6 +305,7 @@ impl<'a> Tile<'a> {
                     })
                 };
                 shares[i as usize % TILE_PIXELS] += Vec4::from_array(std::array::from_fn(light));
+                bounded[i as usize % TILE_PIXELS] += tile_bound(&node, g, r_min);
             }
         }
         let summed = tree(shares, |a, b| a + b);
@@ -308,7 +316,14 @@ impl<'a> Tile<'a> {
                 samples += 1.0;
             }
         }
-        s.tile_error_or_default() * (total / samples)
+        let estimate = total / samples;
+        let zero = estimate == 0.0;
+        let estimate = if zero {
+            ZERO_ESTIMATE_SHARE * tree(bounded, |a, b| a + b)
+        } else {
+            estimate
+        };
+        (s.tile_error_or_default() * estimate, zero)
     }
 
     /// [`near_field`] for the tile's receivers, noting a tie.
@@ -388,19 +403,7 @@ impl<'a> Tile<'a> {
         if at.level == 0 {
             return Some(0);
         }
-        let bound = (0..2)
-            .map(|h| {
-                node_bound(
-                    node.flux.truncate(),
-                    &node,
-                    g.lo[h],
-                    g.hi[h],
-                    g.axis[h],
-                    g.cone[h],
-                    r_min,
-                )
-            })
-            .fold(0.0, f32::max);
+        let bound = tile_bound(&node, g, r_min);
         let mut excess = bound;
         let estimate = s.tile_criterion == TileCriterion::Estimate;
         let start = s.tile_start_level();
@@ -426,8 +429,11 @@ impl<'a> Tile<'a> {
         let s = self.input.settings;
         let capacity = s.tile_capacity_or_default();
         let groups = self.groups();
-        let threshold = self.threshold();
-        let mut cut = TileCut::default();
+        let (threshold, zero_estimate) = self.threshold(&groups);
+        let mut cut = TileCut {
+            zero_estimate,
+            ..TileCut::default()
+        };
         let root = s.rsm_size.ilog2();
         let mut frontier = vec![CutNode {
             level: root,
@@ -538,6 +544,24 @@ fn cone_box_cos_bound(axis: Vec3, half_cos: f32, lo: Vec3, hi: Vec3) -> f32 {
     }
     let half_sin = (1.0 - half_cos * half_cos).max(0.0).sqrt();
     (least_cos * half_cos + (1.0 - least_cos * least_cos).max(0.0).sqrt() * half_sin).max(0.0)
+}
+
+/// What a node may give any receiver of the tile: the larger of its bounds for the two groups
+/// (tile_rule.wgsl's `tile_bound`).
+fn tile_bound(node: &Node, g: &Groups, r_min: f32) -> f32 {
+    (0..2)
+        .map(|h| {
+            node_bound(
+                node.flux.truncate(),
+                node,
+                g.lo[h],
+                g.hi[h],
+                g.axis[h],
+                g.cone[h],
+                r_min,
+            )
+        })
+        .fold(0.0, f32::max)
 }
 
 /// A bound of the luminance of the irradiance a node gives any receiver in the box [lo, hi]

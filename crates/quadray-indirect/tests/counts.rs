@@ -117,7 +117,8 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     );
 
     // per-tile cuts, per tile that sees geometry: the coarse estimate (every node of the start
-    // level read, the non-empty ones evaluated at each 4x4 quadrant's first covered pixel), the
+    // level read, the non-empty ones evaluated at each 4x4 quadrant's first covered pixel and
+    // their bound records read and evaluated against both groups of receivers), the
     // refinement from the root (every node visited read; a bound record read and evaluated
     // against both groups of receivers for the non-empty ones above level 0, which are listed or
     // split, the split ones' four children visited) and the gather (the list read once into
@@ -195,9 +196,10 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
             let (estimated, estimate_evaluations) = (u64::from(reported.0), u64::from(reported.1));
             let split = split.len() as u64;
             // a bound for each of the tile's two groups of receivers
-            bounds += 2 * (listed_above_0 + split);
+            bounds += 2 * (lit_start + listed_above_0 + split);
             evaluations += lit_start * quadrants + pixels_lit * listed + estimate_evaluations;
             fetches += start_nodes
+                + lit_start
                 + (1 + 4 * split)
                 + (listed_above_0 + split)
                 + listed

@@ -8,7 +8,8 @@
 // EMPTY_BOX); `fn tile_sample(q: u32) -> u32`, the sample pixel of quadrant q (its first covered
 // pixel, TILE_PIXELS where none).
 
-// (TILE, NEAR_FIELD_SIZE, EMPTY_BOX, CONE_SLACK and SPLIT_BINS come from the prelude)
+// (TILE, NEAR_FIELD_SIZE, EMPTY_BOX, CONE_SLACK, SPLIT_BINS and ZERO_ESTIMATE_SHARE come from
+// the prelude)
 const TILE_PIXELS: u32 = TILE * TILE;
 const CORNERS: array<u32, 4> = array<u32, 4>(0u, TILE - 1u, TILE_PIXELS - TILE, TILE_PIXELS - 1u);
 
@@ -52,8 +53,10 @@ fn coarse_light(node: Node, r_min: f32) -> vec4<f32> {
 }
 
 // The threshold a node's bound is held to: `tile_error` of the mean of the sample pixels'
-// coarse estimates (`summed` per quadrant; their least refined more for as little error).
-fn tile_threshold(tile_error: f32, summed: vec4<f32>) -> f32 {
+// coarse estimates (`summed` per quadrant; their least refined more for as little error), or
+// where that is zero, of ZERO_ESTIMATE_SHARE of `bounded`, the start level's nodes' bounds at
+// the tile's receivers summed.
+fn tile_threshold(tile_error: f32, summed: vec4<f32>, bounded: f32) -> f32 {
     var total = 0.0;
     var samples = 0.0;
     for (var q = 0u; q < 4u; q++) {
@@ -62,7 +65,8 @@ fn tile_threshold(tile_error: f32, summed: vec4<f32>) -> f32 {
             samples += 1.0;
         }
     }
-    return tile_error * (total / samples);
+    let estimate = total / samples;
+    return tile_error * select(estimate, ZERO_ESTIMATE_SHARE * bounded, estimate == 0.0);
 }
 
 // What a node may give any receiver of the tile: the larger of its bounds for the two groups.

@@ -20,7 +20,8 @@ var<workgroup> tile_x: array<vec3<f32>, TILE_PIXELS>;
 var<workgroup> tile_n: array<vec3<f32>, TILE_PIXELS>;
 // reductions over the tile's pixels: the receivers' box and normals (summed; w: how many), of
 // the tile then of each group, each group's least cosine to its axis (x, y of reduce_n), and
-// the coarse estimate at each quadrant's sample pixel
+// the coarse estimate at each quadrant's sample pixel with the start level's bounds (x of
+// reduce_lo)
 var<workgroup> reduce_lo: array<vec3<f32>, TILE_PIXELS>;
 var<workgroup> reduce_hi: array<vec3<f32>, TILE_PIXELS>;
 var<workgroup> reduce_n: array<vec4<f32>, TILE_PIXELS>;
@@ -200,27 +201,33 @@ fn receiver_groups(local: u32, r: Receiver) -> TileGroups {
 }
 
 // Phase 2: the coarse estimate, the nodes of level `tile_start` at each quadrant's sample pixel,
-// and the threshold from it. Every invocation calls it.
-fn coarse_threshold(local: u32) -> f32 {
+// and the threshold from it (from their bounds at the tile's receivers where it is zero). Every
+// invocation calls it.
+fn coarse_threshold(local: u32, g: TileGroups) -> f32 {
     let side = level_size(params, shade.tile_start);
     let first = level_offset(params, shade.tile_start);
     var e = vec4<f32>(0.0);
+    var bounded = 0.0;
     for (var i = local; i < side * side; i += TILE_PIXELS) {
         fetches++;
         let node = nodes[first + i];
         if (node.flux.w > 0.5) {
             e += coarse_light(node, terms.r_min);
+            fetches++;
+            bounded += tile_bound(node, bounds[first + i], g, terms.r_min);
         }
     }
     reduce_e[local] = e;
+    reduce_lo[local].x = bounded;
     workgroupBarrier();
     for (var stride = TILE_PIXELS / 2u; stride > 0u; stride >>= 1u) {
         if (local < stride) {
             reduce_e[local] += reduce_e[local + stride];
+            reduce_lo[local].x += reduce_lo[local + stride].x;
         }
         workgroupBarrier();
     }
-    return tile_threshold(shade.tile_error, reduce_e[0]);
+    return tile_threshold(shade.tile_error, reduce_e[0], reduce_lo[0].x);
 }
 
 // Phase 3: refinement, one level a step, from the root so that far tiles may keep clusters
@@ -678,7 +685,7 @@ fn indirect_tiles(
         return;
     }
     let groups = receiver_groups(local, r);
-    let threshold = coarse_threshold(local);
+    let threshold = coarse_threshold(local, groups);
     refine(local, tile, groups, threshold);
     storageBarrier();
     let listed = atomicLoad(&list_len);
