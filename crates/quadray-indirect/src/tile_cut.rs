@@ -58,7 +58,7 @@ pub struct TileCut {
     /// The VPL evaluations the estimates took.
     pub estimate_evaluations: u32,
     /// Whether the tile's coarse estimate was zero, its threshold taken from the start level's
-    /// bounds ([`ZERO_ESTIMATE_SHARE`]).
+    /// bounds (`ZERO_ESTIMATE_SHARE` of them).
     pub zero_estimate: bool,
     /// Nodes whose split, near field, nearest receiver or sharing was a tie ([`TIE`]).
     pub ties: Vec<CutNode>,
@@ -283,7 +283,7 @@ impl<'a> Tile<'a> {
     }
 
     /// Phase 2: the threshold, `tile_error` of the mean of the sample pixels' coarse estimates,
-    /// or where that is zero of [`ZERO_ESTIMATE_SHARE`] of the start level's nodes' bounds at
+    /// or where that is zero of `ZERO_ESTIMATE_SHARE` of the start level's nodes' bounds at
     /// the tile's receivers (each thread's share of the start level's nodes summed as the
     /// shader's threads do).
     fn threshold(&self, g: &Groups) -> (f32, bool) {
