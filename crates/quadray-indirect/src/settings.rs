@@ -44,6 +44,15 @@ pub(crate) const CONE_SLACK: f32 = 1e-3;
 /// on the door, corridor and gap scenes, 0.5 walks 8.4, 4.9 and 4.8 at the same FLIP and
 /// blockiness, 1 walks 6.4, 2.7 and 4.3 but took the gap's blockiness to 1.21 and its FLIP up 4%.
 pub(crate) const MIXED_TARGET_ANGLE: f32 = 0.5;
+/// Indirect shadows, per-tile cuts: a shadow target of several surfaces whose normals all lie
+/// within the cone of this cosine about its mean normal (surfaces facing one way at different
+/// depths, such as a box's top and the floor around it) is walked to at its box's farthest face
+/// along that normal, from a receiver beyond that face: its mean lies between its surfaces,
+/// inside the box, where the box's top hid it from the ceiling while every VPL of the cluster
+/// was in view. A cone of about 25 degrees holds flat surfaces and leaves out a corner's floor
+/// and walls (45 degrees apart), whose box's far corner lies out in the room: walked to for
+/// every mixed target, the Cornell box's and the bunny's pictures got worse (BENCHMARKS.md).
+pub(crate) const PARALLEL_TARGET_COS: f32 = 0.9;
 /// Per-tile cuts: a tile whose coarse estimate is zero (its sample pixels get nothing from the
 /// start level's nodes) takes this share of the start level's bounds at its receivers as its
 /// estimate, instead of a threshold of zero that split every node that might light it to the

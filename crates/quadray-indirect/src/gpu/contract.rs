@@ -7,8 +7,8 @@
 use crate::deblock::{ALBEDO as DEBLOCK_ALBEDO, LIMIT as DEBLOCK_LIMIT, PLANE as DEBLOCK_PLANE};
 use crate::occupancy::{BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS, SUBCELLS};
 pub(crate) use crate::settings::{
-    CONE_SLACK, EMPTY_BOX, MIXED_TARGET_ANGLE, NEAR_FIELD_SIZE, SPLIT_BINS, TILE,
-    TILE_ENTRY_INDEX_BITS, TILE_FRONTIER, ZERO_ESTIMATE_SHARE,
+    CONE_SLACK, EMPTY_BOX, MIXED_TARGET_ANGLE, NEAR_FIELD_SIZE, PARALLEL_TARGET_COS, SPLIT_BINS,
+    TILE, TILE_ENTRY_INDEX_BITS, TILE_FRONTIER, ZERO_ESTIMATE_SHARE,
 };
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -55,6 +55,7 @@ pub(crate) fn prelude() -> String {
          const CONE_SLACK: f32 = {CONE_SLACK:?};\n\
          const SPLIT_BINS: u32 = {SPLIT_BINS}u;\n\
          const MIXED_TARGET_ANGLE: f32 = {MIXED_TARGET_ANGLE:?};\n\
+         const PARALLEL_TARGET_COS: f32 = {PARALLEL_TARGET_COS:?};\n\
          const ZERO_ESTIMATE_SHARE: f32 = {ZERO_ESTIMATE_SHARE:?};\n\
          const PI: f32 = {:?};\n\
          const OUTPUT_INDIRECT: u32 = {}u;\n\
@@ -464,6 +465,7 @@ mod tests {
             format!("const CONE_SLACK: f32 = {CONE_SLACK:?};"),
             format!("const SPLIT_BINS: u32 = {SPLIT_BINS}u;"),
             format!("const MIXED_TARGET_ANGLE: f32 = {MIXED_TARGET_ANGLE:?};"),
+            format!("const PARALLEL_TARGET_COS: f32 = {PARALLEL_TARGET_COS:?};"),
             format!("const DEBLOCK_LIMIT: f32 = {DEBLOCK_LIMIT:?};"),
             format!("const DEBLOCK_PLANE: f32 = {DEBLOCK_PLANE:?};"),
             format!("const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};"),

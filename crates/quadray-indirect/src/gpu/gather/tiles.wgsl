@@ -437,18 +437,40 @@ fn corner_visibility(local: u32, base: u32, targets: u32) {
         let slot = k / 4u;
         let c = k % 4u;
         fetches++;
-        let node = nodes[tile_targets[base + slot]];
+        let index = tile_targets[base + slot];
+        let node = nodes[index];
         let a = shadow_anchor(c);
         let x = tile_x[a];
         var seen = 0u;
         if (dot(node.normal.xyz, x - node.pos.xyz) > 0.0) {
             seen = 1u << (c + 4u);
-            if (!behind_every_anchor(node.pos.xyz) && visible(x, tile_n[a], node.pos.xyz, node.normal.xyz)) {
+            if (!behind_every_anchor(node.pos.xyz) && visible(x, tile_n[a], shadow_end(index, node, x), node.normal.xyz)) {
                 seen |= 1u << c;
             }
         }
         atomicOr(&verdicts[slot / 4u], seen << (8u * (slot % 4u)));
     }
+}
+
+// The point a shadow ray from receiver `x` walks to: the target's mean; for a target of several
+// surfaces facing one way (its normal cone within PARALLEL_TARGET_COS, from the prelude) and a
+// receiver beyond its box's farthest face along its normal, a point on that face: the mean lies
+// between the surfaces (inside a box whose top and the floor around it make the cluster), where
+// the top hides it from above while every VPL of the cluster is in view.
+fn shadow_end(index: u32, node: Node, x: vec3<f32>) -> vec3<f32> {
+    let n = node.normal.xyz;
+    if (node.normal.w > 0.5 || dot(n, n) < 0.01) {
+        return node.pos.xyz;
+    }
+    fetches++;
+    let b = bounds[index];
+    if (b.lo.w < PARALLEL_TARGET_COS) {
+        return node.pos.xyz;
+    }
+    let u = normalize(n);
+    let reach = max(u * (b.hi.xyz - node.pos.xyz), u * (b.lo.xyz - node.pos.xyz));
+    let face = node.pos.xyz + u * max(reach.x + reach.y + reach.z, 0.0);
+    return select(node.pos.xyz, face, dot(u, x - face) > 0.0);
 }
 
 // Whether `p` lies behind the plane of every corner's anchor by more than the plane agreement:
@@ -609,8 +631,9 @@ fn lone_sums(local: u32, tile: u32, r: Receiver, listed: u32, lone: bool) -> vec
                 let lone_row = first + k / targets;
                 let p = (atomicLoad(&lone_pixels[lone_row / 4u]) >> (8u * (lone_row % 4u))) & 255u;
                 fetches++;
-                let t = nodes[tile_targets[base + k % targets]];
-                if (!visible(tile_x[p], tile_n[p], t.pos.xyz, t.normal.xyz)) {
+                let index = tile_targets[base + k % targets];
+                let t = nodes[index];
+                if (!visible(tile_x[p], tile_n[p], shadow_end(index, t, tile_x[p]), t.normal.xyz)) {
                     atomicAnd(&verdicts[k / 32u], ~(1u << (k % 32u)));
                 }
             }
