@@ -452,14 +452,16 @@ fn corner_visibility(local: u32, base: u32, targets: u32) {
     }
 }
 
-// The point a shadow ray from receiver `x` walks to: the target's mean; for a target of several
-// surfaces facing one way (its normal cone within PARALLEL_TARGET_COS, from the prelude) and a
-// receiver beyond its box's farthest face along its normal, a point on that face: the mean lies
-// between the surfaces (inside a box whose top and the floor around it make the cluster), where
-// the top hides it from above while every VPL of the cluster is in view.
+// The point a shadow ray from receiver `x` walks to: the target's mean; with the occupancy grid,
+// for a target of several surfaces facing one way (its normal cone within PARALLEL_TARGET_COS,
+// from the prelude) and a receiver beyond its box's farthest face along its normal, a point on
+// that face: the mean lies between the surfaces (inside a box whose top and the floor around it
+// make the cluster), where the grid finds the top in the way while every VPL of the cluster is
+// in view. (The depth maps marched alone judge the mean better: the face took the OBJ box's
+// FLIP with them 0.0243 -> 0.0287.)
 fn shadow_end(index: u32, node: Node, x: vec3<f32>) -> vec3<f32> {
     let n = node.normal.xyz;
-    if (node.normal.w > 0.5 || dot(n, n) < 0.01) {
+    if (node.normal.w > 0.5 || dot(n, n) < 0.01 || occupancy_load(0u) == 0u) {
         return node.pos.xyz;
     }
     fetches++;
