@@ -49,9 +49,10 @@ pub(crate) const MIXED_TARGET_ANGLE: f32 = 0.5;
 /// depths, such as a box's top and the floor around it) is walked to at its box's farthest face
 /// along that normal, from a receiver beyond that face: its mean lies between its surfaces,
 /// inside the box, where the box's top hid it from the ceiling while every VPL of the cluster
-/// was in view. A cone of about 25 degrees holds flat surfaces and leaves out a corner's floor
-/// and walls (45 degrees apart), whose box's far corner lies out in the room: walked to for
-/// every mixed target, the Cornell box's and the bunny's pictures got worse (BENCHMARKS.md).
+/// was in view. A cone of about 25 degrees holds surfaces facing one way and leaves out a
+/// corner's floor and walls (each 45 degrees from their mean normal), whose box's far corner
+/// lies out in the room: walked to for every mixed target, the Cornell box's and the bunny's
+/// pictures got worse (BENCHMARKS.md).
 pub(crate) const PARALLEL_TARGET_COS: f32 = 0.9;
 /// Per-tile cuts: a tile whose coarse estimate is zero (its sample pixels get nothing from the
 /// start level's nodes) takes this share of the start level's bounds at its receivers as its
