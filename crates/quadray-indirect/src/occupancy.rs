@@ -53,8 +53,8 @@ pub struct Walk {
     /// Cells and sub-cells the segment crossed up to the answer (what a grid of a word a cell
     /// would have fetched).
     pub cells: u32,
-    /// Steps of the walk's loop: a cell, a sub-cell, or an empty brick crossed in one step
-    /// (its work on a GPU, beside the fetches).
+    /// Steps of the walk's loop: a box crossed (an empty brick, a cell, a sub-cell), or a word
+    /// read that the next step needs (its work on a GPU, beside the fetches).
     pub steps: u32,
 }
 
@@ -192,9 +192,9 @@ impl OccupancyGrid {
     /// moved [`END_OFFSET_CELLS`] off their surfaces (an end whose normal is shorter than 0.1
     /// stays); `None` where a moved end lies in a set cell (another surface within two cells
     /// of it: in a corner, under a box) or the walk enters a set cell within
-    /// [`END_CLEARANCE_CELLS`] of an end, which the grid cannot judge. Visits the cells the
-    /// segment passes through, in order (a 3D DDA), and crosses a brick whose word is zero in
-    /// one step.
+    /// [`END_CLEARANCE_CELLS`] of an end, which the grid cannot judge. Crosses the boxes the
+    /// segment passes through, in order: a brick whose word is zero, a cell whose bit is not
+    /// set, or a sub-cell of a set one, a box a step.
     pub fn visible(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Option<bool> {
         self.walk(x, n, xp, np).visible
     }
@@ -220,116 +220,62 @@ impl OccupancyGrid {
         np: Vec3,
         reader: &mut WordReader,
     ) -> Option<bool> {
-        let a = self.to_grid(x, n);
-        let b = self.to_grid(xp, np);
-        let d = b - a;
-        let mut c = a.floor().as_ivec3();
-        let end = b.floor().as_ivec3();
-        // the end first: the walk goes on from the start's word
-        if reader.occupied_at(b) || reader.occupied_at(a) {
+        let a_cells = self.to_grid(x, n);
+        let b_cells = self.to_grid(xp, np);
+        // the end first: the walk goes on from its word
+        if reader.occupied_at(b_cells) {
             return None;
         }
-        let step = IVec3::new(sign(d.x), sign(d.y), sign(d.z));
-        let t_delta = Vec3::new(inverse(d.x), inverse(d.y), inverse(d.z));
+        let a = a_cells * SUBCELLS as f32;
+        let d = (b_cells - a_cells) * SUBCELLS as f32;
+        let forward = d.cmpgt(Vec3::ZERO);
+        let still = d.cmpeq(Vec3::ZERO);
+        let inverse = Vec3::ONE / Vec3::select(still, Vec3::ONE, d);
         // the segment parameter of the clearance at each end
-        let clearance = END_CLEARANCE_CELLS / d.length().max(1e-6);
+        let clearance = END_CLEARANCE_CELLS / (b_cells - a_cells).length().max(1e-6);
         let blocked_at = |entered: f32| clearance < entered && entered < 1.0 - clearance;
-        let mut t_max = Vec3::new(
-            first_crossing(a.x, d.x),
-            first_crossing(a.y, d.y),
-            first_crossing(a.z, d.z),
-        );
-        // one loop, over the cells and, with two levels, the sub-cells of the set ones: lavapipe
-        // caps the loop iterations of a shader invocation, the gather's sums and walks together,
-        // and a loop nested here used up that cap even in the one-level walk, which never ran it
-        let mut sub = if self.sub.is_some() && reader.occupied(c) {
-            Some(SubWalk::new(c, a, d, 0.0))
-        } else {
-            None
-        };
-        let cells = self.dims.x + self.dims.y + self.dims.z + 1;
-        let bound = if self.sub.is_some() {
-            cells * (3 * SUBCELLS + 1)
-        } else {
-            cells
-        };
+        // a step a sub-cell face crossed (the ends lie within two cells of the grid), and two
+        // reads a cell at most
+        let bound = 3 * SUBCELLS * (self.dims.element_sum() + 6);
+        let mut s = a.floor().as_ivec3();
+        let mut entered = 0.0;
+        reader.cells += 1;
         for _ in 0..bound {
             reader.steps += 1;
-            if let Some(w) = &mut sub {
-                if w.entered <= 1.0 {
-                    if reader.sub_occupied(w.s) {
-                        return blocked_at(w.entered.max(0.0)).then_some(false);
-                    }
-                    if w.step() {
-                        continue;
-                    }
-                }
-                // past the cell or the segment's end
-                sub = None;
-            }
-            if c == end {
+            let shift = match reader.step_box(s) {
+                StepBox::Read => continue,
+                StepBox::Set => return blocked_at(entered).then_some(false),
+                StepBox::Free(shift) => shift,
+            };
+            let lo = (s >> shift) << shift;
+            let hi = lo + (IVec3::ONE << shift);
+            let exit = Vec3::select(
+                still,
+                Vec3::INFINITY,
+                (IVec3::select(forward, hi, lo).as_vec3() - a) * inverse,
+            );
+            let t = exit.min_element();
+            if t > 1.0 {
+                // the end is in the box
                 break;
             }
-            // the parameter where the walk enters its next cell
-            let mut entered = t_max.min_element();
-            if reader.in_empty_brick(c) {
-                // an empty brick: on to the cell where the segment leaves it, in one step
-                let lo = c.div_euclid(BRICK.as_ivec3()) * BRICK.as_ivec3();
-                let hi = lo + BRICK.as_ivec3();
-                let leaving = |i: usize| {
-                    let face = if step[i] > 0 { hi[i] } else { lo[i] };
-                    face_at(face as f32, a[i], d[i])
-                };
-                let exit = Vec3::new(leaving(0), leaving(1), leaving(2));
-                entered = exit.min_element();
-                if entered > 1.0 {
-                    // the end's cell is in the brick
-                    break;
-                }
-                // the cell across the face it leaves by (ties as the DDA's), kept beside the
-                // brick against rounding
-                let mut next = (a + d * entered).floor().as_ivec3().clamp(lo, hi - 1);
-                let axis = if exit.x <= exit.y && exit.x <= exit.z {
-                    0
-                } else if exit.y <= exit.z {
-                    1
-                } else {
-                    2
-                };
-                next[axis] = if step[axis] > 0 {
-                    hi[axis]
-                } else {
-                    lo[axis] - 1
-                };
-                // the cells a walk of a cell a step would have tested on the way
-                reader.cells += (next - c).abs().element_sum().max(1) as u32 - 1;
-                c = next;
-                let next_face = (c + step.max(IVec3::ZERO)).as_vec3();
-                t_max = Vec3::new(
-                    face_at(next_face.x, a.x, d.x),
-                    face_at(next_face.y, a.y, d.y),
-                    face_at(next_face.z, a.z, d.z),
-                );
-            } else if t_max.x <= t_max.y && t_max.x <= t_max.z {
-                c.x += step.x;
-                t_max.x += t_delta.x;
-            } else if t_max.y <= t_max.z {
-                c.y += step.y;
-                t_max.y += t_delta.y;
+            // the box across the face the segment leaves by (ties: x, then y), kept beside the
+            // box against rounding
+            let mut next = (a + d * t).floor().as_ivec3().clamp(lo, hi - 1);
+            let across = IVec3::select(forward, hi, lo - 1);
+            let axis = if exit.x <= exit.y && exit.x <= exit.z {
+                0
+            } else if exit.y <= exit.z {
+                1
             } else {
-                c.z += step.z;
-                t_max.z += t_delta.z;
-            }
-            if t_max.min_element() > 1.0 && c != end {
-                // past the end in floating point: the end's cell is the last one
-                c = end;
-            }
-            if reader.occupied(c) {
-                if self.sub.is_none() {
-                    return blocked_at(entered).then_some(false);
-                }
-                sub = Some(SubWalk::new(c, a, d, entered));
-            }
+                2
+            };
+            next[axis] = across[axis];
+            // the cells entered (a walk of a cell a step would have tested each)
+            let cells = |s: IVec3| s.div_euclid(IVec3::splat(SUBCELLS as i32));
+            reader.cells += (cells(next) - cells(s)).abs().element_sum() as u32;
+            s = next;
+            entered = t;
         }
         Some(true)
     }
@@ -411,7 +357,7 @@ impl OccupancyGrid {
                     let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
                     if triangle_overlaps_box(t, (low + high) * 0.5, (high - low) * 0.5) {
                         let mask = masks.entry(word * 32 + bit as usize).or_default();
-                        let (w, b) = sub_bit((s - c * SUBCELLS as i32).as_uvec3());
+                        let (w, b) = sub_bit(sub_cell(s));
                         mask[w] |= 1 << b;
                     }
                 }
@@ -454,6 +400,11 @@ fn sub_bit(l: UVec3) -> (usize, u32) {
     ((l.z / 2) as usize, l.x + 4 * (l.y + 4 * (l.z % 2)))
 }
 
+/// Sub-cell `s`'s place in its cell (0..[`SUBCELLS`] each).
+fn sub_cell(s: IVec3) -> UVec3 {
+    s.rem_euclid(IVec3::splat(SUBCELLS as i32)).as_uvec3()
+}
+
 /// A walk's reads of the grid: the last word fetched, how many were, and the cells tested.
 struct WordReader<'a> {
     grid: &'a OccupancyGrid,
@@ -492,40 +443,83 @@ impl WordReader<'_> {
     /// held).
     fn sub_occupied(&mut self, s: IVec3) -> bool {
         self.cells += 1;
-        let sub = self.grid.sub.as_ref().expect("a grid of two levels");
+        if self.first.is_none() {
+            self.read_first();
+        }
+        self.read_sub_word(s) >> sub_bit(sub_cell(s)).1 & 1 == 1
+    }
+
+    /// The box the walk at sub-cell `s` may cross in one step, reading at most one word, as the
+    /// GPU's walk does (its loop has one read): the brick's where another is held; in a set
+    /// cell of a grid of two levels, where the brick's sub-cells start, then the half of the
+    /// cell's sub-cells, each at a step of its own where not held.
+    fn step_box(&mut self, s: IVec3) -> StepBox {
         let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
-        let (index, bit) = self.grid.index(c).expect("a set cell is in the grid");
-        let (held, bits) = self.word.expect("the cell's word is held");
-        debug_assert_eq!(held, index);
-        let first = match self.first {
-            Some(first) => first,
-            None => {
-                self.fetches += 1;
-                let first = sub.first[index];
-                self.first = Some(first);
-                first
-            }
+        let Some((index, bit)) = self.grid.index(c) else {
+            return StepBox::Free(CELL_SHIFT);
         };
+        let two_levels = self.grid.sub.is_some();
+        if self.word.is_none_or(|(held, _)| held != index) {
+            let bits = self.read_brick(index);
+            if two_levels && bits >> bit & 1 == 1 {
+                return StepBox::Read;
+            }
+        }
+        let bits = self.word.expect("the brick is held").1;
+        if bits >> bit & 1 == 0 {
+            return StepBox::Free(if bits == 0 { BRICK_SHIFT } else { CELL_SHIFT });
+        }
+        if !two_levels {
+            return StepBox::Set;
+        }
+        if self.first.is_none() {
+            self.read_first();
+            return StepBox::Read;
+        }
+        if self.sub_occupied(s) {
+            StepBox::Set
+        } else {
+            StepBox::Free(UVec3::ZERO)
+        }
+    }
+
+    /// Reads the word of the brick at `index`.
+    fn read_brick(&mut self, index: usize) -> u32 {
+        self.fetches += 1;
+        let bits = self.grid.bits[index];
+        self.word = Some((index, bits));
+        self.first = None;
+        bits
+    }
+
+    /// Reads where the held brick's sub-cells start.
+    fn read_first(&mut self) {
+        let (index, _) = self.word.expect("the brick is held");
+        self.fetches += 1;
+        self.first = Some(self.sub_cells().first[index]);
+    }
+
+    /// The word of sub-cell `s` of a set cell of the held brick (read where another is held).
+    fn read_sub_word(&mut self, s: IVec3) -> u32 {
+        let (_, bits) = self.word.expect("the brick is held");
+        let first = self.first.expect("the brick's first sub-cells are read");
+        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+        let (_, bit) = self.grid.index(c).expect("a set cell is in the grid");
         let rank = first + (bits & ((1u32 << bit) - 1)).count_ones();
-        let (w, b) = sub_bit((s - c * SUBCELLS as i32).as_uvec3());
-        let word = rank as usize * MASK_WORDS + w;
-        let mask = match self.sub_word {
+        let word = rank as usize * MASK_WORDS + sub_bit(sub_cell(s)).0;
+        match self.sub_word {
             Some((held, mask)) if held == word => mask,
             _ => {
                 self.fetches += 1;
-                let mask = sub.masks[word];
+                let mask = self.sub_cells().masks[word];
                 self.sub_word = Some((word, mask));
                 mask
             }
-        };
-        mask >> b & 1 == 1
+        }
     }
 
-    /// Whether the word of cell `c`'s brick is held and zero: no cell of the brick is set.
-    fn in_empty_brick(&self, c: IVec3) -> bool {
-        self.grid
-            .index(c)
-            .is_some_and(|(index, _)| self.word == Some((index, 0)))
+    fn sub_cells(&self) -> &SubCells {
+        self.grid.sub.as_ref().expect("a grid of two levels")
     }
 
     fn occupied(&mut self, c: IVec3) -> bool {
@@ -535,120 +529,29 @@ impl WordReader<'_> {
         };
         let bits = match self.word {
             Some((held, bits)) if held == index => bits,
-            _ => {
-                self.fetches += 1;
-                let bits = self.grid.bits[index];
-                self.word = Some((index, bits));
-                self.first = None;
-                bits
-            }
+            _ => self.read_brick(index),
         };
         bits >> bit & 1 == 1
     }
 }
 
-/// A walk's way through the sub-cells of a set cell: the sub-cell it is in, the parameter where
-/// it entered it, and the DDA's state.
-struct SubWalk {
-    s: IVec3,
-    entered: f32,
-    lo: IVec3,
-    hi: IVec3,
-    step: IVec3,
-    t_max: Vec3,
-    t_delta: Vec3,
+/// What a step of the walk may cross from its sub-cell ([`WordReader::step_box`]).
+enum StepBox {
+    /// Nothing: the step read a word that the sub-cell's verdict needs before the next one.
+    Read,
+    /// The sub-cell (with one level, the cell) is set.
+    Set,
+    /// The box around the sub-cell, its side 2^shift sub-cells along each axis, is free.
+    Free(UVec3),
 }
 
-impl SubWalk {
-    /// The segment from `a` along `d` (grid units) entering set cell `c` at parameter `entered`.
-    fn new(c: IVec3, a: Vec3, d: Vec3, entered: f32) -> Self {
-        let k = SUBCELLS as f32;
-        let (a, d) = (a * k, d * k);
-        let lo = c * SUBCELLS as i32;
-        let hi = lo + (SUBCELLS as i32 - 1);
-        // the sub-cell entered, kept in the cell against rounding
-        let s = (a + d * entered).floor().as_ivec3().clamp(lo, hi);
-        let face = |s: i32, a: f32, d: f32| {
-            if d > 0.0 {
-                (s as f32 + 1.0 - a) / d
-            } else if d < 0.0 {
-                (s as f32 - a) / d
-            } else {
-                f32::INFINITY
-            }
-        };
-        Self {
-            s,
-            entered,
-            lo,
-            hi,
-            step: IVec3::new(sign(d.x), sign(d.y), sign(d.z)),
-            t_max: Vec3::new(
-                face(s.x, a.x, d.x),
-                face(s.y, a.y, d.y),
-                face(s.z, a.z, d.z),
-            ),
-            t_delta: Vec3::new(inverse(d.x), inverse(d.y), inverse(d.z)),
-        }
-    }
-
-    /// Steps to the next sub-cell: whether it lies in the cell.
-    fn step(&mut self) -> bool {
-        let t = &mut self.t_max;
-        self.entered = t.min_element();
-        if t.x <= t.y && t.x <= t.z {
-            self.s.x += self.step.x;
-            t.x += self.t_delta.x;
-        } else if t.y <= t.z {
-            self.s.y += self.step.y;
-            t.y += self.t_delta.y;
-        } else {
-            self.s.z += self.step.z;
-            t.z += self.t_delta.z;
-        }
-        self.s.cmpge(self.lo).all() && self.s.cmple(self.hi).all()
-    }
-}
-
-fn sign(v: f32) -> i32 {
-    if v > 0.0 {
-        1
-    } else if v < 0.0 {
-        -1
-    } else {
-        0
-    }
-}
-
-/// The segment parameter between two crossings of an axis's cell faces (never, along an axis
-/// the segment does not move).
-fn inverse(d: f32) -> f32 {
-    if d == 0.0 {
-        f32::INFINITY
-    } else {
-        1.0 / d.abs()
-    }
-}
-
-/// The segment parameter at which it reaches the plane `face` of an axis, from `a` moving `d`.
-fn face_at(face: f32, a: f32, d: f32) -> f32 {
-    if d == 0.0 {
-        f32::INFINITY
-    } else {
-        (face - a) / d
-    }
-}
-
-/// The segment parameter at which it first crosses a face of the axis, from `a` moving `d`.
-fn first_crossing(a: f32, d: f32) -> f32 {
-    if d > 0.0 {
-        (a.floor() + 1.0 - a) / d
-    } else if d < 0.0 {
-        (a - a.floor()) / -d
-    } else {
-        f32::INFINITY
-    }
-}
+/// A step's box in sub-cells: a cell's, a brick's (powers of two).
+const CELL_SHIFT: UVec3 = UVec3::splat(SUBCELLS.trailing_zeros());
+const BRICK_SHIFT: UVec3 = UVec3::new(
+    BRICK.x.trailing_zeros() + SUBCELLS.trailing_zeros(),
+    BRICK.y.trailing_zeros() + SUBCELLS.trailing_zeros(),
+    BRICK.z.trailing_zeros() + SUBCELLS.trailing_zeros(),
+);
 
 /// Whether triangle `t` overlaps the box of `centre` and `half` extents (the separating-axis
 /// test of Akenine-Möller: the box's axes, the triangle's normal, and the nine cross products
