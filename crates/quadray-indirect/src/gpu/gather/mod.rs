@@ -59,7 +59,7 @@ pub(crate) fn shaders() -> Vec<(&'static str, Vec<&'static str>)> {
 /// every shader's).
 pub(crate) const STORAGE_BUFFERS_PER_STAGE: u64 = 16;
 /// Workgroup memory of the per-tile cuts' kernel in bytes (the contract test sums its variables).
-pub(crate) const TILE_WORKGROUP_BYTES: u64 = 15_584;
+pub(crate) const TILE_WORKGROUP_BYTES: u64 = 15_612;
 
 /// The shading passes and the radiance they write, at one set of sizes.
 pub struct Gather {

@@ -29,9 +29,19 @@ var<workgroup> reduce_e: array<vec4<f32>, TILE_PIXELS>;
 // per quadrant of the tile, its first covered pixel (TILE_PIXELS: none): the estimate's
 // sample pixels
 var<workgroup> quadrant_pixel: array<atomic<u32>, 4>;
-// per corner of the tile, its shadow anchor: the covered pixel nearest it (the corner itself
-// where covered), as its squared distance in pixels << 8 | the pixel
-var<workgroup> anchor_key: array<atomic<u32>, 4>;
+// per corner of the tile, its shadow anchors: the covered pixel nearest it (the corner itself
+// where covered), then with shadows the nearest of the pixels on none of the first four's
+// surfaces (`second_anchors`), as its squared distance in pixels << 8 | the pixel; how many
+// pixels those are, and the anchor sets the tile walks from (1 or 2, `list_for_gather`)
+var<workgroup> anchor_key: array<atomic<u32>, 8>;
+var<workgroup> off_anchor_count: atomic<u32>;
+var<workgroup> off_anchor_total: u32;
+var<workgroup> anchor_sets: u32;
+// The pixels off the first set's surfaces above which a tile walks from a second set too (four
+// rays a target instead of one a pixel and target: lone pixels' walks were 9-12% of the
+// indirect pass with shadows on the courtyard, leak and shelf scenes, the second set took the
+// pass to 0.89-0.94x the time).
+const SECOND_ANCHORS_FROM: u32 = 4u;
 // the nodes of the level being refined and of the next (pyramid indices)
 var<workgroup> frontier: array<array<u32, TILE_FRONTIER>, 2>;
 var<workgroup> frontier_len: array<atomic<u32>, 2>;
@@ -134,6 +144,8 @@ fn load_tile(pixel: vec2<u32>, inside: bool, local: u32) -> Receiver {
     tile_n[local] = r.n;
     if (local < 4u) {
         atomicStore(&quadrant_pixel[local], TILE_PIXELS);
+    }
+    if (local < 8u) {
         atomicStore(&anchor_key[local], 0xffffffffu);
     }
     if (local < 3u) {
@@ -149,6 +161,7 @@ fn load_tile(pixel: vec2<u32>, inside: bool, local: u32) -> Receiver {
         atomicStore(&frontier_len[1], 0u);
         atomicStore(&list_len, 0u);
         atomicStore(&target_count, 0u);
+        atomicStore(&off_anchor_count, 0u);
         atomicStore(&refused, 0u);
         atomicStore(&estimated_nodes, 0u);
         atomicStore(&estimate_evaluations, 0u);
@@ -164,13 +177,33 @@ fn tile_is_empty(local: u32, r: Receiver) -> bool {
     reduce_receivers(local, r, r.covered);
     if (r.covered) {
         atomicMin(&quadrant_pixel[(local % TILE) / (TILE / 2u) + 2u * (local / (TILE_PIXELS / 2u))], local);
-        let p = vec2<i32>(i32(local % TILE), i32(local / TILE));
-        for (var c = 0u; c < 4u; c++) {
-            let d = p - vec2<i32>(i32(CORNERS[c] % TILE), i32(CORNERS[c] / TILE));
-            atomicMin(&anchor_key[c], (u32(dot(d, d)) << 8u) | local);
-        }
+        offer_anchor(local, 0u);
     }
     return workgroupUniformLoad(&reduce_n[0]).w == 0.0;
+}
+
+// Offers pixel `local` as anchor set `set`'s anchor at each corner (the nearest wins).
+fn offer_anchor(local: u32, anchor_set: u32) {
+    let p = vec2<i32>(i32(local % TILE), i32(local / TILE));
+    for (var c = 0u; c < 4u; c++) {
+        let d = p - vec2<i32>(i32(CORNERS[c] % TILE), i32(CORNERS[c] / TILE));
+        atomicMin(&anchor_key[4u * anchor_set + c], (u32(dot(d, d)) << 8u) | local);
+    }
+}
+
+// Phase 1, then, with shadows: the second set of anchors, among the pixels on none of the first
+// set's surfaces (each would otherwise walk alone, `lone_sums`), and how many those pixels are.
+// Every invocation calls it.
+fn second_anchors(local: u32, r: Receiver, shape: PixelPatch) -> u32 {
+    if (is_lone(r, shape)) {
+        atomicAdd(&off_anchor_count, 1u);
+        offer_anchor(local, 1u);
+    }
+    workgroupBarrier();
+    if (local == 0u) {
+        off_anchor_total = atomicLoad(&off_anchor_count);
+    }
+    return workgroupUniformLoad(&off_anchor_total);
 }
 
 // Phase 1, then: the two groups of receivers, their boxes and normal cones (a node's bound is
@@ -374,9 +407,11 @@ fn apply_verdicts(local: u32, tile: u32, level: u32, current: u32, count: u32) {
 
 // Phase 4: the list copied once into workgroup memory (the frontier's, free now), far nodes
 // marked to be shared; with indirect shadows every listed node without a target its own, each
-// target's visibility from the tile's corners (`corner_visibility`), and per node its target's
-// slot and visibility; how many nodes are shared. Every invocation calls it.
-fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: bool) -> u32 {
+// target's visibility from the tile's anchors (`corner_visibility`; the second set's too where
+// more than SECOND_ANCHORS_FROM pixels are off the first set's surfaces, `off_anchor`), and per
+// node its target's slot << 16 and its visibility bytes (the second set's in bits 8-15); how
+// many nodes are shared. Every invocation calls it.
+fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: bool, off_anchor: u32) -> u32 {
     let base = tile * shade.tile_capacity;
     let lo = min(g.lo[0], g.lo[1]);
     let hi = max(g.hi[0], g.hi[1]);
@@ -408,11 +443,22 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
     if (SHADOWS) {
         // (the targets' nodes in storage, the verdicts cleared by refinement's last step)
         storageBarrier();
-        corner_visibility(local, base, atomicLoad(&target_count));
+        let targets = atomicLoad(&target_count);
+        // a second set where it walks fewer rays than its pixels would alone, and each target's
+        // two bytes fit
+        let sets = select(1u, 2u, off_anchor > SECOND_ANCHORS_FROM && 2u * targets <= TILE_FRONTIER);
+        if (local == 0u) {
+            anchor_sets = sets;
+        }
+        corner_visibility(local, base, targets, sets);
         workgroupBarrier();
         for (var i = local; i < listed; i += TILE_PIXELS) {
             let slot = frontier[1][i];
-            frontier[1][i] = (slot << 8u) | ((atomicLoad(&verdicts[slot / 4u]) >> (8u * (slot % 4u))) & 255u);
+            var bytes = verdict_byte(slot * sets);
+            if (sets == 2u) {
+                bytes |= verdict_byte(2u * slot + 1u) << 8u;
+            }
+            frontier[1][i] = (slot << 16u) | bytes;
         }
     }
     workgroupBarrier();
@@ -422,33 +468,41 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
     return workgroupUniformLoad(&shared_total);
 }
 
-// Indirect shadows per tile: each target's byte of `verdicts`, bit c + 4 set where the target
-// (its mean, mean normal) faces the receiver of corner c's anchor (`shadow_anchor`), and then
-// bit c where that receiver sees it (`visible`, shared.wgsl), one invocation a target and
-// corner; a pixel on an anchor's surface weighs each of its tile's nodes by its target's
-// visibility from the anchors the target faces, interpolated, so that a tile walks at most four
-// shadow rays a target instead of one a pixel and node. (An anchor behind the target's plane
+// Byte `i` of `verdicts`.
+fn verdict_byte(i: u32) -> u32 {
+    return (atomicLoad(&verdicts[i / 4u]) >> (8u * (i % 4u))) & 255u;
+}
+
+// Indirect shadows per tile: each target's byte of `verdicts` a set of anchors (`sets`, 1 or 2;
+// byte `slot * sets + set`), bit c + 4 set where the target (its mean, mean normal) faces the
+// receiver of the set's corner c's anchor (`shadow_anchor`), and then bit c where that receiver
+// sees it (`visible`, shared.wgsl), one invocation a target, set and corner; a pixel on an
+// anchor's surface weighs each of its tile's nodes by its target's visibility from the anchors
+// of its set the target faces, interpolated, so that a tile walks at most four shadow rays a
+// target and set instead of one a pixel and node. (An anchor behind the target's plane
 // gets no light from it and no ray: 1-22% fewer fetches on the visibility scenes, the same
 // pictures or better. Skipping the anchors whose plane the target is behind too made the door
 // scene's shadows blocky, 0.87 -> 1.35; a target behind every anchor's plane walks none:
 // BENCHMARKS.md.)
-fn corner_visibility(local: u32, base: u32, targets: u32) {
-    for (var k = local; k < 4u * targets; k += TILE_PIXELS) {
-        let slot = k / 4u;
+fn corner_visibility(local: u32, base: u32, targets: u32, sets: u32) {
+    for (var k = local; k < 4u * sets * targets; k += TILE_PIXELS) {
+        let slot = k / (4u * sets);
+        let anchor_set = (k / 4u) % sets;
         let c = k % 4u;
         fetches++;
         let index = tile_targets[base + slot];
         let node = nodes[index];
-        let a = shadow_anchor(c);
+        let a = shadow_anchor(4u * anchor_set + c);
         let x = tile_x[a];
         var seen = 0u;
         if (dot(node.normal.xyz, x - node.pos.xyz) > 0.0) {
             seen = 1u << (c + 4u);
-            if (!behind_every_anchor(node.pos.xyz) && visible(x, tile_n[a], shadow_end(index, node, x), node.normal.xyz)) {
+            if (!behind_every_anchor(node.pos.xyz, anchor_set) && visible(x, tile_n[a], shadow_end(index, node, x), node.normal.xyz)) {
                 seen |= 1u << c;
             }
         }
-        atomicOr(&verdicts[slot / 4u], seen << (8u * (slot % 4u)));
+        let byte = slot * sets + anchor_set;
+        atomicOr(&verdicts[byte / 4u], seen << (8u * (byte % 4u)));
     }
 }
 
@@ -478,9 +532,10 @@ fn shadow_end(index: u32, node: Node, x: vec3<f32>) -> vec3<f32> {
 // Whether `p` lies behind the plane of every corner's anchor by more than the plane agreement:
 // the receivers on the anchors' surfaces get no light from it, and a ray from an anchor would
 // pass through the anchor's own surface, so it counts as hidden without one.
-fn behind_every_anchor(p: vec3<f32>) -> bool {
+// (of set `anchor_set`)
+fn behind_every_anchor(p: vec3<f32>, anchor_set: u32) -> bool {
     for (var c = 0u; c < 4u; c++) {
-        let a = shadow_anchor(c);
+        let a = shadow_anchor(4u * anchor_set + c);
         if (dot(tile_n[a], p - tile_x[a]) >= -terms.plane_agreement) {
             return false;
         }
@@ -488,11 +543,11 @@ fn behind_every_anchor(p: vec3<f32>) -> bool {
     return true;
 }
 
-// The pixel that stands for corner c in the shadow rays: the covered pixel nearest the corner
-// (phase 1 found it), so that a tile at the picture's silhouette or with a hole at a corner
-// still tests from four receivers instead of every pixel walking alone. (With them the shadowed
-// gather takes 0.55-0.62x the time of the corners alone on the leak, storeys and gap scenes,
-// though only 4-6% of the pixels walked alone: BENCHMARKS.md.)
+// The pixel that stands for corner c % 4 in the shadow rays of anchor set c / 4: the covered
+// pixel nearest the corner (phase 1 found it), so that a tile at the picture's silhouette or
+// with a hole at a corner still tests from four receivers instead of every pixel walking alone.
+// (With them the shadowed gather takes 0.55-0.62x the time of the corners alone on the leak,
+// storeys and gap scenes, though only 4-6% of the pixels walked alone: BENCHMARKS.md.)
 fn shadow_anchor(c: u32) -> u32 {
     return atomicLoad(&anchor_key[c]) & 255u;
 }
@@ -534,14 +589,17 @@ fn gather_at_corners(local: u32, listed: u32) -> array<mat3x3<f32>, 4> {
     return corners;
 }
 
-// Phase 5, first: where a covered pixel takes the shared nodes from the corners' bilinear patch
-// (`on_patch`; else, across a depth edge, it evaluates them too), and with shadows the weights of
-// the anchors on its own surface, normalised (all zero: none is, and the pixel is lone). Every
-// pixel's own.
+// Phase 1 (with shadows, before `second_anchors`) and phase 5: where a covered pixel takes the
+// shared nodes from the corners' bilinear patch (`on_patch`; else, across a depth edge, it
+// evaluates them too), and with shadows the weights of the first set's anchors on its own
+// surface, normalised (all zero: none is); then, where none is and the tile walks from two sets,
+// the second set's (`second_patch`; all zero again: the pixel is lone). Every pixel's own.
 struct PixelPatch {
     on_patch: bool,
     w: vec4<f32>,
     seen_weights: vec4<f32>,
+    // the anchor set the weights are of
+    anchor_set: u32,
 }
 
 fn pixel_patch(local: u32, r: Receiver, corners_covered: bool) -> PixelPatch {
@@ -557,18 +615,38 @@ fn pixel_patch(local: u32, r: Receiver, corners_covered: bool) -> PixelPatch {
         on_patch = distance(x, r.x) <= terms.plane_agreement;
     }
     if (SHADOWS && r.covered) {
-        for (var c = 0u; c < 4u; c++) {
-            let a = shadow_anchor(c);
-            let same_surface = dot(tile_n[a], r.n) > shade.normal_agreement
-                && abs(dot(r.x - tile_x[a], tile_n[a])) < terms.plane_agreement;
-            seen_weights[c] = select(0.0, max(w[c], 1e-3), same_surface);
-        }
-        if (on_patch) {
-            seen_weights = w;
-        }
+        seen_weights = select(anchor_weights(r, w, 0u), w, on_patch);
     }
-    let seen_total = seen_weights.x + seen_weights.y + seen_weights.z + seen_weights.w;
-    return PixelPatch(on_patch, w, seen_weights / max(seen_total, 1e-6));
+    return PixelPatch(on_patch, w, seen_weights, 0u);
+}
+
+// The weights of anchor set `set`'s anchors on the receiver's surface (bilinear weights `w`),
+// normalised (all zero: none is).
+fn anchor_weights(r: Receiver, w: vec4<f32>, anchor_set: u32) -> vec4<f32> {
+    var weights = vec4<f32>(0.0);
+    for (var c = 0u; c < 4u; c++) {
+        let a = shadow_anchor(4u * anchor_set + c);
+        let same_surface = dot(tile_n[a], r.n) > shade.normal_agreement
+            && abs(dot(r.x - tile_x[a], tile_n[a])) < terms.plane_agreement;
+        weights[c] = select(0.0, max(w[c], 1e-3), same_surface);
+    }
+    return weights / max(weights.x + weights.y + weights.z + weights.w, 1e-6);
+}
+
+// A pixel on none of the first set's surfaces in a tile that walks from two sets: the second
+// set's weights, by the inverse square of the distance to each anchor in pixels (the second
+// set's anchors lie anywhere in the tile, where the first set's stand at the corners; on the
+// leak scene the bilinear weights took the FLIP with shadows 0.00685 -> 0.00700, inverse
+// distances to 0.00693, their squares to 0.00689).
+fn second_patch(local: u32, r: Receiver, shape: PixelPatch) -> PixelPatch {
+    let p = vec2<f32>(f32(local % TILE), f32(local / TILE));
+    var near = vec4<f32>(0.0);
+    for (var c = 0u; c < 4u; c++) {
+        let a = shadow_anchor(4u + c);
+        let d = p - vec2<f32>(f32(a % TILE), f32(a / TILE));
+        near[c] = 1.0 / ((0.25 + dot(d, d)) * (0.25 + dot(d, d)));
+    }
+    return PixelPatch(shape.on_patch, shape.w, anchor_weights(r, near, 1u), 1u);
 }
 
 // Whether a covered pixel is lone: with shadows, no anchor lies on its surface.
@@ -577,7 +655,7 @@ fn is_lone(r: Receiver, shape: PixelPatch) -> bool {
 }
 
 // Phase 5, with shadows: the lone pixels' sums. A lone pixel (off the corners' patch: it sums
-// every listed node) walks once to the target of each node that lights it, and the tile's
+// every listed node; on no anchor's surface of either set) walks once to the target of each node that lights it, and the tile's
 // invocations share those walks: a bit a lone pixel and target in `verdicts` (free once
 // `list_for_gather` copied the corners' bits), as many lone pixels a batch as the bits hold.
 // (Each lone pixel walking to its targets in turn kept the other invocations of its SIMD group
@@ -621,7 +699,7 @@ fn lone_sums(local: u32, tile: u32, r: Receiver, listed: u32, lone: bool) -> vec
                 let node = nodes[frontier[0][i] & ~SHARED];
                 let d = r.x - node.pos.xyz;
                 if (dot(node.normal.xyz, d) > 0.0 && dot(r.n, d) < 0.0) {
-                    let bit = (row - first) * targets + (frontier[1][i] >> 8u);
+                    let bit = (row - first) * targets + (frontier[1][i] >> 16u);
                     atomicOr(&verdicts[bit / 32u], 1u << (bit % 32u));
                 }
             }
@@ -645,7 +723,7 @@ fn lone_sums(local: u32, tile: u32, r: Receiver, listed: u32, lone: bool) -> vec
             for (var i = 0u; i < listed; i++) {
                 fetches++;
                 let node = nodes[frontier[0][i] & ~SHARED];
-                let bit = (row - first) * targets + (frontier[1][i] >> 8u);
+                let bit = (row - first) * targets + (frontier[1][i] >> 16u);
                 let seen = f32((atomicLoad(&verdicts[bit / 32u]) >> (bit % 32u)) & 1u);
                 irradiance += seen * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
             }
@@ -674,7 +752,7 @@ fn pixel_sum(r: Receiver, listed: u32, shared_nodes: bool, shape: PixelPatch, co
             let node = nodes[entry & ~SHARED];
             var seen = 1.0;
             if (SHADOWS) {
-                let bits = vec4<u32>(frontier[1][i] & 255u) >> vec4<u32>(0u, 1u, 2u, 3u);
+                let bits = vec4<u32>((frontier[1][i] >> (8u * shape.anchor_set)) & 255u) >> vec4<u32>(0u, 1u, 2u, 3u);
                 let lit = shape.seen_weights * vec4<f32>((bits >> vec4<u32>(4u)) & vec4<u32>(1u));
                 let lit_total = lit.x + lit.y + lit.z + lit.w;
                 // (no corner on the pixel's surface faces the node: the node lies nearly in
@@ -709,19 +787,27 @@ fn indirect_tiles(
         store_tile_counts(id.xy, inside, local);
         return;
     }
+    let corners_covered = all_corners_covered();
+    var shape = pixel_patch(local, r, corners_covered);
+    var off_anchor = 0u;
+    if (SHADOWS) {
+        off_anchor = second_anchors(local, r, shape);
+    }
     let groups = receiver_groups(local, r);
     let threshold = coarse_threshold(local, groups);
     refine(local, tile, groups, threshold);
     storageBarrier();
     let listed = atomicLoad(&list_len);
-    let corners_covered = all_corners_covered();
     let sharing = shade.tile_share > 0.0 && corners_covered;
-    let shared_nodes = list_for_gather(local, tile, listed, groups, sharing);
+    let shared_nodes = list_for_gather(local, tile, listed, groups, sharing, off_anchor);
     var corner_vectors: array<mat3x3<f32>, 4>;
     if (shared_nodes > 0u) {
         corner_vectors = gather_at_corners(local, listed);
     }
-    let shape = pixel_patch(local, r, corners_covered);
+    let sets = workgroupUniformLoad(&anchor_sets);
+    if (SHADOWS && sets == 2u && is_lone(r, shape)) {
+        shape = second_patch(local, r, shape);
+    }
     let lone = is_lone(r, shape);
     var irradiance = vec3<f32>(0.0);
     if (SHADOWS) {
