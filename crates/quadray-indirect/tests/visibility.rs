@@ -181,17 +181,8 @@ fn lone_pixels_are_shadowed_as_the_anchored_ones() {
 /// pixels walking alone (489,021).
 #[test]
 fn pixels_off_the_anchors_surfaces_walk_from_a_second_set() {
-    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     let scene = Scene::load(&scenes_dir().join("leak.toml")).unwrap();
-    let settings = Settings::sized(32, 32, 64);
-    let [plain, with] = [settings.clone(), shadowed(&settings)].map(|s| {
-        Renderer::new(&gpu, &scene, s)
-            .unwrap()
-            .render_frame(Method::QuadtreeTiles)
-            .unwrap()
-            .counts
-            .texel_fetches
-    });
+    let [plain, with] = per_tile_frames_at_32(&scene).map(|f| f.counts.texel_fetches);
     let ratio = with as f64 / plain as f64;
     println!("leak: fetches {plain} -> {with} with shadows ({ratio:.2}x)");
     assert!(ratio <= 1.9, "{plain} -> {with}: {ratio:.2}x");
@@ -233,19 +224,12 @@ fn assert_per_tile_shadows_lower_flip(file: &str, settings: Settings, measured: 
 /// target that faces an anchor walked to, 3.7% more (lavapipe, 32x32).
 #[test]
 fn targets_behind_every_anchor_get_no_shadow_ray() {
-    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
     let mut scene = Scene::load(&scenes_dir().join("leak.toml")).unwrap();
     // the partition's face towards the dark room, and nothing else
     scene.camera.position = Vec3::new(1.9, 0.8, 0.3);
     scene.camera.target = Vec3::new(1.03, 0.8, 0.3);
     scene.camera.fov_y_deg = 20.0;
-    let settings = Settings::sized(32, 32, 64);
-    let [plain, with] = [settings.clone(), shadowed(&settings)].map(|s| {
-        Renderer::new(&gpu, &scene, s)
-            .unwrap()
-            .render_frame(Method::QuadtreeTiles)
-            .unwrap()
-    });
+    let [plain, with] = per_tile_frames_at_32(&scene);
     let (fetches, fetches_shadowed) = (plain.counts.texel_fetches, with.counts.texel_fetches);
     println!("partition: fetches {fetches} -> {fetches_shadowed} with shadows");
     assert!(
@@ -253,6 +237,19 @@ fn targets_behind_every_anchor_get_no_shadow_ray() {
         "{fetches} -> {fetches_shadowed}"
     );
     assert_eq!(plain.indirect, with.indirect);
+}
+
+/// The per-tile cuts' frame of `scene` at 32x32 with a 64^2 RSM, without and with indirect
+/// shadows.
+fn per_tile_frames_at_32(scene: &Scene) -> [Frame; 2] {
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let settings = Settings::sized(32, 32, 64);
+    [settings.clone(), shadowed(&settings)].map(|s| {
+        Renderer::new(&gpu, scene, s)
+            .unwrap()
+            .render_frame(Method::QuadtreeTiles)
+            .unwrap()
+    })
 }
 
 /// A tile's shadow ray to a target of several surfaces ends above all of them: in the OBJ box
