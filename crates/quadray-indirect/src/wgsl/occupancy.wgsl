@@ -66,10 +66,10 @@ fn occupied(c: vec3<i32>, dims: vec3<u32>, held: ptr<function, OccupancyHeld>) -
 
 // In a grid of two levels of `count` bricks, the sub-cells of a brick's set cells follow a word
 // a brick, the index of its first set cell's, two words a set cell, sub-cell (x, y, z) in word
-// z / 2 at bit x + 4 * (y + 4 * (z % 2)): the word of sub-cell `s` (sub-cell units) of a set cell
-// of the held brick whose first sub-cells are held, and its bit.
-fn sub_word(s: vec3<i32>, count: u32, held: OccupancyHeld) -> u32 {
-    let rank = held.first - 1u + countOneBits(held.bits & ((1u << cell_bit(s / i32(OCCUPANCY_SUBCELLS))) - 1u));
+// z / 2 at bit x + 4 * (y + 4 * (z % 2)): the word of sub-cell `s` (sub-cell units) of the set
+// cell of bit `bit` of the held brick whose first sub-cells are held, and its bit.
+fn sub_word(s: vec3<i32>, bit: u32, count: u32, held: OccupancyHeld) -> u32 {
+    let rank = held.first - 1u + countOneBits(held.bits & ((1u << bit) - 1u));
     return 2u * count + 2u * rank + (u32(s.z) % OCCUPANCY_SUBCELLS) / 2u;
 }
 
@@ -81,11 +81,12 @@ fn sub_bit(s: vec3<i32>) -> u32 {
 // Whether sub-cell `s` (sub-cell units) of a grid of two levels of `count` bricks is set, its
 // cell being set and its cell's word held.
 fn sub_occupied(s: vec3<i32>, count: u32, held: ptr<function, OccupancyHeld>) -> bool {
+    let bit = cell_bit(s >> vec3<u32>(countTrailingZeros(OCCUPANCY_SUBCELLS)));
     if ((*held).first == 0u) {
         fetches++;
         (*held).first = occupancy_word(count + (*held).word - 1u) + 1u;
     }
-    let word = sub_word(s, count, *held);
+    let word = sub_word(s, bit, count, *held);
     if ((*held).sub_word != word + 1u) {
         fetches++;
         (*held).sub_word = word + 1u;
@@ -161,7 +162,7 @@ fn grid_visibility(x: vec3<f32>, n: vec3<f32>, xp: vec3<f32>, np: vec3<f32>) -> 
         let bit = cell_bit(c);
         let brick_held = inside && held.word == word + 1u;
         let in_set_cell = two_levels && brick_held && ((held.bits >> bit) & 1u) == 1u;
-        let sub = sub_word(s, count, held);
+        let sub = sub_word(s, bit, count, held);
         var what = READ_NONE;
         var read = word;
         if (inside && !brick_held) {

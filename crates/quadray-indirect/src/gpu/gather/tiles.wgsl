@@ -644,7 +644,8 @@ fn second_patch(local: u32, r: Receiver, shape: PixelPatch) -> PixelPatch {
     for (var c = 0u; c < 4u; c++) {
         let a = shadow_anchor(4u + c);
         let d = p - vec2<f32>(f32(a % TILE), f32(a / TILE));
-        near[c] = 1.0 / ((0.25 + dot(d, d)) * (0.25 + dot(d, d)));
+        let q = 0.25 + dot(d, d);
+        near[c] = 1.0 / (q * q);
     }
     return PixelPatch(shape.on_patch, shape.w, anchor_weights(r, near, 1u), 1u);
 }
@@ -655,8 +656,8 @@ fn is_lone(r: Receiver, shape: PixelPatch) -> bool {
 }
 
 // Phase 5, with shadows: the lone pixels' sums. A lone pixel (off the corners' patch: it sums
-// every listed node; on no anchor's surface of either set) walks once to the target of each node that lights it, and the tile's
-// invocations share those walks: a bit a lone pixel and target in `verdicts` (free once
+// every listed node; on no anchor's surface of either set) walks once to the target of each
+// node that lights it, and the tile's invocations share those walks: a bit a lone pixel and target in `verdicts` (free once
 // `list_for_gather` copied the corners' bits), as many lone pixels a batch as the bits hold.
 // (Each lone pixel walking to its targets in turn kept the other invocations of its SIMD group
 // waiting: the gather took 0.81-0.86x the time with the lone pixels' walks left out on the leak,
