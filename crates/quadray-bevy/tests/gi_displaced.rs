@@ -421,7 +421,7 @@ fn a_displaced_floor_seen_from_a_light_is_where_the_material_traces_it() {
     }
     // what the occupancy grid of indirect shadows costs over these triangles
     let started = std::time::Instant::now();
-    let grid = quadray_indirect::occupancy::OccupancyGrid::of_triangles(&triangles, 64);
+    let grid = quadray_indirect::shadows::occupancy::OccupancyGrid::of_triangles(&triangles, 64);
     println!(
         "occupancy grid of {} triangles at 64 cells: {:.1} ms ({:?} cells)",
         triangles.len(),

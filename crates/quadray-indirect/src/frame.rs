@@ -4,6 +4,10 @@
 use serde::Serialize;
 use std::collections::BTreeMap;
 
+/// Two receivers lie on one surface only where their normals' dot exceeds this (upsampling,
+/// corner sharing, deblocking).
+pub(crate) const NORMAL_AGREEMENT: f32 = 0.9;
+
 /// The timed passes, in `GpuTimer` order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]

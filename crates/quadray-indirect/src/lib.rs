@@ -4,14 +4,19 @@
 //! a directional light's map is orthographic, a point light's six cube faces, and several lights
 //! are the sum of their maps ([`LightView`]).
 //!
-//! Data flows one way: [`scene`] (load) -> [`gpu`] (RSM, quadtree, cut, shading) -> measured
-//! against [`reference`](mod@reference) (CPU brute force) and the GPU brute force of [`baselines`].
+//! Data flows one way: [`scene`] (load) -> the light (RSM, quadtree, cut) -> the gathers (the
+//! default per-tile cuts of [`tiles`], the one cut, the per-level passes and the baselines of
+//! [`gathers`], with the indirect [`shadows`]) -> the output -> measured against
+//! [`reference`](mod@reference) (CPU brute force) and the GPU brute force.
 //!
-//! The modules are layers, each naming only the ones below it (`tests/layers.rs` checks it):
-//! the settings ([`Settings`], no GPU) and the read-back types ([`Frame`], ...), the scene, the
-//! baselines' sample pattern and the CPU reference, then the GPU side from the Rust <-> WGSL
-//! contract and the engine-neutral shader modules ([`wgsl`]) up through the light, the RSM, the
-//! G-buffer, the light quadtree, the gather passes and the output to quadray's [`Renderer`].
+//! The crate is cut by feature, each folder holding its Rust passes, its WGSL and its CPU twins:
+//! `light/` (light views, RSM, pyramid, cut), `tiles/` (the default method: rule, twin, kernel,
+//! deblocking, blockiness), `shadows/` (occupancy grid, walk, depth-map march), `gathers/` (the
+//! gather's shared resources, the one cut, per-level passes, RSM sampling, brute force, direct
+//! light) and `output/` (upsampling, temporal filter, output pass); [`Settings`] (no GPU) is what
+//! a user configures, `contract.rs` the Rust <-> WGSL contract and [`wgsl`] the engine-neutral
+//! shader modules, and [`Renderer`] quadray's own frame. The modules are layers, each naming only
+//! the ones below it (`tests/layers.rs` lists them).
 //!
 //! To add the bounce to your own wgpu renderer, record the passes into your encoder:
 //! [`RsmPass`] (or your own [`RsmViews`]) -> [`LightQuadtree`] (build, cut) -> [`Gather`] into your
@@ -45,17 +50,22 @@
 
 #![warn(missing_docs)]
 
-pub mod baselines;
-pub mod blockiness;
-pub mod deblock;
+mod contract;
 mod frame;
-pub mod gpu;
-pub mod occupancy;
+pub mod gathers;
+mod gbuffer;
+mod light;
+mod method;
+mod output;
 pub mod picture;
 pub mod reference;
+mod renderer;
 pub mod scene;
 mod settings;
-pub mod tile_cut;
+#[cfg(test)]
+mod shader_tests;
+pub mod shadows;
+pub mod tiles;
 pub mod wgsl;
 
 /// Anything that can go wrong between a scene file and a measured picture.
@@ -72,13 +82,17 @@ pub enum IndirectError {
     Settings(String),
 }
 
+pub use contract::OutputTerm;
 pub use frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
-pub use gpu::{
-    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, OutputPass, OutputTerm,
-    Projection, Renderer, RsmPass, RsmViews, ViewMaps,
-};
+pub use gathers::gather::Gather;
+pub use gathers::resources::ViewMaps;
+pub use gbuffer::GBufferViews;
+pub use light::quadtree::LightQuadtree;
+pub use light::rsm::{FLOAT_FORMAT, RsmPass, RsmViews};
+pub use light::view::{LightView, Projection};
+pub use method::{Method, TileCriterion, Validity};
+pub use output::pass::OutputPass;
 pub use quadray_core::settings::Size;
+pub use renderer::Renderer;
 pub use scene::Scene;
-pub use settings::{
-    ClusterSettings, Levels, Method, NEAR_FIELD_SIZE, Settings, TileCriterion, Validity,
-};
+pub use settings::{ClusterSettings, Levels, Settings};

@@ -29,7 +29,7 @@ pub fn tone_map(width: u32, height: u32, radiance: &[[f32; 3]], exposure: f32) -
     }
 }
 
-/// Outline colours of the cut's clusters by level (0 = single VPLs); `wgsl/cut_view.wgsl` has
+/// Outline colours of the cut's clusters by level (0 = single VPLs); `light/cut_view.wgsl` has
 /// the same.
 const LEVEL_COLOURS: [[u8; 4]; 6] = [
     [255, 255, 255, 255],

@@ -3,7 +3,7 @@
 //! GPU method approximates) or with exact visibility by ray tracing (what the light really
 //! does). For small RSMs and images only.
 
-use crate::gpu::{Receiver, Vpl};
+use crate::frame::{Receiver, Vpl};
 use crate::scene::Scene;
 use glam::{DVec3, Vec3};
 use quadray_core::geom::{Bvh, ConvexPolygon, Ray};

@@ -5,13 +5,13 @@
 
 use glam::{Vec2, Vec3, Vec4};
 use quadray_gpu::Gpu;
-use quadray_indirect::baselines::{SAMPLE_SEED, rsm_samples};
-use quadray_indirect::gpu::{LightView, Receiver};
-use quadray_indirect::tile_cut::{TileInput, tile_cuts};
+use quadray_indirect::gathers::samples::{SAMPLE_SEED, rsm_samples};
+use quadray_indirect::tiles::twin::{TileInput, tile_cuts};
 use quadray_indirect::{
     ClusterSettings, Levels, Method, Renderer, Scene, Settings, Size, TileCriterion, Validity,
     WorkCounts,
 };
+use quadray_indirect::{LightView, Receiver};
 
 const RSM: u32 = 32;
 
@@ -124,7 +124,7 @@ fn shader_counts_match_a_cpu_count_for_every_method() {
     // split, the split ones' four children visited) and the gather (the list read once into
     // workgroup memory, then each covered pixel reads and sums its nodes). With the estimate
     // criterion, the nodes whose error the tile estimated read their four children, and the
-    // evaluations that took, are the CPU twin's (`tile_cut`), but where it found a tie
+    // evaluations that took, are the CPU twin's (`tiles::twin`), but where it found a tie
     let start = c.start;
     let node_bounds = r.read_node_bounds().unwrap();
     let root = RSM.ilog2();

@@ -391,7 +391,7 @@ fn per_tile_cuts_at_the_default_error_stay_within_their_measured_error() {
     );
 }
 
-/// The per-tile cuts' near field (`near_field` in wgsl/tile_rule.wgsl): the atrium's columns stand on its
+/// The per-tile cuts' near field (`near_field` in src/tiles/rule.wgsl): the atrium's columns stand on its
 /// sun-lit floor, and the nodes around a column's foot hold the kernel's clamp, where a node's
 /// children agree with it however far both are from its VPLs; there the bound decides. The
 /// default method on the atrium at 64x64 with a 64^2 RSM: measured 0.0257 rel. L1 at 521

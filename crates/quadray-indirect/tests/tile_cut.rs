@@ -1,10 +1,10 @@
-//! The per-tile cuts on the GPU against their CPU twin (`quadray_indirect::tile_cut`): tile for
+//! The per-tile cuts on the GPU against their CPU twin (`quadray_indirect::tiles::twin`): tile for
 //! tile the same nodes, except below a node whose decision the twin found a tie (its quantity
 //! within `TIE` of its threshold), where f32 sums in another order may decide the other way.
 
 use quadray_gpu::Gpu;
-use quadray_indirect::deblock::deblock;
-use quadray_indirect::tile_cut::{TileInput, tile_cuts};
+use quadray_indirect::tiles::deblock::deblock;
+use quadray_indirect::tiles::twin::{TileInput, tile_cuts};
 use quadray_indirect::{CutNode, Method, Renderer, Scene, Settings, TileCriterion};
 use std::collections::BTreeSet;
 
@@ -139,7 +139,7 @@ fn gpu_tile_cuts_equal_the_cpu_twin() {
     assert!(zero_estimates > 0, "no tile with a zero estimate");
 }
 
-/// The deblocking filter on the GPU against its CPU twin (`quadray_indirect::deblock`): the
+/// The deblocking filter on the GPU against its CPU twin (`quadray_indirect::tiles::deblock`): the
 /// per-tile cuts' light without it, filtered on the CPU, is the light with it, and the filter
 /// changes the light at many boundaries.
 #[test]

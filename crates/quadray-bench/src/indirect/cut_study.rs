@@ -23,7 +23,7 @@ use glam::DVec3;
 use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
 use quadray_indirect::reference::{brute_force, compare, vpl_kernel};
-use quadray_indirect::tile_cut::{self, TILE_PIXELS};
+use quadray_indirect::tiles::twin::{self, TILE_PIXELS};
 use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -278,7 +278,7 @@ fn tile_cut(
         // (the shader's bound splits a node in its near field: the study has no bound)
         let near_field = || {
             let positions = receivers.iter().map(|r| r.0.as_vec3());
-            tile_cut::near_field(
+            twin::near_field(
                 node.lo.as_vec3(),
                 node.hi.as_vec3(),
                 positions,
@@ -409,7 +409,7 @@ fn study_scene(
                         };
                         let pixels: Vec<usize> = (0..TILE_PIXELS).filter_map(at).collect();
                         let covered = std::array::from_fn(|i| at(i).is_some());
-                        let samples: Vec<&Receiver> = tile_cut::sample_pixels(&covered)
+                        let samples: Vec<&Receiver> = twin::sample_pixels(&covered)
                             .into_iter()
                             .flatten()
                             .map(|i| receivers[at(i).unwrap()].as_ref().unwrap())

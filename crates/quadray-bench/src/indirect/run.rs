@@ -5,9 +5,9 @@
 use super::temporal::{self, Temporal};
 use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
 use quadray_gpu::Gpu;
-use quadray_indirect::blockiness::{Order, TileStructure};
 use quadray_indirect::picture::{TONE_MAP_WHITE, flip_against, tone_map};
 use quadray_indirect::reference::{self, ImageError};
+use quadray_indirect::tiles::blockiness::{Order, TileStructure};
 use quadray_indirect::{FrameTiming, IndirectError, Method, Renderer, Scene, Settings, WorkCounts};
 use serde::Serialize;
 

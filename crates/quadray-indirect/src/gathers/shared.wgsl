@@ -1,0 +1,215 @@
+// What every gather pass sees (the quadtree's, the baselines' and the reference's): the settings,
+// light, camera and per-dispatch uniforms, the RSM, quadtree and G-buffer, the outputs, and the
+// helpers every pass shares.
+
+// Whether the gather tests indirect shadows (shade.shadow_steps > 0): a pipeline constant, so
+// that a gather without them compiles no visibility test at all. A walk inlined in a summing
+// loop, even one that never runs, made that loop 4-11 times slower on lavapipe.
+override SHADOWS: bool;
+
+// The gather's settings, written once.
+struct Shade {
+    sample_count: u32,
+    // sub-sampled indirect: one sample per `subsample` x `subsample` pixels
+    subsample: u32,
+    low_width: u32,
+    low_height: u32,
+    // geometry agreement for upsampling: normals' dot
+    normal_agreement: f32,
+    // indirect shadows: points marched between a receiver and a cluster (0: none)
+    shadow_steps: u32,
+    // weight of this frame in the running average of the indirect light (1: no filter)
+    temporal_weight: f32,
+    // per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its estimated
+    // error) exceeds `tile_error` of the tile's irradiance estimated from the nodes of level
+    // `tile_start`; at most `tile_capacity` nodes a tile; tiles in a row of the picture
+    tile_error: f32,
+    tile_capacity: u32,
+    tile_start: u32,
+    tiles_x: u32,
+    tile_estimate: u32,
+    // per-tile cuts: nodes farther than this times the tile's receivers' diagonal are gathered
+    // at the tile's corners and interpolated (0: every pixel evaluates every node)
+    tile_share: f32,
+    // per-tile cuts: pixels on either side of a tile boundary its unexplained step is spread
+    // over (0: none; deblock.wgsl)
+    tile_deblock: u32,
+    // per-tile cuts with indirect shadows: a cluster takes the visibility of its highest
+    // ancestor whose box's diagonal is at most this times its distance from the tile's
+    // receivers, MIXED_TARGET_ANGLE of it for an ancestor of several surfaces (0: each its own;
+    // tiles/kernel.wgsl)
+    tile_shadow_angle: f32,
+}
+
+// Per light view, with the light: the kernel's clamp, the lengths that scale with the scene and
+// where the view's low-resolution samples start.
+struct LightTerms {
+    // the clamp of the VPL kernel's 1/r^4 (world units)
+    r_min: f32,
+    // shadow-map bias in RSM depth units
+    depth_bias: f32,
+    // geometry agreement for upsampling: plane distance (world units)
+    plane_agreement: f32,
+    // indirect shadows: how deep behind a depth map's surface a point counts as inside the
+    // occluder (world units)
+    shadow_thickness: f32,
+    // where this view's low-resolution samples start; 0 for a frame's first light view, which
+    // writes the radiance the others add to
+    low_offset: u32,
+}
+
+// Per camera: the view the G-buffer was rendered from, and its size in pixels.
+struct Camera {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    width: u32,
+    height: u32,
+}
+
+// Group 0, per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
+@group(0) @binding(0) var<uniform> params: ClusterParams;
+@group(0) @binding(1) var<uniform> light: Light;
+// (the light's terms and the camera are read-only storage: lavapipe, Mesa 22.3, crashes running
+// the shadow march with them as uniforms beside `shade`)
+@group(0) @binding(2) var<storage, read> terms: LightTerms;
+@group(0) @binding(3) var rsm_flux: texture_2d<f32>;
+@group(0) @binding(4) var rsm_pos: texture_2d<f32>;
+@group(0) @binding(5) var rsm_normal: texture_2d<f32>;
+@group(0) @binding(6) var<storage, read> nodes: array<Node>;
+@group(0) @binding(7) var<storage, read> cut: array<Node>;
+@group(0) @binding(8) var<storage, read> cut_count: u32;
+@group(0) @binding(9) var<storage, read> bounds: array<NodeBounds>;
+// Group 1, per frame (its targets): the settings, the camera, the G-buffer, the outputs and the
+// RSM samples.
+@group(1) @binding(0) var<uniform> shade: Shade;
+@group(1) @binding(1) var<storage, read> viewer: Camera;
+@group(1) @binding(2) var g_pos: texture_2d<f32>;
+@group(1) @binding(3) var g_normal: texture_2d<f32>;
+@group(1) @binding(4) var g_albedo: texture_2d<f32>;
+// rgb: indirect radiance (or irradiance for the low-resolution pass), w: 1 when recomputed
+@group(1) @binding(5) var<storage, read_write> indirect: array<vec4<f32>>;
+@group(1) @binding(6) var<storage, read_write> direct: array<vec4<f32>>;
+@group(1) @binding(7) var<storage, read_write> low: array<vec4<f32>>;
+// xy: offset in RSM texels, z: weight, w: the pattern's radius
+@group(1) @binding(8) var<storage, read> samples: array<vec4<f32>>;
+// per pixel: VPL evaluations, fetches, bound evaluations and refused splits of the indirect
+// passes (cleared before them)
+@group(1) @binding(9) var<storage, read_write> counts: array<vec4<u32>>;
+// the running average of the indirect light over the last frames (rgb)
+@group(1) @binding(10) var<storage, read_write> history: array<vec4<f32>>;
+// the scene's occupancy grid's words (shadows/occupancy.rs, `gpu_words`), OCCUPANCY_ROW a row:
+// zero dimensions where the gather has none, and indirect shadows march the depth maps instead
+@group(1) @binding(11) var occupancy: texture_2d<u32>;
+// Group 2, per dispatch: the level of a per-level pass, and which slice of a long per-pixel sum
+// this dispatch adds (see SLICE); dynamic offsets into slots 0, 1, 2, ...
+@group(2) @binding(0) var<uniform> current: Level;
+@group(2) @binding(1) var<uniform> slice: Level;
+
+// The accessors of the engine-neutral modules (src/wgsl.rs): node `i` of the pyramid, and a pixel's
+// receiver from the G-buffer.
+fn load_node(i: u32) -> Node {
+    return nodes[i];
+}
+
+fn receiver(pixel: vec2<u32>) -> Receiver {
+    let t = vec2<i32>(pixel);
+    fetches += 3u;
+    let p = textureLoad(g_pos, t, 0);
+    var r: Receiver;
+    r.x = p.xyz;
+    r.n = textureLoad(g_normal, t, 0).xyz;
+    r.albedo = textureLoad(g_albedo, t, 0).rgb;
+    // a texel the kernel cannot take sees no geometry: its NaN would spread through its tile's
+    // cut and the neighbours that upsample or reproject from it
+    r.covered = p.w > 0.5 && kernel_point(r.x, r.n);
+    return r;
+}
+
+// The accessors of shadows/occupancy.wgsl: the header's words, then the bits.
+fn occupancy_load(i: u32) -> u32 {
+    return textureLoad(occupancy, vec2<u32>(i % OCCUPANCY_ROW, i / OCCUPANCY_ROW), 0).x;
+}
+
+fn occupancy_dims() -> vec3<u32> {
+    return vec3<u32>(occupancy_load(0u), occupancy_load(1u), occupancy_load(2u));
+}
+
+fn occupancy_levels() -> u32 {
+    return occupancy_load(3u);
+}
+
+fn occupancy_origin() -> vec3<f32> {
+    return bitcast<vec3<f32>>(vec3<u32>(occupancy_load(4u), occupancy_load(5u), occupancy_load(6u)));
+}
+
+fn occupancy_cell() -> f32 {
+    return bitcast<f32>(occupancy_load(7u));
+}
+
+fn occupancy_word(i: u32) -> u32 {
+    return occupancy_load(OCCUPANCY_HEADER + i);
+}
+
+// The kernel with indirect shadows (the accessor of gather_cut.wgsl and gather_level.wgsl).
+fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
+    let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
+    // (branches, not `||`: the visibility test's loops must not run without shadows, as
+    // lavapipe counts their iterations towards the summing loop's cap)
+    if (SHADOWS && any(e != vec3<f32>(0.0))) {
+        if (!visible(r.x, r.n, node.pos.xyz, node.normal.xyz)) {
+            return vec3<f32>(0.0);
+        }
+    }
+    return e;
+}
+
+// Splits of a per-tile cut refused because the tile's list was full (counted once a tile).
+var<private> refused_splits: u32;
+
+// Adds this invocation's work to pixel `index`'s counts.
+fn store_counts(index: u32) {
+    counts[index] += vec4<u32>(evaluations, fetches, bound_evaluations, refused_splits);
+}
+
+fn pixel_index(pixel: vec2<u32>) -> u32 {
+    return pixel.y * viewer.width + pixel.x;
+}
+
+// This dispatch's items of a sum over `count` items, `per_slice` at a time: [x, y).
+fn slice_range(count: u32, per_slice: u32) -> vec2<u32> {
+    let first = slice.level * per_slice;
+    return vec2<u32>(first, min(first + per_slice, count));
+}
+
+// Whether this is a frame's first light view, which writes the radiance the others add to.
+fn first_view() -> bool {
+    return terms.low_offset == 0u;
+}
+
+// Stores one slice's share of a pixel's indirect light: the first slice of the first light view
+// writes, the others add.
+fn add_indirect(index: u32, value: vec4<f32>) {
+    if (slice.level == 0u && first_view()) {
+        indirect[index] = value;
+    } else {
+        indirect[index] += value;
+    }
+}
+
+// The accessors of gather_vpls.wgsl: an RSM texel's normal (w: 1 where the light sees
+// geometry), position and flux, and RSM sampling's pattern.
+fn load_rsm_normal(t: vec2<i32>) -> vec4<f32> {
+    return textureLoad(rsm_normal, t, 0);
+}
+
+fn load_rsm_position(t: vec2<i32>) -> vec4<f32> {
+    return textureLoad(rsm_pos, t, 0);
+}
+
+fn load_rsm_flux(t: vec2<i32>) -> vec3<f32> {
+    return textureLoad(rsm_flux, t, 0).rgb;
+}
+
+fn load_rsm_sample(i: u32) -> vec4<f32> {
+    return samples[i];
+}

@@ -1,0 +1,314 @@
+//! The lights as the passes see them: each light's reflective shadow maps as views (a spot or a
+//! directional light one, a point light six, one per cube face), plain values a renderer fills
+//! from its own scene, and the per-view uniforms made from them (the light itself, the gather's
+//! per-light terms).
+
+use crate::contract::{LightTermsUniform, LightUniform};
+use crate::scene::{Light, LightKind, Scene, extent_of};
+use crate::settings::Settings;
+use glam::{Mat4, Vec3};
+
+/// How an RSM view projects the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// From a point, a square frustum of this full field of view (degrees): a spot's twice its
+    /// cone, a point light's cube face 90.
+    Perspective {
+        /// Full field of view across (and down) the map.
+        fov_deg: f32,
+    },
+    /// Parallel rays over a square this wide (world units): a directional light's.
+    Orthographic {
+        /// Side of the square the map covers, across the light's direction.
+        width: f32,
+    },
+}
+
+/// One reflective shadow map of a light: its projection, and the light's emission as that map
+/// sees it. A point light's six faces are six views; the gather sums the views' light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightView {
+    /// World -> light clip space: the RSM's projection.
+    pub view_proj: Mat4,
+    /// Where the view looks from: the light, or for a directional light the middle of the map's
+    /// near plane.
+    pub position: Vec3,
+    /// Unit axis of the view (a spot's cone axis, a cube face's normal, the sun's direction).
+    pub direction: Vec3,
+    /// How the map projects.
+    pub projection: Projection,
+    /// A spot's cone: half-angle and falloff width (degrees); `None` lights the whole map.
+    pub cone: Option<(f32, f32)>,
+    /// Radiant intensity (W/sr per channel; a spot's on its axis), or for a directional light
+    /// the irradiance of a surface facing it (W/m^2).
+    pub intensity: [f32; 3],
+    /// The scene's size (its bounds' diagonal): the unit of RSM depth, in which the validity
+    /// thresholds are given.
+    pub extent: f32,
+    /// The view's far plane: everything lit is closer.
+    pub far: f32,
+}
+
+/// The six faces of a cube map: axis and up.
+const CUBE_FACES: [(Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::NEG_Y),
+    (Vec3::NEG_X, Vec3::NEG_Y),
+    (Vec3::Y, Vec3::Z),
+    (Vec3::NEG_Y, Vec3::NEG_Z),
+    (Vec3::Z, Vec3::NEG_Y),
+    (Vec3::NEG_Z, Vec3::NEG_Y),
+];
+
+impl LightView {
+    /// The views of a quadray [`Scene`]'s first `max_lights` lights, in order.
+    pub fn of_scene(scene: &Scene, max_lights: u32) -> Vec<Self> {
+        let bounds = scene.bounds();
+        scene
+            .lights
+            .iter()
+            .take(max_lights as usize)
+            .flat_map(|l| Self::of_light(l, bounds))
+            .collect()
+    }
+
+    /// `light` (its intensity radiometric: [`crate::scene::Intensity::radiometric`]) over
+    /// geometry within `bounds` (min, max): for a renderer that keeps its own scene. A
+    /// directional light's map is fitted to the bounds, not to the camera's view: a moving
+    /// camera changes nothing in it (no shimmer, nothing to snap to texels), for texels spent on
+    /// parts of the scene the camera may not see.
+    pub fn of_light(light: &Light, bounds: (Vec3, Vec3)) -> Vec<Self> {
+        let intensity = light.intensity.radiometric().to_array();
+        let extent = extent_of(bounds);
+        let centre = bounds.0.midpoint(bounds.1);
+        let perspective = |position: Vec3, direction: Vec3, up: Vec3, fov_deg: f32, cone| {
+            let far = position.distance(centre) + extent;
+            let view = Mat4::look_to_rh(position, direction, up);
+            let proj = Mat4::perspective_rh(fov_deg.to_radians(), 1.0, far * 1e-3, far);
+            Self {
+                view_proj: proj * view,
+                position,
+                direction,
+                projection: Projection::Perspective { fov_deg },
+                cone,
+                intensity,
+                extent,
+                far,
+            }
+        };
+        match light.kind {
+            LightKind::Spot { position, cone } => {
+                let direction = cone.direction.normalize();
+                let up = if direction.y.abs() > 0.99 {
+                    Vec3::Z
+                } else {
+                    Vec3::Y
+                };
+                vec![perspective(
+                    position,
+                    direction,
+                    up,
+                    2.0 * cone.cone_deg,
+                    Some((cone.cone_deg, cone.falloff_deg)),
+                )]
+            }
+            LightKind::Point { position } => CUBE_FACES
+                .iter()
+                .map(|&(axis, up)| perspective(position, axis, up, 90.0, None))
+                .collect(),
+            LightKind::Directional { direction } => {
+                vec![Self::orthographic(direction.normalize(), bounds, intensity)]
+            }
+        }
+    }
+
+    /// A directional light's view: the bounds' corners in the light's frame, a square over them.
+    fn orthographic(direction: Vec3, bounds: (Vec3, Vec3), intensity: [f32; 3]) -> Self {
+        let (lo, hi) = bounds;
+        let extent = extent_of(bounds);
+        let centre = lo.midpoint(hi);
+        let up = if direction.y.abs() > 0.99 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        let at_centre = Mat4::look_to_rh(centre, direction, up);
+        let corners = (0..8).map(|i| {
+            let pick = |bit: usize, a: f32, b: f32| if i & bit == 0 { a } else { b };
+            Vec3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            )
+        });
+        let (min, max) = corners.fold((Vec3::MAX, Vec3::MIN), |(a, b), c| {
+            let p = at_centre.transform_point3(c);
+            (a.min(p), b.max(p))
+        });
+        // square, centred on the corners' box, a little wider so its edge texels see geometry
+        let width = (max.x - min.x).max(max.y - min.y).max(1e-3) * 1.02;
+        let middle = at_centre.inverse().transform_point3(Vec3::new(
+            (min.x + max.x) * 0.5,
+            (min.y + max.y) * 0.5,
+            0.0,
+        ));
+        // the view looks down -z: the nearest corner is at z = max.z
+        let margin = 0.01 * extent;
+        let position = middle - direction * (max.z + margin);
+        let far = max.z - min.z + 2.0 * margin;
+        let half = width * 0.5;
+        let view = Mat4::look_to_rh(position, direction, up);
+        Self {
+            view_proj: Mat4::orthographic_rh(-half, half, -half, half, 0.0, far) * view,
+            position,
+            direction,
+            projection: Projection::Orthographic { width },
+            cone: None,
+            intensity,
+            extent,
+            far,
+        }
+    }
+
+    /// An RSM texel's measure on the axis: its solid angle (perspective; it shrinks as cos^3
+    /// off the axis) or its area across the light (orthographic).
+    pub(crate) fn texel_measure(&self, rsm_size: u32) -> f32 {
+        let side = match self.projection {
+            Projection::Perspective { fov_deg } => {
+                2.0 * (0.5 * fov_deg).to_radians().tan() / rsm_size as f32
+            }
+            Projection::Orthographic { width } => width / rsm_size as f32,
+        };
+        side * side
+    }
+
+    /// A texel's side at the far side of the scene, in world units.
+    fn far_texel(&self, rsm_size: u32) -> f32 {
+        match self.projection {
+            Projection::Perspective { .. } => self.texel_measure(rsm_size).sqrt() * self.far,
+            Projection::Orthographic { width } => width / rsm_size as f32,
+        }
+    }
+
+    /// The gather's per-view values for `settings`, with the clamp `r_min` of the VPL kernel's
+    /// 1/r^4 (world units) and where the view's low-resolution samples start (0 for the first
+    /// view of a frame, which writes the radiance the others add to).
+    pub(crate) fn terms(
+        &self,
+        settings: &Settings,
+        r_min: f32,
+        low_offset: u32,
+    ) -> LightTermsUniform {
+        LightTermsUniform {
+            r_min,
+            // a few shadow-map texels' worth of depth at the far side of the scene
+            depth_bias: 0.005 + 3.0 * self.far_texel(settings.rsm_size) / self.extent,
+            plane_agreement: 0.02 * self.extent,
+            shadow_thickness: settings.shadow_thickness * self.extent,
+            low_offset,
+        }
+    }
+
+    pub(crate) fn uniform(&self) -> LightUniform {
+        let (p, d, i) = (self.position, self.direction, self.intensity);
+        // no cone: every direction in front of the map counts (cos >= -1)
+        let (outer, inner) = self.cone.map_or((-1.0, -1.0), |(cone_deg, falloff_deg)| {
+            let cone = cone_deg.to_radians();
+            (cone.cos(), (cone - falloff_deg.to_radians()).cos())
+        });
+        let parallel = matches!(self.projection, Projection::Orthographic { .. });
+        LightUniform {
+            view_proj: self.view_proj.to_cols_array_2d(),
+            position: [p.x, p.y, p.z, 1.0 / self.extent],
+            direction: [d.x, d.y, d.z, outer],
+            intensity: [i[0], i[1], i[2], inner],
+            parallel: [f32::from(u8::from(parallel)), 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Cone, Intensity};
+
+    fn light(kind: LightKind) -> Light {
+        Light {
+            kind,
+            intensity: Intensity::Native(Vec3::ONE),
+        }
+    }
+
+    #[test]
+    fn a_point_light_s_six_faces_see_every_direction_once() {
+        let bounds = (Vec3::ZERO, Vec3::ONE);
+        let views = LightView::of_light(
+            &light(LightKind::Point {
+                position: Vec3::splat(0.5),
+            }),
+            bounds,
+        );
+        assert_eq!(views.len(), 6);
+        // a direction falls in exactly one face's frustum (away from the faces' edges)
+        for d in [
+            Vec3::new(0.3, 0.9, -0.2),
+            Vec3::new(-0.8, 0.1, 0.5),
+            Vec3::new(0.1, -0.2, -0.95),
+        ] {
+            let inside = views
+                .iter()
+                .filter(|v| {
+                    let c = v.view_proj * (Vec3::splat(0.5) + 0.3 * d).extend(1.0);
+                    c.w > 0.0 && c.x.abs() < c.w && c.y.abs() < c.w
+                })
+                .count();
+            assert_eq!(inside, 1, "{d}");
+        }
+    }
+
+    #[test]
+    fn a_directional_light_s_map_holds_the_whole_scene_in_front_of_its_near_plane() {
+        let bounds = (Vec3::new(-2.0, 0.0, -1.0), Vec3::new(3.0, 2.0, 4.0));
+        let [view] = LightView::of_light(
+            &light(LightKind::Directional {
+                direction: Vec3::new(-0.3, -1.0, 0.4),
+            }),
+            bounds,
+        )[..] else {
+            panic!("one view");
+        };
+        for i in 0..8 {
+            let pick = |bit: usize, a: f32, b: f32| if i & bit == 0 { a } else { b };
+            let (lo, hi) = bounds;
+            let corner = Vec3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            );
+            let c = view.view_proj * corner.extend(1.0);
+            assert!(c.x.abs() < 1.0 && c.y.abs() < 1.0, "{corner}: {c}");
+            assert!(c.z > 0.0 && c.z < 1.0, "{corner}: depth {}", c.z);
+        }
+    }
+
+    #[test]
+    fn a_spot_is_one_view_of_twice_its_cone() {
+        let cone = Cone {
+            direction: Vec3::NEG_Y,
+            cone_deg: 40.0,
+            falloff_deg: 10.0,
+        };
+        let views = LightView::of_light(
+            &light(LightKind::Spot {
+                position: Vec3::new(0.5, 1.0, 0.5),
+                cone,
+            }),
+            (Vec3::ZERO, Vec3::ONE),
+        );
+        assert_eq!(views.len(), 1);
+        assert_eq!(
+            views[0].projection,
+            Projection::Perspective { fov_deg: 80.0 }
+        );
+        assert_eq!(views[0].cone, Some((40.0, 10.0)));
+    }
+}

@@ -1,0 +1,786 @@
+//! The scene's occupancy grid, which indirect shadows walk between a receiver and a cluster
+//! ([`crate::Settings::shadow_grid`]): a cell is set where a triangle of the scene overlaps it, so
+//! a wall, a shelf or a slab blocks whatever the camera and the light see of it. The walk
+//! ([`OccupancyGrid::visible`]) is the CPU twin of `occupancy.wgsl`'s `grid_visibility`; both
+//! start and end two cells off the surfaces along their normals, so that a surface never hides
+//! its own points. The bits are stored a brick of [`BRICK`] cells to a word, so that a walk
+//! fetches a word a brick it passes through, not a cell (an empty brick is a zero word). A grid
+//! of two levels ([`OccupancyGrid::two_level`]) also holds, for each set cell, which of its
+//! [`SUBCELLS`]^3 sub-cells a triangle overlaps: the walk crosses the set cells sub-cell by
+//! sub-cell, so an opening is narrowed by a sub-cell, not a cell, on each side, at the cost of
+//! the cells in empty space.
+
+use crate::scene::Vertex;
+use glam::{IVec3, UVec3, Vec3};
+
+/// Cells a segment's ends are moved off their surfaces along the normals: past every cell a
+/// plane through the end may overlap (a cell's diagonal is sqrt(3) sides).
+pub const END_OFFSET_CELLS: f32 = 2.0;
+
+/// A set cell the walk enters within this many cells of either (moved) end makes the walk
+/// undecided, as an end lying on another surface's plane does: a receiver on the edge where a
+/// wall meets the ceiling, moved off the ceiling, lies in the wall's plane (on a cell boundary,
+/// rounded to the free side), and would otherwise see the wall block everything. A margin for
+/// rounding only: half a cell lowered the leak scene's gain with the one cut from 8.5x to 7.1x,
+/// as more walks fell back on the depth maps.
+pub const END_CLEARANCE_CELLS: f32 = 0.05;
+
+/// Words before the bits in [`OccupancyGrid::gpu_words`]: the dimensions (and a pad), the origin
+/// and the cell's side.
+pub const HEADER_WORDS: usize = 8;
+
+/// The cells of a brick, one word of bits: cell (x, y, z) of a brick at bit `x + 4 * (y + 4 * z)`.
+/// The grid's dimensions are multiples of it.
+pub const BRICK: UVec3 = UVec3::new(4, 4, 2);
+
+/// Sub-cells along each side of a set cell in a grid of two levels: a cell's 4x4x4 sub-cells
+/// take two words, each a brick of 4x4x2 ([`BRICK`]) sub-cells.
+pub const SUBCELLS: u32 = 4;
+
+/// Words a set cell's sub-cells take in a grid of two levels.
+pub const MASK_WORDS: usize = 2;
+
+/// What a walk between two points found, and the words it fetched.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Walk {
+    /// Visible, blocked, or `None`: a moved end lies in a set cell.
+    pub visible: Option<bool>,
+    /// Words fetched: one each time the walk enters a brick it has not just read (and in a
+    /// grid of two levels, one for where a brick's sub-cells start, the first time the walk
+    /// enters a set cell of the brick, and one each time it enters a half of a set cell's
+    /// sub-cells it has not just read).
+    pub fetches: u32,
+    /// Cells and sub-cells the segment crossed up to the answer (what a grid of a word a cell
+    /// would have fetched).
+    pub cells: u32,
+    /// Steps of the walk's loop: a box crossed (an empty brick, a cell, a sub-cell), or a word
+    /// read that the next step needs (its work on a GPU, beside the fetches).
+    pub steps: u32,
+}
+
+/// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell; in a grid of
+/// two levels, with the same for the [`SUBCELLS`]^3 sub-cells of each set cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OccupancyGrid {
+    dims: UVec3,
+    origin: Vec3,
+    cell: f32,
+    bits: Vec<u32>,
+    /// Two levels: per brick, the index of the sub-cells of its first set cell (the set cells
+    /// before it counted); then [`MASK_WORDS`] a set cell, in the order of the bricks and bits.
+    sub: Option<SubCells>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct SubCells {
+    first: Vec<u32>,
+    masks: Vec<u32>,
+}
+
+impl OccupancyGrid {
+    /// The grid of `triangles` with `cells` cells along the longest side of their bounds, and a
+    /// margin of [`END_OFFSET_CELLS`] + 1 cells all round (so a moved end stays inside).
+    pub fn of_triangles(triangles: &[[Vertex; 3]], cells: u32) -> Self {
+        Self::one_level(triangles, cells).0
+    }
+
+    /// [`Self::of_triangles`] (`levels` 1) or [`Self::two_level`] (more):
+    /// [`crate::Settings::shadow_grid_levels`].
+    pub fn with_levels(triangles: &[[Vertex; 3]], cells: u32, levels: u32) -> Self {
+        if levels > 1 {
+            Self::two_level(triangles, cells)
+        } else {
+            Self::of_triangles(triangles, cells)
+        }
+    }
+
+    /// [`Self::of_triangles`] with each set cell's [`SUBCELLS`]^3 sub-cells: a cell stays set
+    /// where a triangle overlaps one of its sub-cells. Takes a word a brick and [`MASK_WORDS`]
+    /// words a set cell beyond the grid's bits ([`crate::Settings::MAX_TWO_LEVEL_SHADOW_GRID`]
+    /// bounds it).
+    pub fn two_level(triangles: &[[Vertex; 3]], cells: u32) -> Self {
+        let (mut grid, in_grid) = Self::one_level(triangles, cells);
+        let mut masks = std::collections::HashMap::<usize, [u32; MASK_WORDS]>::new();
+        for t in &in_grid {
+            grid.add_subcells(*t, &mut masks);
+        }
+        // a cell whose sub-cells no triangle overlaps (it touched the cell's margin) is clear
+        grid.bits.fill(0);
+        let mut cells: Vec<(usize, [u32; MASK_WORDS])> = masks.into_iter().collect();
+        cells.sort_unstable_by_key(|&(index, _)| index);
+        for &(index, _) in &cells {
+            grid.bits[index / 32] |= 1 << (index % 32);
+        }
+        let mut first = Vec::with_capacity(grid.bits.len());
+        let mut count = 0;
+        for w in &grid.bits {
+            first.push(count);
+            count += w.count_ones();
+        }
+        let masks = cells.into_iter().flat_map(|(_, m)| m).collect();
+        grid.sub = Some(SubCells { first, masks });
+        grid
+    }
+
+    /// The grid of one level, and its triangles in grid units.
+    fn one_level(triangles: &[[Vertex; 3]], cells: u32) -> (Self, Vec<[Vec3; 3]>) {
+        let (lo, hi) =
+            crate::scene::bounds_of(triangles.iter().flatten().map(|v| Vec3::from(v.position)));
+        let (lo, hi) = if lo.cmple(hi).all() {
+            (lo, hi)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        let cell = ((hi - lo).max_element() / cells.max(1) as f32).max(1e-6);
+        let margin = END_OFFSET_CELLS + 1.0;
+        let origin = lo - Vec3::splat(margin * cell);
+        let cells = (((hi - lo) / cell).ceil() + Vec3::splat(2.0 * margin + 1.0)).as_uvec3();
+        let bricks = (cells + BRICK - 1) / BRICK;
+        let mut grid = Self {
+            dims: bricks * BRICK,
+            origin,
+            cell,
+            bits: vec![0; bricks.element_product() as usize],
+            sub: None,
+        };
+        let in_grid: Vec<[Vec3; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|v| (Vec3::from(v.position) - origin) / cell))
+            .collect();
+        for t in &in_grid {
+            grid.add_triangle(*t);
+        }
+        (grid, in_grid)
+    }
+
+    /// Whether the grid has two levels ([`Self::two_level`]).
+    pub fn is_two_level(&self) -> bool {
+        self.sub.is_some()
+    }
+
+    /// Cells along x, y and z.
+    pub fn dims(&self) -> UVec3 {
+        self.dims
+    }
+
+    /// The side of a cell (world units).
+    pub fn cell(&self) -> f32 {
+        self.cell
+    }
+
+    /// Whether cell `c` holds a piece of a triangle (outside the grid: no).
+    pub fn occupied(&self, c: IVec3) -> bool {
+        self.index(c)
+            .is_some_and(|(word, bit)| self.bits[word] >> bit & 1 == 1)
+    }
+
+    /// How many cells are set.
+    pub fn occupied_count(&self) -> u32 {
+        self.bits.iter().map(|w| w.count_ones()).sum()
+    }
+
+    /// Whether sub-cell `s` (in sub-cell units, [`SUBCELLS`] a cell) holds a piece of a
+    /// triangle: its cell's, in a grid of one level.
+    pub fn subcell_occupied(&self, s: IVec3) -> bool {
+        let mut reader = WordReader::new(self);
+        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+        reader.occupied(c) && (self.sub.is_none() || reader.sub_occupied(s))
+    }
+
+    /// Whether the segment from `x` (a receiver, normal `n`) to `xp` (a VPL or cluster, normal
+    /// `np`, of any length: a cluster's mean normal is shorter) crosses no set cell, its ends
+    /// moved [`END_OFFSET_CELLS`] off their surfaces (an end whose normal is shorter than 0.1
+    /// stays); `None` where a moved end lies in a set cell (another surface within two cells
+    /// of it: in a corner, under a box) or the walk enters a set cell within
+    /// [`END_CLEARANCE_CELLS`] of an end, which the grid cannot judge. Crosses the boxes the
+    /// segment passes through, in order: a brick whose word is zero, a cell whose bit is not
+    /// set, or a sub-cell of a set one, a box a step.
+    pub fn visible(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Option<bool> {
+        self.walk(x, n, xp, np).visible
+    }
+
+    /// [`Self::visible`] with the words the walk fetched, as the GPU's walk counts them: the
+    /// word last read is kept, so a brick costs one fetch however many of its cells are crossed.
+    pub fn walk(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Walk {
+        let mut reader = WordReader::new(self);
+        let visible = self.walk_cells(x, n, xp, np, &mut reader);
+        Walk {
+            visible,
+            fetches: reader.fetches,
+            cells: reader.cells,
+            steps: reader.steps,
+        }
+    }
+
+    fn walk_cells(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        xp: Vec3,
+        np: Vec3,
+        reader: &mut WordReader,
+    ) -> Option<bool> {
+        let a_cells = self.to_grid(x, n);
+        let b_cells = self.to_grid(xp, np);
+        // the end first: the walk goes on from its word
+        if reader.occupied_at(b_cells) {
+            return None;
+        }
+        let a = a_cells * SUBCELLS as f32;
+        let d = (b_cells - a_cells) * SUBCELLS as f32;
+        let forward = d.cmpgt(Vec3::ZERO);
+        let still = d.cmpeq(Vec3::ZERO);
+        let inverse = Vec3::ONE / Vec3::select(still, Vec3::ONE, d);
+        // the segment parameter of the clearance at each end
+        let clearance = END_CLEARANCE_CELLS / (b_cells - a_cells).length().max(1e-6);
+        let blocked_at = |entered: f32| clearance < entered && entered < 1.0 - clearance;
+        // a step a sub-cell face crossed (the ends lie within two cells of the grid), and two
+        // reads a cell at most
+        let bound = 3 * SUBCELLS * (self.dims.element_sum() + 6);
+        let mut s = a.floor().as_ivec3();
+        let mut entered = 0.0;
+        reader.cells += 1;
+        for _ in 0..bound {
+            reader.steps += 1;
+            let shift = match reader.step_box(s) {
+                StepBox::Read => continue,
+                StepBox::Set => return blocked_at(entered).then_some(false),
+                StepBox::Free(shift) => shift,
+            };
+            let lo = (s >> shift) << shift;
+            let hi = lo + (IVec3::ONE << shift);
+            let exit = Vec3::select(
+                still,
+                Vec3::INFINITY,
+                (IVec3::select(forward, hi, lo).as_vec3() - a) * inverse,
+            );
+            let t = exit.min_element();
+            if t > 1.0 {
+                // the end is in the box
+                break;
+            }
+            // the box across the face the segment leaves by (ties: x, then y), kept beside the
+            // box against rounding
+            let mut next = (a + d * t).floor().as_ivec3().clamp(lo, hi - 1);
+            let across = IVec3::select(forward, hi, lo - 1);
+            let axis = if exit.x <= exit.y && exit.x <= exit.z {
+                0
+            } else if exit.y <= exit.z {
+                1
+            } else {
+                2
+            };
+            next[axis] = across[axis];
+            // the cells entered (a walk of a cell a step would have tested each)
+            let cells = |s: IVec3| s.div_euclid(IVec3::splat(SUBCELLS as i32));
+            reader.cells += (cells(next) - cells(s)).abs().element_sum() as u32;
+            s = next;
+            entered = t;
+        }
+        Some(true)
+    }
+
+    /// The grid as the gather reads it: [`HEADER_WORDS`] words (the dimensions, the levels, the
+    /// origin and the cell's side as `f32` bits), then a word a [`BRICK`], brick (x, y, z) at
+    /// word `x + bricks.x * (y + bricks.y * z)`; with two levels then a word a brick, the index
+    /// of its first set cell's sub-cells, and [`MASK_WORDS`] words a set cell, its sub-cell
+    /// (x, y, z) in word `z / 2` at bit `x + 4 * (y + 4 * (z % 2))`.
+    pub fn gpu_words(&self) -> Vec<u32> {
+        let mut words = vec![
+            self.dims.x,
+            self.dims.y,
+            self.dims.z,
+            if self.sub.is_some() { 2 } else { 1 },
+            self.origin.x.to_bits(),
+            self.origin.y.to_bits(),
+            self.origin.z.to_bits(),
+            self.cell.to_bits(),
+        ];
+        words.extend_from_slice(&self.bits);
+        if let Some(sub) = &self.sub {
+            words.extend_from_slice(&sub.first);
+            words.extend_from_slice(&sub.masks);
+        }
+        words
+    }
+
+    /// A segment's end in grid units, moved off its surface.
+    fn to_grid(&self, p: Vec3, n: Vec3) -> Vec3 {
+        let off = if n.length() > 0.1 {
+            n.normalize() * END_OFFSET_CELLS
+        } else {
+            Vec3::ZERO
+        };
+        (p - self.origin) / self.cell + off
+    }
+
+    /// Cell `c`'s word and bit (outside the grid: none).
+    fn index(&self, c: IVec3) -> Option<(usize, u32)> {
+        if c.cmplt(IVec3::ZERO).any() || c.cmpge(self.dims.as_ivec3()).any() {
+            return None;
+        }
+        let (c, bricks) = (c.as_uvec3(), self.dims / BRICK);
+        let (b, l) = (c / BRICK, c % BRICK);
+        let word = b.x + bricks.x * (b.y + bricks.y * b.z);
+        Some((word as usize, l.x + BRICK.x * (l.y + BRICK.y * l.z)))
+    }
+
+    /// Sets, in `masks` (by the cell's bit index), every sub-cell of a set cell that the
+    /// triangle (in grid units) overlaps.
+    fn add_subcells(
+        &self,
+        t: [Vec3; 3],
+        masks: &mut std::collections::HashMap<usize, [u32; MASK_WORDS]>,
+    ) {
+        if !t.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        let k = SUBCELLS as f32;
+        let top = self.dims.as_ivec3() * SUBCELLS as i32 - 1;
+        let lo = (t[0].min(t[1]).min(t[2]) * k)
+            .floor()
+            .as_ivec3()
+            .max(IVec3::ZERO);
+        let hi = (t[0].max(t[1]).max(t[2]) * k).floor().as_ivec3().min(top);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let s = IVec3::new(x, y, z);
+                    let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+                    let (word, bit) = self.index(c).expect("clamped to the grid");
+                    if self.bits[word] >> bit & 1 == 0 {
+                        continue;
+                    }
+                    // the cell's box's rule (a plane at a face in, one at the next out):
+                    // the sub-cells at the cell's faces end where the cell's box does
+                    let low = s.as_vec3() / k - Vec3::splat(1e-5);
+                    let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
+                    if triangle_overlaps_box(t, (low + high) * 0.5, (high - low) * 0.5) {
+                        let mask = masks.entry(word * 32 + bit as usize).or_default();
+                        let (w, b) = sub_bit(sub_cell(s));
+                        mask[w] |= 1 << b;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sets every cell the triangle (in grid units) overlaps. A cell is the half-open
+    /// [i, i + 1): a plane on a cell boundary sets the cells above it only.
+    fn add_triangle(&mut self, t: [Vec3; 3]) {
+        if !t.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        let lo = t[0].min(t[1]).min(t[2]).floor().as_ivec3().max(IVec3::ZERO);
+        let hi = t[0]
+            .max(t[1])
+            .max(t[2])
+            .floor()
+            .as_ivec3()
+            .min(self.dims.as_ivec3() - 1);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let c = IVec3::new(x, y, z);
+                    // the box [i - 1e-5, i + 1 - 1e-4]: a plane at i is in, one at i + 1 out
+                    let centre = c.as_vec3() + Vec3::splat(0.5 - 5.5e-5);
+                    if triangle_overlaps_box(t, centre, Vec3::splat(0.5 - 4.5e-5)) {
+                        let (word, bit) = self.index(c).expect("clamped to the grid");
+                        self.bits[word] |= 1 << bit;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Sub-cell `l` (0..[`SUBCELLS`] each) of a cell: its word among the cell's [`MASK_WORDS`], and
+/// its bit.
+fn sub_bit(l: UVec3) -> (usize, u32) {
+    ((l.z / 2) as usize, l.x + 4 * (l.y + 4 * (l.z % 2)))
+}
+
+/// Sub-cell `s`'s place in its cell (0..[`SUBCELLS`] each).
+fn sub_cell(s: IVec3) -> UVec3 {
+    s.rem_euclid(IVec3::splat(SUBCELLS as i32)).as_uvec3()
+}
+
+/// A walk's reads of the grid: the last word fetched, how many were, and the cells tested.
+struct WordReader<'a> {
+    grid: &'a OccupancyGrid,
+    word: Option<(usize, u32)>,
+    /// The held brick's first sub-cells, once read.
+    first: Option<u32>,
+    /// The last word of sub-cells fetched.
+    sub_word: Option<(usize, u32)>,
+    fetches: u32,
+    cells: u32,
+    steps: u32,
+}
+
+impl WordReader<'_> {
+    fn new(grid: &OccupancyGrid) -> WordReader<'_> {
+        WordReader {
+            grid,
+            word: None,
+            first: None,
+            sub_word: None,
+            fetches: 0,
+            cells: 0,
+            steps: 0,
+        }
+    }
+
+    /// Whether the point `p` (grid units) lies in a set cell, and with two levels in a set
+    /// sub-cell of it.
+    fn occupied_at(&mut self, p: Vec3) -> bool {
+        self.occupied(p.floor().as_ivec3())
+            && (self.grid.sub.is_none()
+                || self.sub_occupied((p * SUBCELLS as f32).floor().as_ivec3()))
+    }
+
+    /// Whether sub-cell `s` (sub-cell units) is set, its cell being set (the word of the cell
+    /// held).
+    fn sub_occupied(&mut self, s: IVec3) -> bool {
+        self.cells += 1;
+        if self.first.is_none() {
+            self.read_first();
+        }
+        self.read_sub_word(s) >> sub_bit(sub_cell(s)).1 & 1 == 1
+    }
+
+    /// The box the walk at sub-cell `s` may cross in one step, reading at most one word, as the
+    /// GPU's walk does (its loop has one read): the brick's where another is held; in a set
+    /// cell of a grid of two levels, where the brick's sub-cells start, then the half of the
+    /// cell's sub-cells, each at a step of its own where not held.
+    fn step_box(&mut self, s: IVec3) -> StepBox {
+        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+        let Some((index, bit)) = self.grid.index(c) else {
+            return StepBox::Free(CELL_SHIFT);
+        };
+        let two_levels = self.grid.sub.is_some();
+        if self.word.is_none_or(|(held, _)| held != index) {
+            let bits = self.read_brick(index);
+            if two_levels && bits >> bit & 1 == 1 {
+                return StepBox::Read;
+            }
+        }
+        let bits = self.word.expect("the brick is held").1;
+        if bits >> bit & 1 == 0 {
+            return StepBox::Free(if bits == 0 { BRICK_SHIFT } else { CELL_SHIFT });
+        }
+        if !two_levels {
+            return StepBox::Set;
+        }
+        if self.first.is_none() {
+            self.read_first();
+            return StepBox::Read;
+        }
+        if self.sub_occupied(s) {
+            StepBox::Set
+        } else {
+            StepBox::Free(UVec3::ZERO)
+        }
+    }
+
+    /// Reads the word of the brick at `index`.
+    fn read_brick(&mut self, index: usize) -> u32 {
+        self.fetches += 1;
+        let bits = self.grid.bits[index];
+        self.word = Some((index, bits));
+        self.first = None;
+        bits
+    }
+
+    /// Reads where the held brick's sub-cells start.
+    fn read_first(&mut self) {
+        let (index, _) = self.word.expect("the brick is held");
+        self.fetches += 1;
+        self.first = Some(self.sub_cells().first[index]);
+    }
+
+    /// The word of sub-cell `s` of a set cell of the held brick (read where another is held).
+    fn read_sub_word(&mut self, s: IVec3) -> u32 {
+        let (_, bits) = self.word.expect("the brick is held");
+        let first = self.first.expect("the brick's first sub-cells are read");
+        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
+        let (_, bit) = self.grid.index(c).expect("a set cell is in the grid");
+        let rank = first + (bits & ((1u32 << bit) - 1)).count_ones();
+        let word = rank as usize * MASK_WORDS + sub_bit(sub_cell(s)).0;
+        match self.sub_word {
+            Some((held, mask)) if held == word => mask,
+            _ => {
+                self.fetches += 1;
+                let mask = self.sub_cells().masks[word];
+                self.sub_word = Some((word, mask));
+                mask
+            }
+        }
+    }
+
+    fn sub_cells(&self) -> &SubCells {
+        self.grid.sub.as_ref().expect("a grid of two levels")
+    }
+
+    fn occupied(&mut self, c: IVec3) -> bool {
+        self.cells += 1;
+        let Some((index, bit)) = self.grid.index(c) else {
+            return false;
+        };
+        let bits = match self.word {
+            Some((held, bits)) if held == index => bits,
+            _ => self.read_brick(index),
+        };
+        bits >> bit & 1 == 1
+    }
+}
+
+/// What a step of the walk may cross from its sub-cell ([`WordReader::step_box`]).
+enum StepBox {
+    /// Nothing: the step read a word that the sub-cell's verdict needs before the next one.
+    Read,
+    /// The sub-cell (with one level, the cell) is set.
+    Set,
+    /// The box around the sub-cell, its side 2^shift sub-cells along each axis, is free.
+    Free(UVec3),
+}
+
+/// A step's box in sub-cells: a cell's, a brick's (powers of two).
+const CELL_SHIFT: UVec3 = UVec3::splat(SUBCELLS.trailing_zeros());
+const BRICK_SHIFT: UVec3 = UVec3::new(
+    BRICK.x.trailing_zeros() + SUBCELLS.trailing_zeros(),
+    BRICK.y.trailing_zeros() + SUBCELLS.trailing_zeros(),
+    BRICK.z.trailing_zeros() + SUBCELLS.trailing_zeros(),
+);
+
+/// Whether triangle `t` overlaps the box of `centre` and `half` extents (the separating-axis
+/// test of Akenine-Möller: the box's axes, the triangle's normal, and the nine cross products
+/// of their edges).
+fn triangle_overlaps_box(t: [Vec3; 3], centre: Vec3, half: Vec3) -> bool {
+    let v = t.map(|p| p - centre);
+    let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    let separates = |axis: Vec3| {
+        if axis.length_squared() < 1e-12 {
+            return false;
+        }
+        let p = v.map(|p| p.dot(axis));
+        let r = half.dot(axis.abs());
+        p[0].min(p[1]).min(p[2]) > r || p[0].max(p[1]).max(p[2]) < -r
+    };
+    for e in edges {
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            if separates(axis.cross(e)) {
+                return false;
+            }
+        }
+    }
+    if [Vec3::X, Vec3::Y, Vec3::Z].into_iter().any(separates) {
+        return false;
+    }
+    !separates(edges[0].cross(edges[1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(corners: [[f32; 3]; 4]) -> [[Vertex; 3]; 2] {
+        let v = corners.map(|position| Vertex {
+            position,
+            normal: [0.0, 0.0, 1.0],
+            albedo: [0.5; 3],
+        });
+        [[v[0], v[1], v[2]], [v[0], v[2], v[3]]]
+    }
+
+    /// A floor (y = 0, 0..1 in x and z) and a thin wall at x = 0.5 up to `wall_top`.
+    fn floor_and_wall(wall_top: f32) -> Vec<[Vertex; 3]> {
+        let mut t = quad([
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 0.0, 1.0],
+            [0.0, 0.0, 1.0],
+        ])
+        .to_vec();
+        t.extend(quad([
+            [0.5, 0.0, 0.0],
+            [0.5, wall_top, 0.0],
+            [0.5, wall_top, 1.0],
+            [0.5, 0.0, 1.0],
+        ]));
+        t
+    }
+
+    #[test]
+    fn a_wall_blocks_and_the_gap_above_it_does_not() {
+        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 32);
+        let up = Vec3::Y;
+        let left = Vec3::new(0.2, 0.0, 0.5);
+        let right = Vec3::new(0.8, 0.0, 0.5);
+        assert_eq!(
+            grid.visible(left, up, right, up),
+            Some(false),
+            "through the wall"
+        );
+        let above = grid.visible(left + 0.8 * up, up, right + 0.8 * up, up);
+        assert_eq!(above, Some(true), "above it");
+        let beside = grid.visible(left, up, left + Vec3::new(0.1, 0.3, 0.2), up);
+        assert_eq!(beside, Some(true), "same side");
+        // a plane sets the cells it passes through on its right: a point just right of it
+        // starts in a set cell
+        let corner = grid.visible(Vec3::new(0.51, 0.0, 0.5), up, right, up);
+        assert_eq!(corner, None, "at the wall's foot");
+    }
+
+    #[test]
+    fn a_walk_crosses_an_empty_brick_in_one_step() {
+        for levels in [1, 2] {
+            let grid = OccupancyGrid::with_levels(&floor_and_wall(0.5), 32, levels);
+            // above the floor and left of the wall, through empty bricks only
+            let (from, to) = (Vec3::new(0.02, 0.3, 0.4), Vec3::new(0.45, 0.4, 0.5));
+            let free = grid.walk(from, Vec3::ZERO, to, Vec3::ZERO);
+            assert_eq!(free.visible, Some(true), "{levels} levels");
+            // a brick spans 4 cells along x and y and 2 along z
+            assert!(free.steps * 2 <= free.cells, "{levels} levels: {free:?}");
+            // on through the wall: blocked
+            let across = grid.walk(from, Vec3::ZERO, to + Vec3::X * 0.5, Vec3::ZERO);
+            assert_eq!(across.visible, Some(false), "{levels} levels");
+        }
+    }
+
+    #[test]
+    fn a_point_on_the_edge_of_two_surfaces_is_not_hidden_by_the_other() {
+        // the wall's plane lies on a cell boundary (x = 0.5 with 32 cells) and sets the cells to
+        // its right; a floor point of the right room on the edge, rounded to the wall's left,
+        // starts in the free cell beside the wall's and crosses the wall's at once
+        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 32);
+        let up = Vec3::Y;
+        let edge = Vec3::new(0.5 - 1e-7, 0.0, 0.5);
+        let across = Vec3::new(0.8, 0.0, 0.5);
+        assert_eq!(
+            grid.visible(edge, up, across, up),
+            None,
+            "undecided, not blocked"
+        );
+        // a real wall a few cells along the way still blocks
+        let left = Vec3::new(0.3, 0.0, 0.5);
+        assert_eq!(grid.visible(left, up, across, up), Some(false));
+    }
+
+    #[test]
+    fn a_surface_does_not_hide_its_own_points_at_any_slope() {
+        for deg in [0.0f32, 10.0, 33.0, 45.0, 71.0] {
+            let (s, c) = deg.to_radians().sin_cos();
+            // a plane through the origin, tilted about z; normal (-s, c, 0)
+            let n = Vec3::new(-s, c, 0.0);
+            let along = Vec3::new(c, s, 0.0);
+            let t = quad([
+                (-along - Vec3::Z).to_array(),
+                (along - Vec3::Z).to_array(),
+                (along + Vec3::Z).to_array(),
+                (-along + Vec3::Z).to_array(),
+            ]);
+            let grid = OccupancyGrid::of_triangles(&t, 40);
+            for k in -4..=4 {
+                let x = along * (k as f32 * 0.1) + Vec3::Z * 0.13;
+                let xp = -along * 0.3 + n * 0.5;
+                assert_eq!(
+                    grid.visible(x, n, xp, -n),
+                    Some(true),
+                    "{deg} deg, point {k}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn grid_words_hold_the_header_and_every_set_cell() {
+        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 16);
+        let words = grid.gpu_words();
+        assert_eq!(&words[..3], &grid.dims().to_array());
+        assert_eq!(f32::from_bits(words[7]), grid.cell());
+        let set: u32 = words[HEADER_WORDS..].iter().map(|w| w.count_ones()).sum();
+        assert_eq!(set, grid.occupied_count());
+        assert!(set > 16 * 16, "the floor alone covers 16 x 16 cells: {set}");
+    }
+
+    /// A wall at x = 0.5 over the whole unit square with a slit 0.04 wide at z = 0.5, standing
+    /// on a floor: narrower than a cell pair at 32 cells, four sub-cells wide.
+    fn wall_with_a_slit() -> Vec<[Vertex; 3]> {
+        let mut t = floor_and_wall(0.0)[..2].to_vec();
+        for (z0, z1) in [(0.0, 0.48), (0.52, 1.0)] {
+            t.extend(quad([
+                [0.5, 0.0, z0],
+                [0.5, 1.0, z0],
+                [0.5, 1.0, z1],
+                [0.5, 0.0, z1],
+            ]));
+        }
+        t
+    }
+
+    #[test]
+    fn two_levels_keep_a_slit_open_that_one_level_closes() {
+        let t = wall_with_a_slit();
+        let (one, two) = (
+            OccupancyGrid::of_triangles(&t, 32),
+            OccupancyGrid::two_level(&t, 32),
+        );
+        let up = Vec3::Y;
+        let at = |z: f32, x: f32| Vec3::new(x, 0.3, z);
+        // through the slit and through the wall beside it
+        let slit = (at(0.5, 0.2), at(0.5, 0.8));
+        let wall = (at(0.3, 0.2), at(0.3, 0.8));
+        assert_eq!(
+            one.visible(slit.0, up, slit.1, up),
+            Some(false),
+            "closed at one level"
+        );
+        assert_eq!(
+            two.visible(slit.0, up, slit.1, up),
+            Some(true),
+            "open at two"
+        );
+        assert_eq!(
+            two.visible(wall.0, up, wall.1, up),
+            Some(false),
+            "the wall blocks"
+        );
+        // a plane on a sub-cell's face sets the sub-cells above it only: the slit's edges at
+        // z = 0.48 and 0.52 (sub-cells 61.44 and 66.56) leave sub-cells 62 to 65 free
+        let column = |z: i32| two.subcell_occupied(IVec3::new(64 + 12, 40, z + 12));
+        let free: Vec<i32> = (58..70).filter(|&z| !column(z)).collect();
+        assert_eq!(free, vec![62, 63, 64, 65], "sub-cells of the slit");
+        // the same set cells (each with a set sub-cell), two more words each
+        assert_eq!(two.occupied_count(), one.occupied_count());
+        let extra = two.gpu_words().len() - one.gpu_words().len();
+        assert_eq!(
+            extra,
+            one.bits.len() + MASK_WORDS * one.occupied_count() as usize
+        );
+        // in empty space the walk costs what one level's does; it crosses the wall's set
+        // cells sub-cell by sub-cell, fetching their words
+        let left = (Vec3::new(0.1, 0.5, 0.2), Vec3::new(0.4, 0.6, 0.8));
+        let (a, b) = (
+            one.walk(left.0, up, left.1, up),
+            two.walk(left.0, up, left.1, up),
+        );
+        assert_eq!((a.visible, b.visible), (Some(true), Some(true)));
+        assert_eq!(a.fetches, b.fetches, "empty space");
+        let (a, b) = (
+            one.walk(slit.0, up, slit.1, up),
+            two.walk(slit.0, up, slit.1, up),
+        );
+        assert!(b.fetches > a.fetches && b.cells > a.cells, "{a:?} {b:?}");
+    }
+
+    #[test]
+    fn no_triangles_make_a_grid_that_blocks_nothing() {
+        let grid = OccupancyGrid::of_triangles(&[], 8);
+        assert_eq!(grid.occupied_count(), 0);
+        assert_eq!(
+            grid.visible(Vec3::ZERO, Vec3::Y, Vec3::ONE, Vec3::Y),
+            Some(true)
+        );
+    }
+}
