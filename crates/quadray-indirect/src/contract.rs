@@ -1,11 +1,13 @@
-//! The Rust side of the Rust <-> WGSL contract: every uniform and storage struct the shaders share
-//! (`#[repr(C)]`, `Pod`; layout entries carry their `min_binding_size`), the constants of a WGSL
-//! prelude generated here and put in front of every shader, and the helpers the passes build
-//! their layouts, buffers and pipelines with. A test parses every shader with naga and holds each
-//! shared struct's size and field offsets against these.
+//! The Rust side of the Rust <-> WGSL contract: the structs the shaders share, each declared
+//! once with [`shader_struct!`] (`#[repr(C)]`, `Pod`; layout entries carry their
+//! `min_binding_size`), the WGSL prelude generated here from the Rust constants and those
+//! structs and put in front of every shader, and the helpers the passes build their layouts,
+//! buffers and pipelines with. A test parses every shader with naga and holds each shared
+//! struct's size and field offsets against these.
 
 use crate::light::node::{CONE_SLACK, EMPTY_BOX, MAX_LEVELS};
-use crate::settings::{TILE, TILE_FRONTIER};
+use crate::settings::{Shade, TILE, TILE_FRONTIER};
+use crate::shader_struct::{Layout, shader_struct};
 use crate::shadows::occupancy::{
     BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS, SUBCELLS,
 };
@@ -16,7 +18,6 @@ use crate::tiles::{
     MIXED_TARGET_ANGLE, NEAR_FIELD_SIZE, PARALLEL_TARGET_COS, SPLIT_BINS, TILE_ENTRY_INDEX_BITS,
     ZERO_ESTIMATE_SHARE,
 };
-use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 /// Items (VPLs, clusters, samples) one dispatch of a per-pixel sum covers; longer sums take
@@ -44,7 +45,7 @@ pub enum OutputTerm {
     Combined = 2,
 }
 
-/// The WGSL constants every shader starts with, generated from the Rust ones.
+/// What every shader starts with, generated from Rust: the constants and the shared structs.
 pub(crate) fn prelude() -> String {
     format!(
         "// Generated from contract.rs: do not repeat these by hand.\n\
@@ -82,7 +83,10 @@ pub(crate) fn prelude() -> String {
         BRICK.x,
         BRICK.y,
         BRICK.z,
-    )
+    ) + &shared_structs()
+        .into_iter()
+        .map(|s| s.wgsl)
+        .collect::<String>()
 }
 
 /// Texels a row of the occupancy grid's texture (`OCCUPANCY_ROW`): a texture, not a storage
@@ -107,109 +111,127 @@ pub(crate) fn shader_module(
     })
 }
 
-/// WGSL `Light`: one RSM view of a light.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(crate) struct LightUniform {
-    pub view_proj: [[f32; 4]; 4],
-    pub position: [f32; 4],
-    pub direction: [f32; 4],
-    pub intensity: [f32; 4],
-    pub parallel: [f32; 4],
+shader_struct! {
+    /// One RSM view of a light (a spot, a point light's cube face, the sun), written with the
+    /// light.
+    pub(crate) struct LightUniform as "Light" {
+        view_proj: [[f32; 4]; 4],
+        /// xyz: position (the sun: the middle of the map's near plane), w: 1 / scene extent (the
+        /// RSM's depth unit).
+        position: [f32; 4],
+        /// xyz: unit axis, w: cos(cone) (-1: no cone).
+        direction: [f32; 4],
+        /// rgb: intensity (a spot's on its axis; the sun: irradiance facing it), w:
+        /// cos(cone - falloff).
+        intensity: [f32; 4],
+        /// x: 1 for parallel light (the sun, an orthographic map), 0 from a point.
+        parallel: [f32; 4],
+    }
 }
 
-/// WGSL `Raster`: a raster pass's projection.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(crate) struct RasterUniform {
-    pub view_proj: [[f32; 4]; 4],
-    pub eye: [f32; 4],
-    pub texel: [f32; 4],
+shader_struct! {
+    /// A raster pass's projection (the RSM from the light, the camera's G-buffer).
+    pub(crate) struct RasterUniform as "Raster" {
+        view_proj: [[f32; 4]; 4],
+        /// The camera's position for the G-buffer (normals are turned towards the viewer).
+        eye: [f32; 4],
+        /// x: an RSM texel's solid angle on the axis (it shrinks as cos^3 off the axis), or its
+        /// area across parallel light.
+        texel: [f32; 4],
+    }
 }
 
-/// WGSL `ClusterParams`: the quadtree's settings.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(crate) struct ClusterUniform {
-    pub rsm_size: u32,
-    pub levels: u32,
-    pub start_level: u32,
-    pub limit_level: u32,
-    pub recursive: u32,
-    pub flux_weighted: u32,
-    pub depth_threshold: f32,
-    pub normal_threshold: f32,
+shader_struct! {
+    /// The light quadtree's settings.
+    pub(crate) struct ClusterUniform as "ClusterParams" {
+        rsm_size: u32,
+        /// Number of levels: log2(rsm_size) + 1.
+        levels: u32,
+        start_level: u32,
+        limit_level: u32,
+        recursive: u32,
+        flux_weighted: u32,
+        depth_threshold: f32,
+        normal_threshold: f32,
+    }
 }
 
-/// WGSL `Shade`: the gather's settings, written once.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(crate) struct ShadeUniform {
-    pub sample_count: u32,
-    pub subsample: u32,
-    pub low_width: u32,
-    pub low_height: u32,
-    pub normal_agreement: f32,
-    pub shadow_steps: u32,
-    pub temporal_weight: f32,
-    pub tile_error: f32,
-    pub tile_capacity: u32,
-    pub tile_start: u32,
-    pub tiles_x: u32,
-    pub tile_estimate: u32,
-    pub tile_share: f32,
-    pub tile_deblock: u32,
-    pub tile_shadow_angle: f32,
+shader_struct! {
+    /// The gather's per-view values, written with the light.
+    pub(crate) struct LightTermsUniform as "LightTerms" {
+        /// The clamp of the VPL kernel's 1/r^4 (world units).
+        r_min: f32,
+        /// Shadow-map bias in RSM depth units.
+        depth_bias: f32,
+        /// Geometry agreement for upsampling: plane distance (world units).
+        plane_agreement: f32,
+        /// Indirect shadows: how deep behind a depth map's surface a point counts as inside the
+        /// occluder (world units).
+        shadow_thickness: f32,
+        /// Where this view's low-resolution samples start; 0 for a frame's first light view,
+        /// which writes the radiance the others add to.
+        low_offset: u32,
+    }
 }
 
-/// WGSL `LightTerms`: the gather's per-view values (the kernel's clamp, the lengths that scale
-/// with the scene, where the view's low-resolution samples start: the first view, at 0, writes
-/// the radiance the others add to), written with the light.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(crate) struct LightTermsUniform {
-    pub r_min: f32,
-    pub depth_bias: f32,
-    pub plane_agreement: f32,
-    pub shadow_thickness: f32,
-    pub low_offset: u32,
+shader_struct! {
+    /// The gather's per-camera values (the G-buffer's view and size), written with the camera.
+    pub(crate) struct CameraUniform as "Camera" {
+        view_proj: [[f32; 4]; 4],
+        eye: [f32; 4],
+        width: u32,
+        height: u32,
+        /// Up to the struct's 16-byte alignment.
+        _pad: [u32; 2],
+    }
 }
 
-/// WGSL `Camera`: the gather's per-camera values (the G-buffer's view and size), written with
-/// the camera.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(crate) struct CameraUniform {
-    pub view_proj: [[f32; 4]; 4],
-    pub eye: [f32; 4],
-    pub width: u32,
-    pub height: u32,
-    /// Up to the struct's 16-byte alignment.
-    pub _pad: [u32; 2],
+shader_struct! {
+    /// One slot of the per-dispatch uniforms (a level, or a slice of a long sum).
+    pub(crate) struct LevelSlot as "Level" {
+        level: u32,
+    }
 }
 
-/// WGSL `Level`: one slot of the per-dispatch uniforms (a level, or a slice of a long sum).
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(crate) struct LevelSlot {
-    pub level: u32,
+shader_struct! {
+    /// One cluster of the light quadtree (a level-0 node is one RSM texel, one VPL).
+    pub(crate) struct GpuNode as "Node" {
+        /// rgb: summed flux, w: number of texels that see geometry.
+        flux: [f32; 4],
+        /// xyz: mean position, w: mean RSM depth (light-axis distance / scene extent).
+        pos: [f32; 4],
+        /// xyz: renormalised mean normal, w: 1 when the cluster is valid.
+        normal: [f32; 4],
+    }
 }
 
-/// WGSL `Node`: one cluster of the quadtree (see common.wgsl for what each lane holds).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct GpuNode {
-    pub flux: [f32; 4],
-    pub pos: [f32; 4],
-    pub normal: [f32; 4],
+shader_struct! {
+    /// What bounds a node's contribution (per-tile cuts): the box of its VPLs' positions and a
+    /// cone holding their normals (axis: the node's mean normal). Empty nodes hold an empty box
+    /// (lo > hi).
+    pub(crate) struct GpuNodeBounds as "NodeBounds" {
+        /// xyz: the box's low corner; w: cosine of the normal cone's half-angle.
+        lo: [f32; 4],
+        /// xyz: the box's high corner.
+        hi: [f32; 4],
+    }
 }
 
-/// WGSL `NodeBounds`: a node's box of VPL positions and normal cone (see common.wgsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct GpuNodeBounds {
-    pub lo: [f32; 4],
-    pub hi: [f32; 4],
+/// Every struct shared with WGSL, each declared once (here, or with what it holds: the gather's
+/// settings in `settings.rs`): the prelude declares them for every shader, the contract test
+/// holds each layout to naga's.
+pub(crate) fn shared_structs() -> Vec<Layout> {
+    vec![
+        Layout::of::<LightUniform>(),
+        Layout::of::<RasterUniform>(),
+        Layout::of::<ClusterUniform>(),
+        Layout::of::<Shade>(),
+        Layout::of::<LightTermsUniform>(),
+        Layout::of::<CameraUniform>(),
+        Layout::of::<LevelSlot>(),
+        Layout::of::<GpuNode>(),
+        Layout::of::<GpuNodeBounds>(),
+    ]
 }
 
 fn min_size<T>() -> Option<wgpu::BufferSize> {

@@ -62,6 +62,7 @@ pub mod reference;
 mod renderer;
 pub mod scene;
 mod settings;
+mod shader_struct;
 #[cfg(test)]
 mod shader_tests;
 pub mod shadows;

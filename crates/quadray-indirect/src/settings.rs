@@ -7,7 +7,9 @@
 //! `quadray indirect`'s clap arguments; `Settings::to_args` spells them back (the viewer's
 //! reproducing command line), and a round-trip test parses them again.
 
+use crate::frame::NORMAL_AGREEMENT;
 use crate::method::{TileCriterion, Validity};
+use crate::shader_struct::shader_struct;
 use quadray_core::settings::{Limits, Size};
 use serde::Serialize;
 
@@ -579,6 +581,45 @@ impl Settings {
     pub fn to_args(&self) -> Vec<String> {
         // serde flattens the size into `width` and `height`: the flag is `WxH`.
         quadray_core::settings::to_args(self, &[("size", self.size.to_string())])
+    }
+}
+
+shader_struct! {
+    /// The settings as the gather's shaders read them (WGSL `Shade`), written once: a gather's
+    /// settings are fixed. A setting a shader reads is a field here and nowhere else on the Rust
+    /// side; the WGSL struct is generated from this list.
+    pub(crate) struct Shade as "Shade" (s: &Settings) {
+        sample_count: u32 = s.samples,
+        /// Sub-sampled indirect: one sample per `subsample` x `subsample` pixels.
+        subsample: u32 = s.subsample,
+        low_width: u32 = s.low_size().0,
+        low_height: u32 = s.low_size().1,
+        /// Geometry agreement for upsampling, corner sharing and deblocking: normals' dot.
+        normal_agreement: f32 = NORMAL_AGREEMENT,
+        /// Indirect shadows: points marched between a receiver and a cluster (0: none).
+        shadow_steps: u32 = s.march_steps(),
+        /// Weight of this frame in the running average of the indirect light (1: no filter).
+        temporal_weight: f32 = s.temporal_weight,
+        /// Per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its
+        /// estimated error) exceeds `tile_error` of the tile's irradiance estimated from the
+        /// nodes of level `tile_start`; at most `tile_capacity` nodes a tile.
+        tile_error: f32 = s.tile_error_or_default(),
+        tile_capacity: u32 = s.tile_capacity_or_default(),
+        tile_start: u32 = s.tile_start_level(),
+        /// Tiles in a row of the picture.
+        tiles_x: u32 = s.tiles().0,
+        tile_estimate: u32 = u32::from(s.tile_criterion == TileCriterion::Estimate),
+        /// Per-tile cuts: nodes farther than this times the tile's receivers' diagonal are
+        /// gathered at the tile's corners and interpolated (0: every pixel evaluates every node).
+        tile_share: f32 = s.tile_share,
+        /// Per-tile cuts: pixels on either side of a tile boundary its unexplained step is
+        /// spread over (0: none; deblock.wgsl).
+        tile_deblock: u32 = s.tile_deblock,
+        /// Per-tile cuts with indirect shadows: a cluster takes the visibility of its highest
+        /// ancestor whose box's diagonal is at most this times its distance from the tile's
+        /// receivers, `MIXED_TARGET_ANGLE` of it for an ancestor of several surfaces (0: each
+        /// its own; tiles/kernel.wgsl).
+        tile_shadow_angle: f32 = s.tile_shadow_angle,
     }
 }
 

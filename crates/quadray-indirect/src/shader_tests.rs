@@ -1,90 +1,16 @@
 //! The Rust <-> WGSL contract checked for every shader: each parses and validates with naga, and
-//! each shared struct's size and field offsets are those of its Rust twin in `contract.rs`. Here,
+//! each shared struct's size and field offsets are those of its Rust declaration
+//! (`shader_struct!`, listed in `contract::shared_structs`), from which its WGSL is generated. Here,
 //! above every pass, since it reads every pass's shader.
 
 use crate::contract::*;
 use crate::gbuffer;
 use crate::light::{quadtree, rsm};
 use crate::output;
-use std::mem::offset_of;
-
-/// A shared struct: its WGSL name, Rust size and Rust field offsets by name.
-struct Shared {
-    wgsl: &'static str,
-    size: usize,
-    fields: Vec<(&'static str, usize)>,
-}
-
-macro_rules! shared {
-    ($wgsl:literal, $rust:ty, [$($field:ident),*]) => {
-        Shared {
-            wgsl: $wgsl,
-            size: size_of::<$rust>(),
-            fields: vec![$((stringify!($field), offset_of!($rust, $field))),*],
-        }
-    };
-}
 
 #[test]
 fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
-    let shared = [
-        shared!(
-            "Light",
-            LightUniform,
-            [view_proj, position, direction, intensity, parallel]
-        ),
-        shared!("Raster", RasterUniform, [view_proj, eye, texel]),
-        shared!(
-            "ClusterParams",
-            ClusterUniform,
-            [
-                rsm_size,
-                levels,
-                start_level,
-                limit_level,
-                recursive,
-                flux_weighted,
-                depth_threshold,
-                normal_threshold
-            ]
-        ),
-        shared!(
-            "Shade",
-            ShadeUniform,
-            [
-                sample_count,
-                subsample,
-                low_width,
-                low_height,
-                normal_agreement,
-                shadow_steps,
-                temporal_weight,
-                tile_error,
-                tile_capacity,
-                tile_start,
-                tiles_x,
-                tile_estimate,
-                tile_share,
-                tile_deblock,
-                tile_shadow_angle
-            ]
-        ),
-        shared!(
-            "LightTerms",
-            LightTermsUniform,
-            [
-                r_min,
-                depth_bias,
-                plane_agreement,
-                shadow_thickness,
-                low_offset
-            ]
-        ),
-        shared!("Camera", CameraUniform, [view_proj, eye, width, height]),
-        shared!("Level", LevelSlot, [level]),
-        shared!("Node", GpuNode, [flux, pos, normal]),
-        shared!("NodeBounds", GpuNodeBounds, [lo, hi]),
-    ];
+    let shared = shared_structs();
     let mut seen = std::collections::BTreeSet::new();
     for (name, parts) in shaders() {
         let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
@@ -98,20 +24,20 @@ fn every_shader_parses_and_its_shared_structs_match_the_rust_side() {
             let naga::TypeInner::Struct { members, span } = &ty.inner else {
                 continue;
             };
-            let Some(s) = shared.iter().find(|s| ty.name.as_deref() == Some(s.wgsl)) else {
+            let Some(s) = shared.iter().find(|s| ty.name.as_deref() == Some(s.name)) else {
                 continue;
             };
-            assert_eq!(*span as usize, s.size, "{name}: size of {}", s.wgsl);
+            assert_eq!(*span as usize, s.size, "{name}: size of {}", s.name);
             let wgsl: Vec<(&str, usize)> = members
                 .iter()
                 .map(|m| (m.name.as_deref().unwrap_or(""), m.offset as usize))
                 .collect();
-            assert_eq!(wgsl, s.fields, "{name}: fields of {}", s.wgsl);
-            seen.insert(s.wgsl);
+            assert_eq!(wgsl, s.offsets, "{name}: fields of {}", s.name);
+            seen.insert(s.name);
         }
     }
     for s in &shared {
-        assert!(seen.contains(s.wgsl), "no shader declares {}", s.wgsl);
+        assert!(seen.contains(s.name), "no shader declares {}", s.name);
     }
 }
 

@@ -12,14 +12,15 @@
 //! points. WGSL declarations may come in any order, so the accessors may follow the modules.
 
 /// The constants every module uses (`SLICE`, `LEVEL_SLICE`, `MAX_LEVELS`, `TILE`,
-/// `TILE_FRONTIER`, `PI`, ...), generated from the Rust ones: put it first.
+/// `TILE_FRONTIER`, `PI`, ...) and the structs shared with Rust (`Node`, `NodeBounds`,
+/// `ClusterParams`, `Light`, ...), generated from the Rust declarations: put it first.
 pub fn prelude() -> String {
     crate::contract::prelude()
 }
 
-/// The light quadtree's node layout (`Node`, `NodeBounds`, `ClusterParams`), its pyramid
-/// addressing (`level_size`, `level_offset`, `node_index`: levels finest first) and the work
-/// counters every module adds to (`evaluations`, `fetches`, `bound_evaluations`). Accessors: none.
+/// The light quadtree's pyramid addressing over the prelude's `Node` and `ClusterParams`
+/// (`level_size`, `level_offset`, `node_index`: levels finest first) and the work counters every
+/// module adds to (`evaluations`, `fetches`, `bound_evaluations`). Accessors: none.
 pub const NODE: &str = include_str!("light/node.wgsl");
 
 /// The VPL kernel: `vpl_irradiance` (a VPL or cluster's irradiance at a receiver, 1/r^4 clamped
@@ -28,7 +29,7 @@ pub const NODE: &str = include_str!("light/node.wgsl");
 /// `all_finite`. Needs [`NODE`]. Accessors: none.
 pub const KERNEL: &str = include_str!("light/kernel.wgsl");
 
-/// The spot light: the `Light` uniform's layout, `spot_intensity` and `light_depth` (the RSM's
+/// The spot light over the prelude's `Light` uniform: `spot_intensity` and `light_depth` (the RSM's
 /// depth). Accessors: none.
 pub const LIGHT: &str = include_str!("light/light.wgsl");
 

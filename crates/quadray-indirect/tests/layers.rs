@@ -9,10 +9,9 @@ use crate::layering::assert_layered;
 /// modules sit on top, beside it.
 const LAYERS: &[&[&str]] = &[
     // the crate's error, defined in lib.rs but naming nothing of the crate
-    &["IndirectError"],
-    &["method"],
+    &["IndirectError", "shader_struct"],
+    &["method", "frame"],
     &["settings"],
-    &["frame"],
     &["scene", "scene::builtin"],
     &[
         "light",

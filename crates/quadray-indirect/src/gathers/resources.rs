@@ -7,18 +7,16 @@
 
 use crate::contract::{
     CameraUniform, ClusterUniform, GpuNode, GpuNodeBounds, LevelSlot, LightTermsUniform,
-    LightUniform, MAX_SLICES, OCCUPANCY_ROW, ShadeUniform, Slots, bind_group, compute_pipeline,
-    dispatch_2d, layout, pipeline_layout, shader_module, storage_buffer, storage_entry, tex,
-    texture_entry, uint_texture_entry, uniform_buffer, uniform_entry, whole,
+    LightUniform, MAX_SLICES, OCCUPANCY_ROW, Slots, bind_group, compute_pipeline, dispatch_2d,
+    layout, pipeline_layout, shader_module, storage_buffer, storage_entry, tex, texture_entry,
+    uint_texture_entry, uniform_buffer, uniform_entry, whole,
 };
 use crate::gathers::samples;
 use crate::gbuffer::{GBufferViews, camera_uniform};
 use crate::light::quadtree::LightQuadtree;
 use crate::light::rsm::RsmViews;
 use crate::light::view::LightView;
-use crate::frame::NORMAL_AGREEMENT;
-use crate::method::TileCriterion;
-use crate::settings::Settings;
+use crate::settings::{Settings, Shade};
 use crate::shadows::MARCH_WGSL;
 use crate::shadows::occupancy::OccupancyGrid;
 use crate::wgsl;
@@ -41,28 +39,6 @@ const SHARED_WGSL: [&str; 7] = [
 /// A gather pass's whole shader: the shared parts, then the pass's `own` in order.
 pub(crate) fn shader(own: &[&'static str]) -> Vec<&'static str> {
     SHARED_WGSL.iter().chain(own).copied().collect()
-}
-
-/// The gather's settings as the shaders read them (written once: a gather's settings are fixed).
-fn shade_uniform(s: &Settings) -> ShadeUniform {
-    let (low_width, low_height) = s.low_size();
-    ShadeUniform {
-        sample_count: s.samples,
-        subsample: s.subsample,
-        low_width,
-        low_height,
-        normal_agreement: NORMAL_AGREEMENT,
-        shadow_steps: s.march_steps(),
-        temporal_weight: s.temporal_weight,
-        tile_error: s.tile_error_or_default(),
-        tile_capacity: s.tile_capacity_or_default(),
-        tile_start: s.tile_start_level(),
-        tiles_x: s.tiles().0,
-        tile_estimate: u32::from(s.tile_criterion == TileCriterion::Estimate),
-        tile_share: s.tile_share,
-        tile_deblock: s.tile_deblock,
-        tile_shadow_angle: s.tile_shadow_angle,
-    }
 }
 
 /// The per-frame group's buffers: the settings, the camera, the radiance out, the RSM samples,
@@ -100,7 +76,7 @@ impl Outputs {
         Self {
             shade: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("shade"),
-                contents: bytemuck::bytes_of(&shade_uniform(s)),
+                contents: bytemuck::bytes_of(&Shade::new(s)),
                 usage: wgpu::BufferUsages::UNIFORM,
             }),
             // the picture's size from the start: a caller without indirect shadows may never
@@ -289,7 +265,7 @@ impl Resources {
             device,
             "gather frame",
             &[
-                uniform_entry::<ShadeUniform>(0, compute, false),
+                uniform_entry::<Shade>(0, compute, false),
                 storage_entry::<CameraUniform>(1, true),
                 texture_entry(2),
                 texture_entry(3),

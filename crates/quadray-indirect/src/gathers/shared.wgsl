@@ -7,64 +7,9 @@
 // loop, even one that never runs, made that loop 4-11 times slower on lavapipe.
 override SHADOWS: bool;
 
-// The gather's settings, written once.
-struct Shade {
-    sample_count: u32,
-    // sub-sampled indirect: one sample per `subsample` x `subsample` pixels
-    subsample: u32,
-    low_width: u32,
-    low_height: u32,
-    // geometry agreement for upsampling: normals' dot
-    normal_agreement: f32,
-    // indirect shadows: points marched between a receiver and a cluster (0: none)
-    shadow_steps: u32,
-    // weight of this frame in the running average of the indirect light (1: no filter)
-    temporal_weight: f32,
-    // per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its estimated
-    // error) exceeds `tile_error` of the tile's irradiance estimated from the nodes of level
-    // `tile_start`; at most `tile_capacity` nodes a tile; tiles in a row of the picture
-    tile_error: f32,
-    tile_capacity: u32,
-    tile_start: u32,
-    tiles_x: u32,
-    tile_estimate: u32,
-    // per-tile cuts: nodes farther than this times the tile's receivers' diagonal are gathered
-    // at the tile's corners and interpolated (0: every pixel evaluates every node)
-    tile_share: f32,
-    // per-tile cuts: pixels on either side of a tile boundary its unexplained step is spread
-    // over (0: none; deblock.wgsl)
-    tile_deblock: u32,
-    // per-tile cuts with indirect shadows: a cluster takes the visibility of its highest
-    // ancestor whose box's diagonal is at most this times its distance from the tile's
-    // receivers, MIXED_TARGET_ANGLE of it for an ancestor of several surfaces (0: each its own;
-    // tiles/kernel.wgsl)
-    tile_shadow_angle: f32,
-}
-
-// Per light view, with the light: the kernel's clamp, the lengths that scale with the scene and
-// where the view's low-resolution samples start.
-struct LightTerms {
-    // the clamp of the VPL kernel's 1/r^4 (world units)
-    r_min: f32,
-    // shadow-map bias in RSM depth units
-    depth_bias: f32,
-    // geometry agreement for upsampling: plane distance (world units)
-    plane_agreement: f32,
-    // indirect shadows: how deep behind a depth map's surface a point counts as inside the
-    // occluder (world units)
-    shadow_thickness: f32,
-    // where this view's low-resolution samples start; 0 for a frame's first light view, which
-    // writes the radiance the others add to
-    low_offset: u32,
-}
-
-// Per camera: the view the G-buffer was rendered from, and its size in pixels.
-struct Camera {
-    view_proj: mat4x4<f32>,
-    eye: vec4<f32>,
-    width: u32,
-    height: u32,
-}
+// The structs bound here (`Shade`, `LightTerms`, `Camera`, `Level`, `ClusterParams`, `Light`,
+// `Node`, `NodeBounds`) are declared in Rust and generated into the prelude (contract.rs; the
+// gather's settings, `Shade`, in settings.rs).
 
 // Group 0, per light update: the quadtree's settings, the light, the RSM, the quadtree and cut.
 @group(0) @binding(0) var<uniform> params: ClusterParams;

@@ -1,18 +1,8 @@
 // One RSM view of a light (a spot, a point light's cube face, the sun): its uniform's layout,
 // its light towards a point and the RSM's depth. Engine-neutral: no bindings, no accessors.
 
-struct Light {
-    view_proj: mat4x4<f32>,
-    // xyz: position (the sun: the middle of the map's near plane), w: 1 / scene extent (RSM
-    // depth unit)
-    position: vec4<f32>,
-    // xyz: unit axis, w: cos(cone) (-1: no cone)
-    direction: vec4<f32>,
-    // rgb: intensity (a spot's on its axis; the sun: irradiance facing it), w: cos(cone - falloff)
-    intensity: vec4<f32>,
-    // x: 1 for parallel light (the sun, an orthographic map), 0 from a point
-    parallel: vec4<f32>,
-}
+// `Light`, one RSM view's uniform, is declared in Rust and generated into the prelude
+// (contract.rs).
 
 fn is_parallel(light: Light) -> bool {
     return light.parallel.x > 0.5;

@@ -1,14 +1,7 @@
 // The vertex stage both raster passes share (the RSM from the spot, the camera's G-buffer):
 // world position, normal and albedo per vertex.
 
-struct Raster {
-    view_proj: mat4x4<f32>,
-    // camera position for the G-buffer (normals are turned towards the viewer)
-    eye: vec4<f32>,
-    // x: an RSM texel's solid angle on the axis (it shrinks as cos^3 off the axis), or its area
-    // across parallel light
-    texel: vec4<f32>,
-}
+// `Raster` is declared in Rust and generated into the prelude (contract.rs).
 
 @group(0) @binding(0) var<uniform> raster: Raster;
 
