@@ -5,11 +5,16 @@ use crate::layering::assert_layered;
 
 /// Every module, by layer, bottom first: the pyramid image, the material at the root, the
 /// displaced surfaces' triangles and the indirect light's main-world side (which reads the
-/// materials), then its render-world side, and the plugin that adds both.
+/// materials), then its render-world side by phase (the pipelines made at startup, the lights'
+/// and the cameras' prepare, the passes), and the plugin that adds both.
 const LAYERS: &[&[&str]] = &[
     &["pyramid_image"],
     &[""],
     &["gi::displaced", "gi::scene"],
+    &["gi::render::pipelines"],
+    &["gi::render::light"],
+    &["gi::render::views"],
+    &["gi::render::passes"],
     &["gi::render"],
     &["gi"],
 ];

@@ -1,0 +1,190 @@
+//! Prepare, the lights' side shared by every camera: per light view an RSM over the scene's
+//! triangles and the light quadtree over it, and the scene's occupancy grid.
+
+use crate::gi::scene::{IndirectLight, IndirectLightScene};
+use bevy::prelude::*;
+use bevy::render::camera::ExtractedCamera;
+use bevy::render::renderer::{RenderDevice, RenderQueue};
+use quadray_indirect::scene::Light;
+use quadray_indirect::shadows::occupancy::OccupancyGrid;
+use quadray_indirect::{LightQuadtree, RsmPass, Settings};
+use quadray_indirect::{LightView, ViewMaps, scene::bounds_of};
+
+/// The lights' side, shared by every camera: an RSM over the scene's triangles and the light
+/// quadtree built over it per light view.
+#[derive(Resource, Default)]
+pub(super) struct LightState(pub(super) Option<LightPasses>);
+
+/// One light view's RSM and quadtree.
+pub(super) struct ViewMapsPasses {
+    pub(super) rsm: RsmPass,
+    pub(super) quadtree: LightQuadtree,
+}
+
+pub(super) struct LightPasses {
+    /// One a light view, in the order of `lights`' views; the first's cut is the one the cut
+    /// view and the diagnostics show.
+    pub(super) views: Vec<ViewMapsPasses>,
+    /// Counts the times `views` was made anew: a camera's gather reads the maps of one.
+    pub(super) maps_generation: u64,
+    pub(super) rsm_size: u32,
+    /// The first camera's [`Settings::max_lights`], which `lights` was taken with.
+    pub(super) max_lights: u32,
+    pub(super) vertices: Option<(wgpu::Buffer, u32)>,
+    pub(super) generation: u64,
+    pub(super) lights: Vec<Light>,
+    /// The lights' RSM views, one a `views` entry.
+    pub(super) light_views: Vec<LightView>,
+    /// The RSMs, pyramids and cuts are to be recorded again (a light or the scene changed).
+    pub(super) stale: bool,
+    /// The scene's occupancy grid that indirect shadows walk, at the first camera's
+    /// [`Settings::shadow_grid`] cells and [`Settings::shadow_grid_levels`] (none without
+    /// indirect shadows, or at 0 cells: the gathers march the depth maps), and how many times
+    /// it was made.
+    pub(super) occupancy: Option<OccupancyGrid>,
+    pub(super) occupancy_cells: (u32, u32),
+    pub(super) occupancy_generation: u64,
+}
+
+impl LightPasses {
+    pub(super) fn maps(&self) -> Vec<ViewMaps<'_>> {
+        self.views
+            .iter()
+            .map(|v| ViewMaps {
+                rsm: v.rsm.views(),
+                quadtree: &v.quadtree,
+            })
+            .collect()
+    }
+
+    /// The passes of `count` light views at `settings`.
+    pub(super) fn make_views(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        settings: &Settings,
+        count: usize,
+    ) {
+        self.views = (0..count)
+            .map(|_| {
+                let rsm = RsmPass::new(device, settings.rsm_size);
+                let quadtree = LightQuadtree::new(
+                    device,
+                    queue,
+                    settings.rsm_size,
+                    settings.cluster,
+                    rsm.views(),
+                );
+                ViewMapsPasses { rsm, quadtree }
+            })
+            .collect();
+        self.rsm_size = settings.rsm_size;
+        self.maps_generation += 1;
+        self.stale = true;
+    }
+}
+
+pub(super) fn prepare_light(
+    scene: Option<Res<IndirectLightScene>>,
+    cameras: Query<&IndirectLight, With<ExtractedCamera>>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    mut state: ResMut<LightState>,
+    mut warned: Local<Option<String>>,
+) {
+    let Some(camera) = cameras.iter().next() else {
+        // no camera gathers: the lights' maps are freed, and made anew for the next one
+        state.0 = None;
+        return;
+    };
+    let Some(scene) = scene else { return };
+    let device = device.wgpu_device();
+    let settings = &camera.settings;
+    // the light's passes are sized by the settings: refuse what the gather would refuse
+    if let Err(e) = settings.validate() {
+        let message = format!("quadray indirect light: the settings are refused: {e}");
+        if warned.as_ref() != Some(&message) {
+            warn!("{message}");
+            *warned = Some(message);
+        }
+        state.0 = None;
+        return;
+    }
+    let l = state.0.get_or_insert_with(|| LightPasses {
+        views: Vec::new(),
+        maps_generation: 0,
+        rsm_size: 0,
+        max_lights: settings.max_lights,
+        vertices: None,
+        generation: u64::MAX,
+        lights: Vec::new(),
+        light_views: Vec::new(),
+        stale: true,
+        occupancy: None,
+        occupancy_cells: (0, 0),
+        occupancy_generation: 0,
+    });
+    let cluster = settings.cluster;
+    for view in &mut l.views {
+        if view.quadtree.cluster() != cluster {
+            view.quadtree.set_cluster(&queue, cluster);
+            l.stale = true;
+        }
+    }
+    let cells = if settings.indirect_shadows {
+        settings.shadow_grid
+    } else {
+        0
+    };
+    let levels = settings.shadow_grid_levels;
+    if l.generation != scene.generation || l.occupancy_cells != (cells, levels) {
+        // (rebuilt with every change of the scene: a few milliseconds for thousands of
+        // triangles at 64 cells)
+        l.occupancy =
+            (cells > 0).then(|| OccupancyGrid::with_levels(&scene.triangles, cells, levels));
+        l.occupancy_cells = (cells, levels);
+        l.occupancy_generation += 1;
+    }
+    if l.generation != scene.generation {
+        l.generation = scene.generation;
+        l.vertices = (!scene.triangles.is_empty()).then(|| {
+            use wgpu::util::DeviceExt;
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("quadray gi triangles"),
+                contents: bytemuck::cast_slice(scene.triangles.as_slice()),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            (buffer, scene.triangles.len() as u32 * 3)
+        });
+        // the maps' projections follow the scene's bounds
+        l.lights.clear();
+    }
+    let lights: Vec<Light> = scene
+        .lights
+        .iter()
+        .take(settings.max_lights as usize)
+        .copied()
+        .collect();
+    if l.lights != lights || l.rsm_size != settings.rsm_size {
+        let bounds = bounds_of(
+            scene
+                .triangles
+                .iter()
+                .flatten()
+                .map(|v| glam::Vec3::from(v.position)),
+        );
+        l.light_views = lights
+            .iter()
+            .flat_map(|light| LightView::of_light(light, bounds))
+            .collect();
+        if l.views.len() != l.light_views.len() || l.rsm_size != settings.rsm_size {
+            l.make_views(device, &queue, settings, l.light_views.len());
+        }
+        for (view, light_view) in l.views.iter().zip(&l.light_views) {
+            view.rsm.set_light(&queue, light_view);
+        }
+        l.lights = lights;
+        l.stale = true;
+    }
+    l.max_lights = settings.max_lights;
+}

@@ -1,0 +1,57 @@
+//! The render world's side: per light view, quadray's RSM and light quadtree; per camera, the
+//! G-buffer translated from Bevy's, quadray's gather, the additive composite into the view and,
+//! on request, the cut over the RSM drawn into the tone-mapped picture.
+//!
+//! By render phase, as Bevy's own features: `pipelines.rs` (made at startup), `light.rs` and
+//! `views.rs` (prepare: the lights' maps, each camera's passes) and `passes.rs` (the `Core3d`
+//! systems that record them).
+
+mod light;
+mod passes;
+mod pipelines;
+pub(super) mod views;
+
+use light::{LightState, prepare_light};
+pub(super) use passes::camera_diagnostics;
+use passes::{cut_view_pass, indirect_light_pass};
+use pipelines::{GBUFFER_SHADER, init_pipelines};
+pub use views::ViewPasses;
+use views::{drop_unused_views, prepare_views};
+
+use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
+use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::core_pipeline::tonemapping::tonemapping;
+use bevy::prelude::*;
+use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
+use bevy::shader::Shader;
+
+pub(super) fn build(app: &mut App) {
+    let _ = app.world_mut().resource_mut::<Assets<Shader>>().insert(
+        &GBUFFER_SHADER,
+        Shader::from_wgsl(include_str!("gbuffer.wgsl"), "quadray/gi_gbuffer.wgsl"),
+    );
+    let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+        return;
+    };
+    render_app
+        .init_resource::<LightState>()
+        .add_systems(RenderStartup, init_pipelines)
+        .add_systems(
+            Render,
+            (drop_unused_views, prepare_light, prepare_views)
+                .chain()
+                .in_set(RenderSystems::PrepareBindGroups),
+        )
+        .add_systems(
+            Core3d,
+            (
+                indirect_light_pass
+                    .after(main_opaque_pass_3d)
+                    .before(main_transparent_pass_3d)
+                    .in_set(Core3dSystems::MainPass),
+                cut_view_pass
+                    .after(tonemapping)
+                    .in_set(Core3dSystems::PostProcess),
+            ),
+        );
+}
