@@ -21,6 +21,16 @@ pub fn vpl_kernel(d: DVec3, receiver_normal: DVec3, vpl_normal: DVec3, r_min: f6
     emit * receive / (r2 * r2)
 }
 
+/// The Rec. 709 weights of linear RGB's luminance, the one measure of a colour's size that the
+/// per-tile cuts' rules (`luminance` in the shaders' kernel), their twin and the studies use.
+pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+/// The luminance of linear RGB `c` in f32, as the shaders weigh it ([`LUMINANCE`]; the weights
+/// round to the same f32 as the shaders' literals).
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::from(LUMINANCE.map(|w| w as f32)))
+}
+
 /// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none), with
 /// E_p = flux_p / pi * [`vpl_kernel`] (the spec's kernel with a diffuse VPL's 1/pi).
 pub fn brute_force(vpls: &[Vpl], receivers: &[Option<Receiver>], r_min: f32) -> Vec<[f32; 3]> {

@@ -52,6 +52,7 @@ const LAYERS: &[&[&str]] = &[
     &["renderer"],
     &[
         "shader_tests",
+        "settings::rules",
         "light::bound_tests",
         "shadows::occupancy_tests",
     ],

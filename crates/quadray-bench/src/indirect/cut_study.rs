@@ -22,7 +22,7 @@ use crate::report::{PlotSpec, Series, Table, line_plot};
 use glam::DVec3;
 use quadray_core::{write_json, write_text};
 use quadray_gpu::Gpu;
-use quadray_indirect::reference::{brute_force, compare, vpl_kernel};
+use quadray_indirect::reference::{LUMINANCE, brute_force, compare, vpl_kernel};
 use quadray_indirect::tiles::twin::{self, TILE_PIXELS};
 use quadray_indirect::{IndirectError, Method, Renderer, Scene, Settings};
 use rayon::prelude::*;
@@ -184,8 +184,9 @@ impl Cluster {
     }
 }
 
+/// Luminance in f64, the study's precision, with the product's weights.
 fn luminance(c: DVec3) -> f64 {
-    c.dot(DVec3::new(0.2126, 0.7152, 0.0722))
+    c.dot(DVec3::from(LUMINANCE))
 }
 
 /// The quadtree over the RSM's texels, finest level first.

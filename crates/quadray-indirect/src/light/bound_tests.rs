@@ -7,7 +7,7 @@ use crate::contract::{
     storage_entry, whole,
 };
 use crate::frame::{Receiver, Vpl};
-use crate::reference::brute_force;
+use crate::reference::{brute_force, luminance};
 use crate::wgsl;
 use glam::Vec3;
 use quadray_core::random::SplitMix;
@@ -132,10 +132,6 @@ impl Random {
     }
 }
 
-fn luminance(c: [f32; 3]) -> f32 {
-    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
-}
-
 #[test]
 fn the_node_bound_is_at_least_the_exact_irradiance_at_any_receiver_of_the_box() {
     let mut rng = Random(SplitMix(7));
@@ -172,7 +168,12 @@ fn the_node_bound_is_at_least_the_exact_irradiance_at_any_receiver_of_the_box() 
             })
             .collect();
         let irradiance = brute_force(&vpls, &receivers, r_min);
-        exact.push(irradiance.into_iter().map(luminance).fold(0.0, f32::max));
+        exact.push(
+            irradiance
+                .into_iter()
+                .map(|c| luminance(Vec3::from(c)))
+                .fold(0.0, f32::max),
+        );
         let flux = vpls.iter().fold(Vec3::ZERO, |s, v| s + Vec3::from(v.flux));
         all.push(BoundCase {
             flux: flux.extend(0.0).into(),

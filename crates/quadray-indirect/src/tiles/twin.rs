@@ -12,7 +12,7 @@ use crate::light::node::{CONE_SLACK, EMPTY_BOX};
 #[cfg(doc)]
 use crate::method::Method;
 use crate::method::TileCriterion;
-use crate::reference::vpl_kernel;
+use crate::reference::{luminance, vpl_kernel};
 use crate::settings::{Settings, TILE};
 use crate::tiles::{NEAR_FIELD_SIZE, SPLIT_BINS, ZERO_ESTIMATE_SHARE};
 use glam::{DVec3, Vec2, Vec3, Vec4};
@@ -104,10 +104,6 @@ pub fn near_field(
         && receivers
             .into_iter()
             .any(|x| gap(lo, hi, x) < r_min * r_min)
-}
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 fn is_tie(quantity: f32, threshold: f32) -> bool {
