@@ -8,8 +8,9 @@
 # with a 512^2 RSM for every method, given --bevy-bin the Bevy frame with and without the bounce
 # (two paired rounds, Bevy's render diagnostics), then, while the time budget lasts, the paper
 # tables of `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
-# name from the adapter, e.g. bench/nvidia-h200/) with every stats file and a summary.md of the
-# tables, and packs it into gpu-tables.tar.gz beside it (one file to copy off the machine).
+# name from the adapter, e.g. bench/nvidia-h200/) with every stats file (each naming the commit
+# and the adapter it measured) and a summary.md of the tables (headed by the adapter, the date and
+# the commit), and packs it into gpu-tables.tar.gz beside it (one file to copy off the machine).
 #
 #   scripts/gpu-tables.sh [--quick] [--smoke-only] [--smoke REGEX] [--bin PATH] [--bevy-bin PATH]
 #                         [--out DIR] [--budget SECONDS]
@@ -64,7 +65,9 @@ device=$(echo "${adapter%% (*}" | tr '[:upper:]' '[:lower:]' | sed 's/[^a-z0-9]\
 [ $quick = 1 ] && device="$device-quick"
 out="$out_root/$device"
 mkdir -p "$out/displace-1080p" "$out/indirect-1080p" "$out/logs" "$out/smoke"
-printf '%s\n%s\n' "$adapter" "$(date -u +%Y-%m-%dT%H:%MZ)" >"$out/adapter.txt"
+# the build measured: `quadray 0.1.0 (commit C)` (every stats file records it too)
+version=$("$bin" --version)
+printf '%s\n%s\n%s\n' "$adapter" "$(date -u +%Y-%m-%dT%H:%MZ)" "$version" >"$out/adapter.txt"
 echo "$adapter -> $out"
 
 # The smoke stage. The layer is used where the Vulkan loader finds it (its manifest in a standard
@@ -179,8 +182,8 @@ fi
 python3 - "$out" <<'EOF' || echo "no summary.md: python3 failed or is missing" >&2
 import json, pathlib, re, sys
 out = pathlib.Path(sys.argv[1])
-adapter, date = (out / "adapter.txt").read_text().split("\n")[:2]
-lines = [f"# GPU tables on {adapter}, {date}", ""]
+adapter, date, version = (out / "adapter.txt").read_text().split("\n")[:3]
+lines = [f"# GPU tables on {adapter}, {date}, {version}", ""]
 lines += ["## Displacement frame", "",
           "| method | view angle | GPU ms | wrong-hit fraction | mean iterations | max iterations | cap hits |",
           "|---|---|---|---|---|---|---|"]

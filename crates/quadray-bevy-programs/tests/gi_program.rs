@@ -149,3 +149,59 @@ fn the_gi_program_renders_a_users_gltf_and_refuses_what_it_cannot_use() {
         "invalid value 'area' for '--gi-lights",
     );
 }
+
+/// `--ev100` exposes the picture as Bevy's `Exposure` does, for Bevy's light and the bounce
+/// alike (and Bevy's ambient light with them): the courtyard glTF with its sun 256 times dimmer
+/// (4.27 lux, black at Bevy's default EV100 of 9.7) at 8 EV less is the courtyard's own picture
+/// at the default, pixel for pixel. An EV100 out of its range is refused.
+#[test]
+fn the_gi_program_exposes_a_dim_sun_as_bright_as_a_strong_one() {
+    let dir = std::env::temp_dir().join(format!("quadray-bevy-gi-ev100-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let courtyard =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes/courtyard.gltf");
+    let text = std::fs::read_to_string(&courtyard).unwrap();
+    let (sun, dim_sun) = ("\"intensity\": 1092.8", "\"intensity\": 4.26875");
+    assert_eq!(text.matches(sun).count(), 1, "the courtyard's sun");
+    let dim = dir.join("dim courtyard.gltf");
+    std::fs::write(&dim, text.replace(sun, dim_sun)).unwrap();
+    let (strong, exposed) = std::thread::scope(|s| {
+        let strong =
+            s.spawn(|| screenshot(&dir, "strong", &["--scene", courtyard.to_str().unwrap()]));
+        let exposed = s.spawn(|| {
+            screenshot(
+                &dir,
+                "exposed",
+                &["--scene", dim.to_str().unwrap(), "--ev100", "1.7"],
+            )
+        });
+        (strong.join().unwrap(), exposed.join().unwrap())
+    });
+    let mean = strong
+        .pixels()
+        .flat_map(|p| &p.0[..3])
+        .map(|&c| f64::from(c))
+        .sum::<f64>()
+        / (3 * strong.pixels().len()) as f64;
+    // Measured: 61.6 (the dim sun at the default: 13.1).
+    assert!(
+        mean > 40.0,
+        "the courtyard at the default exposure is dark: {mean:.1}"
+    );
+    let differing = strong
+        .pixels()
+        .zip(exposed.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(
+        differing, 0,
+        "{differing} pixels differ from the strong sun's"
+    );
+    let run = Command::new(env!("CARGO_BIN_EXE_quadray-bevy-gi"))
+        .args(["--ev100", "30"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("EV100 30 is outside -10..25"), "{stderr}");
+}

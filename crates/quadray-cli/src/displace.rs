@@ -1,5 +1,6 @@
 //! `quadray displace`, and the displacement parts of `quadray demo` and `quadray bench`.
 
+use crate::provenance::recorded;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -130,7 +131,7 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
         accuracy,
         error_map,
     };
-    let json = serde_json::to_string_pretty(&stats)?;
+    let json = serde_json::to_string_pretty(&recorded(&stats, Some(&gpu)))?;
     match &args.stats {
         Some(path) => {
             std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?

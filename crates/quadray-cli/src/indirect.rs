@@ -1,6 +1,7 @@
 //! `quadray indirect`: one scene, one method, pictures and stats (and the error against the brute
 //! force with `--reference`).
 
+use crate::provenance::recorded;
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::Vec3;
@@ -183,10 +184,11 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
     if let Some(cut) = &outcome.cut_view {
         cut.save_png(&beside(&args.out, "cut"))?;
     }
+    let stats = recorded(&outcome.stats, Some(&gpu));
     if let Some(path) = &args.stats {
-        write_json(path, &outcome.stats)?;
+        write_json(path, &stats)?;
     }
-    println!("{}", serde_json::to_string_pretty(&outcome.stats)?);
+    println!("{}", serde_json::to_string_pretty(&stats)?);
     Ok(())
 }
 

@@ -4,6 +4,7 @@
 mod displace;
 mod indirect;
 mod merge;
+mod provenance;
 mod raytrace;
 mod scene;
 mod smoke;
@@ -17,7 +18,7 @@ use std::path::PathBuf;
 #[derive(Parser)]
 #[command(
     name = "quadray",
-    version,
+    version = provenance::VERSION,
     about = "Reference implementations of three rendering papers"
 )]
 struct Cli {

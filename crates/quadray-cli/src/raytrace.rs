@@ -1,5 +1,6 @@
 //! `quadray raytrace`: the Whitted ray tracer with hybrid shadow testing (quadray-shadows).
 
+use crate::provenance::recorded;
 use crate::tiles::{self, Fingerprint, TileHeader, WorkItems};
 use anyhow::{Context, bail, ensure};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -87,7 +88,7 @@ fn orbit(mut scene: Scene, degrees: f32) -> Scene {
 pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     if args.calibrate {
         let costs = cost::calibrate();
-        let text = serde_json::to_string_pretty(&costs)?;
+        let text = serde_json::to_string_pretty(&recorded(&costs, None))?;
         println!("{text}");
         if let Some(path) = &args.stats {
             quadray_core::write_text(path, &text)?;
@@ -161,7 +162,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
             }
         }
         if let Some(path) = &args.stats {
-            quadray_core::write_json(path, &report)?;
+            quadray_core::write_json(path, &recorded(&report, None))?;
         }
         return Ok(());
     };
@@ -204,7 +205,7 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
     };
     let path = out.join(tiles::tile_file_name(frame, tile));
     tiles::write_exr(&path, &radiance, (width, height), Some(&header))?;
-    quadray_core::write_json(&path.with_extension("json"), &report)?;
+    quadray_core::write_json(&path.with_extension("json"), &recorded(&report, None))?;
     println!("{}", path.display());
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! tried on whatever adapter the suite has (lavapipe) in its quick mode, so that it still runs
 //! the day a GPU comes: the smoke stage's lines, every table row written, the results packed.
 
-use crate::common::scratch;
+use crate::common::{assert_provenance, built_commit, scratch};
 use std::path::Path;
 use std::process::Command;
 
@@ -45,6 +45,14 @@ fn the_gpu_tables_script_writes_every_row_and_packs_them() {
         .find(|p| p.is_dir())
         .expect("bench/<device>/");
     let summary = std::fs::read_to_string(folder.join("summary.md")).unwrap();
+    // the tables say which build and adapter they measured, and so does each stats file
+    let heading = summary.lines().next().unwrap();
+    assert!(
+        heading.ends_with(&format!("(commit {})", built_commit())),
+        "{heading}"
+    );
+    let stats = folder.join("indirect-1080p/quadtree.json");
+    assert_provenance(&crate::common::read_json(&stats), true);
     let rows = |section: &str| {
         let (_, rest) = summary.split_once(section).unwrap();
         rest.split("\n## ")

@@ -3,11 +3,12 @@
 
 use crate::layering::assert_layered;
 
-/// Every module, by layer, bottom first: the work items below the ray tracer's subcommand that
+/// Every module, by layer, bottom first: what a stats file was measured with, which every
+/// subcommand that writes one names; the work items below the ray tracer's subcommand that
 /// writes them and the merge that reads them; each technique's subcommand beside the others;
 /// `main` on top. The spinner main.rs defines names nothing of the crate.
 const LAYERS: &[&[&str]] = &[
-    &["spinner"],
+    &["spinner", "provenance"],
     &["tiles"],
     &["raytrace"],
     &["merge", "displace", "indirect", "scene", "smoke"],

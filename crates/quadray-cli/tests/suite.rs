@@ -13,6 +13,7 @@ mod indirect_cli;
 #[path = "../../quadray-indirect/tests/layering.rs"]
 mod layering;
 mod layers;
+mod provenance;
 mod raytrace_cli;
 mod readme_snippets;
 mod scene_cli;

@@ -3,9 +3,12 @@
 use crate::args::{Args, Technique};
 use crate::displace_view::{DisplaceView, MapChoice};
 use crate::indirect_view::IndirectView;
+use crate::legibility::{Legibility, Scrolling};
 use anyhow::{Context, Result};
+use quadray_core::image_out::Rgba8Image;
 use quadray_displace::Settings;
 use quadray_gpu::Gpu;
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
@@ -56,6 +59,8 @@ struct State {
     status: String,
     /// When egui wants the next frame; `None`: only on input (nothing moves).
     repaint_at: Option<Instant>,
+    /// What of the side panel the last frame let a person read.
+    legibility: Option<Legibility>,
 }
 
 impl State {
@@ -115,6 +120,7 @@ impl State {
             frames_drawn: 0,
             status: String::new(),
             repaint_at: Some(Instant::now()),
+            legibility: None,
         })
     }
 
@@ -148,18 +154,38 @@ impl State {
             ..
         } = self;
         let gpu: &'static Gpu = gpu;
+        let mut panel = None;
         let full = egui_ctx.run_ui(raw, |ui| {
-            egui::Panel::left("controls")
+            let shown = egui::Panel::left("controls")
                 .exact_size(PANEL_WIDTH)
                 .show(ui, |ui| {
-                    save |= side_panel(ui, technique, displace, indirect, status, *frame_ms);
+                    // the widgets the panel's contents make, in the order made
+                    let layer = ui.layer_id();
+                    let made = |ui: &egui::Ui| {
+                        ui.ctx()
+                            .viewport(|v| v.this_pass.widgets.get_layer(layer).count())
+                    };
+                    let first = made(ui);
+                    let (clicked, scrolling) =
+                        side_panel(ui, technique, displace, indirect, status, *frame_ms);
+                    save |= clicked;
+                    let widgets: Vec<egui::WidgetRect> = ui.ctx().viewport(|v| {
+                        let all = v.this_pass.widgets.get_layer(layer);
+                        all.skip(first).copied().collect()
+                    });
+                    (scrolling, widgets)
                 });
+            // the panel as far as the window shows it (its content may run on below)
+            panel = Some((shown.response.rect.intersect(ui.max_rect()), shown.inner));
             egui::CentralPanel::default().show(ui, |ui| {
                 let shown = indirect
                     .as_mut()
                     .filter(|_| *technique == Technique::Indirect);
                 save |= central_view(ui, args, displace, shown, gpu, egui_renderer, dt);
             });
+        });
+        self.legibility = panel.map(|(rect, (scrolling, widgets))| {
+            Legibility::of(rect, Some(&scrolling), &widgets, &full.shapes)
         });
         self.finish(args, full, save, now)
     }
@@ -205,15 +231,28 @@ impl State {
             .and_then(|v| Instant::now().checked_add(v.repaint_delay));
         self.frames_drawn += 1;
         let done = args.frames.is_some_and(|n| self.frames_drawn >= n);
-        if save || done {
+        let saving = save || done;
+        if saving {
+            let shot = &args.screenshot;
             let cmd = match (&self.indirect, self.technique) {
-                (Some(view), Technique::Indirect) => view.screenshot(&args.screenshot)?,
-                _ => self.displace.screenshot(self.gpu, &args.screenshot)?,
+                (Some(view), Technique::Indirect) => view.screenshot(shot)?,
+                _ => self.displace.screenshot(self.gpu, shot)?,
             };
-            self.status = format!("saved {}", args.screenshot.display());
+            if let Some(legibility) = &self.legibility {
+                let path = shot.with_extension("panel.txt");
+                std::fs::write(&path, legibility.report())
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+            self.status = format!("saved {}", shot.display());
             println!("{cmd}");
         }
-        self.paint(full.shapes, full.textures_delta, full.pixels_per_point)?;
+        let window = saving.then(|| args.screenshot.with_extension("window.png"));
+        self.paint(
+            full.shapes,
+            full.textures_delta,
+            full.pixels_per_point,
+            window.as_deref(),
+        )?;
         let work_ms = started.elapsed().as_secs_f32() * 1e3;
         self.frame_ms = if self.frame_ms == 0.0 {
             work_ms
@@ -223,11 +262,13 @@ impl State {
         Ok(done)
     }
 
+    /// Paints egui's frame into the window and, given `capture`, into a PNG there too.
     fn paint(
         &mut self,
         shapes: Vec<egui::epaint::ClippedShape>,
         textures: egui::TexturesDelta,
         ppp: f32,
+        capture: Option<&Path>,
     ) -> Result<()> {
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
@@ -269,11 +310,66 @@ impl State {
         self.gpu
             .queue
             .submit(extra.into_iter().chain([encoder.finish()]));
+        if let Some(path) = capture {
+            self.capture(&jobs, &screen, path)?;
+        }
         self.window.pre_present_notify();
         frame.present();
         for id in &textures.free {
             self.egui_renderer.free_texture(id);
         }
+        Ok(())
+    }
+}
+
+impl State {
+    /// The window as painted, panel and view: egui's frame painted again into a texture of the
+    /// window's size and format, read back and saved to `path`.
+    fn capture(
+        &mut self,
+        jobs: &[egui::ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+        path: &Path,
+    ) -> Result<()> {
+        let (width, height) = (self.config.width, self.config.height);
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let texture = quadray_gpu::texture_2d(
+            &self.gpu.device,
+            "window capture",
+            (width, height),
+            self.config.format,
+            usage,
+        );
+        let view = texture.create_view(&Default::default());
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui capture"),
+                color_attachments: &[quadray_gpu::cleared_attachment(&view, wgpu::Color::BLACK)],
+                ..Default::default()
+            });
+            self.egui_renderer
+                .render(&mut pass.forget_lifetime(), jobs, screen);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let bytes = quadray_gpu::read_texture_rgba8(self.gpu, &texture)?;
+        let bgra = matches!(
+            self.config.format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        );
+        let pixels = bytes
+            .chunks_exact(4)
+            .map(|p| match bgra {
+                true => [p[2], p[1], p[0], 255],
+                false => [p[0], p[1], p[2], 255],
+            })
+            .collect();
+        Rgba8Image {
+            width,
+            height,
+            pixels,
+        }
+        .save_png(path)?;
         Ok(())
     }
 }
@@ -333,8 +429,10 @@ impl ApplicationHandler for App {
     }
 }
 
-/// The side panel: the choice of technique, the shown one's controls, timings and errors, and the
-/// screenshot button; returns whether the button was clicked.
+/// The side panel: the choice of technique, the shown one's timings and errors and the screenshot
+/// button, then its controls, which scroll (the figures first, so that they are in view whatever
+/// the window's height, laid out in the frame they change). Returns whether the button was
+/// clicked and where the scrolling part shows its content.
 fn side_panel(
     ui: &mut egui::Ui,
     technique: &mut Technique,
@@ -342,28 +440,57 @@ fn side_panel(
     indirect: &mut Option<IndirectView>,
     status: &str,
     frame_ms: f32,
-) -> bool {
+) -> (bool, Scrolling) {
     ui.horizontal(|ui| {
         ui.selectable_value(technique, Technique::Displace, "Displacement");
         ui.selectable_value(technique, Technique::Indirect, "Indirect light");
     });
     ui.separator();
-    match indirect
+    let shown = indirect
         .as_mut()
-        .filter(|_| *technique == Technique::Indirect)
-    {
-        Some(view) => indirect_panel(ui, view, frame_ms),
-        None => displace_panel(ui, displace, frame_ms),
+        .filter(|_| *technique == Technique::Indirect);
+    match shown.as_deref() {
+        Some(view) => indirect_figures(ui, view, frame_ms),
+        None => displace_figures(ui, displace, frame_ms),
     }
     let save = ui.button("Save screenshot + command (P)").clicked();
-    ui.label(status);
-    save
+    if !status.is_empty() {
+        ui.label(status);
+    }
+    ui.separator();
+    // a bar in view (egui's floats, unseen until hovered) tells that there is more below
+    ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+    let controls = egui::ScrollArea::vertical()
+        .auto_shrink(false)
+        .scroll_bar_visibility(egui::scroll_area::ScrollBarVisibility::AlwaysVisible)
+        .show(ui, |ui| match shown {
+            Some(view) => {
+                view.controls(ui);
+                ui.small(
+                    "Drag: look. Right drag: aim (or move) the selected light. W/A/S/D, Q/E, \
+                     wheel: move. L: animate the selected light. P: screenshot.",
+                );
+            }
+            None => {
+                displace.controls(ui);
+                ui.small(
+                    "Drag: orbit. Right drag: light. Wheel or Q/E: zoom. W/A/S/D: move. \
+                     L: animate light. P: screenshot.",
+                );
+            }
+        });
+    let scrolling = Scrolling {
+        view: controls.inner_rect,
+        content: egui::Rect::from_min_size(
+            controls.inner_rect.min - controls.state.offset,
+            controls.content_size,
+        ),
+    };
+    (save, scrolling)
 }
 
-/// The indirect view's controls, its passes' GPU times, the cut's summary and any error.
-fn indirect_panel(ui: &mut egui::Ui, view: &mut IndirectView, frame_ms: f32) {
-    view.controls(ui);
-    ui.separator();
+/// The indirect view's passes' GPU times, the cut's summary and any error.
+fn indirect_figures(ui: &mut egui::Ui, view: &IndirectView, frame_ms: f32) {
     if let Some(t) = &view.timing {
         // in the order the frame runs them
         for pass in quadray_indirect::Pass::ALL {
@@ -381,17 +508,10 @@ fn indirect_panel(ui: &mut egui::Ui, view: &mut IndirectView, frame_ms: f32) {
     if let Some(e) = &view.error {
         ui.colored_label(egui::Color32::LIGHT_RED, e);
     }
-    ui.small(
-        "Drag: look. Right drag: aim (or move) the selected light. W/A/S/D, Q/E, wheel: move. \
-         L: animate the selected light. \
-         P: screenshot.",
-    );
 }
 
-/// The displacement view's controls, its GPU time, the cone map's build and any error.
-fn displace_panel(ui: &mut egui::Ui, displace: &mut DisplaceView, frame_ms: f32) {
-    displace.controls(ui);
-    ui.separator();
+/// The displacement view's GPU time, the cone map's build and any error.
+fn displace_figures(ui: &mut egui::Ui, displace: &DisplaceView, frame_ms: f32) {
     ui.label(format!(
         "GPU {}  frame {:.1} ms",
         displace
@@ -405,10 +525,6 @@ fn displace_panel(ui: &mut egui::Ui, displace: &mut DisplaceView, frame_ms: f32)
     if let Some(e) = &displace.error {
         ui.colored_label(egui::Color32::LIGHT_RED, e);
     }
-    ui.small(
-        "Drag: orbit. Right drag: light. Wheel or Q/E: zoom. W/A/S/D: move. L: animate light. \
-         P: screenshot.",
-    );
 }
 
 /// The 3-D view of the shown technique (`indirect` when it is shown) at the panel's size in

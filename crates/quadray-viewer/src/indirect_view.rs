@@ -3,7 +3,7 @@
 //! and are tone-mapped by the same code as `quadray indirect`, so the screenshot's command line
 //! renders the same picture headless. A frame is rendered only when something changed.
 
-use crate::widgets::{absolute, choice_box, limits_slider, shell_word};
+use crate::widgets::{absolute, choice_box, limits_slider, named, named_choice_box, shell_word};
 use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use quadray_core::image_out::Rgba8Image;
@@ -490,16 +490,12 @@ impl IndirectView {
             Settings::SAMPLES,
             "RSM samples",
         ));
-        ui.add_enabled(
-            self.method.subsamples(),
-            limits_slider(
-                &mut s.subsample,
-                Settings::SUBSAMPLE,
-                &format!("sub-sampling ({})", Method::subsampling_names().join(", ")),
-            ),
-        );
+        let subsampling = format!("sub-sampling ({})", Method::subsampling_names().join(", "));
+        named(ui, self.method.subsamples(), &subsampling, |ui| {
+            ui.add(limits_slider(&mut s.subsample, Settings::SUBSAMPLE, ""))
+        });
         let criterion = s.tile_criterion;
-        choice_box(
+        named_choice_box(
             ui,
             "tile criterion (quadtree-tiles)",
             &mut s.tile_criterion,
@@ -512,35 +508,32 @@ impl IndirectView {
         }
         let mut tile_error = s.tile_error_or_default();
         let error = Settings::TILE_ERROR;
-        ui.add(limits_slider(
-            &mut tile_error,
-            error,
-            "tile error (quadtree-tiles)",
-        ));
+        named(ui, true, "tile error (quadtree-tiles)", |ui| {
+            ui.add(limits_slider(&mut tile_error, error, ""))
+        });
         if tile_error != s.tile_error_or_default() {
             s.tile_error = Some(tile_error);
         }
-        ui.add(limits_slider(
-            &mut s.tile_share,
-            Settings::TILE_SHARE,
-            "shared beyond, tile extents (quadtree-tiles, 0: off)",
-        ));
-        ui.add(limits_slider(
-            &mut s.tile_deblock,
-            Settings::TILE_DEBLOCK,
-            "deblocking, pixels each side (quadtree-tiles, 0: off)",
-        ));
+        let share = "shared beyond, tile extents (quadtree-tiles, 0: off)";
+        named(ui, true, share, |ui| {
+            ui.add(limits_slider(&mut s.tile_share, Settings::TILE_SHARE, ""))
+        });
+        let deblock = "deblocking, pixels each side (quadtree-tiles, 0: off)";
+        named(ui, true, deblock, |ui| {
+            ui.add(limits_slider(
+                &mut s.tile_deblock,
+                Settings::TILE_DEBLOCK,
+                "",
+            ))
+        });
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
         ui.checkbox(&mut s.indirect_shadows, "indirect shadows (quadtree)");
-        ui.add_enabled(
-            s.indirect_shadows,
-            limits_slider(
-                &mut s.tile_shadow_angle,
-                Settings::TILE_SHADOW_ANGLE,
-                "shadow rays shared within, box over distance (quadtree-tiles, 0: off)",
-            ),
-        );
+        let shared = "shadow rays shared within, box over distance (quadtree-tiles, 0: off)";
+        named(ui, s.indirect_shadows, shared, |ui| {
+            let angle = Settings::TILE_SHADOW_ANGLE;
+            ui.add(limits_slider(&mut s.tile_shadow_angle, angle, ""))
+        });
         let mut temporal = s.temporal_weight < 1.0;
         ui.checkbox(&mut temporal, "temporal filter (reprojected)");
         s.temporal_weight = if temporal {

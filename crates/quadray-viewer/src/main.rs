@@ -6,6 +6,7 @@ mod app;
 mod args;
 mod displace_view;
 mod indirect_view;
+mod legibility;
 mod widgets;
 
 use anyhow::{Context, Result};

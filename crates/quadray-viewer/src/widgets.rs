@@ -13,13 +13,56 @@ pub fn choice_box<T: Copy + PartialEq>(
     choices: &[T],
     name: impl Fn(T) -> String,
 ) {
-    egui::ComboBox::from_label(label)
-        .selected_text(name(*value))
-        .show_ui(ui, |ui| {
-            for &choice in choices {
-                ui.selectable_value(value, choice, name(choice));
-            }
-        });
+    choices_combo(egui::ComboBox::from_label(label), ui, value, choices, name);
+}
+
+/// [`choice_box`] under its `label` ([`named`]).
+pub fn named_choice_box<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut T,
+    choices: &[T],
+    name: impl Fn(T) -> String,
+) {
+    named(ui, true, label, |ui| {
+        choices_combo(
+            egui::ComboBox::from_id_salt(label),
+            ui,
+            value,
+            choices,
+            name,
+        )
+    });
+}
+
+fn choices_combo<T: Copy + PartialEq>(
+    combo: egui::ComboBox,
+    ui: &mut egui::Ui,
+    value: &mut T,
+    choices: &[T],
+    name: impl Fn(T) -> String,
+) {
+    combo.selected_text(name(*value)).show_ui(ui, |ui| {
+        for &choice in choices {
+            ui.selectable_value(value, choice, name(choice));
+        }
+    });
+}
+
+/// `control` under its `name` on a line of its own, which wraps at the panel's width: for names
+/// too long to stand beside a slider or a combo box, whose own text does not wrap and would be
+/// cut at the panel's edge. Disabled, both are greyed.
+pub fn named<R>(
+    ui: &mut egui::Ui,
+    enabled: bool,
+    name: &str,
+    control: impl FnOnce(&mut egui::Ui) -> R,
+) -> R {
+    ui.add_enabled_ui(enabled, |ui| {
+        ui.label(name);
+        control(ui)
+    })
+    .inner
 }
 
 /// A slider over the part of a setting's `limits` an interactive control spans, logarithmic when

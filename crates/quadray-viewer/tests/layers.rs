@@ -8,7 +8,7 @@ mod layering;
 use layering::assert_layered;
 
 const LAYERS: &[&[&str]] = &[
-    &["widgets"],
+    &["widgets", "legibility"],
     &["displace_view", "indirect_view"],
     &["args"],
     &["app"],

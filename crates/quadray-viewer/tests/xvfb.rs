@@ -1,6 +1,9 @@
 //! The viewer in a real window: under Xvfb with the software Vulkan driver it draws a few frames
 //! with a scripted camera, saves a screenshot and the command line that reproduces it, and that
-//! command, run headless by `quadray`, renders the same picture. The viewer runs under the
+//! command, run headless by `quadray`, renders the same picture. Beside it the viewer saves the
+//! whole window (`.window.png`, for a person to look at) and what of its side panel can be read
+//! (`.panel.txt`, from egui's layout): every control whole within the panel or within its
+//! scrolling part, and the indirect light's pass timings in view. The viewer runs under the
 //! Khronos validation layer: its frames (surface, swapchain, both techniques' passes) print no
 //! message.
 //!
@@ -125,6 +128,44 @@ fn assert_screenshot(shot: &Path, size: (u32, u32)) {
     assert!(contrast(&picture) > 10.0, "{} is blank", shot.display());
 }
 
+/// The side panel at the window's height (`args` leave it at the default, 560): no widget cut at
+/// its sides or below the window outside the scrolling part, and a time (`NAME ... ms`) shown
+/// whole for each name in `timed`. The window's picture has the view beside the panel and is not
+/// blank.
+fn assert_panel_legible(shot: &Path, view: (u32, u32), timed: &[&str]) {
+    let window = rgb(&shot.with_extension("window.png"));
+    assert!(
+        window.width() > view.0 && window.height() >= view.1,
+        "the window is {:?} for a view of {view:?}",
+        window.dimensions()
+    );
+    assert!(contrast(&window) > 10.0, "the window's picture is blank");
+    let panel = shot.with_extension("panel.txt");
+    let report = std::fs::read_to_string(&panel).expect("the panel's report");
+    let unreachable: Vec<&str> = report
+        .lines()
+        .filter(|l| l.starts_with("unreachable "))
+        .collect();
+    assert!(
+        unreachable.is_empty(),
+        "{}: widgets no scrolling brings whole into view (x0 y0 x1 y1):\n{}",
+        panel.display(),
+        unreachable.join("\n")
+    );
+    let shown: Vec<&str> = report
+        .lines()
+        .filter_map(|l| l.strip_prefix("shown "))
+        .collect();
+    for name in timed {
+        let time = |s: &&str| s.starts_with(&format!("{name} ")) && s.ends_with(" ms");
+        assert!(
+            shown.iter().any(time),
+            "{}: no time of {name} shown whole",
+            panel.display()
+        );
+    }
+}
+
 /// The `quadray` program built beside the viewer.
 fn quadray() -> PathBuf {
     let path = Path::new(env!("CARGO_BIN_EXE_quadray-view")).with_file_name("quadray");
@@ -185,6 +226,7 @@ fn screenshot_matches_replay(
     args.extend(["--size", &view_size, "--screenshot", shot.to_str().unwrap()]);
     run_on(&x.display, program, &args, Duration::from_secs(300));
     assert_screenshot(shot, size);
+    assert_panel_legible(shot, size, &[]);
     let command = replay(&shot.with_extension("txt"));
     assert_matches(shot, &shot.with_extension("headless.png"));
     command
@@ -234,6 +276,15 @@ fn viewer_screenshots_match_their_headless_command_lines() {
         &dir.join("indirect.png"),
         (96, 72),
     );
+    // the moved light rebuilt the last frame: the panel shows the time of each of its passes
+    let passes = [
+        quadray_indirect::Pass::Rsm,
+        quadray_indirect::Pass::GBuffer,
+        quadray_indirect::Pass::Indirect,
+        quadray_indirect::Pass::Direct,
+    ];
+    let timed: Vec<&str> = passes.iter().map(|p| p.name()).chain(["GPU"]).collect();
+    assert_panel_legible(&dir.join("indirect.png"), (96, 72), &timed);
     let loaded = quadray_indirect::Scene::load(&scene).unwrap();
     let second = &loaded.lights[1];
     let given = |flag: &str| {

@@ -3,7 +3,8 @@
 //! slowly (a scene's every punctual light gives the bounce: sun, point and spot lights), Bevy's direct light and shadows as they are, and quadray's light quadtree adding the
 //! bounce. G turns the bounce on and off; M cycles the method (per-tile cuts, the quadtree's one cut,
 //! RSM sampling, every VPL); C shows the light quadtree's cut over the RSM in the top-left corner;
-//! Space stops and restarts the light. The window's title says what is shown.
+//! Space stops and restarts the light; `[` and `]` brighten and darken the picture by one EV. The
+//! window's title says what is shown.
 //!
 //! `cargo run --release --bin quadray-bevy-gi` (`--bin`, not `-p`: Cargo then resolves features
 //! as for the whole workspace, and what the test build compiled is reused).
@@ -21,9 +22,11 @@
 //! the light's passes, the gather and the composite; clusters in the cut; VPL evaluations and
 //! texel fetches per shaded pixel): the benchmark of the bounce's cost in a Bevy frame. `--size
 //! WxH` (default 256x256) and `--rsm-size N` (default 128) size the off-screen picture and the
-//! RSM. `--help` lists the flags; an unknown one is refused.
+//! RSM. `--ev100 EV` sets the camera's exposure (Bevy's `Exposure`; default 9.7, Bevy's): about
+//! 15 for a glTF lit by a physical sun, 2 for a 4-lux sun or a dim lamp. `--help` lists the
+//! flags; an unknown one is refused.
 
-use bevy::camera::RenderTarget;
+use bevy::camera::{Exposure, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::gltf::GltfAssetLabel;
 use bevy::image::ImageLoaderSettings;
@@ -52,8 +55,8 @@ const TURN: f32 = 0.25;
 /// The scene's camera (the glTF file's, or the displaced scene's), when it appears.
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
-/// What the first frame shows (`--no-gi`, `--method`, `--cut-view`) and at what size (`--size`,
-/// `--rsm-size`).
+/// What the first frame shows (`--no-gi`, `--method`, `--cut-view`), at what size (`--size`,
+/// `--rsm-size`) and exposure (`--ev100`).
 #[derive(Resource, Clone, Copy)]
 struct Shown {
     gi: bool,
@@ -62,6 +65,7 @@ struct Shown {
     turning: bool,
     size: (u32, u32),
     rsm_size: u32,
+    ev100: f32,
 }
 
 /// The command line (`--help` lists it).
@@ -104,6 +108,13 @@ struct Args {
     /// The RSM's side, a power of two.
     #[arg(long, default_value_t = 128, value_parser = Settings::parse_rsm_size)]
     rsm_size: u32,
+    /// The camera's exposure as an EV100 (Bevy's `Exposure`; `[` and `]` step it): one less is
+    /// twice as bright. About log2 of the light in lux: Bevy's default 9.7 for a room lit by lamps
+    /// of a few thousand lumens or a 1,000-lux sun, 15 for a physical sun of 100,000 lux, 2 for a
+    /// 4-lux sun or a dim lamp. Bevy's ambient light is scaled with it.
+    #[arg(long, default_value_t = Exposure::EV100_BLENDER, value_parser = parse_ev100,
+          allow_hyphen_values = true)]
+    ev100: f32,
     /// The kinds of the scene's lights that give the bounce, comma-separated (the others light
     /// the scene directly only).
     #[arg(long, value_delimiter = ',', default_values = ["directional", "point", "spot"])]
@@ -158,6 +169,7 @@ fn main() {
         turning: args.screenshot.is_none() || timed > 0,
         size: (args.size.width, args.size.height),
         rsm_size: args.rsm_size,
+        ev100: args.ev100,
     };
     let mut app = App::new();
     // the picture 10 frames after Bevy's last pipeline compiled (the scene loads meanwhile);
@@ -176,6 +188,33 @@ fn main() {
         .add_systems(Startup, setup)
         .add_systems(Update, (configure, keys, turn_light, show_title).chain())
         .run();
+}
+
+/// The EV100s `--ev100` takes: from a starlit night to well beyond a sunlit snowfield.
+const EV100_RANGE: std::ops::RangeInclusive<f32> = -10.0..=25.0;
+
+fn parse_ev100(text: &str) -> Result<f32, String> {
+    let ev100: f32 = text.parse().map_err(|e| format!("{e}"))?;
+    if EV100_RANGE.contains(&ev100) {
+        Ok(ev100)
+    } else {
+        Err(format!(
+            "EV100 {text} is outside {}..{}",
+            EV100_RANGE.start(),
+            EV100_RANGE.end()
+        ))
+    }
+}
+
+/// Bevy's ambient light at its default exposure (80 cd/m^2 at EV100 9.7), scaled with the
+/// exposure: the same faint fill on screen at every light level, where Bevy's fixed 80 would
+/// wash out a scene lit by a 4-lux sun and exposed for it.
+fn ambient(ev100: f32) -> AmbientLight {
+    let at_default = AmbientLight::default();
+    AmbientLight {
+        brightness: at_default.brightness * (ev100 - Exposure::EV100_BLENDER).exp2(),
+        ..at_default
+    }
 }
 
 /// Bevy's asset plugin reading the folder of a scene file of the user's, the file's name under
@@ -370,6 +409,8 @@ fn configure(
             projection.clone(),
             Msaa::Off,
             Tonemapping::AcesFitted,
+            Exposure { ev100: shown.ev100 },
+            ambient(shown.ev100),
             IndirectLight {
                 settings: Settings {
                     rsm_size: shown.rsm_size,
@@ -390,7 +431,7 @@ fn configure(
 fn keys(
     keys: Res<ButtonInput<KeyCode>>,
     mut shown: ResMut<Shown>,
-    mut cameras: Query<&mut IndirectLight>,
+    mut cameras: Query<(&mut IndirectLight, &mut Exposure, &mut AmbientLight)>,
 ) {
     if keys.just_pressed(KeyCode::KeyG) {
         shown.gi = !shown.gi;
@@ -408,7 +449,16 @@ fn keys(
     if keys.just_pressed(KeyCode::Space) {
         shown.turning = !shown.turning;
     }
-    for mut gi in &mut cameras {
+    for (key, step) in [(KeyCode::BracketLeft, -1.0), (KeyCode::BracketRight, 1.0)] {
+        if keys.just_pressed(key) {
+            shown.ev100 = (shown.ev100 + step).clamp(*EV100_RANGE.start(), *EV100_RANGE.end());
+        }
+    }
+    for (mut gi, mut exposure, mut ambient_light) in &mut cameras {
+        if exposure.ev100 != shown.ev100 {
+            exposure.ev100 = shown.ev100;
+            *ambient_light = ambient(shown.ev100);
+        }
         if gi.enabled != shown.gi || gi.method != shown.method || gi.cut_view != shown.cut_view {
             gi.enabled = shown.gi;
             gi.method = shown.method;
@@ -431,10 +481,11 @@ fn turn_light(
 
 fn show_title(shown: Res<Shown>, mut windows: Query<&mut Window, With<PrimaryWindow>>) {
     let title = format!(
-        "quadray indirect light: {} ({}) - G: bounce on/off, M: method, C: cut over the RSM, \
-         Space: light {}",
+        "quadray indirect light: {} ({}), EV100 {} - G: bounce on/off, M: method, C: cut over \
+         the RSM, Space: light {}, [ ]: exposure",
         if shown.gi { "on" } else { "off" },
         shown.method.name(),
+        shown.ev100,
         if shown.turning { "turning" } else { "still" },
     );
     set_title(&mut windows, &title);

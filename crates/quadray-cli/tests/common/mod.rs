@@ -25,11 +25,60 @@ pub fn quadray_ok(args: &[&str]) -> String {
     stderr
 }
 
-/// Runs `quadray` with `args` and `--out out --stats stats` and checks that it succeeded: the
-/// call of each command's test that writes everything.
+/// Runs `quadray` with `args` and `--out out --stats stats` and checks that it succeeded and that
+/// the stats say what they measured: the call of each command's test that writes everything.
 pub fn quadray_writes(args: &[&str], out: &Path, stats: &Path) {
-    let (out, stats) = (out.to_str().unwrap(), stats.to_str().unwrap());
-    quadray_ok(&[args, &["--out", out, "--stats", stats]].concat());
+    let (out, stats_path) = (out.to_str().unwrap(), stats.to_str().unwrap());
+    quadray_ok(&[args, &["--out", out, "--stats", stats_path]].concat());
+    assert_provenance(&read_json(stats), args[0] != "raytrace");
+}
+
+/// The commit `quadray --version` names (`quadray 0.1.0 (commit C)`).
+pub fn built_commit() -> String {
+    let version = quadray_ok_stdout(&["--version"]);
+    let (_, commit) = version
+        .trim()
+        .strip_suffix(')')
+        .and_then(|v| v.split_once(" (commit "))
+        .unwrap_or_else(|| panic!("no commit in `quadray --version`: {version}"));
+    commit.to_string()
+}
+
+/// `stats` name the commit `quadray --version` names and, from a command that ran on the GPU
+/// (`on_gpu`), the adapter `quadray adapter` names; the ray tracer's, which run on the CPU, none.
+pub fn assert_provenance(stats: &serde_json::Value, on_gpu: bool) {
+    static ADAPTER: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    let provenance = &stats["provenance"];
+    assert_eq!(provenance["commit"], built_commit().as_str(), "{stats}");
+    let adapter = &provenance["adapter"];
+    if !on_gpu {
+        assert!(adapter.is_null(), "{provenance}");
+        return;
+    }
+    let described = ADAPTER.get_or_init(|| quadray_ok_stdout(&["adapter"]).trim().to_string());
+    for field in ["name", "backend", "driver", "driver_info", "device_type"] {
+        assert!(
+            adapter[field].is_string(),
+            "no adapter {field}: {provenance}"
+        );
+    }
+    let name = adapter["name"].as_str().unwrap();
+    let backend = adapter["backend"].as_str().unwrap();
+    assert!(
+        described.starts_with(&format!("{name} ({backend}, ")),
+        "the stats' adapter {adapter} is not `quadray adapter`'s {described}"
+    );
+}
+
+/// Runs `quadray` with `args`, checks that it succeeded and returns what it printed.
+fn quadray_ok_stdout(args: &[&str]) -> String {
+    let run = quadray(args);
+    assert!(
+        run.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    String::from_utf8_lossy(&run.stdout).into_owned()
 }
 
 /// Runs `quadray` with `args` and checks that it failed with an error that mentions `needle`
