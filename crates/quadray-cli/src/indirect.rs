@@ -230,17 +230,6 @@ pub fn bench_cut_study(size: u32, rsm_size: u32, scenes: &[String], out: &Path) 
     Ok(())
 }
 
-/// The indirect-light pictures of `quadray demo`.
-pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
-    let bar = crate::spinner("indirect light");
-    let files =
-        quadray_bench::indirect::demo::render_demo(gpu, &out.join("indirect"), size, |m| {
-            bar.set_message(format!("indirect light: {m}"))
-        })?;
-    bar.finish_and_clear();
-    Ok(files)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
