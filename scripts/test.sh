@@ -2,8 +2,9 @@
 # The test command (README, CI): the system packages, then formatting, lints with warnings
 # denied, the documentation with warnings denied, and the whole test suite. The lints and the
 # docs use the release profile so they share dependency metadata with the test build. The
-# examples are not built as programs: each test suite compiles its example's source and runs
-# it against the command line (and clippy checks them as targets); the doctests come last.
+# example programs are built by the CLI's example tests (`cargo build --workspace --examples`,
+# the test build's features, so only the examples themselves compile) and run against the command
+# line; the doctests come last.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh

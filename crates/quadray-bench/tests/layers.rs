@@ -1,10 +1,7 @@
 //! The crate's modules in layers with a one-way import order (the check of
-//! `crates/quadray-indirect/tests/layering.rs`). A new file must be given its layer in [`LAYERS`].
+//! `quadray_test_support::layering`). A new file must be given its layer in [`LAYERS`].
 
-#[path = "../../quadray-indirect/tests/layering.rs"]
-mod layering;
-
-use layering::assert_layered;
+use quadray_test_support::layering::assert_layered;
 
 /// Every module, by layer, bottom first: the tables and plots; what each technique's tables
 /// share (the displacement bench's measuring context, the GI's scene runs at equal error and

@@ -6,8 +6,6 @@ mod common;
 mod gi;
 mod gi_displaced;
 mod hits;
-#[path = "../../quadray-indirect/tests/layering.rs"]
-mod layering;
 mod layers;
 mod lifecycle;
 mod pass_cost;

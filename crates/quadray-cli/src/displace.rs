@@ -147,24 +147,12 @@ mod tests {
     use clap::Parser;
     use proptest::prelude::*;
     use quadray_displace::{Layers, Lod, Size};
+    use quadray_test_support::flags::assert_settings_round_trip;
 
     #[derive(Parser)]
     struct Cli {
         #[command(flatten)]
         args: DisplaceArgs,
-    }
-
-    fn parsed(settings: &Settings) -> Settings {
-        let mut argv = vec![
-            "displace".to_string(),
-            "--map=m.png".into(),
-            "--out=o.png".into(),
-        ];
-        argv.extend(settings.to_args());
-        Cli::try_parse_from(&argv)
-            .unwrap_or_else(|e| panic!("{argv:?}: {e}"))
-            .args
-            .settings
     }
 
     /// Valid settings, every field drawn from its declared limits.
@@ -247,13 +235,16 @@ mod tests {
         }
     }
 
-    proptest! {
-        /// The viewer prints `Settings::to_args` beside its screenshots: every valid setting must
-        /// come back through the CLI's flags unchanged.
-        #[test]
-        fn settings_round_trip_through_the_flags(settings in valid_settings()) {
-            prop_assert!(settings.validate().is_ok(), "{settings:?}");
-            prop_assert_eq!(parsed(&settings), settings);
-        }
+    /// The viewer prints `Settings::to_args` beside its screenshots: every valid setting must
+    /// come back through the CLI's flags unchanged.
+    #[test]
+    fn settings_round_trip_through_the_flags() {
+        assert_settings_round_trip(
+            &["displace", "--map=m.png", "--out=o.png"],
+            valid_settings(),
+            Settings::validate,
+            Settings::to_args,
+            |args: DisplaceArgs| args.settings,
+        );
     }
 }

@@ -232,17 +232,6 @@ pub fn bench_cut_study(size: u32, rsm_size: u32, scenes: &[String], out: &Path) 
     Ok(())
 }
 
-/// The indirect-light pictures of `quadray demo`.
-pub fn demo(gpu: &Gpu, out: &Path, size: u32) -> Result<Vec<PathBuf>> {
-    let bar = crate::spinner("indirect light");
-    let files =
-        quadray_bench::indirect::demo::render_demo(gpu, &out.join("indirect"), size, |m| {
-            bar.set_message(format!("indirect light: {m}"))
-        })?;
-    bar.finish_and_clear();
-    Ok(files)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -250,20 +239,12 @@ mod tests {
     use proptest::prelude::*;
     use quadray_core::settings::{Limits, Size};
     use quadray_indirect::{ClusterSettings, TileCriterion, Validity};
+    use quadray_test_support::flags::assert_settings_round_trip;
 
     #[derive(Parser)]
     struct Cli {
         #[command(flatten)]
         args: IndirectArgs,
-    }
-
-    fn parsed(settings: &Settings) -> Settings {
-        let mut argv = vec!["indirect".to_string(), "--out=o.png".into()];
-        argv.extend(settings.to_args());
-        Cli::try_parse_from(&argv)
-            .unwrap_or_else(|e| panic!("{argv:?}: {e}"))
-            .args
-            .settings
     }
 
     /// Valid settings, every field drawn from its declared limits (levels and capacities left to
@@ -416,13 +397,16 @@ mod tests {
         }
     }
 
-    proptest! {
-        /// The viewer prints `Settings::to_args` beside its screenshots: every valid setting must
-        /// come back through the CLI's flags unchanged.
-        #[test]
-        fn settings_round_trip_through_the_flags(settings in valid_settings()) {
-            prop_assert!(settings.validate().is_ok(), "{settings:?}");
-            prop_assert_eq!(parsed(&settings), settings);
-        }
+    /// The viewer prints `Settings::to_args` beside its screenshots: every valid setting must
+    /// come back through the CLI's flags unchanged.
+    #[test]
+    fn settings_round_trip_through_the_flags() {
+        assert_settings_round_trip(
+            &["indirect", "--out=o.png"],
+            valid_settings(),
+            Settings::validate,
+            Settings::to_args,
+            |args: IndirectArgs| args.settings,
+        );
     }
 }

@@ -113,6 +113,34 @@ enum Bench {
     },
 }
 
+/// What a long command is doing: a spinner on a terminal; elsewhere (a log, a pipe) a line a step
+/// on stderr, after the wall and CPU seconds since the command started.
+struct Steps {
+    bar: ProgressBar,
+    start: std::time::Instant,
+    cpu_start: f64,
+}
+
+impl Steps {
+    fn new(what: &str) -> Self {
+        Self {
+            bar: spinner(what),
+            start: std::time::Instant::now(),
+            cpu_start: quadray_shadows::process_cpu_s(),
+        }
+    }
+
+    fn step(&self, message: String) {
+        if self.bar.is_hidden() {
+            let wall = self.start.elapsed().as_secs_f64();
+            let cpu = quadray_shadows::process_cpu_s() - self.cpu_start;
+            eprintln!("{wall:6.1} s {cpu:7.1} CPU s  {message}");
+        } else {
+            self.bar.set_message(message);
+        }
+    }
+}
+
 fn spinner(what: &str) -> ProgressBar {
     let bar = ProgressBar::new_spinner().with_message(what.to_string());
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
@@ -160,21 +188,27 @@ fn main() -> Result<()> {
                 anyhow::bail!("--size {size} is outside 16..4096");
             }
             let gpu = quadray_gpu::Gpu::new()?;
-            let bar = spinner("displacement");
-            let files = quadray_bench::displace::demo::render_demo(
+            let steps = Steps::new("demo");
+            let mut files = quadray_bench::displace::demo::render_demo(
                 &gpu,
                 &out.join("displace"),
                 size,
-                |m| bar.set_message(format!("displacement: {m}")),
+                |m| steps.step(format!("displacement: {m}")),
             )?;
-            bar.finish_and_clear();
-            let files = files.into_iter().chain(indirect::demo(&gpu, &out, size)?);
-            let bar = spinner("ray tracing");
-            let traced = quadray_bench::shadows::render_demo(&out.join("raytrace"), size, |m| {
-                bar.set_message(format!("ray tracing: {m}"))
-            })?;
-            bar.finish_and_clear();
-            for f in files.chain(traced) {
+            files.extend(quadray_bench::indirect::demo::render_demo(
+                &gpu,
+                &out.join("indirect"),
+                size,
+                |m| steps.step(format!("indirect light: {m}")),
+            )?);
+            files.extend(quadray_bench::shadows::render_demo(
+                &out.join("raytrace"),
+                size,
+                |m| steps.step(format!("ray tracing: {m}")),
+            )?);
+            steps.step(format!("{} pictures", files.len()));
+            steps.bar.finish_and_clear();
+            for f in files {
                 println!("{}", f.display());
             }
         }

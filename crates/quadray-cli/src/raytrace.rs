@@ -315,20 +315,12 @@ mod tests {
     use clap::Parser;
     use proptest::prelude::*;
     use quadray_core::settings::{Limits, Size};
+    use quadray_test_support::flags::assert_settings_round_trip;
 
     #[derive(Parser)]
     struct Cli {
         #[command(flatten)]
         args: RaytraceArgs,
-    }
-
-    fn parsed(settings: &Settings) -> Settings {
-        let mut argv = vec!["raytrace".to_string(), "--builtin=stars".into()];
-        argv.extend(settings.to_args());
-        Cli::try_parse_from(&argv)
-            .unwrap_or_else(|e| panic!("{argv:?}: {e}"))
-            .args
-            .settings
     }
 
     /// Valid settings, every field drawn from its declared limits (Embree where this build has
@@ -411,13 +403,16 @@ mod tests {
         assert_eq!(pixel_settings(&hst), hst);
     }
 
-    proptest! {
-        /// The tiles carry `Settings::to_args` as their readable settings: every valid setting
-        /// must come back through the CLI's flags unchanged.
-        #[test]
-        fn settings_round_trip_through_the_flags(settings in valid_settings()) {
-            prop_assert!(settings.validate().is_ok(), "{settings:?}");
-            prop_assert_eq!(parsed(&settings), settings);
-        }
+    /// The tiles carry `Settings::to_args` as their readable settings: every valid setting
+    /// must come back through the CLI's flags unchanged.
+    #[test]
+    fn settings_round_trip_through_the_flags() {
+        assert_settings_round_trip(
+            &["raytrace", "--builtin=stars"],
+            valid_settings(),
+            Settings::validate,
+            Settings::to_args,
+            |args: RaytraceArgs| args.settings,
+        );
     }
 }

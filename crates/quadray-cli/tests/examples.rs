@@ -1,70 +1,95 @@
 //! Each example a user copies draws what the `quadray` binary draws for the same setup: the
-//! example's own code (included from its file) against the command line's picture, run as a
-//! user would run it.
+//! example built and run as a program, as a user runs it, against the picture of the `quadray`
+//! command line its own documentation gives.
 
-#[allow(dead_code)] // the example's `main`
-#[path = "../../quadray-displace/examples/displaced_quad.rs"]
-mod displaced_quad;
-#[allow(dead_code)]
-#[path = "../../quadray-indirect/examples/gi_gbuffer.rs"]
-mod gi_gbuffer;
-#[allow(dead_code)]
-#[path = "../../quadray-shadows/examples/hst_scene.rs"]
-mod hst_scene;
-
-use crate::common::{assets, quadray_ok, scratch};
+use crate::common::{quadray_ok_in, scratch};
 use quadray_core::image_out::Rgba8Image;
-use quadray_indirect::picture::{mean_flip, tone_map};
+use quadray_indirect::picture::mean_flip;
+use quadray_test_support::examples::{example_program, workspace};
 use std::path::Path;
+use std::process::Command;
 
 fn load_png(path: &Path) -> Rgba8Image {
-    let image = image::open(path).unwrap().to_rgba8();
+    let image = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8();
     Rgba8Image::from_bytes(image.width(), image.height(), image.as_raw())
 }
 
-/// `quadray ARGS --out DIR/NAME.png`, read back.
-fn quadray_picture(args: &[&str], dir: &Path, name: &str) -> Rgba8Image {
-    let out = dir.join(format!("{name}.png"));
-    quadray_ok(&[args, &["--out", out.to_str().unwrap()]].concat());
+/// The picture of example `name` (`crates/PACKAGE/examples/NAME.rs`), run as a program that writes
+/// it into `dir`.
+fn example_picture(name: &str, dir: &Path) -> Rgba8Image {
+    let out = dir.join(format!("example-{name}.png"));
+    let run = Command::new(example_program(name))
+        .arg(&out)
+        .output()
+        .unwrap_or_else(|e| panic!("running example {name}: {e}"));
+    let log = String::from_utf8_lossy(&run.stdout) + String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "example {name}: {log}");
     load_png(&out)
 }
 
-/// `displaced_quad` against `quadray displace --method pyramid --view-angle 60 --azimuth 0
-/// --light-azimuth 0 --shadows --size 256x256` on the tile map: mean FLIP at most 0.02 (the
-/// example shades with its own simpler shader: the albedo and the normal computed rather than
-/// sampled from 8-bit and half-float textures; the surface and the shadows are the same), while
-/// the picture without shadows differs by more than twice that.
+/// The `quadray` command line the example's documentation says draws its picture: the words
+/// between "`quadray " and the next backtick in its `//!` comment, the command's name first.
+fn documented_command(package: &str, name: &str) -> Vec<String> {
+    let file = workspace().join(format!("crates/{package}/examples/{name}.rs"));
+    let source = std::fs::read_to_string(&file).unwrap();
+    let doc: Vec<&str> = source
+        .lines()
+        .filter_map(|l| l.strip_prefix("//!"))
+        .map(str::trim)
+        .collect();
+    let doc = doc.join(" ");
+    let start = doc
+        .find("`quadray ")
+        .unwrap_or_else(|| panic!("{}: no `quadray ...` command in its doc", file.display()));
+    let command = &doc[start + "`quadray ".len()..];
+    let end = command.find('`').expect("a closing backtick");
+    command[..end]
+        .split_whitespace()
+        .map(String::from)
+        .collect()
+}
+
+/// `quadray ARGS [--frames 1] --out DIR/NAME.png` run from the workspace root (where the
+/// examples' command lines are written), read back; one timed frame where the command times
+/// frames: the picture is what is compared.
+fn quadray_picture(args: &[String], dir: &Path, name: &str) -> Rgba8Image {
+    let out = dir.join(format!("{name}.png"));
+    let timed = ["displace", "indirect"].contains(&args[0].as_str());
+    let argv: Vec<&str> = args
+        .iter()
+        .map(String::as_str)
+        .chain(
+            if timed {
+                ["--frames", "1"].as_slice()
+            } else {
+                &[]
+            }
+            .iter()
+            .copied(),
+        )
+        .chain(["--out", out.to_str().unwrap()])
+        .collect();
+    quadray_ok_in(&workspace(), &argv);
+    load_png(&out)
+}
+
+/// `displaced_quad` against the `quadray displace` line of its doc on the tile map: mean FLIP at
+/// most 0.02 (the example shades with its own simpler shader: the albedo and the normal computed
+/// rather than sampled from 8-bit and half-float textures; the surface and the shadows are the
+/// same), while the picture without `--shadows` differs by more than twice that.
 #[test]
 fn displaced_quad_draws_what_quadray_displace_draws() {
     const FLIP_TOLERANCE: f32 = 0.02;
-    let gpu = quadray_gpu::Gpu::new().expect("a GPU adapter");
-    let map = displaced_quad::tile_map();
-    let picture = displaced_quad::render(&gpu.device, &gpu.queue, &map);
-    let example = Rgba8Image::from_bytes(picture.width(), picture.height(), picture.as_raw());
     let dir = scratch("displaced-quad");
-    let tiles = assets().join("heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
-    let side = displaced_quad::SIZE.to_string();
-    let size = format!("{side}x{side}");
-    let args = [
-        "displace",
-        "--map",
-        tiles.to_str().unwrap(),
-        "--method",
-        "pyramid",
-        "--view-angle",
-        "60",
-        "--azimuth",
-        "0",
-        "--light-azimuth",
-        "0",
-        "--size",
-        &size,
-        // One timed frame: the picture is what is compared.
-        "--frames",
-        "1",
-    ];
-    let shadowed = quadray_picture(&[&args[..], &["--shadows"]].concat(), &dir, "shadowed");
-    let unshadowed = quadray_picture(&args, &dir, "unshadowed");
+    let example = example_picture("displaced_quad", &dir);
+    let command = documented_command("quadray-displace", "displaced_quad");
+    assert_eq!(command[0], "displace");
+    assert!(command.iter().any(|w| w == "--shadows"), "{command:?}");
+    let shadowed = quadray_picture(&command, &dir, "shadowed");
+    let without: Vec<String> = command.into_iter().filter(|w| w != "--shadows").collect();
+    let unshadowed = quadray_picture(&without, &dir, "unshadowed");
     let flip = mean_flip(&shadowed, &example);
     let without_shadows = mean_flip(&unshadowed, &example);
     println!("example vs quadray displace: FLIP {flip}; without shadows {without_shadows}");
@@ -79,52 +104,18 @@ fn displaced_quad_draws_what_quadray_displace_draws() {
     );
 }
 
-/// `gi_gbuffer` (its own device, G-buffer and shader, quadray's public passes) against `quadray
-/// indirect --scene assets/scenes/example-gi.toml --size 256x256 --rsm-size 128`: the file holds
-/// the example's triangles, and the pictures agree to within FLIP noise (mean below 0.005, 99.9%
-/// of the pixels within 2 levels), while the picture without the bounce differs.
+/// `gi_gbuffer` (its own device, G-buffer and shader, quadray's public passes) against the
+/// `quadray indirect --scene assets/scenes/example-gi.toml ...` line of its doc: the file holds
+/// the example's triangles, so the pictures agree to within FLIP noise (mean below 0.005, 99.9% of
+/// the pixels within 2 levels), while the picture without the bounce differs.
 #[test]
 fn gi_gbuffer_draws_what_quadray_indirect_draws() {
-    let scene_file = assets().join("scenes/example-gi.toml");
-    let file = quadray_indirect::scene::Scene::load(&scene_file).unwrap();
-    let built = gi_gbuffer::scene();
-    assert_eq!(file.triangles.len(), built.triangles.len());
-    for (a, b) in file.triangles.iter().zip(&built.triangles) {
-        for (u, v) in a.iter().zip(b) {
-            let same =
-                |x: [f32; 3], y: [f32; 3]| x.iter().zip(y).all(|(p, q)| (p - q).abs() < 1e-6);
-            assert!(
-                same(u.position, v.position)
-                    && same(u.normal, v.normal)
-                    && same(u.albedo, v.albedo),
-                "the scene file's triangles are not the example's: {a:?} vs {b:?}"
-            );
-        }
-    }
-    let gpu = quadray_gpu::Gpu::new().expect("a GPU adapter");
-    let s = gi_gbuffer::settings();
-    let (w, h) = (s.size.width, s.size.height);
-    let radiance = gi_gbuffer::render(&gpu.device, &gpu.queue).unwrap();
-    let rgb: Vec<[f32; 3]> = radiance.iter().map(|p| [p[0], p[1], p[2]]).collect();
-    let example = tone_map(w, h, &rgb, 1.0);
     let dir = scratch("gi-gbuffer");
-    let size = format!("{w}x{h}");
-    let rsm = s.rsm_size.to_string();
-    let cli = quadray_picture(
-        &[
-            "indirect",
-            "--scene",
-            scene_file.to_str().unwrap(),
-            "--size",
-            &size,
-            "--rsm-size",
-            &rsm,
-            "--frames",
-            "1",
-        ],
-        &dir,
-        "default-method",
-    );
+    let example = example_picture("gi_gbuffer", &dir);
+    let command = documented_command("quadray-indirect", "gi_gbuffer");
+    assert_eq!(command[0], "indirect");
+    let cli = quadray_picture(&command, &dir, "default-method");
+    assert_eq!((cli.width, cli.height), (example.width, example.height));
     let flip = mean_flip(&cli, &example);
     let close = cli
         .pixels
@@ -138,10 +129,10 @@ fn gi_gbuffer_draws_what_quadray_indirect_draws() {
         "mean FLIP {flip} (pictures in {})",
         dir.display()
     );
+    let pixels = example.pixels.len();
     assert!(
-        close as f64 >= 0.999 * f64::from(w * h),
-        "{close} of {} pixels within 2 levels",
-        w * h
+        close as f64 >= 0.999 * pixels as f64,
+        "{close} of {pixels} pixels within 2 levels"
     );
     // The direct light alone, which the command writes beside its picture.
     let direct = load_png(&dir.join("default-method.direct.png"));
@@ -152,31 +143,27 @@ fn gi_gbuffer_draws_what_quadray_indirect_draws() {
     );
 }
 
-/// `hst_scene` against `quadray raytrace --scene assets/scenes/example-hst.toml` with the
-/// example's settings as flags (`--shadows hst --nth 8 --size 320x240 ...`): pixel for pixel, no
-/// tolerance (the same polygons, vertices and materials), and not an empty picture.
+/// `hst_scene` against the `quadray raytrace --scene assets/scenes/example-hst.toml ...` line of
+/// its doc: pixel for pixel, no tolerance (the same polygons, vertices and materials), and not an
+/// empty picture.
 #[test]
 fn hst_scene_draws_what_quadray_raytrace_draws() {
-    let example = hst_scene::render(hst_scene::scene().unwrap()).unwrap();
     let dir = scratch("hst-scene");
-    let scene_file = assets().join("scenes/example-hst.toml");
-    let flags = hst_scene::settings().to_args();
-    let args: Vec<&str> = ["raytrace", "--scene", scene_file.to_str().unwrap()]
-        .into_iter()
-        .chain(flags.iter().map(String::as_str))
-        .collect();
-    let cli = quadray_picture(&args, &dir, "hst");
+    let example = example_picture("hst_scene", &dir);
+    let command = documented_command("quadray-shadows", "hst_scene");
+    assert_eq!(command[0], "raytrace");
+    let cli = quadray_picture(&command, &dir, "hst");
+    assert_eq!(
+        (cli.width, cli.height),
+        (example.width, example.height),
+        "picture sizes"
+    );
     let differing = example
         .pixels
         .iter()
         .zip(&cli.pixels)
         .filter(|(a, b)| a != b)
         .count();
-    assert_eq!(
-        (cli.width, cli.height),
-        (example.width, example.height),
-        "picture sizes"
-    );
     assert_eq!(
         differing, 0,
         "pixels differ between the example and quadray raytrace"

@@ -1,7 +1,7 @@
 //! The command line's modules in layers with a one-way import order (the check of
-//! `crates/quadray-indirect/tests/layering.rs`). A new file must be given its layer in [`LAYERS`].
+//! `quadray_test_support::layering`). A new file must be given its layer in [`LAYERS`].
 
-use crate::layering::assert_layered;
+use quadray_test_support::layering::assert_layered;
 
 /// Every module, by layer, bottom first: what a stats file was measured with, which every
 /// subcommand that writes one names; the work items below the ray tracer's subcommand that

@@ -2,7 +2,7 @@
 //! a doctest in one of the workspace's crates (`cargo test --doc` compiles them all; the lines
 //! that set up what a snippet takes for granted are hidden from the docs with `# `).
 
-use crate::layering::rust_files;
+use quadray_test_support::layering::rust_files;
 use std::path::{Path, PathBuf};
 
 fn workspace() -> PathBuf {

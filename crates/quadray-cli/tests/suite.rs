@@ -10,8 +10,6 @@ mod fuzz_loaders;
 mod gpu_tables;
 mod headless_cli;
 mod indirect_cli;
-#[path = "../../quadray-indirect/tests/layering.rs"]
-mod layering;
 mod layers;
 mod provenance;
 mod raytrace_cli;

@@ -1,7 +1,7 @@
 //! The crate's modules in layers with a one-way import order (the check of
-//! `crates/quadray-indirect/tests/layering.rs`). A new file must be given its layer in [`LAYERS`].
+//! `quadray_test_support::layering`). A new file must be given its layer in [`LAYERS`].
 
-use crate::layering::assert_layered;
+use quadray_test_support::layering::assert_layered;
 
 /// Every module, by layer, bottom first; the crate root re-exports nothing and sits on top. The
 /// items that lib.rs defines itself (the file error, the small parsers) are named at the bottom:

@@ -4,8 +4,6 @@
 
 mod common;
 mod gltf_export;
-#[path = "../../quadray-indirect/tests/layering.rs"]
-mod layering;
 mod layers;
 mod mesh;
 mod scene;

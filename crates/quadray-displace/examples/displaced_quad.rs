@@ -1,8 +1,14 @@
 //! A displaced quad drawn by your own render pass: open a wgpu device, load a height map, build
 //! its [`HeightPyramid`], and trace it per pixel in a small fragment shader that includes
-//! quadray's tracing module. Writes `out/examples/displaced_quad.png`.
+//! quadray's tracing module. Writes `out/examples/displaced_quad.png` under the workspace root, or
+//! the PNG file given as its argument:
 //!
-//! `cargo run --release -p quadray-displace --example displaced_quad`
+//! `cargo run --release -p quadray-displace --example displaced_quad [-- PICTURE.png]`
+//!
+//! From the workspace root, `quadray displace --map
+//! assets/heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png --method pyramid --view-angle
+//! 60 --azimuth 0 --light-azimuth 0 --shadows --size 256x256` draws the same surface and shadows
+//! (its shading samples the albedo and the normal from textures where this one computes them).
 
 use glam::Vec3;
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
@@ -11,10 +17,10 @@ use quadray_displace::{HeightPyramid, PyramidInfo, PyramidKind, TRACE_WGSL};
 use std::path::{Path, PathBuf};
 
 /// Picture side in pixels (a multiple of 64, so rows need no padding when read back).
-pub const SIZE: u32 = 256;
+const SIZE: u32 = 256;
 /// Where the camera and the light are: the wall seen 60 degrees off its normal.
-pub const EYE: Vec3 = Vec3::new(0.0, 0.8, -1.385_640_6);
-pub const LIGHT: Vec3 = Vec3::new(1.6, 1.2, 0.4);
+const EYE: Vec3 = Vec3::new(0.0, 0.8, -1.385_640_6);
+const LIGHT: Vec3 = Vec3::new(1.6, 1.2, 0.4);
 
 // A quad in y = 0 spanning x, z in [-4, 4] with the map repeated 8 x 8 times: tangent +u along
 // +x, +v along +z, normal +y; one repeat is one world unit.
@@ -72,14 +78,14 @@ struct Uniforms {
 }
 
 /// The bundled tile map (16-bit PNG, white = high).
-pub fn tile_map() -> HeightMap {
+fn tile_map() -> HeightMap {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let file = root.join("assets/heightmaps/ambientcg_tiles105/Tiles105_1K_Displacement.png");
     HeightMap::load(&file, Convention::Height, Fit::Exact).expect("the bundled tile map")
 }
 
 /// Draws the displaced quad on `device` and reads the picture back.
-pub fn render(device: &wgpu::Device, queue: &wgpu::Queue, map: &HeightMap) -> image::RgbaImage {
+fn render(device: &wgpu::Device, queue: &wgpu::Queue, map: &HeightMap) -> image::RgbaImage {
     let pyramid = HeightPyramid::build_gpu(device, queue, map, PyramidKind::Point);
     let view = glam::Mat4::look_at_rh(EYE, Vec3::ZERO, Vec3::Y);
     let proj = glam::Mat4::perspective_rh(50f32.to_radians(), 1.0, 0.01, 100.0);
@@ -253,11 +259,15 @@ fn main() {
     let (device, queue) =
         pollster::block_on(adapter.request_device(&Default::default())).expect("a device");
     let picture = render(&device, &queue, &tile_map());
-    let out: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples");
-    std::fs::create_dir_all(&out).expect("create out/examples");
-    let path = std::fs::canonicalize(out)
-        .expect("out/examples")
-        .join("displaced_quad.png");
+    let path = std::env::args_os().nth(1).map_or_else(
+        || {
+            let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples");
+            std::fs::create_dir_all(&out).expect("create out/examples");
+            let out = std::fs::canonicalize(out).expect("out/examples");
+            out.join("displaced_quad.png")
+        },
+        PathBuf::from,
+    );
     picture.save(&path).expect("write the picture");
     println!("{}", path.display());
 }

@@ -5,7 +5,5 @@
 mod common;
 mod gpu_vs_reference;
 mod height_maps;
-#[path = "../../quadray-indirect/tests/layering.rs"]
-mod layering;
 mod layers;
 mod non_finite;

@@ -1,10 +1,7 @@
 //! The crate's modules in layers with a one-way import order (the check of
-//! `crates/quadray-indirect/tests/layering.rs`). A new file must be given its layer in [`LAYERS`].
+//! `quadray_test_support::layering`). A new file must be given its layer in [`LAYERS`].
 
-#[path = "../../quadray-indirect/tests/layering.rs"]
-mod layering;
-
-use layering::assert_layered;
+use quadray_test_support::layering::assert_layered;
 
 /// Every module, by layer, bottom first. The device and its error, which lib.rs defines, come
 /// first: the read-backs and the timer wait through it; the crate root re-exports on top.

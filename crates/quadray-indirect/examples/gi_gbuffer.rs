@@ -2,9 +2,14 @@
 //! wgpu device, builds a Cornell-like box with a block in code, rasterises its own G-buffer with
 //! its own shader, then records quadray's passes into its encoder: the spot's RSM, the light
 //! quadtree and its cut, the gather into its G-buffer, and the radiance into its output texture.
-//! Writes `out/examples/gi_gbuffer.png`.
+//! Writes `out/examples/gi_gbuffer.png` under the workspace root, or the PNG file given as its
+//! argument:
 //!
-//! `cargo run --release -p quadray-indirect --example gi_gbuffer`
+//! `cargo run --release -p quadray-indirect --example gi_gbuffer [-- PICTURE.png]`
+//!
+//! The same box as a scene file is `assets/scenes/example-gi.toml`; from the workspace root,
+//! `quadray indirect --scene assets/scenes/example-gi.toml --size 256x256 --rsm-size 128` draws
+//! the same picture.
 
 use glam::Vec3;
 use quadray_gpu::{nearest_depth, texture_2d};
@@ -76,7 +81,7 @@ fn box_faces(min: Vec3, max: Vec3) -> [[Vec3; 4]; 6] {
 
 /// A unit room open towards +z (red wall left, green right) with a white block, a spot light
 /// under the ceiling and the camera in front.
-pub fn scene() -> Scene {
+fn scene() -> Scene {
     let (white, red, green) = ([0.73; 3], [0.63, 0.065, 0.05], [0.14, 0.45, 0.091]);
     let mut triangles = Vec::new();
     // the room's faces wound inwards; no wall on the camera's side
@@ -123,12 +128,12 @@ pub fn scene() -> Scene {
 }
 
 /// The picture's size and the quadtree's defaults for a 128^2 RSM.
-pub fn settings() -> Settings {
+fn settings() -> Settings {
     Settings::sized(256, 256, 128)
 }
 
 /// Renders the scene (direct + one bounce) and returns linear radiance, rgba per pixel.
-pub fn render(
+fn render(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
 ) -> Result<Vec<[f32; 4]>, Box<dyn std::error::Error>> {
@@ -297,7 +302,7 @@ pub fn render(
 }
 
 /// Linear radiance to 8-bit sRGB with quadray's tone curve (1 - exp(-x)).
-pub fn to_png(width: u32, height: u32, radiance: &[[f32; 4]]) -> image::RgbaImage {
+fn to_png(width: u32, height: u32, radiance: &[[f32; 4]]) -> image::RgbaImage {
     let rgb: Vec<[f32; 3]> = radiance.iter().map(|p| [p[0], p[1], p[2]]).collect();
     let picture = quadray_indirect::picture::tone_map(width, height, &rgb, 1.0);
     image::RgbaImage::from_raw(width, height, picture.pixels.concat()).expect("sized")
@@ -315,8 +320,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }))?;
     let radiance = render(&device, &queue)?;
     let s = settings();
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples/gi_gbuffer.png");
+    let path = std::env::args_os().nth(1).map_or_else(
+        || {
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../out/examples/gi_gbuffer.png")
+        },
+        std::path::PathBuf::from,
+    );
     std::fs::create_dir_all(path.parent().unwrap())?;
     to_png(s.size.width, s.size.height, &radiance).save(&path)?;
     println!("{}", path.display());

@@ -2,7 +2,7 @@
 //! with `crate::` or `super::` (in `use` lines and in code, not in comments) must lead to a module
 //! of its own layer or one below. A new file must be given its layer in [`LAYERS`].
 
-use crate::layering::assert_layered;
+use quadray_test_support::layering::assert_layered;
 
 /// Every module, by layer, bottom first. The feature folders' `mod.rs` (`tiles`, `shadows`, ...)
 /// hold their constants and sit low; the crate root re-exports the layers below it; the test-only

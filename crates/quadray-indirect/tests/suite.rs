@@ -5,7 +5,6 @@
 mod counts;
 mod gltf_export;
 mod gpu;
-mod layering;
 mod layers;
 mod lights;
 mod non_finite;

@@ -1,27 +1,28 @@
 //! A small scene built in code and ray traced with hybrid shadow testing (HST): a floor and a
 //! back wall, two boxes, a triangular prism, a mirror, two point lights. Writes
-//! `out/examples/hst_scene.png` under the workspace root:
+//! `out/examples/hst_scene.png` under the workspace root, or the PNG file given as its argument:
 //!
 //! ```text
-//! cargo run --release -p quadray-shadows --example hst_scene
+//! cargo run --release -p quadray-shadows --example hst_scene [-- PICTURE.png]
 //! ```
 //!
-//! The same scene as a scene file is `assets/scenes/example-hst.toml`; `quadray raytrace --scene
-//! assets/scenes/example-hst.toml --shadows hst --nth 8 --size 320x240` renders the same picture.
+//! The same scene as a scene file is `assets/scenes/example-hst.toml`; from the workspace root,
+//! `quadray raytrace --scene assets/scenes/example-hst.toml --shadows hst --nth 8 --size 320x240`
+//! renders the same picture.
 
 use glam::Vec3;
 use quadray_core::image_out::Rgba8Image;
 use quadray_shadows::{
     BuildError, Camera, Light, Material, Nth, Scene, SchemeChoice, Settings, Size,
 };
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// HST's threshold N_th, fixed so that the picture does not depend on timing (`Nth::Auto`
 /// predicts it from the cost model and pilot renders).
-pub const NTH: f32 = 8.0;
+const NTH: f32 = 8.0;
 
 /// The scene: materials, lights, then the objects.
-pub fn scene() -> Result<Scene, BuildError> {
+fn scene() -> Result<Scene, BuildError> {
     let camera = Camera {
         position: Vec3::new(0.5, 2.2, 5.0),
         target: Vec3::new(0.0, 0.6, 0.0),
@@ -77,7 +78,7 @@ pub fn scene() -> Result<Scene, BuildError> {
 }
 
 /// How it is rendered: HST at [`NTH`], 320 x 240, reflections to depth 5 (the default).
-pub fn settings() -> Settings {
+fn settings() -> Settings {
     Settings {
         scheme: SchemeChoice::Hst,
         nth: Nth::Fixed(NTH),
@@ -87,7 +88,7 @@ pub fn settings() -> Settings {
 }
 
 /// The picture of `scene` rendered with [`settings`].
-pub fn render(scene: Scene) -> Result<Rgba8Image, BuildError> {
+fn render(scene: Scene) -> Result<Rgba8Image, BuildError> {
     let (image, report) = quadray_shadows::run(scene, &settings(), &|| {})?;
     let shares = &report.subschemes;
     println!(
@@ -105,7 +106,10 @@ pub fn render(scene: Scene) -> Result<Rgba8Image, BuildError> {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let image = render(scene()?)?;
-    let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples/hst_scene.png");
+    let out = std::env::args_os().nth(1).map_or_else(
+        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../../out/examples/hst_scene.png"),
+        PathBuf::from,
+    );
     image.save_png(&out)?;
     println!("wrote {}", out.display());
     Ok(())

@@ -352,46 +352,12 @@ pub fn ticks() -> u64 {
     }
 }
 
-/// CPU time of this process, all threads, in seconds.
+/// CPU time of this process, all threads, in seconds (0 where the clock cannot be read).
 pub fn process_cpu_s() -> f64 {
-    cpu_clock_s(CpuClock::Process)
+    cpu_time::ProcessTime::try_now().map_or(0.0, |t| t.as_duration().as_secs_f64())
 }
 
-/// CPU time of the calling thread, in seconds.
+/// CPU time of the calling thread, in seconds (0 where the clock cannot be read).
 pub fn thread_cpu_s() -> f64 {
-    cpu_clock_s(CpuClock::Thread)
-}
-
-enum CpuClock {
-    Process,
-    Thread,
-}
-
-#[cfg(unix)]
-fn cpu_clock_s(which: CpuClock) -> f64 {
-    let id = match which {
-        CpuClock::Process => libc::CLOCK_PROCESS_CPUTIME_ID,
-        CpuClock::Thread => libc::CLOCK_THREAD_CPUTIME_ID,
-    };
-    let mut t = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime only writes the timespec we pass.
-    let ok = unsafe { libc::clock_gettime(id, &mut t) } == 0;
-    if ok {
-        t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
-    } else {
-        0.0
-    }
-}
-
-/// Without CPU clocks, clock time since the first call.
-#[cfg(not(unix))]
-fn cpu_clock_s(_: CpuClock) -> f64 {
-    static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
-    START
-        .get_or_init(std::time::Instant::now)
-        .elapsed()
-        .as_secs_f64()
+    cpu_time::ThreadTime::try_now().map_or(0.0, |t| t.as_duration().as_secs_f64())
 }

@@ -1,11 +1,8 @@
 //! The viewer's modules in layers with a one-way import order (the check of
-//! `crates/quadray-indirect/tests/layering.rs`): the shared controls below the two views, the
+//! `quadray_test_support::layering`): the shared controls below the two views, the
 //! views below the command line, the window above them, `main` on top.
 
-#[path = "../../quadray-indirect/tests/layering.rs"]
-mod layering;
-
-use layering::assert_layered;
+use quadray_test_support::layering::assert_layered;
 
 const LAYERS: &[&[&str]] = &[
     &["widgets", "legibility"],

@@ -26,11 +26,13 @@ pub fn render_demo(
 ) -> Result<Vec<PathBuf>, DisplaceError> {
     let mut written = Vec::new();
     for bundled in &BUNDLED {
-        progress(bundled.name);
+        let name = bundled.name;
+        progress(&format!("{name}: loading"));
         let map = bundled.load()?;
         let color = bundled.load_color()?;
         let mut renderer = Renderer::new(gpu, &map, color.as_ref(), bundled.surface);
         for angle in [35.0, 65.0, 80.0] {
+            progress(&format!("{name}: every method at {angle:.0} degrees"));
             let methods = Method::ALL.map(|m| Settings {
                 view_angle_deg: angle,
                 size: Size::new(size, size),
@@ -55,6 +57,7 @@ pub fn render_demo(
             written.push(path);
         }
         // A curved mesh whose tangents MikkTSpace generated.
+        progress(&format!("{name}: a torus"));
         let mut torus = Renderer::new(gpu, &map, color.as_ref(), SurfaceKind::Torus);
         let mut tiles = Vec::new();
         for (method, truth) in Method::ALL
@@ -80,6 +83,7 @@ pub fn render_demo(
         montage(&tiles, 4).save_png(&path)?;
         written.push(path);
         // Self-shadowing, and the cost of the search per pixel.
+        progress(&format!("{name}: self-shadowing"));
         let s = Settings {
             view_angle_deg: 60.0,
             size: Size::new(size, size),
@@ -112,6 +116,7 @@ pub fn render_demo(
         montage(&tiles, 4).save_png(&path)?;
         written.push(path);
         // Figure 18: the finest level the traversal may reach, coarser and coarser.
+        progress(&format!("{name}: levels of detail"));
         let top = map.levels();
         let lods: Vec<(String, Rgba8Image)> = [
             Lod::Auto,

@@ -5,13 +5,14 @@
 //! indirect shadows beside the ground truth with visibility; the sunlit courtyard and the room lit
 //! by three point lights beside their ground truths; the two visibility scenes held apart from
 //! tuning without indirect shadows, with the depth maps marched and with the occupancy grid,
-//! beside their ground truths.
+//! beside their ground truths. The pictures beside a ground truth with visibility are half the
+//! demo's side, and the point lights' RSMs 16^2 a view: the truths are most of the demo's time.
 
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{flip_against, tone_map};
 use quadray_indirect::reference::{compare, error_map, ground_truth};
-use quadray_indirect::scene::scenes_dir;
+use quadray_indirect::scene::{LightKind, scenes_dir};
 use quadray_indirect::{Frame, IndirectError, Method, Renderer, Scene, Settings};
 use std::path::{Path, PathBuf};
 
@@ -25,6 +26,27 @@ fn settings(gpu: &Gpu, width: u32, height: u32, samples: u32) -> Settings {
         samples,
         ..Settings::sized(width, height, rsm_size)
     }
+}
+
+/// The side of a picture beside a ground truth with visibility: half the demo's (at least 16).
+/// The truth traces a ray for every pixel and VPL that face each other, the most of the demo's
+/// CPU time; a quarter of the pixels is a quarter of it.
+fn truth_side(size: u32) -> u32 {
+    (size / 2).max(16)
+}
+
+/// The RSM side a light view for a ground truth with visibility of `scene`: 32 (1,024 VPLs a
+/// view), 16 where a point light's six views would multiply the truth's rays by six or more.
+fn truth_rsm_size(scene: &Scene) -> u32 {
+    let views: usize = scene
+        .lights
+        .iter()
+        .map(|l| match l.kind {
+            LightKind::Point { .. } => 6,
+            _ => 1,
+        })
+        .sum();
+    if views > 2 { 16 } else { 32 }
 }
 
 fn caption_ms(ms: Option<f64>) -> String {
@@ -195,7 +217,7 @@ const DARK_EXPOSURE: f32 = 4.0 * EXPOSURE;
 /// A visibility scene held apart from tuning (`scenes_dir()/NAME.toml`): the default method's
 /// bounce without indirect shadows, with the depth maps marched alone, with the occupancy grid
 /// (the default), and the bounce from every VPL with exact visibility, each with its FLIP to the
-/// last (a 32^2 RSM keeps the ground truth to seconds).
+/// last (at [`truth_side`] with a [`truth_rsm_size`] RSM, the ground truth takes seconds).
 fn held_apart_picture(
     gpu: &Gpu,
     size: u32,
@@ -203,8 +225,9 @@ fn held_apart_picture(
     path: &Path,
 ) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join(format!("{name}.toml")))?;
-    let (w, h) = (size * 4 / 3, size);
-    let plain = Settings::sized(w, h, 32);
+    let side = truth_side(size);
+    let (w, h) = (side * 4 / 3, side);
+    let plain = Settings::sized(w, h, truth_rsm_size(&scene));
     let mut r = Renderer::new(gpu, &scene, plain.clone())?;
     let without = r.render_frame(Method::DEFAULT)?;
     let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
@@ -233,14 +256,15 @@ fn held_apart_picture(
 
 /// A scene lit by other lights than a spot (`scenes_dir()/NAME.toml`): the direct light, with the
 /// default method's bounce (indirect shadows on), and with the bounce from every VPL with exact
-/// visibility (the ground truth; a 32^2 RSM a light view keeps it to seconds); below, the
+/// visibility (the ground truth, at [`truth_side`] with a [`truth_rsm_size`] RSM); below, the
 /// method's bounce with its FLIP, the true bounce and the error heat map.
 fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join(format!("{name}.toml")))?;
-    let (w, h) = (size * 4 / 3, size);
+    let side = truth_side(size);
+    let (w, h) = (side * 4 / 3, side);
     let settings = Settings {
         indirect_shadows: true,
-        ..Settings::sized(w, h, 32)
+        ..Settings::sized(w, h, truth_rsm_size(&scene))
     };
     let mut r = Renderer::new(gpu, &scene, settings)?;
     let frame = r.render_frame(Method::DEFAULT)?;
@@ -268,13 +292,15 @@ fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathB
 }
 
 /// The leak scene's indirect light without and with indirect shadows, beside one bounce from
-/// every VPL with exact visibility (the ground truth on the CPU; a 32^2 RSM keeps it to seconds):
-/// the one cut marching from every pixel, then the per-tile cuts (estimate, far clusters shared)
-/// marching from the tiles' corners, with the latter's error against the ground truth.
+/// every VPL with exact visibility (the ground truth on the CPU, at [`truth_side`] with a
+/// [`truth_rsm_size`] RSM): the one cut marching from every pixel, then the per-tile cuts
+/// (estimate, far clusters shared) marching from the tiles' corners, with the latter's error
+/// against the ground truth.
 fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join("leak.toml"))?;
+    let size = truth_side(size);
     // the defaults: the per-tile cuts with the estimate and far clusters shared
-    let settings = Settings::sized(size, size, 32);
+    let settings = Settings::sized(size, size, truth_rsm_size(&scene));
     // (a frame first: it renders the RSM and the G-buffer the ground truth reads)
     let mut r = Renderer::new(gpu, &scene, settings.clone())?;
     r.render_frame(Method::Quadtree)?;

@@ -7,19 +7,30 @@ pub fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")
 }
 
-/// Runs `quadray` with `args`, backtraces off so stderr holds just the error.
-fn quadray(args: &[&str]) -> Output {
+/// Runs `quadray` with `args` in the folder `dir`, backtraces off so stderr holds just the error.
+fn quadray_in(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_quadray"))
+        .current_dir(dir)
         .args(args)
         .env("RUST_BACKTRACE", "0")
         .output()
         .expect("run quadray")
 }
 
+fn quadray(args: &[&str]) -> Output {
+    quadray_in(Path::new("."), args)
+}
+
 /// Runs `quadray` with `args`, checks that it succeeded and returns what it wrote to stderr
 /// (warnings).
 pub fn quadray_ok(args: &[&str]) -> String {
-    let run = quadray(args);
+    quadray_ok_in(Path::new("."), args)
+}
+
+/// [`quadray_ok`] run in the folder `dir` (the workspace root, where the documentation writes its
+/// command lines).
+pub fn quadray_ok_in(dir: &Path, args: &[&str]) -> String {
+    let run = quadray_in(dir, args);
     let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
     assert!(run.status.success(), "{args:?}: {stderr}");
     stderr

@@ -1,7 +1,6 @@
 //! The layering check of quadray's crates: every path a source file names with `crate::` or
 //! `super::` (in `use` lines and in code, not in comments) must lead to a module of its own layer
-//! or one below. Each crate's `tests/layers.rs` lists its layers and calls [`upward_imports`];
-//! the other crates include this file by path.
+//! or one below. Each crate's `tests/layers.rs` lists its layers and calls [`assert_layered`].
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -20,7 +19,8 @@ fn module_of(src: &Path, file: &Path) -> String {
     parts.join("::")
 }
 
-pub(crate) fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+/// Every `.rs` file under `dir`, appended to `out`.
+pub fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         if path.is_dir() {
@@ -257,4 +257,63 @@ pub fn upward_imports(src: &Path, layers: &[&[&str]], facades: &[(&str, &str)]) 
 pub fn assert_layered(manifest_dir: &str, layers: &[&[&str]], facades: &[(&str, &str)]) {
     let wrong = upward_imports(&Path::new(manifest_dir).join("src"), layers, facades);
     assert!(wrong.is_empty(), "{wrong:#?}");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A crate `src/` of three modules, each written from `files` (path, text), in a fresh folder.
+    fn source_tree(test: &str, files: &[(&str, &str)]) -> std::path::PathBuf {
+        let src = std::env::temp_dir()
+            .join(format!("quadray-layering-{}-{test}", std::process::id()))
+            .join("src");
+        let _ = std::fs::remove_dir_all(&src);
+        for (path, text) in files {
+            let file = src.join(path);
+            std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+            std::fs::write(file, text).unwrap();
+        }
+        src
+    }
+
+    const LAYERS: &[&[&str]] = &[&["low"], &["high", "high::inner"], &[""]];
+
+    /// An import of a higher layer is found, through a `use` group, `super::` and a facade's
+    /// re-export; imports downward and comments are not.
+    #[test]
+    fn upward_imports_are_named_and_downward_ones_pass() {
+        let src = source_tree(
+            "both",
+            &[
+                (
+                    "lib.rs",
+                    "pub mod high;\npub mod low;\npub use high::Top;\n",
+                ),
+                ("high/mod.rs", "pub mod inner;\nuse crate::low::Base;\n"),
+                (
+                    "high/inner.rs",
+                    "use super::super::low::Base;\n// crate::Top\n",
+                ),
+                (
+                    "low.rs",
+                    "use crate::{high::inner::X, Top};\nfn f() { super::high::g() }\n",
+                ),
+            ],
+        );
+        let wrong = upward_imports(&src, LAYERS, &[("", "lib.rs")]);
+        assert_eq!(wrong.len(), 3, "{wrong:#?}");
+        assert!(wrong.iter().all(|w| w.starts_with("low.rs:")), "{wrong:#?}");
+        assert!(wrong.iter().any(|w| w.ends_with("names Top (layer 1)")));
+    }
+
+    /// A file whose module has no layer is an error of its own.
+    #[test]
+    fn a_module_without_a_layer_is_named() {
+        let src = source_tree("unlisted", &[("lib.rs", ""), ("stray.rs", "")]);
+        assert_eq!(
+            upward_imports(&src, LAYERS, &[]),
+            vec!["stray: not in LAYERS".to_string()]
+        );
+    }
 }
