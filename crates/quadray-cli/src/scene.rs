@@ -20,7 +20,7 @@ enum SceneCommand {
         /// The scene file: TOML, or glTF 2.0 (.gltf, .glb).
         scene: PathBuf,
         /// The glTF file to write (.gltf; its buffer embedded); its folder must exist.
-        #[arg(value_parser = quadray_core::image_out::output_file(&["gltf"]))]
+        #[arg(value_parser = quadray_core::image_out::output_file(&[]))]
         out: PathBuf,
     },
 }

@@ -464,6 +464,12 @@ fn bad_toml_values_are_refused_with_the_reason() {
             "not finite",
         ),
         ("fov_y_deg = 50", "fov_y_deg = 0", "fov_y_deg"),
+        // as far as a mesh's vertices may be, and no further
+        (
+            "eye = [0.3, 1.6, 4.2]",
+            "eye = [1e30, 1.6, 4.2]",
+            "camera: position x = 1e30 is outside the limit |coordinate| <= 1e7",
+        ),
         (
             "intensity = [0.7, 0.7, 0.7]",
             "candela = [1, 1, 1]\nintensity = [1, 1, 1]",
