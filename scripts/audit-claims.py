@@ -10,7 +10,7 @@ table (breakage, where the snippet was, the tests, which failed and the first li
 failure) and writes it to --out.
 
     python3 scripts/audit-claims.py [--list FILE] [--only TEXT]... [--out FILE] [--timeout S]
-                                    [--target-dir DIR]
+                                    [--target-dir DIR] [--no-baseline]
 
 The builds share target/ with the working tree unless --target-dir says otherwise (a copy of it
 lets the tree build meanwhile): the dependencies are reused, the scratch copy's own crates build
@@ -89,7 +89,8 @@ def first_failure(output: str) -> str:
                 if not text.strip() or text.startswith("note:"):
                     break
                 message.append(text.strip())
-            message = " ".join(message)
+            # the scratch folders' names change from run to run
+            message = " ".join(message).replace(tempfile.gettempdir() + "/", "$TMP/")
             return message if len(message) <= 300 else message[:297] + "..."
     return next((l for l in lines if l.startswith("error")), "")
 
@@ -105,6 +106,8 @@ def main() -> int:
                         help="only the breakages whose name holds this text (repeatable)")
     parser.add_argument("--out", help="also write the table here")
     parser.add_argument("--timeout", type=int, default=1800, help="seconds a test run may take")
+    parser.add_argument("--no-baseline", action="store_true",
+                        help="skip the unbroken run of the tests")
     parser.add_argument("--target-dir", default=str(ROOT / "target"),
                         help="cargo's target folder (default the tree's: its dependencies reused)")
     args = parser.parse_args()
@@ -118,7 +121,7 @@ def main() -> int:
         groups = {}
         for b in breakages:
             groups.setdefault((b["package"], b["target"]), []).extend(b["tests"])
-        for (package, target), tests in groups.items():
+        for (package, target), tests in ({} if args.no_baseline else groups).items():
             status, failed, message = run_tests(scratch, package, target, tests, args)
             print(f"unbroken {package} {target}: {status} {failed} {message}", file=sys.stderr)
             if status != "passed":

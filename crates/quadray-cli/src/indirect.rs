@@ -152,10 +152,8 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         ("--light-orbit", args.light_orbit),
         ("--camera-orbit", args.camera_orbit),
     ] {
-        if orbit.is_some() {
-            if args.frames < 2 {
-                anyhow::bail!("{flag} needs --frames 2 or more (a sequence)");
-            }
+        if orbit.is_some() && args.frames < 2 {
+            anyhow::bail!("{flag} needs --frames 2 or more (a sequence)");
         }
     }
     let gpu = Gpu::new()?;

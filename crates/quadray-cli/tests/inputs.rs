@@ -4,7 +4,49 @@
 //! otherwise; a bare mesh file is refused with what to give instead.
 
 use crate::common::{assets, quadray_refuses, scratch};
+use std::io::Read;
 use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Runs `quadray` with `args` and checks that it is refused within seconds (an input let through
+/// would start the work: `--frames 1000000` runs for hours) with `needle` in its error and no
+/// panic; returns the exit code.
+fn refused_before_the_work(args: &[&str], needle: &str) -> Option<i32> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_quadray"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if started.elapsed() > Duration::from_secs(30) {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("{args:?}: still running after 30 s, not refused");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    assert!(!status.success(), "{args:?} succeeded");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: `{needle}` not in {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    status.code()
+}
 
 /// A glTF scene whose one buffer is `uri` (a triangle's 36 bytes), without a camera.
 fn gltf_with_buffer(path: &Path, uri: &str) {
@@ -107,7 +149,7 @@ fn bad_inputs_are_refused_before_any_work() {
     ];
     for (args, needle) in cases {
         // clap's refusal at parse time, or quadray's before the GPU is opened
-        let code = quadray_refuses(&args, &needle);
+        let code = refused_before_the_work(&args, &needle);
         assert!(matches!(code, Some(1 | 2)), "{args:?}: exit code {code:?}");
     }
     assert!(!Path::new(out).exists() && !missing_dir.exists());

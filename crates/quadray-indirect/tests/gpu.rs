@@ -605,7 +605,7 @@ fn renderer_and_gather_refuse_a_device_below_the_settings_by_name() {
         albedo: &albedo,
     };
     let made = small.checked(|| Gather::new(d, &settings, &maps, gbuffer).map(|_| ()));
-    let error = made.unwrap().err().expect("refused").to_string();
+    let error = made.unwrap().expect_err("refused").to_string();
     assert_eq!(error, format!("the device {refusal}"));
 }
 
