@@ -205,3 +205,31 @@ fn the_gi_program_exposes_a_dim_sun_as_bright_as_a_strong_one() {
     assert_eq!(run.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("EV100 30 is outside -10..25"), "{stderr}");
 }
+
+/// The program reads a scene through quadray's loader first, so a glTF whose buffer lies outside
+/// its folder (`..`, an absolute path) is refused by name before Bevy starts, as `quadray` does.
+#[test]
+fn the_gi_program_refuses_a_scene_that_reads_outside_its_folder() {
+    let dir = std::env::temp_dir().join(format!("quadray-bevy-gi-outside-{}", std::process::id()));
+    let folder = dir.join("scene");
+    std::fs::create_dir_all(&folder).unwrap();
+    let outside = dir.join("outside.bin");
+    std::fs::write(&outside, [0u8; 36]).unwrap();
+    for uri in ["../outside.bin", outside.to_str().unwrap()] {
+        let scene = folder.join("room.gltf");
+        let text = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":36,"uri":"{uri}"}}]}}"#
+        );
+        std::fs::write(&scene, text).unwrap();
+        let run = Command::new(env!("CARGO_BIN_EXE_quadray-bevy-gi"))
+            .args(["--scene", scene.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{uri}: {stderr}");
+        assert!(
+            stderr.contains(&format!("room.gltf: refers to `{uri}`, outside the folder")),
+            "{uri}: {stderr}"
+        );
+    }
+}

@@ -4,6 +4,7 @@ use crate::provenance::recorded;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use quadray_core::image_out::output_file;
 use quadray_displace::accuracy::{Accuracy, Cost};
 use quadray_displace::heightmap::{Convention, Fit, HeightMap};
 use quadray_displace::maps::load_color;
@@ -38,11 +39,13 @@ pub struct DisplaceArgs {
     #[arg(long)]
     color: Option<PathBuf>,
     /// Frames to time (median).
-    #[arg(long, default_value_t = 30)]
-    frames: usize,
-    #[arg(long)]
+    #[arg(long, default_value_t = 30, value_parser = Renderer::TIMED_FRAMES.parser())]
+    frames: u32,
+    /// The picture (PNG; the error heat map beside it); its folder must exist.
+    #[arg(long, value_parser = output_file(&["png"]))]
     out: PathBuf,
-    #[arg(long)]
+    /// Statistics JSON.
+    #[arg(long, value_parser = output_file(&[]))]
     stats: Option<PathBuf>,
 }
 
@@ -58,7 +61,7 @@ struct Stats<'a> {
     surface: SurfaceKind,
     adapter: String,
     gpu_time_ms: Option<f64>,
-    frames: usize,
+    frames: u32,
     iteration_cap_hits: usize,
     mean_iterations: f64,
     texel_fetches_per_pixel: f64,
@@ -79,9 +82,6 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
     if let Err(e) = settings.validate() {
         bail!("{e}");
     }
-    if args.frames == 0 || args.frames > 100_000 {
-        bail!("--frames {} is outside 1..100000", args.frames);
-    }
     let fit = if args.resample {
         Fit::Resample
     } else {
@@ -100,7 +100,7 @@ pub fn run(args: DisplaceArgs) -> Result<()> {
     }
     let frame = renderer.render(&gpu, settings)?;
     frame.color.save_png(&args.out)?;
-    let timing = renderer.time(&gpu, settings, args.frames)?;
+    let timing = renderer.time(&gpu, settings, args.frames as usize)?;
     let cost = Cost::of(&frame);
     let truth = settings.method.truth().filter(|_| args.reference);
     let (accuracy, error_map) = if let Some(truth) = truth {

@@ -6,7 +6,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 use glam::Vec3;
 use quadray_bench::indirect::run::{RunOptions, run};
-use quadray_core::image_out::EXPOSURE;
+use quadray_core::image_out::{EXPOSURE, output_file};
+use quadray_core::mesh::parse_point;
 use quadray_core::write_json;
 use quadray_gpu::Gpu;
 use quadray_indirect::scene::Light;
@@ -39,55 +40,63 @@ pub struct IndirectArgs {
     ground_truth: bool,
     /// Frames timed per light mode (median); with --light-orbit or --camera-orbit also the
     /// frames of the sequence.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = RunOptions::FRAMES.parser())]
     frames: u32,
     /// Render a sequence of --frames frames with the lights turning DEG a frame about the
     /// vertical axis (a spot and the sun turn, a point light moves round the scene's middle); adds temporal {cut_changed_fraction, flicker_ratio, ...} to the stats, and
     /// with --temporal-weight below 1 temporal_unfiltered: the same frames without the filter.
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    #[arg(long, value_name = "DEG", value_parser = RunOptions::ORBIT.parser(), allow_hyphen_values = true)]
     light_orbit: Option<f32>,
     /// In that sequence (or alone), the camera moves DEG a frame along an orbit about its
     /// target's vertical axis; adds temporal {disoccluded_fraction, disoccluded_rel_l1}: the
     /// pixels showing what the last frame did not see, and the error there.
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    #[arg(long, value_name = "DEG", value_parser = RunOptions::ORBIT.parser(), allow_hyphen_values = true)]
     camera_orbit: Option<f32>,
     /// Radiance scale before tone mapping (a picture that comes out nearly black or white says
     /// which exposure would show it).
     #[arg(long, default_value_t = 1.0, value_parser = EXPOSURE.parser(), allow_negative_numbers = true)]
     exposure: f32,
-    /// Camera position X,Y,Z instead of the scene file's.
-    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
+    /// Camera position X,Y,Z instead of the scene file's (each within a mesh's coordinate limit,
+    /// 1e7).
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     camera_position: Option<[f32; 3]>,
-    /// Camera target X,Y,Z instead of the scene file's.
-    #[arg(long, value_parser = quadray_core::parse_vec3, allow_hyphen_values = true)]
+    /// Camera target X,Y,Z instead of the scene file's (as the position).
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     camera_target: Option<[f32; 3]>,
     /// A light's position, `[N:]X,Y,Z`, instead of the scene file's (a point or spot light; N
     /// counts the scene's lights from 1, the first by default; once per light).
-    #[arg(long, value_parser = parse_light_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_parser = numbered(parse_point), allow_hyphen_values = true)]
     light_position: Vec<NumberedVec3>,
     /// A light's direction, `[N:]X,Y,Z`, instead of the scene file's (a spot's axis, the sun's
     /// direction; N as for --light-position).
-    #[arg(long, value_parser = parse_light_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_parser = numbered(quadray_core::parse_vec3), allow_hyphen_values = true)]
     light_direction: Vec<NumberedVec3>,
-    #[arg(long)]
+    /// The picture (PNG; its direct and indirect light, and the other pictures asked for,
+    /// beside it); its folder must exist.
+    #[arg(long, value_parser = output_file(&["png"]))]
     out: PathBuf,
-    #[arg(long)]
+    /// Statistics JSON.
+    #[arg(long, value_parser = output_file(&[]))]
     stats: Option<PathBuf>,
 }
 
 /// A light's number (from 1) and a vector.
 type NumberedVec3 = (usize, [f32; 3]);
 
-/// `[N:]X,Y,Z`: a light's number (1 when left out) and a vector.
-fn parse_light_vec3(s: &str) -> Result<NumberedVec3, String> {
-    let (number, v) = match s.split_once(':') {
-        Some((n, v)) => match n.trim().parse::<usize>() {
-            Ok(n) if n >= 1 => (n, v),
-            _ => return Err(format!("`{n}` is not a light's number (1, 2, ...)")),
-        },
-        None => (1, s),
-    };
-    Ok((number, quadray_core::parse_vec3(v)?))
+/// The parser of `[N:]X,Y,Z`: a light's number (1 when left out) and a vector `parse` reads.
+fn numbered(
+    parse: fn(&str) -> Result<[f32; 3], String>,
+) -> impl Fn(&str) -> Result<NumberedVec3, String> + Clone + Send + Sync + 'static {
+    move |s: &str| {
+        let (number, v) = match s.split_once(':') {
+            Some((n, v)) => match n.trim().parse::<usize>() {
+                Ok(n) if n >= 1 => (n, v),
+                _ => return Err(format!("`{n}` is not a light's number (1, 2, ...)")),
+            },
+            None => (1, s),
+        };
+        Ok((number, parse(v)?))
+    }
 }
 
 /// `picture.png` -> `picture.SUFFIX.png`.
@@ -144,13 +153,8 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         ("--light-orbit", args.light_orbit),
         ("--camera-orbit", args.camera_orbit),
     ] {
-        if let Some(degrees) = orbit {
-            if !(degrees.is_finite() && degrees.abs() <= 180.0) {
-                anyhow::bail!("{flag} {degrees} must be a finite angle within [-180, 180]");
-            }
-            if args.frames < 2 {
-                anyhow::bail!("{flag} needs --frames 2 or more (a sequence)");
-            }
+        if orbit.is_some() && args.frames < 2 {
+            anyhow::bail!("{flag} needs --frames 2 or more (a sequence)");
         }
     }
     let gpu = Gpu::new()?;

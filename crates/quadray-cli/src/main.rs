@@ -24,6 +24,11 @@ use std::path::PathBuf;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Read the files a scene or mesh file refers to even where they lie outside its folder
+    /// (`..`, an absolute path, a link that points out); without it they are refused, so that a
+    /// scene from someone else reads only the files that came with it.
+    #[arg(long, global = true)]
+    allow_outside_paths: bool,
 }
 
 #[derive(Subcommand)]
@@ -154,6 +159,7 @@ fn main() -> Result<()> {
         unsafe { quadray_gpu::skip_display_probing() };
     }
     quadray_core::init_logging();
+    quadray_core::mesh::allow_outside_paths(cli.allow_outside_paths);
     match cli.command {
         Command::View { args } => {
             let viewer = std::env::current_exe()?

@@ -95,6 +95,11 @@ pub fn run(args: RaytraceArgs) -> anyhow::Result<()> {
         }
         return Ok(());
     }
+    // a work item's --out is the folder of its tiles; a whole picture's is checked before the work
+    if let (Some(out), None, None) = (&args.out, args.tiles, &args.frames) {
+        quadray_core::image_out::output_file(&["png", "exr"])(&out.to_string_lossy())
+            .map_err(|e| anyhow::anyhow!("--out {}: {e}", out.display()))?;
+    }
     let scene = match (&args.scene, &args.builtin) {
         (Some(path), None) => Scene::load(path)?,
         (None, Some(name)) => Scene::builtin(name).with_context(|| {

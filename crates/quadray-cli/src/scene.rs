@@ -19,7 +19,8 @@ enum SceneCommand {
     Export {
         /// The scene file: TOML, or glTF 2.0 (.gltf, .glb).
         scene: PathBuf,
-        /// The glTF file to write (.gltf; its buffer embedded).
+        /// The glTF file to write (.gltf; its buffer embedded); its folder must exist.
+        #[arg(value_parser = quadray_core::image_out::output_file(&[]))]
         out: PathBuf,
     },
 }

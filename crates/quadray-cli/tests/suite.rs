@@ -10,6 +10,7 @@ mod fuzz_loaders;
 mod gpu_tables;
 mod headless_cli;
 mod indirect_cli;
+mod inputs;
 mod layers;
 mod provenance;
 mod raytrace_cli;

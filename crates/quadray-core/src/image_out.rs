@@ -214,6 +214,35 @@ fn two_digits(x: f32) -> f32 {
     format!("{x:.1e}").parse().unwrap_or(x)
 }
 
+/// The command-line parser of a file a program writes (`--out`, `--stats`), so that a wrong name
+/// fails before any work: its name ends in one of `extensions` (any name where none are given),
+/// which choose the format, and its folder exists (none is made: a mistyped one would scatter
+/// the results).
+pub fn output_file(
+    extensions: &'static [&'static str],
+) -> impl Fn(&str) -> Result<std::path::PathBuf, String> + Clone + Send + Sync + 'static {
+    move |text: &str| {
+        let path = std::path::PathBuf::from(text);
+        let extension = path.extension().and_then(|e| e.to_str());
+        if !extensions.is_empty()
+            && !extension.is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
+        {
+            let names: Vec<String> = extensions.iter().map(|e| format!(".{e}")).collect();
+            return Err(format!(
+                "the format is chosen by the name's ending: one of {}",
+                names.join(", ")
+            ));
+        }
+        match path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            Some(dir) if !dir.is_dir() => Err(format!(
+                "the folder {} does not exist (make it first)",
+                dir.display()
+            )),
+            _ => Ok(path),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,7 +12,8 @@ mod ply;
 use crate::image_out::Rgba8Image;
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use thiserror::Error;
 
 /// The largest |coordinate| a vertex may have, in its file's units, wherever a scene places it.
@@ -25,6 +26,106 @@ use thiserror::Error;
 /// The bound refuses what no f32 pipeline can use; it cannot make a model of mixed scales safe (a
 /// small object beside a vertex near the limit may still vanish).
 pub const MAX_COORDINATE: f32 = 1e7;
+
+/// Set by [`allow_outside_paths`]: files a scene refers to may lie anywhere.
+static OUTSIDE_PATHS_ALLOWED: AtomicBool = AtomicBool::new(false);
+
+/// Lets every later load read the files a scene or mesh file refers to wherever they lie (a
+/// program's `--allow-outside-paths`). By default a glTF file's buffers and images and an OBJ
+/// file's material library and textures must lie in its own folder, and a TOML scene's meshes in
+/// the folder above the scene's (its folder and those beside it, as `assets/scenes` and
+/// `assets/meshes`); a path that leaves it (`..`, an absolute path, a link that points out) is
+/// [`MeshError::Outside`]: a scene from someone else reads only what came with it, as Bevy's
+/// asset server forbids paths outside its folder.
+pub fn allow_outside_paths(allow: bool) {
+    OUTSIDE_PATHS_ALLOWED.store(allow, Ordering::Relaxed);
+}
+
+/// A file a scene refers to, outside the folder it may read ([`allow_outside_paths`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OutsidePath {
+    /// As the scene writes it.
+    pub referenced: PathBuf,
+    pub folder: PathBuf,
+}
+
+impl fmt::Display for OutsidePath {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "`{}`, outside the folder {}: files are read only inside the scene's folder \
+             (--allow-outside-paths reads it)",
+            self.referenced.display(),
+            self.folder.display()
+        )
+    }
+}
+
+/// `referenced` (as a scene writes it) in `dir`, where it is inside `folder` (`dir` or a folder
+/// above it), links followed, or anywhere once [`allow_outside_paths`].
+pub(crate) fn inside_folder(
+    folder: &Path,
+    dir: &Path,
+    referenced: &Path,
+) -> Result<PathBuf, OutsidePath> {
+    let joined = dir.join(referenced);
+    if OUTSIDE_PATHS_ALLOWED.load(Ordering::Relaxed) {
+        return Ok(joined);
+    }
+    let inside = !referenced.has_root()
+        && match (joined.canonicalize(), folder.canonicalize()) {
+            (Ok(real), Ok(folder)) => real.starts_with(folder),
+            // a file that is not there: its written path decides, and the read fails as missing
+            _ => match (std::path::absolute(&joined), std::path::absolute(folder)) {
+                (Ok(path), Ok(folder)) => lexical(&path).starts_with(lexical(&folder)),
+                _ => false,
+            },
+        };
+    if inside {
+        Ok(joined)
+    } else {
+        Err(OutsidePath {
+            referenced: referenced.to_owned(),
+            folder: folder.to_owned(),
+        })
+    }
+}
+
+/// [`inside_folder`] for a mesh file's own references (its folder is `folder`), the error naming
+/// the mesh file.
+fn beside(path: &Path, folder: &Path, referenced: &Path) -> Result<PathBuf, MeshError> {
+    inside_folder(folder, folder, referenced).map_err(|outside| MeshError::Outside {
+        path: path.to_owned(),
+        outside,
+    })
+}
+
+/// `path` with `.` left out and each `..` taking away the name before it.
+fn lexical(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for part in path.components() {
+        match part {
+            Component::CurDir => {}
+            Component::ParentDir
+                if matches!(out.components().next_back(), Some(Component::Normal(_))) =>
+            {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// A point of a scene on a command line (a camera's or a light's position), `X,Y,Z` as
+/// [`crate::parse_vec3`] reads it, every coordinate within [`MAX_COORDINATE`].
+pub fn parse_point(s: &str) -> Result<[f32; 3], String> {
+    let point = crate::parse_vec3(s)?;
+    match FarCoordinate::find([Vec3::from(point)]) {
+        Some((_, far)) => Err(far.to_string()),
+        None => Ok(point),
+    }
+}
 
 /// A vertex coordinate beyond [`MAX_COORDINATE`], or not a number.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -135,6 +236,8 @@ pub enum MeshError {
         path.display()
     )]
     Utf16 { path: PathBuf },
+    #[error("{}: refers to {outside}", path.display())]
+    Outside { path: PathBuf, outside: OutsidePath },
     #[error("{}: invalid {format} file: {reason}", path.display())]
     Parse {
         path: PathBuf,

@@ -379,8 +379,17 @@ impl SceneDescription {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
-        if matches!(extension.as_deref(), Some("gltf" | "glb")) {
-            return read_gltf::load(path, false).map(|(scene, _)| scene);
+        match extension.as_deref() {
+            Some("gltf" | "glb") => return read_gltf::load(path, false).map(|(scene, _)| scene),
+            Some("obj" | "ply") => {
+                return Err(FileError::new(
+                    path,
+                    "a mesh file, not a scene: give a scene that places it with a camera and a \
+                     light (TOML: [camera], [[lights]] and [[objects]] mesh = \"FILE\", see \
+                     docs/scenes.md), or a glTF file with a camera and a light",
+                ));
+            }
+            _ => {}
         }
         let text = std::fs::read_to_string(path).map_err(|e| FileError::new(path, e))?;
         Self::from_toml(&text, path)
@@ -492,12 +501,15 @@ impl Camera {
     /// [`Camera::fov_y_deg`]: a picture needs some, a pinhole cannot reach 180.
     pub const FOV_Y: crate::settings::Limits<f32> = crate::settings::Limits::above(0.0, 179.0);
 
-    /// The one check of a camera, whichever technique renders it: finite, looking somewhere,
-    /// its field of view within [`Camera::FOV_Y`].
+    /// The one check of a camera, whichever technique renders it: finite, within the coordinates
+    /// a mesh may have, looking somewhere, its field of view within [`Camera::FOV_Y`].
     pub fn validate(&self) -> Result<(), String> {
         let c = self;
         if !(c.position.is_finite() && c.target.is_finite() && c.up.is_finite()) {
             return Err("camera: a coordinate is not finite".into());
+        }
+        if let Some((i, far)) = crate::mesh::FarCoordinate::find([c.position, c.target]) {
+            return Err(format!("camera: {} {far}", ["position", "target"][i]));
         }
         if c.position.distance(c.target) < 1e-6 {
             return Err("camera: position and target are the same point".into());

@@ -676,3 +676,67 @@ fn gltf_base_color_texture_is_decoded() {
     assert_eq!((texture.width, texture.height), (be(16), be(20)));
     assert_eq!(texture.pixels.len(), (be(16) * be(20)) as usize);
 }
+
+/// A mesh file reads only files in its own folder: a glTF buffer or an OBJ material library
+/// reached by `..`, an absolute path or a link that points out is refused by name (and not
+/// read); inside, links included, it is read.
+#[test]
+fn files_outside_a_mesh_file_s_folder_are_refused_by_name() {
+    let dir = scratch("outside-paths");
+    let folder = dir.join("scene");
+    std::fs::create_dir_all(&folder).unwrap();
+    let mut buffer = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        buffer.extend(v.to_le_bytes());
+    }
+    write(&dir, "outside.bin", &buffer);
+    write(&folder, "inside.bin", &buffer);
+    let gltf = |uri: &str| {
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "buffers":[{{"byteLength":36,"uri":"{uri}"}}]}}"#
+        )
+    };
+    let outside = dir.join("outside.bin");
+    let _ = std::fs::remove_file(folder.join("out-link.bin"));
+    let _ = std::fs::remove_file(folder.join("in-link.bin"));
+    std::os::unix::fs::symlink(&outside, folder.join("out-link.bin")).unwrap();
+    std::os::unix::fs::symlink("inside.bin", folder.join("in-link.bin")).unwrap();
+    for uri in ["inside.bin", "in-link.bin", "./inside.bin"] {
+        let model = load_model(&write(&folder, "in.gltf", gltf(uri))).unwrap();
+        assert_eq!(model.triangle_count(), 1, "{uri}");
+    }
+    let absolute = outside.to_str().unwrap();
+    for uri in [
+        "../outside.bin",
+        "../../../../../../../../etc/passwd",
+        absolute,
+        "out-link.bin",
+        "sub/../../outside.bin",
+    ] {
+        let path = write(&folder, "out.gltf", gltf(uri));
+        let error = error_message(&path);
+        assert_eq!(
+            error,
+            format!(
+                "{}: refers to `{uri}`, outside the folder {}: files are read only inside the \
+                 scene's folder (--allow-outside-paths reads it)",
+                path.display(),
+                folder.display()
+            )
+        );
+    }
+    // an OBJ's material library outside is left unread, as a missing one is
+    write(&dir, "outside.mtl", "newmtl a\nKd 0.5 0.5 0.5\n");
+    write(&folder, "inside.mtl", "newmtl a\nKd 0.5 0.5 0.5\n");
+    for (library, grey) in [("inside.mtl", 0.5), ("../outside.mtl", 1.0)] {
+        let obj = format!("mtllib {library}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+        let model = load_model(&write(&folder, "lib.obj", obj)).unwrap();
+        let colour = model.materials[model.meshes[0].material].base_color;
+        assert_eq!(colour, Vec3::splat(grey), "{library}");
+    }
+}

@@ -2,7 +2,7 @@
 //! canonical one, the bundled glTF scene, a glTF file without a camera framed, and bad input (malformed glTF, no camera, transforms
 //! that overflow, bad values) refused with the file named, never a panic.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use quadray_core::scene::{Intensity, Light, LightKind, SceneDescription, Shape, Transform};
 use std::path::{Path, PathBuf};
 
@@ -196,8 +196,8 @@ fn the_bundled_gltf_scene_has_the_camera_and_spot_of_cornell_toml() {
 }
 
 /// A glTF file without a camera (the Blender Cornell box) is refused as a scene, and on request
-/// framed: the camera looks at the meshes' middle and sees every corner of their bounds; a file
-/// with a camera keeps its own.
+/// framed: the camera looks at the meshes' middle, sees every corner of their bounds and the
+/// bounds fill at least half of the picture's height; a file with a camera keeps its own.
 #[test]
 fn a_gltf_scene_without_a_camera_is_framed_on_request() {
     let glb = asset("meshes/cornell_box_gltf/cornell-box.glb");
@@ -220,6 +220,18 @@ fn a_gltf_scene_without_a_camera_is_framed_on_request() {
             "corner {corner}: {degrees} deg off the axis"
         );
     }
+    // and fills the picture: the bounds' sphere just fits the field of view, so the bounds span
+    // at least half of the picture's height (measured 64%; a camera twice as far, about 30%)
+    let view_proj = Mat4::perspective_rh(c.fov_y_deg.to_radians(), 1.0, 0.01, 100.0)
+        * Mat4::look_at_rh(c.position, c.target, c.up);
+    let heights = (0..8).map(|i| view_proj.project_point3(Shape::box_corner(lo, hi, i)).y);
+    let (low, high) = heights.fold((f32::MAX, f32::MIN), |(l, h), y| (l.min(y), h.max(y)));
+    let share = 0.5 * (high - low);
+    println!("the bounds span {share} of the picture's height");
+    assert!(
+        (0.5..=1.0).contains(&share),
+        "the bounds span {share} of the picture's height"
+    );
     let bundled = asset("scenes/cornell_spot.gltf");
     let (own, framed) = SceneDescription::load_framing(&bundled).unwrap();
     assert!(!framed);
@@ -452,6 +464,12 @@ fn bad_toml_values_are_refused_with_the_reason() {
             "not finite",
         ),
         ("fov_y_deg = 50", "fov_y_deg = 0", "fov_y_deg"),
+        // as far as a mesh's vertices may be, and no further
+        (
+            "eye = [0.3, 1.6, 4.2]",
+            "eye = [1e30, 1.6, 4.2]",
+            "camera: position x = 1e30 is outside the limit |coordinate| <= 1e7",
+        ),
         (
             "intensity = [0.7, 0.7, 0.7]",
             "candela = [1, 1, 1]\nintensity = [1, 1, 1]",
@@ -529,5 +547,52 @@ fn a_transform_that_carries_a_mesh_beyond_the_coordinate_limit_is_refused() {
                 "is outside the limit |coordinate| <= 1e7, once the object's transform places it"
             ),
         "{e}"
+    );
+}
+
+/// A TOML scene's meshes lie in its folder or beside it (`scenes/` and `meshes/` under one
+/// folder): a mesh path that leaves the folder above (`..` further up, an absolute path) is
+/// refused by name; a bare mesh file is no scene, and the refusal says what to give.
+#[test]
+fn a_toml_scene_reads_meshes_only_beside_it_and_a_mesh_file_is_no_scene() {
+    let dir = scratch("toml-outside").join("project");
+    let (scenes, meshes) = (dir.join("scenes"), dir.join("meshes"));
+    std::fs::create_dir_all(&scenes).unwrap();
+    std::fs::create_dir_all(&meshes).unwrap();
+    let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::fs::write(meshes.join("triangle.obj"), triangle).unwrap();
+    std::fs::write(dir.join("../triangle.obj"), triangle).unwrap();
+    let scene = |mesh: &str| {
+        let path = scenes.join("scene.toml");
+        let text = format!(
+            "[camera]\nposition = [0.5, 0.5, 3.0]\ntarget = [0.5, 0.5, 0.0]\nfov_y_deg = 40.0\n\
+             [[lights]]\nposition = [0.5, 0.5, 2.0]\nintensity = [1.0, 1.0, 1.0]\n\
+             [[objects]]\nmesh = {mesh:?}\n"
+        );
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    SceneDescription::load(&scene("../meshes/triangle.obj")).unwrap();
+    let absolute = meshes.join("triangle.obj");
+    for mesh in ["../../triangle.obj", absolute.to_str().unwrap()] {
+        let error = refused(&scene(mesh));
+        assert!(
+            error.ends_with(&format!(
+                "scene.toml: object 0: mesh `{mesh}`, outside the folder {}: files are read \
+                 only inside the scene's folder (--allow-outside-paths reads it)",
+                scenes.join("..").display()
+            )),
+            "{error}"
+        );
+    }
+    let error = refused(&meshes.join("triangle.obj"));
+    assert!(
+        error.ends_with(
+            "triangle.obj: a mesh file, not a scene: give a scene that places it \
+                         with a camera and a light (TOML: [camera], [[lights]] and [[objects]] \
+                         mesh = \"FILE\", see docs/scenes.md), or a glTF file with a camera and \
+                         a light"
+        ),
+        "{error}"
     );
 }

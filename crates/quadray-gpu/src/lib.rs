@@ -12,7 +12,7 @@ pub mod validation;
 
 pub use readback::{read_buffer, read_texture_f32, read_texture_rgba8};
 pub use target::{cleared_attachment, nearest_depth, texture_2d, texture_2d_with_data};
-pub use timer::{GpuTimer, TimingSummary};
+pub use timer::{GpuTimer, ResolveEncoder, TimingSummary};
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -194,12 +194,19 @@ impl Gpu {
     /// Opens a device on a given adapter, with timestamp queries when the adapter has them and the
     /// adapter's own limits (ray casting wants large textures and several float render targets).
     pub fn from_adapter(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
+        let limits = adapter.limits();
+        Self::with_limits(adapter, limits)
+    }
+
+    /// As [`Gpu::from_adapter`], with the device held to `limits` (at most the adapter's): a
+    /// program that must run where WebGPU's defaults are all there is, checked on a larger GPU.
+    pub fn with_limits(adapter: wgpu::Adapter, limits: wgpu::Limits) -> Result<Self, GpuError> {
         let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE;
         let features = adapter.features() & wanted;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("quadray"),
             required_features: features,
-            required_limits: adapter.limits(),
+            required_limits: limits,
             ..Default::default()
         }))
         .map_err(|e| GpuError::NoDevice {

@@ -3,12 +3,72 @@
 //! medians back. CPU wall time never stands in for GPU time.
 
 use crate::{Gpu, GpuError};
+use std::ops::Range;
 use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 
 pub use quadray_core::stats::Summary as TimingSummary;
 
 /// Bytes between two passes' timestamps in the resolve buffer (`QUERY_RESOLVE_BUFFER_ALIGNMENT`).
 const RESOLVE_STRIDE: u64 = wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT;
+
+/// What [`GpuTimer::resolve`] records into: a command encoder, or a recorder of the queries it
+/// resolves. Resolving a query no pass wrote passes wgpu's validation, yet never finishes on
+/// NVIDIA's driver, so only a recording shows which queries a resolve would wait for.
+pub trait ResolveEncoder {
+    /// [`wgpu::CommandEncoder::resolve_query_set`].
+    fn resolve_query_set(
+        &mut self,
+        query_set: &wgpu::QuerySet,
+        queries: Range<u32>,
+        destination: &wgpu::Buffer,
+        destination_offset: u64,
+    );
+    /// [`wgpu::CommandEncoder::copy_buffer_to_buffer`].
+    fn copy_buffer_to_buffer(
+        &mut self,
+        source: &wgpu::Buffer,
+        source_offset: u64,
+        destination: &wgpu::Buffer,
+        destination_offset: u64,
+        size: u64,
+    );
+}
+
+impl ResolveEncoder for wgpu::CommandEncoder {
+    fn resolve_query_set(
+        &mut self,
+        query_set: &wgpu::QuerySet,
+        queries: Range<u32>,
+        destination: &wgpu::Buffer,
+        destination_offset: u64,
+    ) {
+        wgpu::CommandEncoder::resolve_query_set(
+            self,
+            query_set,
+            queries,
+            destination,
+            destination_offset,
+        );
+    }
+
+    fn copy_buffer_to_buffer(
+        &mut self,
+        source: &wgpu::Buffer,
+        source_offset: u64,
+        destination: &wgpu::Buffer,
+        destination_offset: u64,
+        size: u64,
+    ) {
+        wgpu::CommandEncoder::copy_buffer_to_buffer(
+            self,
+            source,
+            source_offset,
+            destination,
+            destination_offset,
+            size,
+        );
+    }
+}
 
 /// A query set with room for `passes` begin/end pairs, resolved once per frame.
 pub struct GpuTimer {
@@ -142,7 +202,7 @@ impl GpuTimer {
 
     /// Records the resolve of this frame's timestamps, those of the passes given writes since the
     /// last resolve; call after the timed passes, before finish.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+    pub fn resolve(&self, encoder: &mut impl ResolveEncoder) {
         let written = self.written.swap(0, Ordering::Relaxed);
         self.resolved.store(written, Ordering::Relaxed);
         if let (Some(q), Some(resolve), Some(readback)) =

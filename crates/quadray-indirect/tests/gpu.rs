@@ -3,10 +3,11 @@
 //! VPL against the brute force, the per-level passes against the compacted cut, and the error of
 //! the default thresholds.
 
-use quadray_gpu::Gpu;
+use quadray_gpu::{Gpu, texture_2d};
 use quadray_indirect::reference::{self, ImageError, compare};
 use quadray_indirect::{
-    ClusterSettings, CutNode, Method, Renderer, Scene, Settings, Size, TileCriterion, Validity,
+    ClusterSettings, CutNode, FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, Method, Renderer,
+    RsmViews, Scene, Settings, Size, TileCriterion, Validity, ViewMaps,
 };
 
 fn settings(rsm_size: u32) -> Settings {
@@ -556,6 +557,56 @@ fn a_device_below_the_settings_limits_is_refused_by_name() {
         "lavapipe allows max_storage_buffer_binding_size = 134217728, but --size 4096x4096 \
          needs 268435456"
     );
+}
+
+/// A device opened below what the settings need (lavapipe held to 1 MiB a storage binding, as
+/// a small GPU) is refused by [`Renderer::new`] and by [`Gather::new`] on the caller's device
+/// before any pass is made, with quadray's message rather than wgpu's validation error.
+#[test]
+fn renderer_and_gather_refuse_a_device_below_the_settings_by_name() {
+    let adapter = gpu().adapter.clone();
+    let limits = wgpu::Limits {
+        max_storage_buffer_binding_size: 1 << 20,
+        ..adapter.limits()
+    };
+    let small = Gpu::with_limits(adapter, limits).unwrap();
+    // a vec4 of radiance a pixel: 4 MiB at 512x512
+    let settings = Settings::sized(512, 512, 16);
+    let refusal = "allows max_storage_buffer_binding_size = 1048576, but --size 512x512 needs \
+                   4194304";
+    let error = Renderer::new(&small, &Scene::cornell(), settings.clone())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert_eq!(error, format!("{} {refusal}", small.describe()));
+    let d = &small.device;
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING;
+    let texture = |size| texture_2d(d, "input", size, FLOAT_FORMAT, usage);
+    let (gbuffer, rsm) = (
+        [(); 3].map(|_| texture((512, 512))),
+        [(); 3].map(|_| texture((16, 16))),
+    );
+    let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+    let ([position, normal, albedo], [flux, rsm_position, rsm_normal]) =
+        (gbuffer.each_ref().map(view), rsm.each_ref().map(view));
+    let rsm = RsmViews {
+        flux: &flux,
+        position: &rsm_position,
+        normal: &rsm_normal,
+    };
+    let quadtree = LightQuadtree::new(d, &small.queue, 16, settings.cluster, rsm);
+    let maps = [ViewMaps {
+        rsm,
+        quadtree: &quadtree,
+    }];
+    let gbuffer = GBufferViews {
+        position: &position,
+        normal: &normal,
+        albedo: &albedo,
+    };
+    let made = small.checked(|| Gather::new(d, &settings, &maps, gbuffer).map(|_| ()));
+    let error = made.unwrap().expect_err("refused").to_string();
+    assert_eq!(error, format!("the device {refusal}"));
 }
 
 /// Each refusal names the parameter and its range.

@@ -4,6 +4,7 @@
 
 use super::temporal::{self, Temporal};
 use quadray_core::image_out::{ExposureAdvice, Rgba8Image, check_exposure, heat_map};
+use quadray_core::settings::Limits;
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{TONE_MAP_WHITE, flip_against, tone_map};
 use quadray_indirect::reference::{self, ImageError};
@@ -29,6 +30,14 @@ pub struct RunOptions {
     pub camera_orbit: Option<f32>,
     /// Radiance scale before tone mapping.
     pub exposure: f32,
+}
+
+impl RunOptions {
+    /// [`RunOptions::frames`]: a sequence of a few hundred frames is a turn and more; far more
+    /// runs for hours.
+    pub const FRAMES: Limits<u32> = Limits::closed(0, 1000);
+    /// [`RunOptions::light_orbit`] and [`RunOptions::camera_orbit`], degrees a frame.
+    pub const ORBIT: Limits<f32> = Limits::closed(-180.0, 180.0);
 }
 
 #[derive(Clone, Debug, Serialize)]

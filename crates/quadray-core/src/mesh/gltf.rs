@@ -4,7 +4,8 @@
 //! byte ranges and strides (and panics on some bad ones): every range is checked before use.
 
 use super::{
-    Material, MeshBuilder, MeshError, Model, decode_texture, finish_all, read_file, reject_utf16,
+    Material, MeshBuilder, MeshError, Model, beside, decode_texture, finish_all, read_file,
+    reject_utf16,
 };
 use base64::Engine;
 use glam::{Mat4, Vec2, Vec3};
@@ -211,8 +212,9 @@ fn read_uri(path: &Path, dir: &Path, uri: &str) -> Result<Vec<u8>, MeshError> {
     let relative = percent_encoding::percent_decode_str(uri)
         .decode_utf8()
         .map_err(|e| MeshError::parse(path, FORMAT, format!("URI `{uri}`: {e}")))?;
+    let referenced = beside(path, dir, Path::new(&*relative))?;
     // Named in the error as "<gltf file>: cannot read: <referenced file>: <reason>".
-    read_file(&dir.join(&*relative)).map_err(|e| match e {
+    read_file(&referenced).map_err(|e| match e {
         MeshError::Io {
             path: referenced,
             source,

@@ -1,7 +1,8 @@
 //! Wavefront OBJ + MTL through `tobj`.
 
 use super::{
-    Material, MeshBuilder, MeshError, Model, decode_texture, finish_all, read_file, read_text_file,
+    Material, MeshBuilder, MeshError, Model, beside, decode_texture, finish_all, read_file,
+    read_text_file,
 };
 use glam::{Mat4, Vec2, Vec3};
 use std::cell::RefCell;
@@ -18,9 +19,10 @@ pub(super) fn load(path: &Path) -> Result<(Model, usize), MeshError> {
     };
     let mtl_problems = RefCell::new(Vec::new());
     let (objects, materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |mtl_path| {
-        let mtl_path = dir.join(mtl_path);
-        read_mtl(&mtl_path)
-            .and_then(|mtl| {
+        beside(path, dir, mtl_path)
+            .map_err(|e| e.to_string())
+            .and_then(|mtl_path| read_mtl(&mtl_path).map(|mtl| (mtl, mtl_path)))
+            .and_then(|(mtl, mtl_path)| {
                 tobj::load_mtl_buf(&mut mtl.as_bytes())
                     .map_err(|e| format!("{}: {e}", mtl_path.display()))
             })
@@ -40,7 +42,7 @@ pub(super) fn load(path: &Path) -> Result<(Model, usize), MeshError> {
     let mut materials: Vec<Material> = materials
         .unwrap_or_default()
         .iter()
-        .map(|m| convert_material(m, dir))
+        .map(|m| convert_material(m, path, dir))
         .collect();
     // Objects without a (known) material use a default appended after the file's own.
     let default_material = materials.len();
@@ -103,7 +105,7 @@ fn read_mtl(path: &Path) -> Result<String, String> {
     Ok(normalised)
 }
 
-fn convert_material(m: &tobj::Material, dir: &Path) -> Material {
+fn convert_material(m: &tobj::Material, path: &Path, dir: &Path) -> Material {
     let defaults = Material::default();
     let transmission = match (m.dissolve, m.unknown_param.get("Tr")) {
         (Some(d), _) => 1.0 - d,
@@ -114,9 +116,10 @@ fn convert_material(m: &tobj::Material, dir: &Path) -> Material {
         name: m.name.clone(),
         base_color: m.diffuse.map_or(defaults.base_color, Vec3::from),
         base_color_texture: m.diffuse_texture.as_ref().and_then(|file| {
-            let texture_path = dir.join(file);
-            read_file(&texture_path)
-                .and_then(|bytes| decode_texture(&texture_path, &bytes))
+            beside(path, dir, Path::new(file))
+                .and_then(|texture_path| {
+                    read_file(&texture_path).and_then(|bytes| decode_texture(&texture_path, &bytes))
+                })
                 .inspect_err(|e| tracing::warn!("{e}; material `{}` left untextured", m.name))
                 .ok()
         }),

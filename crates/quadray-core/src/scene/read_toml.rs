@@ -5,7 +5,7 @@ use super::{
     Camera, Cone, Intensity, Light, LightKind, Material, Object, SceneDescription, Shape,
     Transform, stem,
 };
-use crate::mesh::{FarCoordinate, load_model};
+use crate::mesh::{FarCoordinate, inside_folder, load_model};
 use glam::Vec3;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -240,7 +240,9 @@ fn object(
     };
     let shape = match (entry.mesh, entry.builtin, entry.cuboid, entry.polygons) {
         (Some(mesh), None, None, None) => {
-            let path = dir.join(mesh);
+            // the scene's folder and those beside it: `scenes/` and `meshes/`
+            let path = inside_folder(&dir.join(".."), dir, &mesh)
+                .map_err(|outside| format!("mesh {outside}"))?;
             let model = load_model(&path).map_err(|e| e.to_string())?;
             model
                 .check_placed(&path, transform.matrix())

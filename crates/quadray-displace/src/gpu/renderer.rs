@@ -16,6 +16,7 @@ use crate::scene::{Plane, SurfaceKind, View, mesh_grid};
 use crate::{DisplaceError, Settings};
 use glam::DVec2;
 use quadray_core::image_out::Rgba8Image;
+use quadray_core::settings::Limits;
 use quadray_core::stats::Summary;
 use quadray_gpu::{Gpu, GpuTimer, read_texture_f32, read_texture_rgba8, texture_2d};
 use wgpu::util::DeviceExt;
@@ -71,6 +72,9 @@ pub struct Renderer {
 }
 
 impl Renderer {
+    /// [`Renderer::time`]'s frames: a median needs one, ten thousand take minutes at 1080p on
+    /// a software rasterizer.
+    pub const TIMED_FRAMES: Limits<u32> = Limits::closed(1, 10_000);
     /// `color`: the albedo texture; `None` tints by depth.
     pub fn new(
         gpu: &Gpu,
