@@ -4,6 +4,7 @@
 //! allow-list does not cover, naming its VUID, and fails if the layer did not run at all.
 
 use quadray_gpu::validation::run_under_layer;
+use quadray_test_support::examples::example_program;
 use std::process::{Command, Output};
 
 /// Runs `command` under the layer; panics with the layer's messages or the failure.
@@ -38,21 +39,18 @@ fn every_pass_of_quadray_smoke_passes_the_layer() {
     }
 }
 
-/// Both examples a user copies (their own wgpu code and quadray's passes on their device);
-/// `quadray indirect`'s sequence with the light and the
+/// Both examples a user copies that use the GPU (their own wgpu code and quadray's passes on
+/// their device), each run as its program; `quadray indirect`'s sequence with the light and the
 /// camera moving, filtered and not (its defaults: timed frames, the reference, the cut).
 #[test]
 fn the_examples_and_quadray_indirect_pass_the_layer() {
-    assert_clean(
-        Command::new(std::env::current_exe().unwrap()).args([
-            "--exact",
-            "examples::displaced_quad_draws_what_quadray_displace_draws",
-            "examples::gi_gbuffer_draws_what_quadray_indirect_draws",
-            "--test-threads",
-            "1",
-        ]),
-        "the examples' tests",
-    );
+    let dir = crate::common::scratch("validation-examples");
+    for example in ["displaced_quad", "gi_gbuffer"] {
+        assert_clean(
+            Command::new(example_program(example)).arg(dir.join(format!("{example}.png"))),
+            &format!("example {example}"),
+        );
+    }
     let picture = crate::common::scratch("validation-indirect").join("indirect.png");
     assert_clean(
         Command::new(env!("CARGO_BIN_EXE_quadray"))
