@@ -77,7 +77,11 @@ pub fn child_log(tests: &[&str]) -> String {
         .unwrap();
     let log = String::from_utf8_lossy(&output.stdout).into_owned()
         + &String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{log}");
+    assert!(
+        output.status.success(),
+        "the child {}: {log}",
+        output.status
+    );
     log
 }
 
