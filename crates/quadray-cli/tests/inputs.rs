@@ -50,15 +50,7 @@ fn refused_before_the_work(args: &[&str], needle: &str) -> Option<i32> {
 
 /// A glTF scene whose one buffer is `uri` (a triangle's 36 bytes), without a camera.
 fn gltf_with_buffer(path: &Path, uri: &str) {
-    let text = format!(
-        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
-        "nodes":[{{"mesh":0}}],
-        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
-        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}}],
-        "bufferViews":[{{"buffer":0,"byteLength":36}}],
-        "buffers":[{{"byteLength":36,"uri":"{uri}"}}]}}"#
-    );
-    std::fs::write(path, text).unwrap();
+    std::fs::write(path, quadray_test_support::gltf::triangle_with_buffer(uri)).unwrap();
 }
 
 #[test]

@@ -691,16 +691,7 @@ fn files_outside_a_mesh_file_s_folder_are_refused_by_name() {
     }
     write(&dir, "outside.bin", &buffer);
     write(&folder, "inside.bin", &buffer);
-    let gltf = |uri: &str| {
-        format!(
-            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
-            "nodes":[{{"mesh":0}}],
-            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
-            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}}],
-            "bufferViews":[{{"buffer":0,"byteLength":36}}],
-            "buffers":[{{"byteLength":36,"uri":"{uri}"}}]}}"#
-        )
-    };
+    let gltf = quadray_test_support::gltf::triangle_with_buffer;
     let outside = dir.join("outside.bin");
     let _ = std::fs::remove_file(folder.join("out-link.bin"));
     let _ = std::fs::remove_file(folder.join("in-link.bin"));
