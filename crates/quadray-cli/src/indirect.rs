@@ -140,14 +140,18 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
         .validate()
         .map_err(|e| anyhow::anyhow!("camera or light options: {e}"))?;
     // a flag that would change nothing is a mistake to report, not to ignore
-    if args.settings.subsample > 1 && !args.method.subsamples() {
-        anyhow::bail!(
-            "--subsample {} applies to --method {} (the methods that gather at low resolution), \
-             not {}",
-            args.settings.subsample,
-            Method::subsampling_names().join(" and "),
-            args.method
-        );
+    for (flag, value) in [
+        ("--subsample", args.settings.subsample),
+        ("--interleave", args.settings.interleave),
+    ] {
+        if value > 1 && !args.method.subsamples() {
+            anyhow::bail!(
+                "{flag} {value} applies to --method {} (the methods that gather at low \
+                 resolution or interleaved), not {}",
+                Method::subsampling_names().join(" and "),
+                args.method
+            );
+        }
     }
     for (flag, orbit) in [
         ("--light-orbit", args.light_orbit),
@@ -273,6 +277,7 @@ mod tests {
                 u(Settings::SAMPLES),
                 f(Settings::RSM_RADIUS, 0.0, 1.0),
                 u(Settings::SUBSAMPLE),
+                u(Settings::INTERLEAVE),
                 any::<bool>(),
                 u(Settings::SHADOW_STEPS),
                 f(Settings::SHADOW_THICKNESS, 0.0, 1.0),
@@ -292,7 +297,16 @@ mod tests {
             .prop_map(
                 |(
                     ((w, h), rsm_log, start, limit, depth, normal, validity, flux_weighted),
-                    (samples, rsm_radius, subsample, shadows, steps, thickness, temporal),
+                    (
+                        samples,
+                        rsm_radius,
+                        subsample,
+                        interleave,
+                        shadows,
+                        steps,
+                        thickness,
+                        temporal,
+                    ),
                     (
                         tile_error,
                         tile_criterion,
@@ -327,6 +341,8 @@ mod tests {
                         samples,
                         rsm_radius,
                         subsample,
+                        // (the two exclude each other)
+                        interleave: if subsample > 1 { 1 } else { interleave },
                         indirect_shadows: shadows,
                         shadow_steps: steps,
                         shadow_thickness: thickness,
@@ -373,6 +389,7 @@ mod tests {
             ),
             ("--samples", "0", Settings::SAMPLES.to_string()),
             ("--subsample", "65", Settings::SUBSAMPLE.to_string()),
+            ("--interleave", "9", Settings::INTERLEAVE.to_string()),
             ("--shadow-steps", "0", Settings::SHADOW_STEPS.to_string()),
             ("--shadow-grid", "513", Settings::SHADOW_GRID.to_string()),
             (

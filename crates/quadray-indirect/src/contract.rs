@@ -74,7 +74,8 @@ pub(crate) fn prelude() -> String {
          const OCCUPANCY_SUBCELLS: u32 = {SUBCELLS}u;\n\
          const DEBLOCK_LIMIT: f32 = {DEBLOCK_LIMIT:?};\n\
          const DEBLOCK_PLANE: f32 = {DEBLOCK_PLANE:?};\n\
-         const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};\n",
+         const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};\n\
+         const MAX_INTERLEAVE: u32 = {}u;\n",
         std::f32::consts::PI,
         OutputTerm::Indirect as u32,
         OutputTerm::Direct as u32,
@@ -83,6 +84,7 @@ pub(crate) fn prelude() -> String {
         BRICK.x,
         BRICK.y,
         BRICK.z,
+        crate::Settings::INTERLEAVE.max,
     ) + &shared_structs()
         .into_iter()
         .map(|s| s.wgsl)

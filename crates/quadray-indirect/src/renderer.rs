@@ -367,7 +367,7 @@ impl<'g> Renderer<'g> {
             }
         }
         passes.extend([Pass::GBuffer, Pass::Indirect, Pass::Direct]);
-        if method.subsamples() && self.settings().subsample > 1 {
+        if self.settings().reconstructs(method) {
             passes.push(Pass::Upsample);
         }
         passes

@@ -224,6 +224,16 @@ pub struct Settings {
         value_parser = Settings::SUBSAMPLE.parser(),
     ))]
     pub subsample: u32,
+    /// Interleaved sampling at full resolution (quadtree, rsm: the methods that
+    /// [`crate::Method::subsamples`]): each pixel of an NxN block sums every N^2-th cluster or
+    /// sample from its own offset, and a geometry-aware NxN filter rejoins the parts; a pixel
+    /// with too few neighbours on its surface sums them all (1: off). Not with `subsample`.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.interleave,
+        value_parser = Settings::INTERLEAVE.parser(),
+    ))]
+    pub interleave: u32,
     /// Indirect shadows (quadtree methods): test each receiver's view of each cluster, walking
     /// the scene's occupancy grid (--shadow-grid), or marching points against the camera's and
     /// the light's depth (off in the paper). The per-tile cuts test from each tile's four
@@ -355,6 +365,7 @@ impl Settings {
         samples: 256,
         rsm_radius: 1.0,
         subsample: 1,
+        interleave: 1,
         indirect_shadows: false,
         shadow_steps: 8,
         shadow_thickness: 0.03,
@@ -382,6 +393,10 @@ impl Settings {
     pub const RSM_RADIUS: Limits<f32> = Limits::above(0.0, 1.0);
     /// [`Settings::subsample`].
     pub const SUBSAMPLE: Limits<u32> = Limits::closed(1, 64).interactive(1, 8);
+    /// [`Settings::interleave`]: at 4 a pixel sums 1/16 of the cut; the filter that rejoins the
+    /// parts holds its workgroup's pixels and 2 (N - 1) more across and down in workgroup
+    /// memory (9.4 KB at 4).
+    pub const INTERLEAVE: Limits<u32> = Limits::closed(1, 4);
     /// [`Settings::shadow_steps`].
     pub const SHADOW_STEPS: Limits<u32> = Limits::closed(1, 64);
     /// [`Settings::shadow_thickness`].
@@ -477,6 +492,12 @@ impl Settings {
         1 << capacity.ilog2()
     }
 
+    /// Whether `method` gathers into the low-resolution samples and reconstructs the picture from
+    /// them (sub-sampled or interleaved).
+    pub fn reconstructs(&self, method: crate::Method) -> bool {
+        method.subsamples() && (self.subsample > 1 || self.interleave > 1)
+    }
+
     /// The low-resolution samples across and down the picture (one per `subsample`^2 pixels).
     pub(crate) fn low_size(&self) -> (u32, u32) {
         (
@@ -537,6 +558,14 @@ impl Settings {
         Self::SAMPLES.check("samples", s.samples)?;
         Self::RSM_RADIUS.check("RSM radius", s.rsm_radius)?;
         Self::SUBSAMPLE.check("subsample", s.subsample)?;
+        Self::INTERLEAVE.check("interleave", s.interleave)?;
+        if s.interleave > 1 && s.subsample > 1 {
+            return Err(format!(
+                "interleave {} and subsample {} cannot both be above 1: interleaved sampling \
+                 rejoins full-resolution pixels",
+                s.interleave, s.subsample
+            ));
+        }
         Self::SHADOW_STEPS.check("shadow steps", s.shadow_steps)?;
         Self::SHADOW_THICKNESS.check("shadow thickness", s.shadow_thickness)?;
         Self::SHADOW_GRID.check("shadow grid", s.shadow_grid)?;
@@ -592,6 +621,8 @@ shader_struct! {
         sample_count: u32 = s.samples,
         /// Sub-sampled indirect: one sample per `subsample` x `subsample` pixels.
         subsample: u32 = s.subsample,
+        /// Interleaved sampling: a pixel sums one of `interleave`^2 parts (1: all).
+        interleave: u32 = s.interleave,
         low_width: u32 = s.low_size().0,
         low_height: u32 = s.low_size().1,
         /// Geometry agreement for upsampling, corner sharing and deblocking: normals' dot.
@@ -653,6 +684,7 @@ mod tests {
             samples: 100,
             rsm_radius: 0.3,
             subsample: 2,
+            interleave: 4,
             indirect_shadows: true,
             shadow_steps: 5,
             shadow_thickness: 0.1,
@@ -666,7 +698,19 @@ mod tests {
             tile_shadow_angle: 0.5,
             tile_deblock: 1,
         };
-        assert!(every.validate().is_ok());
+        // (interleave and subsample exclude each other: each is checked alone)
+        for valid in [
+            Settings {
+                interleave: 1,
+                ..every.clone()
+            },
+            Settings {
+                subsample: 1,
+                ..every.clone()
+            },
+        ] {
+            assert!(valid.validate().is_ok(), "{valid:?}");
+        }
         assert_flags_round_trip(
             every,
             [Settings::DEFAULT, Settings::DEFAULT.resolved()],

@@ -58,7 +58,8 @@ pub const BOUND: &str = include_str!("light/bound.wgsl");
 /// `fn tile_sample(q: u32) -> u32` (quadrant `q`'s sample pixel, `TILE_PIXELS` where none).
 pub const TILE_RULE: &str = include_str!("tiles/rule.wgsl");
 
-/// The compacted cut's sum at a receiver, `cut_sum(r, range)` (method `quadtree`). Needs
+/// The compacted cut's sum at a receiver, `cut_sum(r, range)` (method `quadtree`; `range`: the
+/// first cluster, the end and the stride). Needs
 /// [`NODE`], [`RECEIVER`]. Accessors: `fn load_cut_node(i: u32) -> Node`, cluster `i` of the cut;
 /// `fn node_irradiance(node: Node, r: Receiver) -> vec3<f32>`, [`KERNEL`]'s `vpl_irradiance`
 /// with the including shader's visibility.
@@ -70,7 +71,7 @@ pub const GATHER_CUT: &str = include_str!("gathers/gather_cut.wgsl");
 pub const GATHER_LEVEL: &str = include_str!("gathers/gather_level.wgsl");
 
 /// The sums over RSM texels at a receiver: `vpl_sum` (every VPL, method `reference`) and
-/// `sampled_sum` (RSM sampling, method `rsm`). Needs [`NODE`], [`KERNEL`], [`LIGHT`],
+/// `sampled_sum` (RSM sampling, method `rsm`; every `range.z`-th sample). Needs [`NODE`], [`KERNEL`], [`LIGHT`],
 /// [`RECEIVER`]. Accessors: `fn load_rsm_normal(t: vec2<i32>) -> vec4<f32>` (w: 1 where the light
 /// sees geometry), `fn load_rsm_position(t: vec2<i32>) -> vec4<f32>`,
 /// `fn load_rsm_flux(t: vec2<i32>) -> vec3<f32>`, and for `sampled_sum`

@@ -503,6 +503,48 @@ fn rsm_sampling_converges_to_the_brute_force() {
     assert!(errors[2] < 0.03, "{errors:?}");
 }
 
+/// Interleaved sampling at 4x4: each pixel evaluates a sixteenth of the one cut or of RSM
+/// sampling's samples, and the rejoined picture stays within a few times the whole sums' error
+/// to the brute force.
+#[test]
+fn interleaved_indirect_stays_as_close_to_the_brute_force() {
+    let gpu = gpu();
+    // (the filter is 7 pixels wide: the picture large enough that it blurs little of the room)
+    let at_128 = Settings {
+        samples: 64,
+        ..Settings::sized(128, 128, 64)
+    };
+    let mut r = cornell(&gpu, at_128.clone());
+    let brute = render(&mut r, Method::Reference);
+    for method in [Method::Quadtree, Method::Rsm] {
+        let whole = r.render_frame(method).unwrap();
+        let mut interleaved = cornell(
+            &gpu,
+            Settings {
+                interleave: 4,
+                ..at_128.clone()
+            },
+        );
+        let frame = interleaved.render_frame(method).unwrap();
+        let (e, e_whole) = (
+            compare(&frame.indirect, &brute),
+            compare(&whole.indirect, &brute),
+        );
+        let evaluations =
+            frame.counts.vpl_evaluations_per_pixel() / whole.counts.vpl_evaluations_per_pixel();
+        println!(
+            "{method} to the brute force, interleave 4: {e:?}, whole: {e_whole:?}; \
+             {evaluations:.3} of the evaluations, {} pixels recomputed",
+            frame.recomputed
+        );
+        assert!(frame.recomputed < 128 * 128 / 4, "{}", frame.recomputed);
+        assert!(evaluations < 0.25, "{evaluations}");
+        // (measured 2.2x for the cut and 1.0x for RSM sampling; the filter's 7 pixels are a
+        // nineteenth of the picture here, a 270th at 1920x1080)
+        assert!(e.rel_l1 < 3.0 * e_whole.rel_l1, "{e:?} against {e_whole:?}");
+    }
+}
+
 #[test]
 fn subsampled_indirect_stays_close_to_full_resolution() {
     let gpu = gpu();

@@ -331,17 +331,20 @@ impl IndirectView {
         }))
     }
 
-    /// The settings the picture is drawn with: sub-sampling only where the method sub-samples
-    /// (the slider keeps its value for the methods that do; `quadray indirect` refuses it for
-    /// the others).
+    /// The settings the picture is drawn with: sub-sampling and interleaving only where the
+    /// method sub-samples (the sliders keep their values for the methods that do; `quadray
+    /// indirect` refuses them for the others), and interleaving only at full resolution.
     fn shown_settings(&self) -> Settings {
+        let s = &self.settings;
+        let (subsample, interleave) = match self.method.subsamples() {
+            false => (1, 1),
+            true if s.subsample > 1 => (s.subsample, 1),
+            true => (1, s.interleave),
+        };
         Settings {
-            subsample: if self.method.subsamples() {
-                self.settings.subsample
-            } else {
-                1
-            },
-            ..self.settings.clone()
+            subsample,
+            interleave,
+            ..s.clone()
         }
     }
 
@@ -493,6 +496,10 @@ impl IndirectView {
         let subsampling = format!("sub-sampling ({})", Method::subsampling_names().join(", "));
         named(ui, self.method.subsamples(), &subsampling, |ui| {
             ui.add(limits_slider(&mut s.subsample, Settings::SUBSAMPLE, ""))
+        });
+        let interleaving = format!("interleaving ({})", Method::subsampling_names().join(", "));
+        named(ui, self.method.subsamples(), &interleaving, |ui| {
+            ui.add(limits_slider(&mut s.interleave, Settings::INTERLEAVE, ""))
         });
         let criterion = s.tile_criterion;
         named_choice_box(

@@ -19,16 +19,17 @@ pub(crate) struct Cut {
 
 impl Cut {
     pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
-        let [full, low, upsample] = res.pipelines(
+        let [low, reconstruct] = upsample::entries(res.settings());
+        let [full, low, reconstruct] = res.pipelines(
             device,
             "gather cut",
             &WGSL,
-            ["indirect_cut", upsample::ENTRIES[0], upsample::ENTRIES[1]],
+            ["indirect_cut", low, reconstruct],
             &[],
         );
         Self {
             full,
-            upsampled: Upsampled { low, upsample },
+            upsampled: Upsampled { low, reconstruct },
         }
     }
 

@@ -1,9 +1,9 @@
 // Indirect light from the light quadtree's compacted cut: every pixel sums the cut's clusters
 // (the sum in gather_cut.wgsl).
 
-// This dispatch's slice of the cut.
-fn cut_irradiance(r: Receiver) -> vec3<f32> {
-    return cut_sum(r, slice_range(min(cut_count, arrayLength(&cut)), SLICE));
+// A part of this dispatch's slice of the cut.
+fn cut_irradiance(r: Receiver, part: vec2<u32>) -> vec3<f32> {
+    return cut_sum(r, part_range(slice_range(min(cut_count, arrayLength(&cut)), SLICE), part));
 }
 
 // The accessor gather_cut.wgsl reads the cut with.
@@ -19,13 +19,14 @@ fn indirect_cut(@builtin(global_invocation_id) id: vec3<u32>) {
     let r = receiver(id.xy);
     var e = vec3<f32>(0.0);
     if (r.covered) {
-        e = cut_irradiance(r);
+        e = cut_irradiance(r, WHOLE_SUM);
     }
     add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * e, 0.0));
     store_counts(pixel_index(id.xy));
 }
 
-// What the sub-sampled passes (upsample.wgsl) gather: this dispatch's slice of the cut.
-fn gathered_irradiance(r: Receiver) -> vec3<f32> {
-    return cut_irradiance(r);
+// What the sub-sampled and interleaved passes (upsample.wgsl) gather: a part of this dispatch's
+// slice of the cut.
+fn gathered_irradiance(r: Receiver, part: vec2<u32>) -> vec3<f32> {
+    return cut_irradiance(r, part);
 }

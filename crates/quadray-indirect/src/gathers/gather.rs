@@ -220,13 +220,13 @@ impl Gather {
             "one quadtree a light view"
         );
         let s = res.settings();
-        // the sub-sampled methods: their passes, and the slices of their sum
+        // the sub-sampled and interleaved methods: their passes, and the slices of their sum
         let upsampled = match method {
             Method::Quadtree => Some(&self.cut.upsampled),
             Method::Rsm => Some(&self.rsm_sampling.upsampled),
             _ => None,
         }
-        .filter(|_| method.subsamples() && s.subsample > 1);
+        .filter(|_| s.reconstructs(method));
         let slices = |quadtree| match method {
             Method::Quadtree => Cut::slices(quadtree),
             _ => RsmSampling::slices(res),

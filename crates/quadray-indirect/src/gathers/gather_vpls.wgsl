@@ -35,8 +35,9 @@ fn vpl_sum(r: Receiver, rsm_size: u32, r_min: f32, range: vec2<u32>) -> vec3<f32
 }
 
 // RSM sampling's sum at `r` (method rsm): samples `range.x` to `range.y` (excluded) of the
-// pattern around `r`'s projection into the RSM (of side `rsm_size`) of `light`.
-fn sampled_sum(r: Receiver, light: Light, rsm_size: u32, r_min: f32, range: vec2<u32>) -> vec3<f32> {
+// pattern, every `range.z`-th (interleaved sampling's part), around `r`'s projection into the
+// RSM (of side `rsm_size`) of `light`.
+fn sampled_sum(r: Receiver, light: Light, rsm_size: u32, r_min: f32, range: vec3<u32>) -> vec3<f32> {
     var e = vec3<f32>(0.0);
     let clip = light.view_proj * vec4<f32>(r.x, 1.0);
     let side = f32(rsm_size);
@@ -52,7 +53,7 @@ fn sampled_sum(r: Receiver, light: Light, rsm_size: u32, r_min: f32, range: vec2
     // sample, so shrink it to that corner (weights scale with the disk's area).
     let corner = max(centre, vec2<f32>(side) - centre);
     let size = i32(rsm_size);
-    for (var s = range.x; s < range.y; s++) {
+    for (var s = range.x; s < range.y; s += range.z) {
         let sample = load_rsm_sample(s);
         let scale = min(1.0, length(corner) / sample.w);
         let t = vec2<i32>(floor(centre + sample.xy * scale));

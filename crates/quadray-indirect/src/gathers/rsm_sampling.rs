@@ -23,16 +23,17 @@ pub(crate) struct RsmSampling {
 
 impl RsmSampling {
     pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
-        let [full, low, upsample] = res.pipelines(
+        let [low, reconstruct] = upsample::entries(res.settings());
+        let [full, low, reconstruct] = res.pipelines(
             device,
             "gather rsm sampling",
             &WGSL,
-            ["rsm_sampling", upsample::ENTRIES[0], upsample::ENTRIES[1]],
+            ["rsm_sampling", low, reconstruct],
             &[],
         );
         Self {
             full,
-            upsampled: Upsampled { low, upsample },
+            upsampled: Upsampled { low, reconstruct },
         }
     }
 

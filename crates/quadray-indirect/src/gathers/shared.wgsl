@@ -126,6 +126,22 @@ fn slice_range(count: u32, per_slice: u32) -> vec2<u32> {
     return vec2<u32>(first, min(first + per_slice, count));
 }
 
+// The whole of a sum, as a part of it: the first item and the stride (`part_range`).
+const WHOLE_SUM: vec2<u32> = vec2<u32>(0u, 1u);
+
+// Interleaved sampling: the part of a sum pixel `pixel` takes, its offset in its
+// `interleave` x `interleave` block (x) of the block's parts (y).
+fn interleaved_part(pixel: vec2<u32>) -> vec2<u32> {
+    let n = shade.interleave;
+    return vec2<u32>(pixel.x % n + n * (pixel.y % n), n * n);
+}
+
+// A part's items of a slice [x, y) of a sum: every `part.y`-th from the first of its offset
+// (first, end, stride).
+fn part_range(range: vec2<u32>, part: vec2<u32>) -> vec3<u32> {
+    return vec3<u32>(range.x + (part.x + part.y - range.x % part.y) % part.y, range.y, part.y);
+}
+
 // Whether this is a frame's first light view, which writes the radiance the others add to.
 fn first_view() -> bool {
     return terms.low_offset == 0u;

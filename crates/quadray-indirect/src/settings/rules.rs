@@ -95,6 +95,15 @@ fn validate_uses_the_declared_limits() {
         ),
         (
             Settings {
+                interleave: 4,
+                subsample: 2,
+                ..ok.clone()
+            },
+            "interleave 4 and subsample 2 cannot both be above 1",
+            "rejoins full-resolution pixels".to_string(),
+        ),
+        (
+            Settings {
                 shadow_grid_levels: 3,
                 ..ok.clone()
             },
