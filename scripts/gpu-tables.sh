@@ -5,7 +5,7 @@
 # and its synchronization validation where the machine has the layer (crates/quadray-gpu/vk_layer_settings.txt),
 # one line a pass, so that a pass that hangs or faults costs seconds and is named. Then the 1920x1080 displacement frame of every method at 0, 60 and 85
 # degrees (with the CPU ground truth's wrong-hit fraction), each indirect-light pass at 1920x1080
-# with a 512^2 RSM for every method, given --bevy-bin the Bevy frame with and without the bounce
+# with a 512^2 RSM for every method and the gather's candidates (runtime options; run first), given --bevy-bin the Bevy frame with and without the bounce
 # (two paired rounds, Bevy's render diagnostics), then, while the time budget lasts, the paper
 # tables of `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
 # name from the adapter, e.g. bench/nvidia-h200/) with every stats file (each naming the commit
@@ -52,9 +52,9 @@ start=$SECONDS
 left() { echo $((budget - (SECONDS - start))); }
 
 if [ $quick = 1 ]; then
-    size=96x54 rsm=32 frames=3 angles=60 bevy_frames=3
+    size=96x54 rsm=32 frames=3 ee_frames=2 angles=60 bevy_frames=3
 else
-    size=1920x1080 rsm=512 frames=20 angles="0 60 85" bevy_frames=60
+    size=1920x1080 rsm=512 frames=20 ee_frames=10 angles="0 60 85" bevy_frames=60
 fi
 
 # The adapter's name as a folder: "NVIDIA H200 (Vulkan, NVIDIA 580.159.04)" -> nvidia-h200.
@@ -119,8 +119,64 @@ step() {
         echo "$name: failed or stopped after 180 s (logs/$name.log)" >>"$out/skipped.txt"
 }
 
+# Indirect light first (the real-time gather leads), then displacement.
+for m in quadtree quadtree-passes quadtree-tiles rsm; do
+    step "indirect-$m" "$bin" indirect --method $m --size $size --rsm-size $rsm \
+        --frames $frames --out "$probe/i.png" --stats "$out/indirect-1080p/$m.json"
+done
+for m in quadtree quadtree-tiles; do
+    step "indirect-$m-shadows" "$bin" indirect --method $m --indirect-shadows \
+        --size $size --rsm-size $rsm --frames $frames --out "$probe/i.png" \
+        --stats "$out/indirect-1080p/$m-shadows.json"
+done
+# The gather's candidates, each a runtime option of the same binary (name, then its flags):
+# interleaved sampling of the one cut and of RSM sampling, and the one cut made finer under it.
+while read -r name flags; do
+    # shellcheck disable=SC2086 # $flags is several words
+    step "indirect-$name" "$bin" indirect $flags --size $size --rsm-size $rsm \
+        --frames $frames --out "$probe/i.png" --stats "$out/indirect-1080p/$name.json"
+done <<'CANDIDATES'
+quadtree-interleave-2 --method quadtree --interleave 2
+quadtree-interleave-4 --method quadtree --interleave 4
+quadtree-limit-2-interleave-4 --method quadtree --limit-level 2 --interleave 4
+rsm-interleave-4 --method rsm --interleave 4
+rsm-1024-interleave-4 --method rsm --samples 1024 --interleave 4
+CANDIDATES
+# An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
+# each submit), to see where it stops.
+if grep -qs '^indirect-' "$out/skipped.txt"; then
+    RUST_LOG=wgpu_core=trace,quadray=debug step indirect-trace "$bin" indirect --size 16x16 \
+        --rsm-size 16 --frames 1 --out "$probe/t.png" --stats "$probe/t.json"
+fi
+
+# Equal error in GPU time: each method's rel. L1 to the GPU brute force (--reference) beside its
+# static frame's indirect passes, on the Cornell box, the atrium and the leak scene; RSM sampling
+# swept so that the summary interpolates its time at each other run's error.
+mkdir -p "$out/equal-error"
+for scene in cornell atrium leak; do
+    while read -r name flags; do
+        # shellcheck disable=SC2086 # $flags is several words or none
+        step "equal-error-$scene-$name" "$bin" indirect --scene "assets/scenes/$scene.toml" $flags \
+            --size $size --rsm-size $rsm --frames $ee_frames --reference --out "$probe/e.png" \
+            --stats "$out/equal-error/$scene-$name.json"
+    done <<'RUNS'
+default
+one-cut --method quadtree
+one-cut-interleave-4 --method quadtree --interleave 4
+one-cut-limit-2-interleave-4 --method quadtree --limit-level 2 --interleave 4
+rsm-64 --method rsm --samples 64
+rsm-256 --method rsm --samples 256
+rsm-1024 --method rsm --samples 1024
+rsm-4096 --method rsm --samples 4096
+rsm-16384 --method rsm --samples 16384
+rsm-1024-interleave-4 --method rsm --samples 1024 --interleave 4
+RUNS
+done
+
+# Displacement, while the budget lasts.
 for m in pom pyramid pyramid-ascend pyramid-bilinear relief; do
     for a in $angles; do
+        [ "$(left)" -gt 60 ] || { echo "displace-$m-$a: skipped, $(left) s left" >>"$out/skipped.txt"; continue; }
         step "displace-$m-$a" "$bin" displace --map $map --method $m --layers 1,16 \
             --view-angle "$a" --size $size --reference --out "$probe/d.png" \
             --stats "$out/displace-1080p/$m-$a.json"
@@ -129,20 +185,6 @@ done
 step displace-pyramid-lodauto-60 "$bin" displace --map $map --method pyramid --lod auto \
     --view-angle 60 --size $size --reference --out "$probe/d.png" \
     --stats "$out/displace-1080p/pyramid-lodauto-60.json"
-
-for m in quadtree quadtree-passes quadtree-tiles rsm; do
-    step "indirect-$m" "$bin" indirect --method $m --size $size --rsm-size $rsm \
-        --frames $frames --out "$probe/i.png" --stats "$out/indirect-1080p/$m.json"
-done
-step indirect-quadtree-shadows "$bin" indirect --method quadtree --indirect-shadows \
-    --size $size --rsm-size $rsm --frames $frames --out "$probe/i.png" \
-    --stats "$out/indirect-1080p/quadtree-shadows.json"
-# An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
-# each submit), to see where it stops.
-if grep -qs '^indirect-' "$out/skipped.txt"; then
-    RUST_LOG=wgpu_core=trace,quadray=debug step indirect-trace "$bin" indirect --size 16x16 \
-        --rsm-size 16 --frames 1 --out "$probe/t.png" --stats "$probe/t.json"
-fi
 
 # The Bevy frame, the light turning (every frame a new RSM, pyramid, cut and gather), with and
 # without the bounce, in two paired rounds.
@@ -194,16 +236,48 @@ for f in sorted((out / "displace-1080p").glob("*.json")):
     lines.append(f"| {method} | {s['view_angle_deg']:g} | {s['gpu_time_ms']:.3f} | {wrong} | "
                  f"{s['mean_iterations']:.1f} | {s['max_iterations']} | {s['iteration_cap_hits']} |")
 lines += ["", "## Indirect light, per pass (GPU ms, median)", "",
-          "| run | G-buffer | direct | indirect | static frame | moving-light frame | VPL evaluations / pixel |",
-          "|---|---|---|---|---|---|---|"]
+          "| run | G-buffer | direct | indirect | reconstruct | static frame | moving-light frame | VPL evaluations / pixel |",
+          "|---|---|---|---|---|---|---|---|"]
 for f in sorted((out / "indirect-1080p").glob("*.json")):
     s = json.loads(f.read_text())
     still, moving = s["gpu_time_ms_static"] or {}, s["gpu_time_ms_moving"] or {}
     p = still.get("passes", {})
     cell = lambda v: f"{v:.3f}" if isinstance(v, (int, float)) else "-"
     lines.append(f"| {f.stem} | {cell(p.get('gbuffer'))} | {cell(p.get('direct'))} | "
-                 f"{cell(p.get('indirect'))} | {cell(still.get('total_ms'))} | "
+                 f"{cell(p.get('indirect'))} | {cell(p.get('upsample'))} | {cell(still.get('total_ms'))} | "
                  f"{cell(moving.get('total_ms'))} | {s['vpl_evaluations_per_pixel']:.1f} |")
+# Equal error: RSM sampling's indirect time at each run's rel. L1, interpolated log-log between
+# the two sample counts whose errors bracket it, over the run's own.
+def indirect_ms(s):
+    p = (s["gpu_time_ms_static"] or {}).get("passes", {})
+    return p.get("indirect", 0.0) + p.get("upsample", 0.0)
+import math
+ee = {}
+for f in sorted((out / "equal-error").glob("*.json")) if (out / "equal-error").exists() else []:
+    s = json.loads(f.read_text())
+    if s.get("error") and s.get("gpu_time_ms_static"):
+        scene, name = f.stem.split("-", 1)
+        ee.setdefault(scene, []).append((name, s["error"]["rel_l1"], indirect_ms(s), s["vpl_evaluations_per_pixel"]))
+if ee:
+    lines += ["", "## Equal error (rel. L1 to the brute force; indirect passes, GPU ms, static light)", "",
+              "| scene | run | rel L1 | indirect ms | evals / px | RSM sampling's ms at that error | ratio |",
+              "|---|---|---|---|---|---|---|"]
+    for scene, runs in ee.items():
+        rsm = sorted((e, t) for n, e, t, _ in runs if re.fullmatch(r"rsm-\d+", n))
+        for name, e, t, evals in runs:
+            at = "-"
+            for (e1, t1), (e0, t0) in zip(rsm, rsm[1:]):
+                if e1 <= e <= e0 and min(e0, e1, t0, t1) > 0:
+                    k = math.log(e / e0) / math.log(e1 / e0) if e1 != e0 else 0.0
+                    at = math.exp(math.log(t0) + k * (math.log(t1) - math.log(t0)))
+            ratio = f"{at / t:.2f}" if at != "-" and t > 0 else "-"
+            if at != "-":
+                at = f"{at:.3f}"
+            elif rsm:
+                at = f"below the sweep's {rsm[0][0]:.4f}" if e < rsm[0][0] else "above the sweep"
+            else:
+                at = "no sweep"
+            lines.append(f"| {scene} | {name} | {e:.4f} | {t:.3f} | {evals:.1f} | {at} | {ratio} |")
 bevy = sorted((out / "bevy").glob("*.log")) if (out / "bevy").exists() else []
 if bevy:
     lines += ["", "## The Bevy frame (quadray-bevy-gi, light turning; medians)", "",
