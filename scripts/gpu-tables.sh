@@ -130,7 +130,8 @@ for m in quadtree quadtree-tiles; do
         --stats "$out/indirect-1080p/$m-shadows.json"
 done
 # The gather's candidates, each a runtime option of the same binary (name, then its flags):
-# interleaved sampling of the one cut and of RSM sampling, and the one cut made finer under it.
+# interleaved sampling of the one cut and of RSM sampling, the one cut made finer under it, and
+# the one cut with indirect shadows, whose pixels then walk to a sixteenth of its clusters.
 while read -r name flags; do
     # shellcheck disable=SC2086 # $flags is several words
     step "indirect-$name" "$bin" indirect $flags --size $size --rsm-size $rsm \
@@ -141,6 +142,7 @@ quadtree-interleave-4 --method quadtree --interleave 4
 quadtree-limit-2-interleave-4 --method quadtree --limit-level 2 --interleave 4
 rsm-interleave-4 --method rsm --interleave 4
 rsm-1024-interleave-4 --method rsm --samples 1024 --interleave 4
+quadtree-shadows-interleave-4 --method quadtree --indirect-shadows --interleave 4
 CANDIDATES
 # An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
 # each submit), to see where it stops.
