@@ -193,11 +193,15 @@ step displace-pyramid-lodauto-60 "$bin" displace --map $map --method pyramid --l
 if [ -n "$bevy_bin" ]; then
     mkdir -p "$out/bevy"
     for round in 1 2; do
-        for gi in gi no-gi; do
-            flag=$([ $gi = no-gi ] && echo --no-gi || true)
-            # shellcheck disable=SC2086 # $flag is one word or none
+        for gi in gi gi-interleaved no-gi; do
+            case $gi in
+                no-gi) flags=--no-gi ;;
+                gi-interleaved) flags="--method quadtree --interleave 4" ;;
+                *) flags= ;;
+            esac
+            # shellcheck disable=SC2086 # $flags is several words or none
             step "bevy-$gi-$round" "$bevy_bin" --screenshot "$out/bevy/$gi.png" \
-                --frames $bevy_frames --size $size --rsm-size $rsm $flag
+                --frames $bevy_frames --size $size --rsm-size $rsm $flags
             grep -a -E '^(median frame|render/)' "$out/logs/bevy-$gi-$round.log" \
                 >"$out/bevy/$gi-$round.log" || true
         done

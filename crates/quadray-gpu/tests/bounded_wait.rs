@@ -87,7 +87,12 @@ fn stall_child() {
 fn a_shader_that_never_ends_is_an_error_within_the_bound() {
     let start = Instant::now();
     let mut child = Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", "bounded_wait::stall_child", "--ignored", "--nocapture"])
+        .args([
+            "--exact",
+            "bounded_wait::stall_child",
+            "--ignored",
+            "--nocapture",
+        ])
         .env(CHILD, "1")
         .env(WAIT_BOUND_ENV, BOUND_S.to_string())
         .stdout(Stdio::piped())
@@ -136,7 +141,12 @@ fn a_shader_that_never_ends_is_an_error_within_the_bound() {
 #[test]
 fn an_absurd_bound_is_refused_by_name() {
     let mut child = Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", "bounded_wait::bound_child", "--ignored", "--nocapture"])
+        .args([
+            "--exact",
+            "bounded_wait::bound_child",
+            "--ignored",
+            "--nocapture",
+        ])
         .env(CHILD, "1")
         .env(WAIT_BOUND_ENV, "forever")
         .stdout(Stdio::piped())

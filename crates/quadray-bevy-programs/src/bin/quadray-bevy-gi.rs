@@ -56,7 +56,7 @@ const TURN: f32 = 0.25;
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
 /// What the first frame shows (`--no-gi`, `--method`, `--cut-view`), at what size (`--size`,
-/// `--rsm-size`) and exposure (`--ev100`).
+/// `--rsm-size`), interleaving (`--interleave`) and exposure (`--ev100`).
 #[derive(Resource, Clone, Copy)]
 struct Shown {
     gi: bool,
@@ -65,6 +65,7 @@ struct Shown {
     turning: bool,
     size: (u32, u32),
     rsm_size: u32,
+    interleave: u32,
     ev100: f32,
 }
 
@@ -108,6 +109,11 @@ struct Args {
     /// The RSM's side, a power of two.
     #[arg(long, default_value_t = 128, value_parser = Settings::parse_rsm_size)]
     rsm_size: u32,
+    /// Interleaved sampling for the one cut and RSM sampling: each pixel of an NxN block sums
+    /// every N^2-th cluster or sample, and a geometry-aware filter rejoins them (1: off).
+    #[arg(long, default_value_t = Settings::DEFAULT.interleave,
+          value_parser = Settings::INTERLEAVE.parser())]
+    interleave: u32,
     /// The camera's exposure as an EV100 (Bevy's `Exposure`; `[` and `]` step it): one less is
     /// twice as bright. About log2 of the light in lux: Bevy's default 9.7 for a room lit by lamps
     /// of a few thousand lumens or a 1,000-lux sun, 15 for a physical sun of 100,000 lux, 2 for a
@@ -169,6 +175,7 @@ fn main() {
         turning: args.screenshot.is_none() || timed > 0,
         size: (args.size.width, args.size.height),
         rsm_size: args.rsm_size,
+        interleave: args.interleave,
         ev100: args.ev100,
     };
     let mut app = App::new();
@@ -414,6 +421,7 @@ fn configure(
             IndirectLight {
                 settings: Settings {
                     rsm_size: shown.rsm_size,
+                    interleave: shown.interleave,
                     ..Settings::DEFAULT
                 },
                 method: shown.method,
