@@ -277,7 +277,8 @@ mod tests {
                 u(Settings::SAMPLES),
                 f(Settings::RSM_RADIUS, 0.0, 1.0),
                 u(Settings::SUBSAMPLE),
-                u(Settings::INTERLEAVE),
+                // (powers of two)
+                proptest::sample::select(vec![1u32, 2, 4]),
                 any::<bool>(),
                 u(Settings::SHADOW_STEPS),
                 f(Settings::SHADOW_THICKNESS, 0.0, 1.0),

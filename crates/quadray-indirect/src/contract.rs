@@ -5,7 +5,7 @@
 //! buffers and pipelines with. A test parses every shader with naga and holds each shared
 //! struct's size and field offsets against these.
 
-use crate::light::node::{CONE_SLACK, EMPTY_BOX, MAX_LEVELS};
+use crate::light::node::{CONE_SLACK, CUT_CLASS_SIDE, EMPTY_BOX, MAX_LEVELS};
 use crate::settings::{Shade, TILE, TILE_FRONTIER};
 use crate::shader_struct::{Layout, shader_struct};
 use crate::shadows::occupancy::{
@@ -75,7 +75,8 @@ pub(crate) fn prelude() -> String {
          const DEBLOCK_LIMIT: f32 = {DEBLOCK_LIMIT:?};\n\
          const DEBLOCK_PLANE: f32 = {DEBLOCK_PLANE:?};\n\
          const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};\n\
-         const MAX_INTERLEAVE: u32 = {}u;\n",
+         const MAX_INTERLEAVE: u32 = {}u;\n\
+         const CUT_CLASS_SIDE: u32 = {CUT_CLASS_SIDE}u;\n",
         std::f32::consts::PI,
         OutputTerm::Indirect as u32,
         OutputTerm::Direct as u32,

@@ -8,6 +8,7 @@ use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts}
 use crate::gathers::gather::Gather;
 use crate::gathers::resources::ViewMaps;
 use crate::gbuffer::GBufferPass;
+use crate::light::node::{CutCounts, cut_class_capacity};
 use crate::light::quadtree::LightQuadtree;
 use crate::light::rsm::RsmPass;
 use crate::light::view::LightView;
@@ -468,12 +469,16 @@ impl<'g> Renderer<'g> {
     /// The clusters of the first light view's compacted cut (after a `Quadtree` frame with
     /// rebuild), in no order.
     pub fn read_cut(&self) -> Result<Vec<CutNode>, IndirectError> {
-        let count = self.clusters_in_cut()? as usize;
-        let clusters = self.read_vec4(self.first_view().quadtree.cut())?;
+        let quadtree = &self.first_view().quadtree;
+        let bytes = quadray_gpu::read_buffer(self.gpu, quadtree.cut_count())?;
+        let counts: CutCounts = bytemuck::pod_read_unaligned(&bytes);
+        let clusters = self.read_vec4(quadtree.cut())?;
         // three vec4 a cluster; the normal's w holds the node's index
+        let segment = 3 * cut_class_capacity(self.settings().rsm_size) as usize;
         Ok(clusters
-            .chunks_exact(3)
-            .take(count)
+            .chunks(segment)
+            .zip(&counts[1..])
+            .flat_map(|(class, &count)| class.chunks_exact(3).take(count as usize))
             .map(|c| CutNode::at(self.settings().rsm_size, c[2][3].to_bits()))
             .collect())
     }

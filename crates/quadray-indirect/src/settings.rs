@@ -394,7 +394,8 @@ impl Settings {
     pub const RSM_RADIUS: Limits<f32> = Limits::above(0.0, 1.0);
     /// [`Settings::subsample`].
     pub const SUBSAMPLE: Limits<u32> = Limits::closed(1, 64).interactive(1, 8);
-    /// [`Settings::interleave`]: at 4 a pixel sums 1/16 of the cut; the filter that rejoins the
+    /// [`Settings::interleave`] (also a power of two): at 4 a pixel sums 1/16 of the cut (its
+    /// parts are the cut's classes, 4x4 of them: `CUT_CLASS_SIDE`); the filter that rejoins the
     /// parts holds its workgroup's pixels and 2 (N - 1) more across and down in workgroup
     /// memory (9.4 KB at 4).
     pub const INTERLEAVE: Limits<u32> = Limits::closed(1, 4);
@@ -560,6 +561,14 @@ impl Settings {
         Self::RSM_RADIUS.check("RSM radius", s.rsm_radius)?;
         Self::SUBSAMPLE.check("subsample", s.subsample)?;
         Self::INTERLEAVE.check("interleave", s.interleave)?;
+        if !s.interleave.is_power_of_two() {
+            return Err(format!(
+                "interleave {} must be a power of two (its parts are classes of the cut's \
+                 {side}x{side})",
+                s.interleave,
+                side = Self::INTERLEAVE.max
+            ));
+        }
         if s.interleave > 1 && s.subsample > 1 {
             return Err(format!(
                 "interleave {} and subsample {} cannot both be above 1: interleaved sampling \

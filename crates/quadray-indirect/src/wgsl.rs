@@ -58,8 +58,7 @@ pub const BOUND: &str = include_str!("light/bound.wgsl");
 /// `fn tile_sample(q: u32) -> u32` (quadrant `q`'s sample pixel, `TILE_PIXELS` where none).
 pub const TILE_RULE: &str = include_str!("tiles/rule.wgsl");
 
-/// The compacted cut's sum at a receiver, `cut_sum(r, range)` (method `quadtree`; `range`: the
-/// first cluster, the end and the stride). Needs
+/// The compacted cut's sum at a receiver, `cut_sum(r, range)` (method `quadtree`). Needs
 /// [`NODE`], [`RECEIVER`]. Accessors: `fn load_cut_node(i: u32) -> Node`, cluster `i` of the cut;
 /// `fn node_irradiance(node: Node, r: Receiver) -> vec3<f32>`, [`KERNEL`]'s `vpl_irradiance`
 /// with the including shader's visibility.

@@ -1,9 +1,29 @@
 // Indirect light from the light quadtree's compacted cut: every pixel sums the cut's clusters
 // (the sum in gather_cut.wgsl).
 
-// A part of this dispatch's slice of the cut.
+// A part of this dispatch's slice of the cut: the segments of the part's classes, in turn, as
+// one list (the whole cut: every class). Part `part.x` of `part.y` = N^2 (an offset in an NxN
+// block) holds the classes whose offsets in the CUT_CLASS_SIDE^2 block are the same modulo N.
 fn cut_irradiance(r: Receiver, part: vec2<u32>) -> vec3<f32> {
-    return cut_sum(r, part_range(slice_range(min(cut_count, arrayLength(&cut)), SLICE), part));
+    let n = u32(round(sqrt(f32(part.y))));
+    let offset = vec2<u32>(part.x % n, part.x / n);
+    let per_side = CUT_CLASS_SIDE / n;
+    let segment = arrayLength(&cut) / (CUT_CLASS_SIDE * CUT_CLASS_SIDE);
+    let range = slice_range(arrayLength(&cut), SLICE);
+    var e = vec3<f32>(0.0);
+    var before = 0u;
+    for (var j = 0u; j < per_side * per_side; j++) {
+        let c = offset + n * vec2<u32>(j % per_side, j / per_side);
+        let cut_class = c.x + CUT_CLASS_SIDE * c.y;
+        let count = min(cut_count[1u + cut_class], segment);
+        let first = max(range.x, before);
+        let end = min(range.y, before + count);
+        if (first < end) {
+            e += cut_sum(r, vec2<u32>(first, end) - before + cut_class * segment);
+        }
+        before += count;
+    }
+    return e;
 }
 
 // The accessor gather_cut.wgsl reads the cut with.

@@ -13,6 +13,7 @@ use crate::contract::{
 };
 use crate::gathers::samples;
 use crate::gbuffer::{GBufferViews, camera_uniform};
+use crate::light::node::CutCounts;
 use crate::light::quadtree::LightQuadtree;
 use crate::light::rsm::RsmViews;
 use crate::light::view::LightView;
@@ -257,7 +258,7 @@ impl Resources {
                 texture_entry(5),
                 storage_entry::<GpuNode>(6, true),
                 storage_entry::<GpuNode>(7, true),
-                storage_entry::<u32>(8, true),
+                storage_entry::<CutCounts>(8, true),
                 storage_entry::<GpuNodeBounds>(9, true),
             ],
         );

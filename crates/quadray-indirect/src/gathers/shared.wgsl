@@ -22,7 +22,8 @@ override SHADOWS: bool;
 @group(0) @binding(5) var rsm_normal: texture_2d<f32>;
 @group(0) @binding(6) var<storage, read> nodes: array<Node>;
 @group(0) @binding(7) var<storage, read> cut: array<Node>;
-@group(0) @binding(8) var<storage, read> cut_count: u32;
+// the cut's clusters in all, then in each class's segment of `cut` (light/node.rs)
+@group(0) @binding(8) var<storage, read> cut_count: array<u32, CUT_CLASS_SIDE * CUT_CLASS_SIDE + 1u>;
 @group(0) @binding(9) var<storage, read> bounds: array<NodeBounds>;
 // Group 1, per frame (its targets): the settings, the camera, the G-buffer, the outputs and the
 // RSM samples.
@@ -126,7 +127,7 @@ fn slice_range(count: u32, per_slice: u32) -> vec2<u32> {
     return vec2<u32>(first, min(first + per_slice, count));
 }
 
-// The whole of a sum, as a part of it: the first item and the stride (`part_range`).
+// The whole of a sum, as a part of it (`interleaved_part`'s form: part 0 of 1).
 const WHOLE_SUM: vec2<u32> = vec2<u32>(0u, 1u);
 
 // Interleaved sampling: the part of a sum pixel `pixel` takes, its offset in its

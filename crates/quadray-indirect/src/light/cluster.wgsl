@@ -7,10 +7,12 @@
 @group(0) @binding(2) var rsm_pos: texture_2d<f32>;
 @group(0) @binding(3) var rsm_normal: texture_2d<f32>;
 @group(0) @binding(4) var<storage, read_write> nodes: array<Node>;
-// the cut's clusters, copied out of the pyramid so that shading reads them in a row; normal.w
-// holds the node's index (bit pattern) instead of its validity
+// the cut's clusters, copied out of the pyramid so that shading reads them in a row, a segment
+// of arrayLength / CUT_CLASS_SIDE^2 a class (node.rs); normal.w holds the node's index (bit
+// pattern) instead of its validity
 @group(0) @binding(5) var<storage, read_write> cut: array<Node>;
-@group(0) @binding(6) var<storage, read_write> cut_count: atomic<u32>;
+// the cut's clusters in all, then in each class
+@group(0) @binding(6) var<storage, read_write> cut_count: array<atomic<u32>, CUT_CLASS_SIDE * CUT_CLASS_SIDE + 1u>;
 // per node, what bounds its contribution (reduced with the means, read by the per-tile cuts)
 @group(0) @binding(7) var<storage, read_write> bounds: array<NodeBounds>;
 // Group 1, per dispatch: the level (a dynamic offset into slots 0, 1, 2, ...).
@@ -147,9 +149,14 @@ fn select_cut(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let local = index - level_offset(params, level);
     let size = level_size(params, level);
-    if (in_cut(params, level, vec2<u32>(local % size, local / size))) {
+    let xy = vec2<u32>(local % size, local / size);
+    if (in_cut(params, level, xy)) {
         var node = nodes[index];
         node.normal.w = bitcast<f32>(index);
-        cut[atomicAdd(&cut_count, 1u)] = node;
+        let c = xy % CUT_CLASS_SIDE;
+        let cut_class = c.x + CUT_CLASS_SIDE * c.y;
+        let segment = arrayLength(&cut) / (CUT_CLASS_SIDE * CUT_CLASS_SIDE);
+        atomicAdd(&cut_count[0], 1u);
+        cut[cut_class * segment + atomicAdd(&cut_count[1u + cut_class], 1u)] = node;
     }
 }

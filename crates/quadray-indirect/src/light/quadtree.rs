@@ -7,7 +7,9 @@ use crate::contract::{
     compute_pipeline, dispatch_2d, layout, pipeline_layout, shader_module, storage_buffer,
     storage_entry, tex, texture_entry, uniform_buffer, uniform_entry, whole,
 };
-use crate::light::node::{MAX_LEVELS, level_offset, node_count};
+use crate::light::node::{
+    CUT_CLASS_SIDE, CutCounts, MAX_LEVELS, cut_class_capacity, level_offset, node_count,
+};
 use crate::light::rsm::RsmViews;
 use crate::method::Validity;
 use crate::settings::{ClusterSettings, Levels};
@@ -65,7 +67,7 @@ impl LightQuadtree {
                 texture_entry(3),
                 storage_entry::<GpuNode>(4, false),
                 storage_entry::<GpuNode>(5, false),
-                storage_entry::<u32>(6, false),
+                storage_entry::<CutCounts>(6, false),
                 storage_entry::<GpuNodeBounds>(7, false),
             ],
         );
@@ -80,9 +82,13 @@ impl LightQuadtree {
         let node_size = size_of::<GpuNode>() as u64;
         let params = uniform_buffer::<ClusterUniform>(device, "cluster settings");
         let nodes = storage_buffer(device, "nodes", node_count(rsm_size) * node_size);
-        // a cut partitions the RSM: at most one cluster per texel
-        let cut = storage_buffer(device, "cut", u64::from(rsm_size).pow(2) * node_size);
-        let cut_count = storage_buffer(device, "cut count", 4);
+        let classes = u64::from(CUT_CLASS_SIDE).pow(2);
+        let cut = storage_buffer(
+            device,
+            "cut",
+            classes * cut_class_capacity(rsm_size) * node_size,
+        );
+        let cut_count = storage_buffer(device, "cut count", (classes + 1) * 4);
         let bounds = storage_buffer(
             device,
             "node bounds",
@@ -214,7 +220,7 @@ impl LightQuadtree {
     }
 
     /// Records the compacted cut (after [`Self::record_build`]): one thread per node of the
-    /// levels limit..start, atomic append.
+    /// levels limit..start, atomic append to its class's segment.
     pub fn record_cut(&self, encoder: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         encoder.clear_buffer(&self.cut_count, 0, None);
         let levels = self.levels();
@@ -255,13 +261,14 @@ impl LightQuadtree {
         &self.nodes
     }
 
-    /// The compacted cut's clusters ([`GpuNode`]s, `normal.w` the node's index as bits).
+    /// The compacted cut's clusters ([`GpuNode`]s, `normal.w` the node's index as bits), a
+    /// segment of [`cut_class_capacity`] a class.
     pub(crate) fn cut(&self) -> &wgpu::Buffer {
         &self.cut
     }
 
-    /// How many clusters the last cut holds (one `u32`, copyable: for a read-back or a
-    /// profiler's counter).
+    /// How many clusters the last cut holds (its first `u32`, copyable: for a read-back or a
+    /// profiler's counter), then how many each of its classes holds (`CUT_CLASS_SIDE`^2 more).
     pub fn cut_count(&self) -> &wgpu::Buffer {
         &self.cut_count
     }

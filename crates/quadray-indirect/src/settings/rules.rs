@@ -95,6 +95,14 @@ fn validate_uses_the_declared_limits() {
         ),
         (
             Settings {
+                interleave: 3,
+                ..ok.clone()
+            },
+            "interleave 3 must be a power of two",
+            "(its parts are classes of the cut's 4x4)".to_string(),
+        ),
+        (
+            Settings {
                 interleave: 4,
                 subsample: 2,
                 ..ok.clone()
