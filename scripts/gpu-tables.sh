@@ -12,11 +12,14 @@
 # and the adapter it measured) and a summary.md of the tables (headed by the adapter, the date and
 # the commit), and packs it into gpu-tables.tar.gz beside it (one file to copy off the machine).
 #
-#   scripts/gpu-tables.sh [--quick] [--smoke-only] [--smoke REGEX] [--bin PATH] [--bevy-bin PATH]
-#                         [--out DIR] [--budget SECONDS]
+#   scripts/gpu-tables.sh [--quick] [--smoke-only] [--smoke REGEX] [--runs REGEX] [--bin PATH]
+#                         [--bevy-bin PATH] [--out DIR] [--budget SECONDS]
 #
 # --smoke-only: the smoke stage alone.
 # --smoke: only the smoke cases whose names match (grep -E; `quadray smoke --list` names them).
+# --runs: only the runs after the smoke stage whose names match (bash =~; the names are the
+#   logs/NAME.log files: indirect-METHOD, indirect-CANDIDATE, equal-error-SCENE-RUN,
+#   displace-METHOD-ANGLE, bevy-...).
 # --quick: small frames, for trying the script on a software rasterizer (a minute on lavapipe).
 # --bin: the quadray binary (default target/release/quadray, built if missing).
 # --bevy-bin: the quadray-bevy-gi program (`cargo build --release --bin quadray-bevy-gi`); it
@@ -28,6 +31,7 @@ cd "$(dirname "$0")/.."
 quick=0
 smoke_only=0
 smoke_cases=.
+runs=.
 bin=target/release/quadray
 bevy_bin=
 out_root=bench
@@ -37,6 +41,7 @@ while [ $# -gt 0 ]; do
         --quick) quick=1 ;;
         --smoke-only) smoke_only=1 ;;
         --smoke) smoke_cases=$2; shift ;;
+        --runs) runs=$2; shift ;;
         --bin) bin=$2; shift ;;
         --bevy-bin) bevy_bin=$2; shift ;;
         --out) out_root=$2; shift ;;
@@ -114,6 +119,7 @@ fi
 step() {
     local name=$1
     shift
+    [[ $name =~ $runs ]] || return 0
     echo "$((SECONDS - start)) s: $name"
     timeout 180 "$@" >"$out/logs/$name.log" 2>&1 ||
         echo "$name: failed or stopped after 180 s (logs/$name.log)" >>"$out/skipped.txt"
@@ -175,10 +181,9 @@ rsm-1024-interleave-4 --method rsm --samples 1024 --interleave 4
 RUNS
 done
 
-# Displacement, while the budget lasts.
+# Displacement.
 for m in pom pyramid pyramid-ascend pyramid-bilinear relief; do
     for a in $angles; do
-        [ "$(left)" -gt 60 ] || { echo "displace-$m-$a: skipped, $(left) s left" >>"$out/skipped.txt"; continue; }
         step "displace-$m-$a" "$bin" displace --map $map --method $m --layers 1,16 \
             --view-angle "$a" --size $size --reference --out "$probe/d.png" \
             --stats "$out/displace-1080p/$m-$a.json"
