@@ -287,6 +287,7 @@ mod tests {
                 u(Settings::SHADOW_GRID),
                 u(Settings::TILE_DEBLOCK),
                 f(Settings::TILE_SHADOW_ANGLE, 0.0, 100.0),
+                proptest::option::of(4u32..=13),
             ),
         )
             .prop_map(
@@ -302,6 +303,7 @@ mod tests {
                         shadow_grid,
                         tile_deblock,
                         tile_shadow_angle,
+                        shadow_map_log,
                     ),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
@@ -315,6 +317,7 @@ mod tests {
                     Settings {
                         size: Size::new(w, h),
                         rsm_size: 1 << rsm_log,
+                        shadow_map_size: shadow_map_log.map(|l| 1 << l),
                         max_lights,
                         cluster: ClusterSettings {
                             start_level,
@@ -360,6 +363,11 @@ mod tests {
             ("--size", "0x10", Settings::SIDE.to_string()),
             ("--rsm-size", "96", Settings::RSM_SIZE.to_string()),
             ("--rsm-size", "2048", Settings::RSM_SIZE.to_string()),
+            (
+                "--shadow-map-size",
+                "3000",
+                Settings::SHADOW_MAP_SIZE.to_string(),
+            ),
             ("--limit-level", "11", ClusterSettings::LEVEL.to_string()),
             (
                 "--normal-threshold",
