@@ -32,9 +32,10 @@ pub struct IndirectArgs {
     #[arg(long)]
     reference: bool,
     /// Also compute one bounce from every VPL with exact visibility on the CPU (ray traced);
-    /// adds ground_truth {rel_l1, rmse, flip, blockiness, blockiness_bends} to the stats (the
-    /// error's steps and bends across the 8-pixel tiles' boundaries over elsewhere, relative to
-    /// the brute force's; 1 = no tile structure).
+    /// adds ground_truth {rel_l1, rmse, flip, blockiness, blockiness_bends,
+    /// direct_shadows_wrong} to the stats (the error's steps and bends across the 8-pixel tiles'
+    /// boundaries over elsewhere, relative to the brute force's, 1 = no tile structure; the share
+    /// of the directly lit pixels whose shadow differs from one traced to each light).
     /// Traces a ray per pixel and VPL: small --size and --rsm-size (at most 2^30 rays).
     #[arg(long)]
     ground_truth: bool,
