@@ -1,7 +1,7 @@
 //! quadray's own renderer of a [`Scene`]: its triangles in a vertex buffer, its G-buffer, and
-//! the public passes (an RSM and a light quadtree per light view, the gather summing them)
-//! recorded in one encoder per frame, timed per pass. The CLI, the viewer and the benchmarks
-//! render through it.
+//! the public passes (an RSM and a light quadtree per light view, the gather summing them, the
+//! direct light through a shadow map per light view) recorded in one encoder per frame, timed
+//! per pass. The CLI, the viewer and the benchmarks render through it.
 
 use crate::IndirectError;
 use crate::direct::pass::DirectLight;
