@@ -1,7 +1,7 @@
 //! [`DirectLight`]: the light views' direct light on the caller's G-buffer, each view shadowed by
-//! a shadow map of its own ([`super::shadow_map`]) sized for the picture, filtered by 3x3
-//! bilinear comparisons (PCF) with a normal offset. Runs over the gather's shared groups, its own
-//! group 3 a view: the map's view, its depth and the comparison sampler.
+//! a shadow map of its own ([`super::shadow_map`]) sized for the picture, filtered by four
+//! bilinear comparisons (PCF over 3x3 texels) with a normal offset. Runs over the gather's shared
+//! groups, its own group 3 a view: the map's view, its depth and the comparison sampler.
 
 use super::shadow_map::ShadowMaps;
 use crate::contract::{
