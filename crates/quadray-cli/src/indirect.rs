@@ -32,9 +32,10 @@ pub struct IndirectArgs {
     #[arg(long)]
     reference: bool,
     /// Also compute one bounce from every VPL with exact visibility on the CPU (ray traced);
-    /// adds ground_truth {rel_l1, rmse, flip, blockiness, blockiness_bends} to the stats (the
-    /// error's steps and bends across the 8-pixel tiles' boundaries over elsewhere, relative to
-    /// the brute force's; 1 = no tile structure).
+    /// adds ground_truth {rel_l1, rmse, flip, blockiness, blockiness_bends,
+    /// direct_shadows_wrong} to the stats (the error's steps and bends across the 8-pixel tiles'
+    /// boundaries over elsewhere, relative to the brute force's, 1 = no tile structure; the share
+    /// of the directly lit pixels whose shadow differs from one traced to each light).
     /// Traces a ray per pixel and VPL: small --size and --rsm-size (at most 2^30 rays).
     #[arg(long)]
     ground_truth: bool,
@@ -293,6 +294,7 @@ mod tests {
                 u(Settings::SHADOW_GRID),
                 u(Settings::TILE_DEBLOCK),
                 f(Settings::TILE_SHADOW_ANGLE, 0.0, 100.0),
+                proptest::option::of(4u32..=13),
             ),
         )
             .prop_map(
@@ -317,6 +319,7 @@ mod tests {
                         shadow_grid,
                         tile_deblock,
                         tile_shadow_angle,
+                        shadow_map_log,
                     ),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
@@ -330,6 +333,7 @@ mod tests {
                     Settings {
                         size: Size::new(w, h),
                         rsm_size: 1 << rsm_log,
+                        shadow_map_size: shadow_map_log.map(|l| 1 << l),
                         max_lights,
                         cluster: ClusterSettings {
                             start_level,
@@ -377,6 +381,11 @@ mod tests {
             ("--size", "0x10", Settings::SIDE.to_string()),
             ("--rsm-size", "96", Settings::RSM_SIZE.to_string()),
             ("--rsm-size", "2048", Settings::RSM_SIZE.to_string()),
+            (
+                "--shadow-map-size",
+                "3000",
+                Settings::SHADOW_MAP_SIZE.to_string(),
+            ),
             ("--limit-level", "11", ClusterSettings::LEVEL.to_string()),
             (
                 "--normal-threshold",

@@ -1,7 +1,8 @@
 //! One-bounce indirect light added to a G-buffer you render yourself. This program opens its own
 //! wgpu device, builds a Cornell-like box with a block in code, rasterises its own G-buffer with
 //! its own shader, then records quadray's passes into its encoder: the spot's RSM, the light
-//! quadtree and its cut, the gather into its G-buffer, and the radiance into its output texture.
+//! quadtree and its cut, the gather into its G-buffer, the direct light through a shadow map of
+//! its own, and the radiance into its output texture.
 //! Writes `out/examples/gi_gbuffer.png` under the workspace root, or the PNG file given as its
 //! argument:
 //!
@@ -15,8 +16,8 @@ use glam::Vec3;
 use quadray_gpu::{nearest_depth, texture_2d};
 use quadray_indirect::scene::{Camera, Cone, Intensity, Light, LightKind, Scene, Vertex};
 use quadray_indirect::{
-    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass, OutputTerm,
-    RsmPass, Settings, ViewMaps,
+    DirectLight, FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass,
+    OutputTerm, RsmPass, Settings, ViewMaps,
 };
 use wgpu::util::DeviceExt;
 
@@ -153,9 +154,8 @@ fn render(
     };
     let gbuffer = [(); 3].map(|_| view(FLOAT_FORMAT));
     let depth = view(wgpu::TextureFormat::Depth32Float);
-    let camera = scene
-        .camera_view_proj(s.size.width as f32 / s.size.height as f32)
-        .to_cols_array();
+    let view_proj = scene.camera_view_proj(s.size.width as f32 / s.size.height as f32);
+    let camera = view_proj.to_cols_array();
     let eye = scene.camera.position;
     let camera = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("camera"),
@@ -217,6 +217,9 @@ fn render(
     }];
     let gather = Gather::new(device, &s, &maps, views)?;
     gather.set_lights(queue, &lights, scene.r_min);
+    // the direct light: a shadow map a light view, sized for the picture
+    let direct = DirectLight::new(device, &gather);
+    direct.set_lights(queue, &lights, view_proj, scene.bounds());
     let output_pass = OutputPass::new(device, FLOAT_FORMAT, OutputTerm::Combined)?;
     let output_usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
     let output = texture_2d(device, "output", size, FLOAT_FORMAT, output_usage);
@@ -260,7 +263,8 @@ fn render(
     quadtree.record_build(&mut encoder, None);
     quadtree.record_cut(&mut encoder, None);
     gather.record_indirect(&mut encoder, Method::DEFAULT, &[&quadtree], None);
-    gather.record_direct(&mut encoder, None);
+    direct.record_shadow_maps(&mut encoder, vertices.slice(..), vertex_count, None);
+    direct.record(&mut encoder, &gather, None);
     output_pass.record(
         device,
         &mut encoder,

@@ -39,7 +39,7 @@ pub(crate) const MAX_SLICES: u32 = 1024 * 1024 / LEVEL_SLICE;
 pub enum OutputTerm {
     /// The one-bounce indirect light alone (to add to the caller's own direct light).
     Indirect = 0,
-    /// The spot's direct light, shadowed by the RSM.
+    /// The lights' direct light, shadowed by their shadow maps.
     Direct = 1,
     /// Direct plus indirect: what `quadray indirect` pictures.
     Combined = 2,
@@ -145,6 +145,18 @@ shader_struct! {
 }
 
 shader_struct! {
+    /// One light view's shadow map for the direct light (the sun's fitted to the camera's view, a
+    /// spot's or a cube face's the RSM's view), written with the light and the camera.
+    pub(crate) struct ShadowUniform as "Shadow" {
+        /// World -> the shadow map's clip space.
+        view_proj: [[f32; 4]; 4],
+        /// x: a texel's side in world units (parallel light), or at unit distance along the
+        /// axis (from a point); y: 1 for parallel light; z: the map's side in texels.
+        texel: [f32; 4],
+    }
+}
+
+shader_struct! {
     /// The light quadtree's settings.
     pub(crate) struct ClusterUniform as "ClusterParams" {
         rsm_size: u32,
@@ -164,8 +176,6 @@ shader_struct! {
     pub(crate) struct LightTermsUniform as "LightTerms" {
         /// The clamp of the VPL kernel's 1/r^4 (world units).
         r_min: f32,
-        /// Shadow-map bias in RSM depth units.
-        depth_bias: f32,
         /// Geometry agreement for upsampling: plane distance (world units).
         plane_agreement: f32,
         /// Indirect shadows: how deep behind a depth map's surface a point counts as inside the
@@ -227,6 +237,7 @@ pub(crate) fn shared_structs() -> Vec<Layout> {
     vec![
         Layout::of::<LightUniform>(),
         Layout::of::<RasterUniform>(),
+        Layout::of::<ShadowUniform>(),
         Layout::of::<ClusterUniform>(),
         Layout::of::<Shade>(),
         Layout::of::<LightTermsUniform>(),

@@ -26,13 +26,15 @@ pub enum Pass {
     Indirect,
     /// Sub-sampled indirect light brought to full resolution.
     Upsample,
-    /// The spot's direct light on the G-buffer.
+    /// Each light view's shadow map for the direct light (the sun's fitted to the camera).
+    ShadowMap,
+    /// The lights' direct light on the G-buffer, through the shadow maps.
     Direct,
 }
 
 impl Pass {
     /// Every pass, in the order a frame records them.
-    pub const ALL: [Pass; 8] = [
+    pub const ALL: [Pass; 9] = [
         Pass::Rsm,
         Pass::Pyramid,
         Pass::Validity,
@@ -40,6 +42,7 @@ impl Pass {
         Pass::GBuffer,
         Pass::Indirect,
         Pass::Upsample,
+        Pass::ShadowMap,
         Pass::Direct,
     ];
 
@@ -53,6 +56,7 @@ impl Pass {
             Pass::GBuffer => "gbuffer",
             Pass::Indirect => "indirect",
             Pass::Upsample => "upsample",
+            Pass::ShadowMap => "shadow-map",
             Pass::Direct => "direct",
         }
     }

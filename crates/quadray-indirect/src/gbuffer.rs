@@ -62,7 +62,13 @@ impl GBufferPass {
         let module = shader_module(device, "gbuffer", &SOURCES);
         let camera = uniform_buffer::<RasterUniform>(device, "camera");
         Self {
-            pipeline: raster_pipeline(device, &group_layout, &module, "gbuffer"),
+            pipeline: raster_pipeline::<3>(
+                device,
+                &group_layout,
+                &module,
+                "gbuffer",
+                Some("gbuffer"),
+            ),
             group: bind_group(device, "gbuffer", &group_layout, vec![whole(&camera)]),
             camera,
             targets: RasterTargets::new(device, ["g position", "g normal", "g albedo"], size),

@@ -12,8 +12,9 @@
 //! The crate is cut by feature, each folder holding its Rust passes, its WGSL and its CPU twins:
 //! `light/` (light views, RSM, pyramid, cut), `tiles/` (the default method: rule, twin, kernel,
 //! deblocking, blockiness), `shadows/` (occupancy grid, walk, depth-map march), `gathers/` (the
-//! gather's shared resources, the one cut, per-level passes, RSM sampling, brute force, direct
-//! light) and `output/` (upsampling, temporal filter, output pass); [`Settings`] (no GPU) is what
+//! gather's shared resources, the one cut, per-level passes, RSM sampling, brute force),
+//! `direct/` (the direct light through shadow maps of its own) and `output/` (upsampling,
+//! temporal filter, output pass); [`Settings`] (no GPU) is what
 //! a user configures, `contract.rs` the Rust <-> WGSL contract and [`wgsl`] the engine-neutral
 //! shader modules, and [`Renderer`] quadray's own frame. The modules are layers, each naming only
 //! the ones below it (`tests/layers.rs` lists them).
@@ -47,10 +48,15 @@
 //! # Ok(())
 //! # }
 //! ```
+//!
+//! For the direct light too (a renderer without its own), a [`DirectLight`] made for the gather
+//! renders each light view a shadow map sized for the picture and lights the G-buffer through
+//! them; `examples/gi_gbuffer.rs` records it.
 
 #![warn(missing_docs)]
 
 mod contract;
+mod direct;
 mod frame;
 pub mod gathers;
 mod gbuffer;
@@ -84,6 +90,7 @@ pub enum IndirectError {
 }
 
 pub use contract::OutputTerm;
+pub use direct::pass::DirectLight;
 pub use frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
 pub use gathers::gather::Gather;
 pub use gathers::resources::ViewMaps;

@@ -1,10 +1,11 @@
 //! Ground truth on the CPU: the indirect radiance of every receiver from every VPL, with the same
 //! kernel (including the r_min clamp) as the GPU, summed in f64; without visibility (what every
 //! GPU method approximates) or with exact visibility by ray tracing (what the light really
-//! does). For small RSMs and images only.
+//! does). For small RSMs and images only. Beside it the direct light with each light's shadow
+//! traced exactly, and the share of pixels whose direct shadow a GPU picture gets wrong.
 
 use crate::frame::{Receiver, Vpl};
-use crate::scene::Scene;
+use crate::scene::{Light, LightKind, Scene};
 use glam::{DVec3, Vec3};
 use quadray_core::geom::{Bvh, ConvexPolygon, Ray};
 use rayon::prelude::*;
@@ -75,9 +76,17 @@ impl Visibility {
     /// Whether the segment between the VPL and the receiver, each end lifted along its normal,
     /// is free.
     fn between(&self, vpl: &Vpl, receiver: &Receiver) -> bool {
-        let lift = |p: [f32; 3], n: [f32; 3]| Vec3::from(p) + self.offset * Vec3::from(n);
-        let from = lift(receiver.position, receiver.normal);
-        let to = lift(vpl.position, vpl.normal);
+        let to = self.lift(vpl.position, vpl.normal);
+        self.free(self.lift(receiver.position, receiver.normal), to)
+    }
+
+    /// `p` lifted off its surface along `n`.
+    fn lift(&self, p: [f32; 3], n: [f32; 3]) -> Vec3 {
+        Vec3::from(p) + self.offset * Vec3::from(n)
+    }
+
+    /// Whether nothing lies between `from` and `to`.
+    fn free(&self, from: Vec3, to: Vec3) -> bool {
         if from.distance_squared(to) < self.offset * self.offset {
             return true;
         }
@@ -115,6 +124,110 @@ fn sum_vpls(
             (v(receiver.albedo) / PI * e).as_vec3().to_array()
         })
         .collect()
+}
+
+/// The direct light of a scene's lights at every receiver, as the GPU's direct pass lights it
+/// (albedo / pi times the irradiance facing the light times the cosine), without shadows and
+/// with each light's shadow traced exactly.
+#[derive(Clone, Debug)]
+pub struct DirectTruth {
+    /// Direct radiance with no shadows at all (zero where there is no receiver).
+    pub unshadowed: Vec<[f32; 3]>,
+    /// Direct radiance where a ray from the receiver (lifted off its surface) to each light
+    /// (the sun: against its direction, out of the scene) meets nothing.
+    pub shadowed: Vec<[f32; 3]>,
+}
+
+/// Where `light` lights `x` from (a point; the sun: a point out of the scene against its
+/// direction, `reach` away) and its irradiance there on a surface facing it (W/m^2 per channel:
+/// a spot's I(w) / d^2 within its cone, as `light.wgsl`'s `light_irradiance`).
+fn light_at(light: &Light, x: Vec3, reach: f32) -> (Vec3, Vec3) {
+    let intensity = light.intensity.radiometric();
+    let from_point = |position: Vec3, edge: f32| {
+        let d2 = x.distance_squared(position).max(1e-30);
+        (position, intensity * edge / d2)
+    };
+    match light.kind {
+        LightKind::Directional { direction } => (x - direction.normalize() * reach, intensity),
+        LightKind::Point { position } => from_point(position, 1.0),
+        LightKind::Spot { position, cone } => {
+            let c = (x - position).normalize().dot(cone.direction.normalize());
+            let outer = cone.cone_deg.to_radians().cos();
+            let inner = (cone.cone_deg - cone.falloff_deg).to_radians().cos();
+            let edge = if inner > outer {
+                let t = ((c - outer) / (inner - outer)).clamp(0.0, 1.0);
+                t * t * (3.0 - 2.0 * t)
+            } else {
+                f32::from(u8::from(c >= outer))
+            };
+            from_point(position, edge)
+        }
+    }
+}
+
+/// The direct light of `scene`'s first `max_lights` lights at every receiver, without shadows
+/// and with each light's shadow traced ([`DirectTruth`]).
+pub fn direct_truth(receivers: &[Option<Receiver>], scene: &Scene, max_lights: u32) -> DirectTruth {
+    let visibility = Visibility::new(scene);
+    let lights = &scene.lights[..scene.lights.len().min(max_lights as usize)];
+    let reach = 2.0 * scene.extent();
+    let (unshadowed, shadowed) = receivers
+        .par_iter()
+        .map(|r| {
+            let Some(r) = r else {
+                return ([0.0; 3], [0.0; 3]);
+            };
+            let (x, n, albedo) = (
+                Vec3::from(r.position),
+                Vec3::from(r.normal),
+                Vec3::from(r.albedo),
+            );
+            let (mut all, mut seen) = (Vec3::ZERO, Vec3::ZERO);
+            for light in lights {
+                let (from, irradiance) = light_at(light, x, reach);
+                let cos = n.dot((from - x).normalize_or_zero());
+                if cos <= 0.0 {
+                    continue;
+                }
+                let l = albedo / std::f32::consts::PI * irradiance * cos;
+                all += l;
+                if visibility.free(visibility.lift(r.position, r.normal), from) {
+                    seen += l;
+                }
+            }
+            (all.to_array(), seen.to_array())
+        })
+        .unzip();
+    DirectTruth {
+        unshadowed,
+        shadowed,
+    }
+}
+
+/// The share of the receivers the direct light reaches (unshadowed luminance above zero) whose
+/// shadow `direct` (a GPU picture's direct light) gets wrong: where its light differs from the
+/// traced shadow's by more than half the unshadowed light, i.e. where the GPU's visibility (its
+/// light over the unshadowed) rounded to lit or shadowed is not the traced one. A soft edge a
+/// pixel wide counts only where it is more than half wrong.
+pub fn shadow_mismatch(direct: &[[f32; 3]], truth: &DirectTruth) -> f64 {
+    assert_eq!(
+        direct.len(),
+        truth.shadowed.len(),
+        "images of different sizes"
+    );
+    let lum = |c: &[f32; 3]| luminance(Vec3::from(*c));
+    let (mut reached, mut wrong) = (0u64, 0u64);
+    for ((gpu, seen), all) in direct.iter().zip(&truth.shadowed).zip(&truth.unshadowed) {
+        let all = lum(all);
+        if all <= 0.0 {
+            continue;
+        }
+        reached += 1;
+        if (lum(gpu) - lum(seen)).abs() > 0.5 * all {
+            wrong += 1;
+        }
+    }
+    wrong as f64 / reached.max(1) as f64
 }
 
 /// Error of an image against a reference (both linear RGB, same size).

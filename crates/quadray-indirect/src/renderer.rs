@@ -1,9 +1,10 @@
 //! quadray's own renderer of a [`Scene`]: its triangles in a vertex buffer, its G-buffer, and
-//! the public passes (an RSM and a light quadtree per light view, the gather summing them)
-//! recorded in one encoder per frame, timed per pass. The CLI, the viewer and the benchmarks
-//! render through it.
+//! the public passes (an RSM and a light quadtree per light view, the gather summing them, the
+//! direct light through a shadow map per light view) recorded in one encoder per frame, timed
+//! per pass. The CLI, the viewer and the benchmarks render through it.
 
 use crate::IndirectError;
+use crate::direct::pass::DirectLight;
 use crate::frame::{CutNode, Frame, FrameTiming, Pass, Receiver, Vpl, WorkCounts};
 use crate::gathers::gather::Gather;
 use crate::gathers::resources::ViewMaps;
@@ -42,6 +43,9 @@ pub struct Renderer<'g> {
     views: Vec<ViewPasses>,
     gbuffer: GBufferPass,
     gather: Gather,
+    direct: DirectLight,
+    /// The scene's bounds, which the sun's shadow map is fitted within.
+    bounds: (glam::Vec3, glam::Vec3),
     /// A timer for all passes; `None` when the adapter has no timestamp queries.
     timer: GpuTimer,
 }
@@ -52,7 +56,8 @@ impl<'g> Renderer<'g> {
     /// lights left out); refuses settings that make no picture with [`IndirectError::Settings`].
     pub fn new(gpu: &'g Gpu, scene: &Scene, settings: Settings) -> Result<Self, IndirectError> {
         settings.validate().map_err(IndirectError::Settings)?;
-        let needs = Gather::limit_needs(&settings);
+        let mut needs = Gather::limit_needs(&settings);
+        needs.extend(DirectLight::limit_needs(&settings));
         quadray_gpu::check_limits(&gpu.device.limits(), &gpu.describe(), &needs)?;
         let left_out = scene
             .lights
@@ -94,6 +99,7 @@ impl<'g> Renderer<'g> {
                 );
                 gather.set_occupancy(d, q, &grid, gbuffer.views());
             }
+            let direct = DirectLight::new(d, &gather);
             let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("vertices"),
                 contents: bytemuck::cast_slice(&scene.triangles),
@@ -107,6 +113,8 @@ impl<'g> Renderer<'g> {
                 views,
                 gbuffer,
                 gather,
+                direct,
+                bounds: scene.bounds(),
                 timer: GpuTimer::new(gpu, Pass::ALL.len() as u32),
             })
         })??;
@@ -141,6 +149,7 @@ impl<'g> Renderer<'g> {
         let eye = scene.camera.position;
         self.gbuffer.set_camera(q, view_proj, eye);
         self.gather.set_camera(q, view_proj, eye);
+        self.direct.set_lights(q, &lights, view_proj, self.bounds);
         Ok(())
     }
 
@@ -310,10 +319,26 @@ impl<'g> Renderer<'g> {
                 }),
             ));
         }
+        if run.contains(&Pass::ShadowMap) {
+            steps.push((
+                Pass::ShadowMap,
+                Box::new(move |encoder| {
+                    self.direct.record_shadow_maps(
+                        encoder,
+                        self.vertices.slice(..),
+                        self.vertex_count,
+                        slot(Pass::ShadowMap),
+                    )
+                }),
+            ));
+        }
         if run.contains(&Pass::Direct) {
             steps.push((
                 Pass::Direct,
-                Box::new(move |encoder| self.gather.record_direct(encoder, slot(Pass::Direct))),
+                Box::new(move |encoder| {
+                    self.direct
+                        .record(encoder, &self.gather, slot(Pass::Direct))
+                }),
             ));
         }
         steps
@@ -367,7 +392,8 @@ impl<'g> Renderer<'g> {
                 passes.push(Pass::Cut);
             }
         }
-        passes.extend([Pass::GBuffer, Pass::Indirect, Pass::Direct]);
+        // the sun's shadow map follows the camera: drawn every frame, as the G-buffer
+        passes.extend([Pass::GBuffer, Pass::Indirect, Pass::ShadowMap, Pass::Direct]);
         if self.settings().reconstructs(method) {
             passes.push(Pass::Upsample);
         }

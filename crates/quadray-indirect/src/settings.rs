@@ -157,6 +157,19 @@ fn check_rsm_size(size: u32) -> Result<u32, String> {
     }
 }
 
+/// The shadow-map check `validate()` and `--shadow-map-size` share: a power of two within
+/// [`Settings::SHADOW_MAP_SIZE`].
+fn check_shadow_map_size(size: u32) -> Result<u32, String> {
+    if size.is_power_of_two() && Settings::SHADOW_MAP_SIZE.contains(size) {
+        Ok(size)
+    } else {
+        Err(format!(
+            "shadow map size {size} must be a power of two in {}",
+            Settings::SHADOW_MAP_SIZE
+        ))
+    }
+}
+
 impl Settings {
     /// `--size`'s parser (`WxH`, each side within [`Settings::SIDE`]), also for a program with a
     /// command line of its own.
@@ -167,6 +180,11 @@ impl Settings {
     /// `--rsm-size`'s parser (a power of two within [`Settings::RSM_SIZE`]), likewise.
     pub fn parse_rsm_size(text: &str) -> Result<u32, String> {
         check_rsm_size(Settings::RSM_SIZE.parser()(text)?)
+    }
+
+    /// `--shadow-map-size`'s parser (a power of two within [`Settings::SHADOW_MAP_SIZE`]).
+    pub fn parse_shadow_map_size(text: &str) -> Result<u32, String> {
+        check_shadow_map_size(Settings::SHADOW_MAP_SIZE.parser()(text)?)
     }
 }
 
@@ -190,6 +208,14 @@ pub struct Settings {
         value_parser = Settings::parse_rsm_size,
     ))]
     pub rsm_size: u32,
+    /// Side of each light view's shadow map for the direct light's shadows, in texels (a power
+    /// of two; a point light has six): the sun's map is fitted to what the camera sees, a spot's
+    /// and a point light's faces are their RSM views. Default: twice the picture's longer side
+    /// rounded up to a power of two, within 256-2048 (a 512x512 picture's is 1024, a 1920x1080
+    /// picture's 2048): the fitted map then spends a texel or more on every pixel of the ground
+    /// near the camera, where a pixel covers least of it.
+    #[cfg_attr(feature = "cli", arg(long, value_parser = Settings::parse_shadow_map_size))]
+    pub shadow_map_size: Option<u32>,
     /// The most lights rendered: the scene's first N, each with its own RSM of --rsm-size^2
     /// texels and light quadtree (a point light six, one per cube face), so the light's work
     /// grows linearly with the count.
@@ -361,6 +387,7 @@ impl Settings {
     pub const DEFAULT: Settings = Settings {
         size: Size::new(512, 512),
         rsm_size: 512,
+        shadow_map_size: None,
         max_lights: 4,
         cluster: ClusterSettings::DEFAULT,
         samples: 256,
@@ -386,6 +413,10 @@ impl Settings {
     /// [`Settings::rsm_size`] (also a power of two): 1024^2 VPLs make a 67 MB quadtree, within
     /// every adapter's storage-buffer limit.
     pub const RSM_SIZE: Limits<u32> = Limits::closed(4, 1024).interactive(8, 1024);
+    /// [`Settings::shadow_map_size`] (also a power of two): an 8192^2 map takes 256 MB.
+    pub const SHADOW_MAP_SIZE: Limits<u32> = Limits::closed(16, 8192).interactive(256, 4096);
+    /// The range [`Settings::shadow_map_size_or_default`] keeps a derived side within.
+    pub const DEFAULT_SHADOW_MAP_SIZES: (u32, u32) = (256, 2048);
     /// [`Settings::max_lights`].
     pub const MAX_LIGHTS: Limits<u32> = Limits::closed(1, 16);
     /// [`Settings::samples`].
@@ -459,6 +490,18 @@ impl Settings {
             .unwrap_or_else(|| Self::tile_capacity_within(self.size, Self::DEFAULT_TILE_LIST_BYTES))
     }
 
+    /// The side of the direct light's shadow maps: [`Settings::shadow_map_size`], else twice
+    /// the picture's longer side rounded up to a power of two, within
+    /// [`Self::DEFAULT_SHADOW_MAP_SIZES`].
+    pub fn shadow_map_size_or_default(&self) -> u32 {
+        let (least, most) = Self::DEFAULT_SHADOW_MAP_SIZES;
+        self.shadow_map_size.unwrap_or_else(|| {
+            (2 * self.size.width.max(self.size.height))
+                .next_power_of_two()
+                .clamp(least, most)
+        })
+    }
+
     /// Points marched per receiver and cluster: [`Settings::shadow_steps`] with indirect
     /// shadows, else 0.
     pub fn march_steps(&self) -> u32 {
@@ -481,6 +524,7 @@ impl Settings {
             },
             tile_error: Some(self.tile_error_or_default()),
             tile_capacity: Some(self.tile_capacity_or_default()),
+            shadow_map_size: Some(self.shadow_map_size_or_default()),
             ..self.clone()
         }
     }
@@ -537,6 +581,9 @@ impl Settings {
         let s = self;
         check_size(&s.size)?;
         check_rsm_size(s.rsm_size)?;
+        if let Some(size) = s.shadow_map_size {
+            check_shadow_map_size(size)?;
+        }
         let c = &s.cluster;
         for (what, level) in [
             ("start level", c.start_level),
@@ -682,6 +729,7 @@ mod tests {
         let every = Settings {
             size: Size::new(96, 64),
             rsm_size: 256,
+            shadow_map_size: Some(512),
             max_lights: 3,
             cluster: ClusterSettings {
                 start_level: Some(5),

@@ -88,6 +88,13 @@ fn shaders() -> Vec<(&'static str, Vec<String>)> {
         ("gbuffer", owned(&gbuffer::SOURCES)),
         ("quadtree", owned(&quadtree::SOURCES)),
         ("output", output::pass::sources("rgba16float").to_vec()),
+        ("shadow map", owned(&[rsm::RASTER_WGSL])),
+        (
+            "direct",
+            owned(&crate::gathers::resources::shader(
+                &crate::direct::pass::WGSL,
+            )),
+        ),
     ];
     shaders.extend(
         crate::gathers::gather::shaders()

@@ -5,8 +5,8 @@
 use quadray_gpu::{Gpu, read_buffer, read_texture_f32, texture_2d};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{
-    FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass, OutputTerm,
-    Renderer, RsmPass, RsmViews, Scene, Settings, ViewMaps,
+    DirectLight, FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass,
+    OutputTerm, Renderer, RsmPass, RsmViews, Scene, Settings, ViewMaps,
 };
 use wgpu::util::DeviceExt;
 
@@ -85,6 +85,9 @@ struct Passes {
     rsm: [wgpu::Texture; 3],
     quadtree: LightQuadtree,
     gather: Gather,
+    /// The direct light, its shadow maps drawn from the scene's triangles.
+    direct: DirectLight,
+    vertices: (wgpu::Buffer, u32),
     output: wgpu::Texture,
     output_pass: OutputPass,
 }
@@ -116,9 +119,18 @@ impl Passes {
             quadtree: &quadtree,
         }];
         let gather = Gather::new(d, &s, &maps, gbuffer_views).unwrap();
-        gather.set_lights(q, &LightView::of_scene(scene, 1), scene.r_min);
+        let lights = LightView::of_scene(scene, 1);
+        gather.set_lights(q, &lights, scene.r_min);
         let aspect = size.0 as f32 / size.1 as f32;
-        gather.set_camera(q, scene.camera_view_proj(aspect), scene.camera.position);
+        let view_proj = scene.camera_view_proj(aspect);
+        gather.set_camera(q, view_proj, scene.camera.position);
+        let direct = DirectLight::new(d, &gather);
+        direct.set_lights(q, &lights, view_proj, scene.bounds());
+        let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vertices"),
+            contents: bytemuck::cast_slice(&scene.triangles),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
         let output = texture_2d(
             d,
             "output",
@@ -132,6 +144,8 @@ impl Passes {
             rsm,
             quadtree,
             gather,
+            direct,
+            vertices: (vertices, scene.triangles.len() as u32 * 3),
             output,
             output_pass,
         }
@@ -169,7 +183,10 @@ impl Passes {
         self.quadtree.record_cut(&mut encoder, None);
         self.gather
             .record_indirect(&mut encoder, method, &[&self.quadtree], None);
-        self.gather.record_direct(&mut encoder, None);
+        let (vertices, count) = &self.vertices;
+        self.direct
+            .record_shadow_maps(&mut encoder, vertices.slice(..), *count, None);
+        self.direct.record(&mut encoder, &self.gather, None);
         self.output_pass.record(
             d,
             &mut encoder,

@@ -458,6 +458,17 @@ impl IndirectView {
             s.cluster.start_level = None;
             s.cluster.limit_level = None;
         }
+        // the direct light's shadow maps: their default follows the window until one is chosen
+        let mut shadow_log = s.shadow_map_size_or_default().ilog2();
+        let (smallest, largest) = Settings::SHADOW_MAP_SIZE.interactive_range();
+        ui.add(
+            egui::Slider::new(&mut shadow_log, smallest.ilog2()..=largest.ilog2())
+                .custom_formatter(|v, _| format!("{}", 1u32 << v as u32))
+                .text("shadow map size"),
+        );
+        if 1 << shadow_log != s.shadow_map_size_or_default() {
+            s.shadow_map_size = Some(1 << shadow_log);
+        }
         let levels = s.levels();
         let (mut start, mut limit) = (levels.start, levels.limit);
         ui.add(egui::Slider::new(&mut start, 0..=rsm_log).text("start level"));

@@ -11,7 +11,9 @@
 use quadray_core::image_out::{Rgba8Image, heat_map, montage};
 use quadray_gpu::Gpu;
 use quadray_indirect::picture::{flip_against, tone_map};
-use quadray_indirect::reference::{compare, error_map, ground_truth};
+use quadray_indirect::reference::{
+    compare, direct_truth, error_map, ground_truth, shadow_mismatch,
+};
 use quadray_indirect::scene::{LightKind, scenes_dir};
 use quadray_indirect::{Frame, IndirectError, Method, Renderer, Scene, Settings};
 use std::path::{Path, PathBuf};
@@ -254,10 +256,11 @@ fn held_apart_picture(
     save(&montage(&pictures, 2), path)
 }
 
-/// A scene lit by other lights than a spot (`scenes_dir()/NAME.toml`): the direct light, with the
-/// default method's bounce (indirect shadows on), and with the bounce from every VPL with exact
-/// visibility (the ground truth, at [`truth_side`] with a [`truth_rsm_size`] RSM); below, the
-/// method's bounce with its FLIP, the true bounce and the error heat map.
+/// A scene lit by other lights than a spot (`scenes_dir()/NAME.toml`): the direct light (with the
+/// share of its pixels whose shadow differs from a traced one's), with the default method's
+/// bounce (indirect shadows on), and with the bounce from every VPL with exact visibility (the
+/// ground truth, at [`truth_side`] with a [`truth_rsm_size`] RSM); below, the method's bounce
+/// with its FLIP, the true bounce and the error heat map.
 fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathBuf, IndirectError> {
     let scene = Scene::load(&scenes_dir().join(format!("{name}.toml")))?;
     let side = truth_side(size);
@@ -266,9 +269,12 @@ fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathB
         indirect_shadows: true,
         ..Settings::sized(w, h, truth_rsm_size(&scene))
     };
-    let mut r = Renderer::new(gpu, &scene, settings)?;
+    let mut r = Renderer::new(gpu, &scene, settings.clone())?;
     let frame = r.render_frame(Method::DEFAULT)?;
-    let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
+    let receivers = r.read_receivers()?;
+    let truth = ground_truth(&r.read_vpls()?, &receivers, &scene);
+    let direct = direct_truth(&receivers, &scene, settings.max_lights);
+    let off = shadow_mismatch(&frame.direct, &direct);
     let tile = |v: &[[f32; 3]]| tone_map(w, h, v, EXPOSURE);
     let with_truth = Frame {
         indirect: truth.clone(),
@@ -278,7 +284,10 @@ fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathB
     let flip = flip_against(&frame, &truth, EXPOSURE);
     // (short captions: the demo's smallest pictures are 128 pixels wide)
     let pictures = [
-        ("direct".into(), tile(&frame.direct)),
+        (
+            format!("direct, {:.1}% off", off * 100.0),
+            tile(&frame.direct),
+        ),
         ("+ bounce".into(), tile(&frame.combined())),
         ("+ true bounce".into(), tile(&with_truth)),
         (format!("FLIP {flip:.3}"), tile(&frame.indirect)),

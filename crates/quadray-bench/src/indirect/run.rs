@@ -98,6 +98,9 @@ pub struct TruthError {
     /// The same by the bends of the error there ([`Order::Bend`]), which see an error that is
     /// continuous across the boundaries but changes slope there.
     pub blockiness_bends: Option<f64>,
+    /// The share of the pixels the direct light reaches whose direct shadow differs from the
+    /// traced one ([`reference::shadow_mismatch`]).
+    pub direct_shadows_wrong: f64,
 }
 
 /// Refuses a ground truth that would trace more than [`reference::MAX_GROUND_TRUTH_RAYS`].
@@ -185,7 +188,11 @@ pub fn run(
     let flip = reference.map(|r| flip_against(&frame, r, options.exposure));
     let truth = if options.ground_truth {
         let (vpls, receivers) = (renderer.read_vpls()?, renderer.read_receivers()?);
-        Some(reference::ground_truth(&vpls, &receivers, scene))
+        let direct = reference::direct_truth(&receivers, scene, s.max_lights);
+        Some((
+            reference::ground_truth(&vpls, &receivers, scene),
+            reference::shadow_mismatch(&frame.direct, &direct),
+        ))
     } else {
         None
     };
@@ -203,7 +210,7 @@ pub fn run(
             options.frames,
         )?),
     };
-    let ground_truth = truth.as_ref().map(|truth| {
+    let ground_truth = truth.as_ref().map(|(truth, direct_shadows_wrong)| {
         let e = reference::compare(&frame.indirect, truth);
         let structure = brute_force.as_deref().and_then(|brute_force| {
             let edges_of = [frame.direct.as_slice(), brute_force];
@@ -219,6 +226,7 @@ pub fn run(
             flip: flip_against(&frame, truth, options.exposure),
             blockiness: blockiness(Order::Step),
             blockiness_bends: blockiness(Order::Bend),
+            direct_shadows_wrong: *direct_shadows_wrong,
         }
     });
     Ok(Outcome {
@@ -251,6 +259,6 @@ pub fn run(
         exposure_advice,
         error_map,
         cut_view: cut,
-        ground_truth: truth.map(|t| tone_map(w, h, &t, options.exposure)),
+        ground_truth: truth.map(|(t, _)| tone_map(w, h, &t, options.exposure)),
     })
 }

@@ -3,7 +3,6 @@
 
 use super::brute_force::BruteForce;
 use super::cut::Cut;
-use super::direct::Direct;
 use super::passes::Passes;
 use super::resources::{Resources, ViewMaps};
 use super::rsm_sampling::RsmSampling;
@@ -43,10 +42,6 @@ pub(crate) fn shaders() -> Vec<(&'static str, Vec<&'static str>)> {
             super::resources::shader(&super::brute_force::WGSL),
         ),
         (
-            "gather direct",
-            super::resources::shader(&super::direct::WGSL),
-        ),
-        (
             "gather temporal",
             super::resources::shader(&crate::output::temporal::WGSL),
         ),
@@ -67,7 +62,6 @@ pub struct Gather {
     tiles: Tiles,
     rsm_sampling: RsmSampling,
     brute_force: BruteForce,
-    direct: Direct,
     temporal: Temporal,
 }
 
@@ -136,7 +130,6 @@ impl Gather {
             tiles: Tiles::new(device, &res),
             rsm_sampling: RsmSampling::new(device, &res),
             brute_force: BruteForce::new(device, &res),
-            direct: Direct::new(device, &res),
             temporal: Temporal::new(device, &res),
             res,
         })
@@ -276,21 +269,6 @@ impl Gather {
         }
     }
 
-    /// Records the direct light of every light view, shadowed by its RSM depth, into `timer`'s
-    /// `slot`.
-    pub fn record_direct(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: Option<(&GpuTimer, u32)>,
-    ) {
-        let stamps = timer.and_then(|(t, slot)| t.compute_pass(slot));
-        let mut pass = compute_pass(encoder, "direct", stamps);
-        for view in 0..self.res.view_count() {
-            self.res.bind_groups(&mut pass, view);
-            self.direct.record(&mut pass, &self.res);
-        }
-    }
-
     /// The settings the gather was built with.
     pub fn settings(&self) -> &Settings {
         self.res.settings()
@@ -303,9 +281,15 @@ impl Gather {
         &self.res.outputs.indirect
     }
 
-    /// Direct radiance per pixel, row-major (rgb, w = 1 where the G-buffer has geometry).
+    /// Direct radiance per pixel, row-major (rgb, w = 1 where the G-buffer has geometry), as a
+    /// [`crate::DirectLight`] writes it.
     pub(crate) fn direct(&self) -> &wgpu::Buffer {
         &self.res.outputs.direct
+    }
+
+    /// The resources every pass shares, for the passes outside the gather (the direct light).
+    pub(crate) fn resources(&self) -> &Resources {
+        &self.res
     }
 
     /// Per pixel, the last indirect passes' VPL evaluations, texel fetches, bound evaluations and

@@ -1,8 +1,8 @@
 //! The gather: deferred shading of the caller's G-buffer from the light quadtree (the compacted
 //! cut, the paper's one pass per level, per-tile cuts; the cut and RSM sampling optionally at low
 //! resolution with geometry-aware upsampling), the baselines of the same shape (RSM sampling,
-//! the brute force over every VPL), the temporal filter, and the direct light, each light view's
-//! RSM depth its shadow map. Every pass sums the light views (a spot or the sun one, a point light
+//! the brute force over every VPL) and the temporal filter; the direct light
+//! ([`crate::DirectLight`]) runs over the same resources. Every pass sums the light views (a spot or the sun one, a point light
 //! six): the first view writes the radiance, the others add. Writes radiance buffers an
 //! [`crate::OutputPass`] copies into the caller's texture.
 //!
@@ -12,7 +12,6 @@
 
 mod brute_force;
 mod cut;
-mod direct;
 pub(crate) mod gather;
 mod passes;
 pub(crate) mod resources;

@@ -1,6 +1,6 @@
 //! The RSM pass: the caller's triangles rasterised from one light view into a reflective shadow
 //! map (flux, position + depth, normal), the input of the light quadtree. Also the raster
-//! helpers quadray's own G-buffer pass shares.
+//! helpers quadray's own G-buffer pass and the direct light's shadow maps share.
 
 use crate::contract::{
     LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
@@ -53,15 +53,17 @@ pub(crate) fn view(texture: &wgpu::Texture) -> wgpu::TextureView {
     texture.create_view(&Default::default())
 }
 
-/// Three float colour targets and a depth buffer of one size, as both raster passes write them.
-pub(crate) struct RasterTargets {
-    pub colors: [wgpu::Texture; 3],
-    pub views: [wgpu::TextureView; 3],
-    depth: wgpu::TextureView,
+/// `N` float colour targets (three for the RSM and the G-buffer, none for a shadow map) and a
+/// depth buffer of one size, as the raster passes write them.
+pub(crate) struct RasterTargets<const N: usize = 3> {
+    pub colors: [wgpu::Texture; N],
+    pub views: [wgpu::TextureView; N],
+    /// Also read as a texture: a shadow map's depth.
+    pub depth: wgpu::TextureView,
 }
 
-impl RasterTargets {
-    pub fn new(device: &wgpu::Device, labels: [&str; 3], size: (u32, u32)) -> Self {
+impl<const N: usize> RasterTargets<N> {
+    pub fn new(device: &wgpu::Device, labels: [&str; N], size: (u32, u32)) -> Self {
         let colors = labels.map(|l| target(device, l, size, FLOAT_FORMAT));
         let depth = target(device, "depth", size, DEPTH_FORMAT);
         Self {
@@ -72,15 +74,19 @@ impl RasterTargets {
     }
 }
 
-/// A raster pipeline over [`Vertex`] triangles into three float targets with a depth test.
-pub(crate) fn raster_pipeline(
+/// A raster pipeline over [`Vertex`] triangles into `N` float targets (written by the entry
+/// point `fragment`; none: depth only) with a depth test.
+pub(crate) fn raster_pipeline<const N: usize>(
     device: &wgpu::Device,
     group: &wgpu::BindGroupLayout,
     module: &wgpu::ShaderModule,
-    fragment: &str,
+    label: &str,
+    fragment: Option<&str>,
 ) -> wgpu::RenderPipeline {
+    let targets: [Option<wgpu::ColorTargetState>; N] =
+        std::array::from_fn(|_| Some(FLOAT_FORMAT.into()));
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(fragment),
+        label: Some(label),
         layout: Some(&pipeline_layout(device, &[group])),
         vertex: wgpu::VertexState {
             module,
@@ -95,15 +101,11 @@ pub(crate) fn raster_pipeline(
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: Some(nearest_depth(DEPTH_FORMAT)),
         multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
+        fragment: fragment.map(|entry| wgpu::FragmentState {
             module,
-            entry_point: Some(fragment),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
-            targets: &[
-                Some(FLOAT_FORMAT.into()),
-                Some(FLOAT_FORMAT.into()),
-                Some(FLOAT_FORMAT.into()),
-            ],
+            targets: &targets,
         }),
         multiview_mask: None,
         cache: None,
@@ -112,10 +114,10 @@ pub(crate) fn raster_pipeline(
 
 /// Clears `targets` and draws `vertex_count` vertices of `vertices` into them.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn record_raster(
+pub(crate) fn record_raster<const N: usize>(
     encoder: &mut wgpu::CommandEncoder,
     label: &str,
-    targets: &RasterTargets,
+    targets: &RasterTargets<N>,
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
     vertices: wgpu::BufferSlice,
@@ -176,7 +178,7 @@ impl RsmPass {
         let raster = uniform_buffer::<RasterUniform>(device, "rsm projection");
         Self {
             rsm_size,
-            pipeline: raster_pipeline(device, &group_layout, &module, "rsm"),
+            pipeline: raster_pipeline::<3>(device, &group_layout, &module, "rsm", Some("rsm")),
             group: bind_group(
                 device,
                 "rsm",

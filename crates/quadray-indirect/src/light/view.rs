@@ -3,10 +3,10 @@
 //! from its own scene, and the per-view uniforms made from them (the light itself, the gather's
 //! per-light terms).
 
-use crate::contract::{LightTermsUniform, LightUniform};
+use crate::contract::{LightTermsUniform, LightUniform, ShadowUniform};
 use crate::scene::{Light, LightKind, Scene, extent_of};
 use crate::settings::Settings;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 /// How an RSM view projects the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,8 +121,25 @@ impl LightView {
         }
     }
 
-    /// A directional light's view: the bounds' corners in the light's frame, a square over them.
+    /// A directional light's RSM view: the bounds' corners in the light's frame, a square over
+    /// them.
     fn orthographic(direction: Vec3, bounds: (Vec3, Vec3), intensity: [f32; 3]) -> Self {
+        Self::orthographic_over(direction, &corners(bounds), bounds, intensity, None)
+    }
+
+    /// A directional light's view over `receivers` (world points): a square over them across the
+    /// light, from in front of every caster within `bounds` to behind the receivers. With a
+    /// shadow map's side, the square's width is rounded up to a step of the scene's size and its
+    /// middle moved to a whole texel of a frame fixed to the scene, so that a map fitted to a
+    /// moving camera keeps its texels on the same world points while its width holds (no
+    /// shimmering edges).
+    fn orthographic_over(
+        direction: Vec3,
+        receivers: &[Vec3],
+        bounds: (Vec3, Vec3),
+        intensity: [f32; 3],
+        snap_to_texels: Option<u32>,
+    ) -> Self {
         let (lo, hi) = bounds;
         let extent = extent_of(bounds);
         let centre = lo.midpoint(hi);
@@ -132,26 +149,29 @@ impl LightView {
             Vec3::Y
         };
         let at_centre = Mat4::look_to_rh(centre, direction, up);
-        let corners = (0..8).map(|i| {
-            let pick = |bit: usize, a: f32, b: f32| if i & bit == 0 { a } else { b };
-            Vec3::new(
-                pick(1, lo.x, hi.x),
-                pick(2, lo.y, hi.y),
-                pick(4, lo.z, hi.z),
-            )
-        });
-        let (min, max) = corners.fold((Vec3::MAX, Vec3::MIN), |(a, b), c| {
-            let p = at_centre.transform_point3(c);
-            (a.min(p), b.max(p))
-        });
-        // square, centred on the corners' box, a little wider so its edge texels see geometry
-        let width = (max.x - min.x).max(max.y - min.y).max(1e-3) * 1.02;
-        let middle = at_centre.inverse().transform_point3(Vec3::new(
-            (min.x + max.x) * 0.5,
-            (min.y + max.y) * 0.5,
-            0.0,
-        ));
-        // the view looks down -z: the nearest corner is at z = max.z
+        let span = |points: &mut dyn Iterator<Item = Vec3>| {
+            points.fold((Vec3::MAX, Vec3::MIN), |(a, b), c| {
+                let p = at_centre.transform_point3(c);
+                (a.min(p), b.max(p))
+            })
+        };
+        let (min, max) = span(&mut receivers.iter().copied());
+        // casters lie anywhere in the bounds towards the light
+        let (_, casters_max) = span(&mut corners(bounds).into_iter());
+        let max = Vec3::new(max.x, max.y, max.z.max(casters_max.z));
+        // square, centred on the receivers' box, a little wider so its edge texels see geometry
+        let mut width = (max.x - min.x).max(max.y - min.y).max(1e-3) * 1.02;
+        let mut across = Vec2::new(min.x + max.x, min.y + max.y) * 0.5;
+        if let Some(size) = snap_to_texels {
+            let step = extent / 64.0;
+            width = (width / step).ceil() * step;
+            let texel = width / size as f32;
+            across = (across / texel).round() * texel;
+        }
+        let middle = at_centre
+            .inverse()
+            .transform_point3(Vec3::new(across.x, across.y, 0.0));
+        // the view looks down -z: the nearest point is at z = max.z
         let margin = 0.01 * extent;
         let position = middle - direction * (max.z + margin);
         let far = max.z - min.z + 2.0 * margin;
@@ -169,6 +189,43 @@ impl LightView {
         }
     }
 
+    /// The view of this light view's shadow map of `size`^2 texels for the direct light: a
+    /// directional light's fitted to the part of `bounds` (the scene's) inside the camera's
+    /// frustum (`camera_view_proj`, world -> clip with depth 0..1), which holds every receiver
+    /// the camera sees, as engines fit a cascade; a spot's and a point light's face are the RSM's
+    /// view (the cone, a cube face), only with more texels.
+    pub(crate) fn shadow_view(
+        &self,
+        camera_view_proj: Mat4,
+        bounds: (Vec3, Vec3),
+        size: u32,
+    ) -> Self {
+        match self.projection {
+            Projection::Perspective { .. } => *self,
+            Projection::Orthographic { .. } => {
+                let seen = visible_region(camera_view_proj, bounds);
+                if seen.is_empty() {
+                    return *self;
+                }
+                Self::orthographic_over(self.direction, &seen, bounds, self.intensity, Some(size))
+            }
+        }
+    }
+
+    /// The direct pass's uniform of this view as the view of a shadow map of `size`^2 texels.
+    pub(crate) fn shadow_uniform(&self, size: u32) -> ShadowUniform {
+        let parallel = matches!(self.projection, Projection::Orthographic { .. });
+        ShadowUniform {
+            view_proj: self.view_proj.to_cols_array_2d(),
+            texel: [
+                self.texel_measure(size).sqrt(),
+                f32::from(u8::from(parallel)),
+                size as f32,
+                0.0,
+            ],
+        }
+    }
+
     /// An RSM texel's measure on the axis: its solid angle (perspective; it shrinks as cos^3
     /// off the axis) or its area across the light (orthographic).
     pub(crate) fn texel_measure(&self, rsm_size: u32) -> f32 {
@@ -179,14 +236,6 @@ impl LightView {
             Projection::Orthographic { width } => width / rsm_size as f32,
         };
         side * side
-    }
-
-    /// A texel's side at the far side of the scene, in world units.
-    fn far_texel(&self, rsm_size: u32) -> f32 {
-        match self.projection {
-            Projection::Perspective { .. } => self.texel_measure(rsm_size).sqrt() * self.far,
-            Projection::Orthographic { width } => width / rsm_size as f32,
-        }
     }
 
     /// The gather's per-view values for `settings`, with the clamp `r_min` of the VPL kernel's
@@ -200,8 +249,6 @@ impl LightView {
     ) -> LightTermsUniform {
         LightTermsUniform {
             r_min,
-            // a few shadow-map texels' worth of depth at the far side of the scene
-            depth_bias: 0.005 + 3.0 * self.far_texel(settings.rsm_size) / self.extent,
             plane_agreement: 0.02 * self.extent,
             shadow_thickness: settings.shadow_thickness * self.extent,
             low_offset,
@@ -224,6 +271,84 @@ impl LightView {
             parallel: [f32::from(u8::from(parallel)), 0.0, 0.0, 0.0],
         }
     }
+}
+
+/// The eight corners of `bounds` (min, max); corner `i` takes max on x, y, z where bits 0, 1, 2
+/// of `i` are set.
+fn corners((lo, hi): (Vec3, Vec3)) -> [Vec3; 8] {
+    std::array::from_fn(|i| {
+        let pick = |bit: usize, a: f32, b: f32| if i & bit == 0 { a } else { b };
+        Vec3::new(
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
+        )
+    })
+}
+
+/// The six faces of a hexahedron whose corners are numbered as [`corners`]', each a cycle of
+/// four corners.
+fn faces(c: &[Vec3; 8]) -> [[Vec3; 4]; 6] {
+    std::array::from_fn(|f| {
+        let (axis, side) = (f / 2, (f % 2) << (f / 2));
+        let (i, j) = (1 << ((axis + 1) % 3), 1 << ((axis + 2) % 3));
+        [side, side | i, side | i | j, side | j].map(|k| c[k])
+    })
+}
+
+/// The planes of a convex hexahedron's faces, as (normal, offset) with `normal . p + offset >= 0`
+/// inside.
+fn inner_planes(c: &[Vec3; 8]) -> Vec<(Vec3, f32)> {
+    let middle = c.iter().copied().sum::<Vec3>() / 8.0;
+    faces(c)
+        .iter()
+        .filter_map(|f| {
+            let n = (f[1] - f[0]).cross(f[3] - f[0]).try_normalize()?;
+            let n = if n.dot(middle - f[0]) < 0.0 { -n } else { n };
+            Some((n, -n.dot(f[0])))
+        })
+        .collect()
+}
+
+/// `polygon` clipped to the inside of every one of `planes` (Sutherland-Hodgman).
+fn clip(polygon: &[Vec3], planes: &[(Vec3, f32)]) -> Vec<Vec3> {
+    let mut out = polygon.to_vec();
+    for &(n, d) in planes {
+        let input = std::mem::take(&mut out);
+        for (k, &a) in input.iter().enumerate() {
+            let b = input[(k + 1) % input.len()];
+            let (da, db) = (n.dot(a) + d, n.dot(b) + d);
+            if da >= 0.0 {
+                out.push(a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                out.push(a + (b - a) * (da / (da - db)));
+            }
+        }
+    }
+    out
+}
+
+/// The corners of the part of `bounds` inside the camera's frustum (`view_proj`: world -> clip
+/// with depth 0..1): every vertex of the two solids' intersection lies on a face of one clipped
+/// to the other. Empty where they do not meet; the whole bounds where the frustum has no finite
+/// far corners.
+fn visible_region(view_proj: Mat4, bounds: (Vec3, Vec3)) -> Vec<Vec3> {
+    let inverse = view_proj.inverse();
+    let ndc = corners((Vec3::new(-1.0, -1.0, 0.0), Vec3::ONE));
+    let frustum = ndc.map(|p| inverse * p.extend(1.0));
+    if frustum
+        .iter()
+        .any(|p| !(p.w.abs() > 1e-12 && p.is_finite()))
+    {
+        return corners(bounds).to_vec();
+    }
+    let frustum = frustum.map(|p| p.truncate() / p.w);
+    let solid = corners(bounds);
+    let (frustum_planes, solid_planes) = (inner_planes(&frustum), inner_planes(&solid));
+    let from_frustum = faces(&frustum).into_iter().map(|f| clip(&f, &solid_planes));
+    let from_solid = faces(&solid).into_iter().map(|f| clip(&f, &frustum_planes));
+    from_frustum.chain(from_solid).flatten().collect()
 }
 
 #[cfg(test)]
@@ -288,6 +413,53 @@ mod tests {
             assert!(c.x.abs() < 1.0 && c.y.abs() < 1.0, "{corner}: {c}");
             assert!(c.z > 0.0 && c.z < 1.0, "{corner}: depth {}", c.z);
         }
+    }
+
+    /// The sun's shadow view, fitted to a camera that sees a corner of a wide floor, is narrower
+    /// than its RSM's over the whole floor, and still holds every floor point the camera sees.
+    #[test]
+    fn the_sun_s_shadow_map_is_fitted_to_what_the_camera_sees() {
+        let bounds = (Vec3::new(-20.0, 0.0, -20.0), Vec3::new(20.0, 1.0, 20.0));
+        let sun = light(LightKind::Directional {
+            direction: Vec3::new(-0.3, -1.0, 0.2),
+        });
+        let [rsm] = LightView::of_light(&sun, bounds)[..] else {
+            panic!("one view");
+        };
+        let eye = Vec3::new(5.0, 2.0, 5.0);
+        let camera = Mat4::perspective_rh(1.0, 1.5, 0.1, 80.0)
+            * Mat4::look_at_rh(eye, Vec3::new(20.0, 0.0, 20.0), Vec3::Y);
+        let fitted = rsm.shadow_view(camera, bounds, 1024);
+        let width = |v: &LightView| match v.projection {
+            Projection::Orthographic { width } => width,
+            Projection::Perspective { .. } => panic!("orthographic"),
+        };
+        assert!(
+            width(&fitted) < 0.5 * width(&rsm),
+            "{} of {}",
+            width(&fitted),
+            width(&rsm)
+        );
+        let mut seen = 0;
+        for i in 0..=40 {
+            for j in 0..=40 {
+                let p = Vec3::new(-20.0 + i as f32, 0.0, -20.0 + j as f32);
+                let c = camera * p.extend(1.0);
+                if !(c.w > 0.0 && c.x.abs() < c.w && c.y.abs() < c.w && c.z < c.w) {
+                    continue;
+                }
+                seen += 1;
+                let s = fitted.view_proj * p.extend(1.0);
+                assert!(
+                    s.x.abs() < 1.0 && s.y.abs() < 1.0 && s.z > 0.0 && s.z < 1.0,
+                    "{p}: {s}"
+                );
+            }
+        }
+        assert!(seen > 20, "{seen} points seen");
+        // a point light's face's shadow view is its RSM's
+        let face = LightView::of_light(&light(LightKind::Point { position: Vec3::Y }), bounds)[0];
+        assert_eq!(face.shadow_view(camera, bounds, 1024), face);
     }
 
     #[test]

@@ -20,6 +20,16 @@ fn default_levels_follow_the_rsm_and_given_ones_are_kept() {
 fn resolved_settings_render_the_same_and_write_every_default_out() {
     let s = Settings::sized(1920, 1080, 256);
     let r = s.resolved();
+    // the shadow maps' default: twice the longer side, within 256-2048
+    assert_eq!(r.shadow_map_size, Some(2048));
+    assert_eq!(
+        Settings::sized(100, 60, 64).shadow_map_size_or_default(),
+        256
+    );
+    assert_eq!(
+        Settings::sized(300, 500, 64).shadow_map_size_or_default(),
+        1024
+    );
     assert_eq!(
         (
             r.levels(),
@@ -46,6 +56,14 @@ fn validate_uses_the_declared_limits() {
             },
             "RSM size 96 must be a power of two in",
             Settings::RSM_SIZE.to_string(),
+        ),
+        (
+            Settings {
+                shadow_map_size: Some(3000),
+                ..ok.clone()
+            },
+            "shadow map size 3000 must be a power of two in",
+            Settings::SHADOW_MAP_SIZE.to_string(),
         ),
         (
             Settings {
