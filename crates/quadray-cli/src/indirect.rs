@@ -242,7 +242,7 @@ mod tests {
     use clap::Parser;
     use proptest::prelude::*;
     use quadray_core::settings::{Limits, Size};
-    use quadray_indirect::{ClusterSettings, TileCriterion, Validity};
+    use quadray_indirect::{ClusterSettings, GBufferLayout, TileCriterion, Validity};
     use quadray_test_support::flags::assert_settings_round_trip;
 
     #[derive(Parser)]
@@ -277,6 +277,7 @@ mod tests {
                 u(Settings::SHADOW_STEPS),
                 f(Settings::SHADOW_THICKNESS, 0.0, 1.0),
                 f(Settings::TEMPORAL_WEIGHT, 0.0, 1.0),
+                proptest::sample::select(GBufferLayout::ALL.to_vec()),
             ),
             (
                 proptest::option::of(f(Settings::TILE_ERROR, 0.0, 1.0)),
@@ -292,7 +293,16 @@ mod tests {
             .prop_map(
                 |(
                     ((w, h), rsm_log, start, limit, depth, normal, validity, flux_weighted),
-                    (samples, rsm_radius, subsample, shadows, steps, thickness, temporal),
+                    (
+                        samples,
+                        rsm_radius,
+                        subsample,
+                        shadows,
+                        steps,
+                        thickness,
+                        temporal,
+                        gbuffer_layout,
+                    ),
                     (
                         tile_error,
                         tile_criterion,
@@ -316,6 +326,7 @@ mod tests {
                         size: Size::new(w, h),
                         rsm_size: 1 << rsm_log,
                         max_lights,
+                        gbuffer_layout,
                         cluster: ClusterSettings {
                             start_level,
                             limit_level,

@@ -6,6 +6,7 @@
 //! struct's size and field offsets against these.
 
 use crate::light::node::{CONE_SLACK, EMPTY_BOX, MAX_LEVELS};
+use crate::method::GBufferLayout;
 use crate::settings::{Shade, TILE, TILE_FRONTIER};
 use crate::shader_struct::{Layout, shader_struct};
 use crate::shadows::occupancy::{
@@ -116,6 +117,9 @@ shader_struct! {
     /// light.
     pub(crate) struct LightUniform as "Light" {
         view_proj: [[f32; 4]; 4],
+        /// Clip -> world relative to `position`: a compact RSM's positions are rebuilt from its
+        /// depth (relative, so that the translation does not cancel out in f32).
+        inv_view_proj: [[f32; 4]; 4],
         /// xyz: position (the sun: the middle of the map's near plane), w: 1 / scene extent (the
         /// RSM's depth unit).
         position: [f32; 4],
@@ -178,6 +182,9 @@ shader_struct! {
     /// The gather's per-camera values (the G-buffer's view and size), written with the camera.
     pub(crate) struct CameraUniform as "Camera" {
         view_proj: [[f32; 4]; 4],
+        /// Clip -> world relative to `eye`: a compact G-buffer's positions are rebuilt from its
+        /// depth (relative, so that the translation does not cancel out in f32).
+        inv_view_proj: [[f32; 4]; 4],
         eye: [f32; 4],
         width: u32,
         height: u32,
@@ -422,6 +429,12 @@ pub(crate) fn compute_pipeline(
         },
         cache: None,
     })
+}
+
+/// The pipeline constant `name` (`COMPACT_RSM`, `COMPACT_GBUFFER`) that says whether what a
+/// pipeline reads is in the compact layout.
+pub(crate) fn compact_constant(name: &'static str, layout: GBufferLayout) -> (&'static str, f64) {
+    (name, f64::from(u8::from(layout == GBufferLayout::Compact)))
 }
 
 pub(crate) fn whole(buffer: &wgpu::Buffer) -> wgpu::BindingResource<'_> {

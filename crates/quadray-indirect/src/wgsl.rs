@@ -33,6 +33,12 @@ pub const KERNEL: &str = include_str!("light/kernel.wgsl");
 /// depth). Accessors: none.
 pub const LIGHT: &str = include_str!("light/light.wgsl");
 
+/// The compact G-buffer and RSM layout's encodings ([`crate::GBufferLayout::Compact`]):
+/// `octahedral_encode` and `octahedral_decode` (a unit normal in two coordinates) and `unproject`
+/// (a depth texel's world position through the inverse of its view's projection relative to its
+/// eye). Accessors: none.
+pub const COMPACT: &str = include_str!("light/compact.wgsl");
+
 /// `Receiver`, what a G-buffer texel holds (position, normal, albedo, covered); the including
 /// shader reads its G-buffer into it. Accessors: none.
 pub const RECEIVER: &str = include_str!("gathers/receiver.wgsl");
@@ -125,11 +131,12 @@ fn occupancy_word(i: u32) -> u32 { return 0u; }
 ";
 
     /// Each module after the modules it needs, then the stub accessors it calls.
-    fn modules() -> [(&'static str, Vec<&'static str>); 12] {
+    fn modules() -> [(&'static str, Vec<&'static str>); 13] {
         [
             ("node", vec![NODE]),
             ("kernel", vec![NODE, KERNEL]),
             ("light", vec![LIGHT]),
+            ("compact", vec![COMPACT]),
             ("receiver", vec![RECEIVER]),
             ("cut rule", vec![NODE, CUT_RULE, NODE_ACCESSORS]),
             ("bound", vec![NODE, KERNEL, BOUND]),
@@ -185,6 +192,7 @@ fn occupancy_word(i: u32) -> u32 { return 0u; }
             NODE,
             KERNEL,
             LIGHT,
+            COMPACT,
             RECEIVER,
             CUT_RULE,
             BOUND,

@@ -45,6 +45,7 @@ const LAYERS: &[&[&str]] = &[
         "gathers::rsm_sampling",
         "gathers::brute_force",
         "gathers::direct",
+        "gathers::decode",
         "output::temporal",
     ],
     &["gathers::gather"],

@@ -12,8 +12,8 @@ fn direct_light(@builtin(global_invocation_id) id: vec3<u32>) {
         let size = f32(params.rsm_size);
         let texel = map_texel(clip, vec2<f32>(size));
         if (texel.x >= 0) {
-            let occluder = textureLoad(rsm_pos, texel, 0);
-            let lit = textureLoad(rsm_normal, texel, 0).w < 0.5
+            let occluder = load_rsm_position(texel);
+            let lit = load_rsm_normal(texel).w < 0.5
                 || light_depth(light, r.x) <= occluder.w + terms.depth_bias;
             if (lit) {
                 let w = light_towards(light, r.x);

@@ -12,6 +12,7 @@
 
 mod brute_force;
 mod cut;
+mod decode;
 mod direct;
 pub(crate) mod gather;
 mod passes;

@@ -1,39 +1,117 @@
 //! The RSM pass: the caller's triangles rasterised from one light view into a reflective shadow
-//! map (flux, position + depth, normal), the input of the light quadtree. Also the raster
-//! helpers quadray's own G-buffer pass shares.
+//! map (flux, position + depth, normal, in one of the [`GBufferLayout`]s), the input of the light
+//! quadtree. Also the raster helpers quadray's own G-buffer pass shares.
 
 use crate::contract::{
     LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
     uniform_buffer, uniform_entry, whole,
 };
 use crate::light::view::LightView;
+use crate::method::GBufferLayout;
 use crate::scene::Vertex;
+use crate::settings::Settings;
 use crate::wgsl;
 use quadray_gpu::{GpuTimer, cleared_attachment, nearest_depth, texture_2d};
 
-/// Format of every RSM and G-buffer colour target.
+/// Format of every wide RSM and G-buffer colour target.
 pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// A compact target's normal: two octahedral coordinates (compact.wgsl).
+const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
+/// A compact G-buffer's albedo (a reflectance in [0, 1]): 10 bits a channel, for as many ROP
+/// cycles as 8, hold a dark channel to 1% (the Cornell box's red wall's 0.05: 0.3%; 8 bits, 2%).
+const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgb10a2Unorm;
+/// A compact RSM's flux: high dynamic range.
+const FLUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The G-buffer's colour targets in `layout`: position, normal and albedo, or normal and albedo.
+pub(crate) fn gbuffer_formats(layout: GBufferLayout) -> &'static [wgpu::TextureFormat] {
+    match layout {
+        GBufferLayout::Wide => &[FLOAT_FORMAT; 3],
+        GBufferLayout::Compact => &[NORMAL_FORMAT, ALBEDO_FORMAT],
+    }
+}
+
+/// An RSM's colour targets in `layout`: flux, position and normal, or flux and normal.
+pub(crate) fn rsm_formats(layout: GBufferLayout) -> &'static [wgpu::TextureFormat] {
+    match layout {
+        GBufferLayout::Wide => &[FLOAT_FORMAT; 3],
+        GBufferLayout::Compact => &[FLUX_FORMAT, NORMAL_FORMAT],
+    }
+}
 
 const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
 
-pub(crate) const RASTER_WGSL: &str = include_str!("raster.wgsl");
+/// The raster passes' shared modules: the vertex stage, and the compact layout's encodings.
+pub(crate) const RASTER_WGSL: [&str; 2] = [include_str!("raster.wgsl"), wgsl::COMPACT];
+/// How the quadtree and the gather read an RSM texel in either layout (`load_rsm_normal`,
+/// `load_rsm_position`, `load_rsm_flux`; needs [`wgsl::LIGHT`], [`wgsl::COMPACT`] and the
+/// including shader's `rsm_flux`, `rsm_pos`, `rsm_normal`, `light` and `params`).
+pub(crate) const RSM_READ_WGSL: &str = include_str!("rsm_read.wgsl");
 /// The RSM pass's shader, in order.
-pub(crate) const SOURCES: [&str; 3] = [wgsl::LIGHT, RASTER_WGSL, include_str!("rsm.wgsl")];
+pub(crate) const SOURCES: [&str; 4] = [
+    wgsl::LIGHT,
+    RASTER_WGSL[0],
+    RASTER_WGSL[1],
+    include_str!("rsm.wgsl"),
+];
 
-/// The RSM as the quadtree and the gather read it, whoever renders it: three square textures of
-/// the same side (a power of two), any float format `textureLoad` reads (quadray's are
-/// [`FLOAT_FORMAT`]). An empty texel has `normal.w = 0`.
+/// The RSM as the quadtree and the gather read it, whoever renders it: square textures of the
+/// same side (a power of two), any float formats `textureLoad` reads (quadray's
+/// [`RsmPass`] writes the layout [`Settings::gbuffer_layout`] names).
 #[derive(Clone, Copy)]
-pub struct RsmViews<'a> {
-    /// rgb: flux the texel's surface reflects (W), `I(w) * solid angle * albedo` (parallel
-    /// light: `E * area * albedo`); w unused.
-    pub flux: &'a wgpu::TextureView,
-    /// xyz: world position; w: depth along the light's axis in units of [`LightView::extent`].
-    pub position: &'a wgpu::TextureView,
-    /// xyz: unit normal facing the light; w: 1 where the light sees geometry, else 0.
-    pub normal: &'a wgpu::TextureView,
+pub enum RsmViews<'a> {
+    /// Each quantity whole. An empty texel has `normal.w = 0`.
+    Wide {
+        /// rgb: flux the texel's surface reflects (W), `I(w) * solid angle * albedo` (parallel
+        /// light: `E * area * albedo`); w unused.
+        flux: &'a wgpu::TextureView,
+        /// xyz: world position; w: depth along the light's axis in units of
+        /// [`LightView::extent`].
+        position: &'a wgpu::TextureView,
+        /// xyz: unit normal facing the light; w: 1 where the light sees geometry, else 0.
+        normal: &'a wgpu::TextureView,
+    },
+    /// The position rebuilt from the light view's depth (an empty texel keeps the cleared 1).
+    Compact {
+        /// rgb: flux, as [`RsmViews::Wide`]'s.
+        flux: &'a wgpu::TextureView,
+        /// x: the depth the light view's projection gave the texel's surface.
+        depth: &'a wgpu::TextureView,
+        /// xy: the unit normal facing the light in octahedral coordinates.
+        normal: &'a wgpu::TextureView,
+        /// The light view the RSM was rendered from, as [`RsmPass::set_light`] writes it: the
+        /// quadtree rebuilds positions and depths with it.
+        light: &'a wgpu::Buffer,
+    },
+}
+
+impl<'a> RsmViews<'a> {
+    /// The layout the views are in.
+    pub fn layout(&self) -> GBufferLayout {
+        match self {
+            RsmViews::Wide { .. } => GBufferLayout::Wide,
+            RsmViews::Compact { .. } => GBufferLayout::Compact,
+        }
+    }
+
+    /// The textures in the order the readers bind them: flux, position (or depth), normal.
+    pub(crate) fn textures(&self) -> [&'a wgpu::TextureView; 3] {
+        match *self {
+            RsmViews::Wide {
+                flux,
+                position,
+                normal,
+            } => [flux, position, normal],
+            RsmViews::Compact {
+                flux,
+                depth,
+                normal,
+                ..
+            } => [flux, depth, normal],
+        }
+    }
 }
 
 /// A render target `size` (width, height), also bound as a texture and copied from.
@@ -53,32 +131,46 @@ pub(crate) fn view(texture: &wgpu::Texture) -> wgpu::TextureView {
     texture.create_view(&Default::default())
 }
 
-/// Three float colour targets and a depth buffer of one size, as both raster passes write them.
+/// The colour targets of one layout and a depth buffer of one size, as both raster passes
+/// write them.
 pub(crate) struct RasterTargets {
-    pub colors: [wgpu::Texture; 3],
-    pub views: [wgpu::TextureView; 3],
-    depth: wgpu::TextureView,
+    pub colors: Vec<wgpu::Texture>,
+    pub views: Vec<wgpu::TextureView>,
+    pub depth: wgpu::TextureView,
 }
 
 impl RasterTargets {
-    pub fn new(device: &wgpu::Device, labels: [&str; 3], size: (u32, u32)) -> Self {
-        let colors = labels.map(|l| target(device, l, size, FLOAT_FORMAT));
-        let depth = target(device, "depth", size, DEPTH_FORMAT);
+    /// Targets of `formats` (labelled `labels`) and a depth buffer.
+    pub fn new(
+        device: &wgpu::Device,
+        labels: &[&str],
+        formats: &[wgpu::TextureFormat],
+        size: (u32, u32),
+    ) -> Self {
+        let colors: Vec<wgpu::Texture> = labels
+            .iter()
+            .zip(formats)
+            .map(|(l, &f)| target(device, l, size, f))
+            .collect();
         Self {
-            views: colors.each_ref().map(view),
+            views: colors.iter().map(view).collect(),
             colors,
-            depth: view(&depth),
+            depth: view(&target(device, "depth", size, DEPTH_FORMAT)),
         }
     }
 }
 
-/// A raster pipeline over [`Vertex`] triangles into three float targets with a depth test.
+/// A raster pipeline over [`Vertex`] triangles into colour targets of `formats` with a depth
+/// test, shaded by the entry point `fragment`.
 pub(crate) fn raster_pipeline(
     device: &wgpu::Device,
     group: &wgpu::BindGroupLayout,
     module: &wgpu::ShaderModule,
     fragment: &str,
+    formats: &[wgpu::TextureFormat],
 ) -> wgpu::RenderPipeline {
+    let targets: Vec<Option<wgpu::ColorTargetState>> =
+        formats.iter().map(|&f| Some(f.into())).collect();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(fragment),
         layout: Some(&pipeline_layout(device, &[group])),
@@ -99,15 +191,16 @@ pub(crate) fn raster_pipeline(
             module,
             entry_point: Some(fragment),
             compilation_options: Default::default(),
-            targets: &[
-                Some(FLOAT_FORMAT.into()),
-                Some(FLOAT_FORMAT.into()),
-                Some(FLOAT_FORMAT.into()),
-            ],
+            targets: &targets,
         }),
         multiview_mask: None,
         cache: None,
     })
+}
+
+/// The fragment entry point of a raster pass `name` in `layout` (`rsm_wide`, `gbuffer_compact`).
+pub(crate) fn fragment_entry(name: &str, layout: GBufferLayout) -> String {
+    format!("{name}_{}", layout.name())
 }
 
 /// Clears `targets` and draws `vertex_count` vertices of `vertices` into them.
@@ -122,10 +215,11 @@ pub(crate) fn record_raster(
     vertex_count: u32,
     timestamps: Option<wgpu::RenderPassTimestampWrites>,
 ) {
-    let attachments = targets
+    let attachments: Vec<_> = targets
         .views
-        .each_ref()
-        .map(|v| cleared_attachment(v, wgpu::Color::TRANSPARENT));
+        .iter()
+        .map(|v| cleared_attachment(v, wgpu::Color::TRANSPARENT))
+        .collect();
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &attachments,
@@ -146,11 +240,13 @@ pub(crate) fn record_raster(
     pass.draw(0..vertex_count, 0..1);
 }
 
-/// Renders the RSM of one light view into textures it owns ([`RsmPass::views`]). Its three
-/// Rgba32Float targets take 48 bytes a sample: open the device with the adapter's limits
-/// (`max_color_attachment_bytes_per_sample` is 32 by default).
+/// Renders the RSM of one light view into textures it owns ([`RsmPass::views`]), in the layout
+/// [`Settings::gbuffer_layout`] names. The wide layout's three Rgba32Float targets take 48 bytes
+/// a sample: open the device with the adapter's limits (`max_color_attachment_bytes_per_sample`
+/// is 32 by default).
 pub struct RsmPass {
     rsm_size: u32,
+    layout: GBufferLayout,
     pipeline: wgpu::RenderPipeline,
     light: wgpu::Buffer,
     raster: wgpu::Buffer,
@@ -160,23 +256,29 @@ pub struct RsmPass {
 }
 
 impl RsmPass {
-    /// An RSM of `rsm_size`^2 texels (the size [`crate::Settings::rsm_size`] names).
-    pub fn new(device: &wgpu::Device, rsm_size: u32) -> Self {
-        let vertex_fragment = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let group_layout = layout(
-            device,
-            "rsm",
-            &[
-                uniform_entry::<RasterUniform>(0, vertex_fragment, false),
-                uniform_entry::<LightUniform>(1, vertex_fragment, false),
-            ],
-        );
+    /// An RSM of [`Settings::rsm_size`]^2 texels in [`Settings::gbuffer_layout`].
+    pub fn new(device: &wgpu::Device, settings: &Settings) -> Self {
+        let (rsm_size, layout) = (settings.rsm_size, settings.gbuffer_layout);
+        let group_layout = layout_of(device);
         let module = shader_module(device, "rsm", &SOURCES);
         let light = uniform_buffer::<LightUniform>(device, "rsm light");
         let raster = uniform_buffer::<RasterUniform>(device, "rsm projection");
+        let formats = rsm_formats(layout);
+        let labels = ["rsm flux", "rsm position", "rsm normal"];
+        let labels: &[&str] = match layout {
+            GBufferLayout::Wide => &labels,
+            GBufferLayout::Compact => &[labels[0], labels[2]],
+        };
         Self {
             rsm_size,
-            pipeline: raster_pipeline(device, &group_layout, &module, "rsm"),
+            layout,
+            pipeline: raster_pipeline(
+                device,
+                &group_layout,
+                &module,
+                &fragment_entry("rsm", layout),
+                formats,
+            ),
             group: bind_group(
                 device,
                 "rsm",
@@ -185,11 +287,7 @@ impl RsmPass {
             ),
             light,
             raster,
-            targets: RasterTargets::new(
-                device,
-                ["rsm flux", "rsm position", "rsm normal"],
-                (rsm_size, rsm_size),
-            ),
+            targets: RasterTargets::new(device, labels, formats, (rsm_size, rsm_size)),
         }
     }
 
@@ -231,16 +329,38 @@ impl RsmPass {
 
     /// The RSM's textures, for the quadtree and the gather.
     pub fn views(&self) -> RsmViews<'_> {
-        let [flux, position, normal] = &self.targets.views;
-        RsmViews {
-            flux,
-            position,
-            normal,
+        let v = &self.targets.views;
+        match self.layout {
+            GBufferLayout::Wide => RsmViews::Wide {
+                flux: &v[0],
+                position: &v[1],
+                normal: &v[2],
+            },
+            GBufferLayout::Compact => RsmViews::Compact {
+                flux: &v[0],
+                depth: &self.targets.depth,
+                normal: &v[1],
+                light: &self.light,
+            },
         }
     }
 
-    /// The RSM's textures (flux, position, normal), for reading back.
-    pub fn textures(&self) -> &[wgpu::Texture; 3] {
+    /// The RSM's colour targets, for reading back: flux, position and normal (wide), or flux and
+    /// normal (compact, whose positions lie in the depth of [`RsmViews::Compact`]).
+    pub fn textures(&self) -> &[wgpu::Texture] {
         &self.targets.colors
     }
+}
+
+/// The RSM pass's group layout: its projection and its light.
+fn layout_of(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let vertex_fragment = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    layout(
+        device,
+        "rsm",
+        &[
+            uniform_entry::<RasterUniform>(0, vertex_fragment, false),
+            uniform_entry::<LightUniform>(1, vertex_fragment, false),
+        ],
+    )
 }

@@ -218,12 +218,20 @@ impl LightView {
         let parallel = matches!(self.projection, Projection::Orthographic { .. });
         LightUniform {
             view_proj: self.view_proj.to_cols_array_2d(),
+            inv_view_proj: relative_inverse(self.view_proj, p).to_cols_array_2d(),
             position: [p.x, p.y, p.z, 1.0 / self.extent],
             direction: [d.x, d.y, d.z, outer],
             intensity: [i[0], i[1], i[2], inner],
             parallel: [f32::from(u8::from(parallel)), 0.0, 0.0, 0.0],
         }
     }
+}
+
+/// The inverse of `view_proj` to world positions relative to `origin` (clip -> world - origin):
+/// the view's translation is not multiplied into terms that cancel, so that positions rebuilt
+/// from a depth keep their place across the view to a few ulps.
+pub(crate) fn relative_inverse(view_proj: Mat4, origin: Vec3) -> Mat4 {
+    (view_proj * Mat4::from_translation(origin)).inverse()
 }
 
 #[cfg(test)]
