@@ -64,10 +64,14 @@ fn the_gpu_tables_script_writes_every_row_and_packs_them() {
             })
             .count()
     };
-    // 5 methods at the quick mode's one angle and pyramid with lod auto; 4 methods and the cut
-    // with shadows
+    // 5 methods at the quick mode's one angle and pyramid with lod auto; 4 methods, the default
+    // one with the wide G-buffer too, and the cut with shadows
     assert_eq!(rows("## Displacement frame"), 6, "{summary}");
-    assert_eq!(rows("## Indirect light"), 5, "{summary}");
+    assert_eq!(rows("## Indirect light"), 6, "{summary}");
+    assert!(
+        summary.contains("| quadtree-tiles-wide | wide |") && summary.contains("| compact |"),
+        "{summary}"
+    );
     assert!(
         summary.contains("Skipped: bench-indirect"),
         "the budget of 0 s skips the paper tables"
