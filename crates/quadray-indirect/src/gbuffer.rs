@@ -9,7 +9,7 @@ use crate::contract::{
 use crate::light::rsm::{
     RASTER_WGSL, RasterTargets, fragment_entry, gbuffer_formats, raster_pipeline, record_raster,
 };
-use crate::light::view::relative_inverse;
+use crate::light::view::{relative_inverse, reversed_depth};
 use crate::method::GBufferLayout;
 use glam::{Mat4, Vec3};
 
@@ -30,8 +30,9 @@ pub enum GBufferViews<'a> {
     /// The position rebuilt from the depth through the camera that
     /// [`crate::Gather::set_camera`] gives (which it then needs).
     Compact {
-        /// x: the depth the camera's `view_proj` gave the pixel's surface (clip z / w, in
-        /// [0, 1]); 1 where geometry is not seen, as a depth buffer cleared to 1 holds.
+        /// x: the depth the camera's `view_proj` gave the pixel's surface, reversed: clip
+        /// (w - z) / w, 1 at the near plane, 0 at the far plane and where geometry is not seen
+        /// (a depth buffer cleared to 0, as Bevy's).
         depth: &'a wgpu::TextureView,
         /// xy: the unit normal turned towards the viewer, in octahedral coordinates
         /// (`octahedral_encode` of the `COMPACT` WGSL module, [`crate::wgsl::COMPACT`]).
@@ -131,7 +132,7 @@ impl GBufferPass {
             &self.camera,
             0,
             bytemuck::bytes_of(&RasterUniform {
-                view_proj: view_proj.to_cols_array_2d(),
+                view_proj: reversed_depth(view_proj).to_cols_array_2d(),
                 eye: [eye.x, eye.y, eye.z, 1.0],
                 texel: [0.0; 4],
             }),

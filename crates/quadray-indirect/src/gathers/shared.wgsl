@@ -56,14 +56,14 @@ override COMPACT_GBUFFER: bool;
 @group(2) @binding(1) var<uniform> slice: Level;
 
 // A G-buffer pixel's world position (w: 1 where geometry is seen, else 0) and unit normal, in
-// either layout (`GBufferLayout`; the compact one's g_pos holds the camera's depth, cleared to 1
+// either layout (`GBufferLayout`; the compact one's g_pos holds the camera's reversed depth, 0
 // where nothing is seen, its g_normal octahedral coordinates).
 fn load_g_position(t: vec2<i32>) -> vec4<f32> {
     let texel = textureLoad(g_pos, t, 0);
     if (COMPACT_GBUFFER) {
         let size = vec2<f32>(f32(viewer.width), f32(viewer.height));
         let x = unproject(viewer.inv_view_proj, viewer.eye.xyz, t, size, texel.x);
-        return vec4<f32>(x, select(0.0, 1.0, texel.x < 1.0));
+        return vec4<f32>(x, select(0.0, 1.0, texel.x > 0.0));
     }
     return texel;
 }

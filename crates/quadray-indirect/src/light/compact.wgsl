@@ -21,8 +21,9 @@ fn octahedral_decode(e: vec2<f32>) -> vec3<f32> {
 }
 
 // The world position whose depth texel `t` of a `size` map holds, through `inverse` (clip ->
-// world relative to `origin`, the view's eye): the texel's centre at that depth, as the
-// rasteriser interpolated it. Relative to the eye, f32 rounding moves it along its ray only.
+// world relative to `origin`, the view's eye; the depth reversed, as quadray's raster passes draw
+// it): the texel's centre at that depth, as the rasteriser interpolated it. Relative to the eye,
+// f32 rounding moves it along its ray only.
 fn unproject(inverse: mat4x4<f32>, origin: vec3<f32>, t: vec2<i32>, size: vec2<f32>, depth: f32) -> vec3<f32> {
     let uv = (vec2<f32>(t) + 0.5) / size;
     let clip = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);

@@ -6,12 +6,12 @@ use crate::contract::{
     LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
     uniform_buffer, uniform_entry, whole,
 };
-use crate::light::view::LightView;
+use crate::light::view::{LightView, reversed_depth};
 use crate::method::GBufferLayout;
 use crate::scene::Vertex;
 use crate::settings::Settings;
 use crate::wgsl;
-use quadray_gpu::{GpuTimer, cleared_attachment, nearest_depth, texture_2d};
+use quadray_gpu::{GpuTimer, cleared_attachment, texture_2d};
 
 /// Format of every wide RSM and G-buffer colour target.
 pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -73,11 +73,13 @@ pub enum RsmViews<'a> {
         /// xyz: unit normal facing the light; w: 1 where the light sees geometry, else 0.
         normal: &'a wgpu::TextureView,
     },
-    /// The position rebuilt from the light view's depth (an empty texel keeps the cleared 1).
+    /// The position rebuilt from the light view's depth.
     Compact {
         /// rgb: flux, as [`RsmViews::Wide`]'s.
         flux: &'a wgpu::TextureView,
-        /// x: the depth the light view's projection gave the texel's surface.
+        /// x: the depth the light view's projection gave the texel's surface, reversed: clip
+        /// (w - z) / w, 1 at the near plane, 0 at the far plane and where the light sees
+        /// nothing (a depth buffer cleared to 0).
         depth: &'a wgpu::TextureView,
         /// xy: the unit normal facing the light in octahedral coordinates.
         normal: &'a wgpu::TextureView,
@@ -185,7 +187,14 @@ pub(crate) fn raster_pipeline(
             }],
         },
         primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(nearest_depth(DEPTH_FORMAT)),
+        // reversed depth (`reversed_depth`): the nearest surface has the greatest
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Greater),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module,
@@ -226,7 +235,7 @@ pub(crate) fn record_raster(
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &targets.depth,
             depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
+                load: wgpu::LoadOp::Clear(0.0),
                 store: wgpu::StoreOp::Store,
             }),
             stencil_ops: None,
@@ -299,7 +308,7 @@ impl RsmPass {
             &self.raster,
             0,
             bytemuck::bytes_of(&RasterUniform {
-                view_proj: view.view_proj.to_cols_array_2d(),
+                view_proj: reversed_depth(view.view_proj).to_cols_array_2d(),
                 eye: [p.x, p.y, p.z, 1.0],
                 texel: [view.texel_measure(self.rsm_size), 0.0, 0.0, 0.0],
             }),

@@ -1,7 +1,8 @@
 // An RSM texel as its readers see it (the quadtree's packing, the gather's sums, direct light and
 // the light's depth map in indirect shadows), in either layout (`GBufferLayout`). The including
 // shader binds `rsm_flux`, `rsm_pos` (the compact layout: the light view's depth) and
-// `rsm_normal` (the compact layout: octahedral), the view's `light` and `params`.
+// `rsm_normal` (the compact layout: octahedral), the view's `light` and `params`. Depths are
+// reversed (`reversed_depth` in light/view.rs).
 
 // Whether the RSM is compact: a pipeline constant, so that each layout compiles its own reads.
 override COMPACT_RSM: bool;
@@ -10,8 +11,8 @@ override COMPACT_RSM: bool;
 fn load_rsm_normal(t: vec2<i32>) -> vec4<f32> {
     let texel = textureLoad(rsm_normal, t, 0);
     if (COMPACT_RSM) {
-        // where the light sees nothing the depth keeps its cleared 1
-        let seen = textureLoad(rsm_pos, t, 0).x < 1.0;
+        // where the light sees nothing the (reversed) depth keeps its cleared 0
+        let seen = textureLoad(rsm_pos, t, 0).x > 0.0;
         return select(vec4<f32>(0.0), vec4<f32>(octahedral_decode(texel.xy), 1.0), seen);
     }
     return texel;
@@ -24,7 +25,7 @@ fn load_rsm_position(t: vec2<i32>) -> vec4<f32> {
     if (COMPACT_RSM) {
         let size = vec2<f32>(f32(params.rsm_size));
         let x = unproject(light.inv_view_proj, light.position.xyz, t, size, texel.x);
-        return select(vec4<f32>(0.0), vec4<f32>(x, light_depth(light, x)), texel.x < 1.0);
+        return select(vec4<f32>(0.0), vec4<f32>(x, light_depth(light, x)), texel.x > 0.0);
     }
     return texel;
 }

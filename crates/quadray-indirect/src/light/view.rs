@@ -6,7 +6,7 @@
 use crate::contract::{LightTermsUniform, LightUniform};
 use crate::scene::{Light, LightKind, Scene, extent_of};
 use crate::settings::Settings;
-use glam::{Mat4, Vec3};
+use glam::{DMat4, Mat4, Vec3, Vec4};
 
 /// How an RSM view projects the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -227,11 +227,24 @@ impl LightView {
     }
 }
 
-/// The inverse of `view_proj` to world positions relative to `origin` (clip -> world - origin):
-/// the view's translation is not multiplied into terms that cancel, so that positions rebuilt
-/// from a depth keep their place across the view to a few ulps.
+/// `view_proj` with its depth reversed (clip z -> w - z: 1 at the near plane, 0 at the far), as
+/// quadray's raster passes draw: a float depth then holds a surface's distance to about 1e-7 of
+/// it at any distance (not reversed, to 6e-8 times distance / near, 1.5e-5 of the far plane's
+/// distance half-way there), for the compact layout to rebuild positions from.
+pub(crate) fn reversed_depth(view_proj: Mat4) -> Mat4 {
+    let reverse = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::NEG_Z, Vec4::new(0.0, 0.0, 1.0, 1.0));
+    reverse * view_proj
+}
+
+/// The inverse of [`reversed_depth`]`(view_proj)` to world positions relative to `origin` (clip
+/// -> world - origin), the depth a raster pass wrote decoded: the view's translation is not
+/// multiplied into terms that cancel, so that f32 rounding moves a rebuilt position along its ray
+/// only (inverted in f64 from the very f32 matrix the pass drew with).
 pub(crate) fn relative_inverse(view_proj: Mat4, origin: Vec3) -> Mat4 {
-    (view_proj * Mat4::from_translation(origin)).inverse()
+    let drawn = reversed_depth(view_proj).as_dmat4();
+    (drawn * DMat4::from_translation(origin.as_dvec3()))
+        .inverse()
+        .as_mat4()
 }
 
 #[cfg(test)]
