@@ -7,7 +7,7 @@ use crate::contract::{
     whole,
 };
 use crate::light::rsm::{
-    RASTER_WGSL, RasterTargets, fragment_entry, gbuffer_formats, raster_pipeline, record_raster,
+    RASTER_WGSL, RasterTargets, fragment_entry, gbuffer_targets, raster_pipeline, record_raster,
 };
 use crate::light::view::{relative_inverse, reversed_depth};
 use crate::method::GBufferLayout;
@@ -111,19 +111,14 @@ impl GBufferPass {
         );
         let module = shader_module(device, "gbuffer", &SOURCES);
         let camera = uniform_buffer::<RasterUniform>(device, "camera");
-        let formats = gbuffer_formats(layout);
-        let labels = ["g position", "g normal", "g albedo"];
-        let labels: &[&str] = match layout {
-            GBufferLayout::Wide => &labels,
-            GBufferLayout::Compact => &labels[1..],
-        };
+        let targets = gbuffer_targets(layout);
         let entry = fragment_entry("gbuffer", layout);
         Self {
             layout,
-            pipeline: raster_pipeline(device, &group_layout, &module, &entry, formats),
+            pipeline: raster_pipeline(device, &group_layout, &module, &entry, targets),
             group: bind_group(device, "gbuffer", &group_layout, vec![whole(&camera)]),
             camera,
-            targets: RasterTargets::new(device, labels, formats, size),
+            targets: RasterTargets::new(device, targets, size),
         }
     }
 

@@ -201,8 +201,8 @@ pub struct Settings {
     /// How quadray's G-buffer and RSM passes store their targets: compact (position rebuilt
     /// from depth, the normal in 16-bit octahedral, the albedo in 10 bits, the RSM's flux in
     /// 16-bit floats: a sixth of the G-buffer's raster output cycles on NVIDIA, a quarter of the
-    /// RSM's) or wide (each in 32-bit floats). A renderer that brings its own G-buffer or RSM declares its layout in
-    /// `GBufferViews` and `RsmViews`.
+    /// RSM's) or wide (each in 32-bit floats). A renderer that brings its own G-buffer or RSM
+    /// declares its layout in `GBufferViews` and `RsmViews`.
     #[cfg_attr(
         feature = "cli",
         arg(long, default_value_t = Settings::DEFAULT.gbuffer_layout)

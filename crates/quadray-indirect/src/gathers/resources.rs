@@ -24,9 +24,9 @@ use crate::wgsl;
 use wgpu::util::DeviceExt;
 
 /// What every gather pass's shader starts with (after the prelude): the node layout and kernel,
-/// the light, the compact layout's encodings, the receiver, the occupancy walk and the depth-map march of indirect shadows, and
-/// `shared.wgsl` (the bindings of groups 0-2, the accessors the
-/// engine-neutral modules read them with, and the helpers every pass uses).
+/// the light, the compact layout's encodings, the receiver, the occupancy walk and the depth-map
+/// march of indirect shadows, the RSM's reads, and `shared.wgsl` (the bindings of groups 0-2, the
+/// accessors the engine-neutral modules read them with, and the helpers every pass uses).
 const SHARED_WGSL: [&str; 9] = [
     wgsl::NODE,
     wgsl::KERNEL,
@@ -129,6 +129,7 @@ impl Outputs {
         layout: &wgpu::BindGroupLayout,
         gbuffer: GBufferViews,
     ) -> wgpu::BindGroup {
+        let [position, normal, albedo] = gbuffer.textures();
         bind_group(
             device,
             "gather frame",
@@ -136,9 +137,9 @@ impl Outputs {
             vec![
                 whole(&self.shade),
                 whole(&self.camera),
-                tex(gbuffer.textures()[0]),
-                tex(gbuffer.textures()[1]),
-                tex(gbuffer.textures()[2]),
+                tex(position),
+                tex(normal),
+                tex(albedo),
                 whole(&self.indirect),
                 whole(&self.direct),
                 whole(&self.low),
@@ -475,6 +476,7 @@ fn light_group(
     [light, terms]: [&wgpu::Buffer; 2],
     ViewMaps { rsm, quadtree }: ViewMaps,
 ) -> wgpu::BindGroup {
+    let [flux, position, normal] = rsm.textures();
     bind_group(
         device,
         "gather light",
@@ -483,9 +485,9 @@ fn light_group(
             whole(quadtree.params()),
             whole(light),
             whole(terms),
-            tex(rsm.textures()[0]),
-            tex(rsm.textures()[1]),
-            tex(rsm.textures()[2]),
+            tex(flux),
+            tex(position),
+            tex(normal),
             whole(quadtree.nodes()),
             whole(quadtree.cut()),
             whole(quadtree.cut_count()),

@@ -24,19 +24,30 @@ const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgb10a2Unorm;
 /// A compact RSM's flux: high dynamic range.
 const FLUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
+/// A raster pass's colour target: its label and format.
+pub(crate) type ColorTarget = (&'static str, wgpu::TextureFormat);
+
 /// The G-buffer's colour targets in `layout`: position, normal and albedo, or normal and albedo.
-pub(crate) fn gbuffer_formats(layout: GBufferLayout) -> &'static [wgpu::TextureFormat] {
+pub(crate) fn gbuffer_targets(layout: GBufferLayout) -> &'static [ColorTarget] {
     match layout {
-        GBufferLayout::Wide => &[FLOAT_FORMAT; 3],
-        GBufferLayout::Compact => &[NORMAL_FORMAT, ALBEDO_FORMAT],
+        GBufferLayout::Wide => &[
+            ("g position", FLOAT_FORMAT),
+            ("g normal", FLOAT_FORMAT),
+            ("g albedo", FLOAT_FORMAT),
+        ],
+        GBufferLayout::Compact => &[("g normal", NORMAL_FORMAT), ("g albedo", ALBEDO_FORMAT)],
     }
 }
 
 /// An RSM's colour targets in `layout`: flux, position and normal, or flux and normal.
-pub(crate) fn rsm_formats(layout: GBufferLayout) -> &'static [wgpu::TextureFormat] {
+pub(crate) fn rsm_targets(layout: GBufferLayout) -> &'static [ColorTarget] {
     match layout {
-        GBufferLayout::Wide => &[FLOAT_FORMAT; 3],
-        GBufferLayout::Compact => &[FLUX_FORMAT, NORMAL_FORMAT],
+        GBufferLayout::Wide => &[
+            ("rsm flux", FLOAT_FORMAT),
+            ("rsm position", FLOAT_FORMAT),
+            ("rsm normal", FLOAT_FORMAT),
+        ],
+        GBufferLayout::Compact => &[("rsm flux", FLUX_FORMAT), ("rsm normal", NORMAL_FORMAT)],
     }
 }
 
@@ -142,17 +153,11 @@ pub(crate) struct RasterTargets {
 }
 
 impl RasterTargets {
-    /// Targets of `formats` (labelled `labels`) and a depth buffer.
-    pub fn new(
-        device: &wgpu::Device,
-        labels: &[&str],
-        formats: &[wgpu::TextureFormat],
-        size: (u32, u32),
-    ) -> Self {
-        let colors: Vec<wgpu::Texture> = labels
+    /// The colour `targets` and a depth buffer.
+    pub fn new(device: &wgpu::Device, targets: &[ColorTarget], size: (u32, u32)) -> Self {
+        let colors: Vec<wgpu::Texture> = targets
             .iter()
-            .zip(formats)
-            .map(|(l, &f)| target(device, l, size, f))
+            .map(|&(label, format)| target(device, label, size, format))
             .collect();
         Self {
             views: colors.iter().map(view).collect(),
@@ -162,17 +167,17 @@ impl RasterTargets {
     }
 }
 
-/// A raster pipeline over [`Vertex`] triangles into colour targets of `formats` with a depth
-/// test, shaded by the entry point `fragment`.
+/// A raster pipeline over [`Vertex`] triangles into the colour `targets` with a depth test,
+/// shaded by the entry point `fragment`.
 pub(crate) fn raster_pipeline(
     device: &wgpu::Device,
     group: &wgpu::BindGroupLayout,
     module: &wgpu::ShaderModule,
     fragment: &str,
-    formats: &[wgpu::TextureFormat],
+    targets: &[ColorTarget],
 ) -> wgpu::RenderPipeline {
     let targets: Vec<Option<wgpu::ColorTargetState>> =
-        formats.iter().map(|&f| Some(f.into())).collect();
+        targets.iter().map(|&(_, f)| Some(f.into())).collect();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(fragment),
         layout: Some(&pipeline_layout(device, &[group])),
@@ -272,12 +277,7 @@ impl RsmPass {
         let module = shader_module(device, "rsm", &SOURCES);
         let light = uniform_buffer::<LightUniform>(device, "rsm light");
         let raster = uniform_buffer::<RasterUniform>(device, "rsm projection");
-        let formats = rsm_formats(layout);
-        let labels = ["rsm flux", "rsm position", "rsm normal"];
-        let labels: &[&str] = match layout {
-            GBufferLayout::Wide => &labels,
-            GBufferLayout::Compact => &[labels[0], labels[2]],
-        };
+        let targets = rsm_targets(layout);
         Self {
             rsm_size,
             layout,
@@ -286,7 +286,7 @@ impl RsmPass {
                 &group_layout,
                 &module,
                 &fragment_entry("rsm", layout),
-                formats,
+                targets,
             ),
             group: bind_group(
                 device,
@@ -296,7 +296,7 @@ impl RsmPass {
             ),
             light,
             raster,
-            targets: RasterTargets::new(device, labels, formats, (rsm_size, rsm_size)),
+            targets: RasterTargets::new(device, targets, (rsm_size, rsm_size)),
         }
     }
 

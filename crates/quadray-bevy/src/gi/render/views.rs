@@ -316,8 +316,8 @@ pub(super) fn prepare_views(
         {
             warn(
                 "its RSM size, G-buffer layout, light count or cluster settings differ from the \
-                 first IndirectLight camera's, which the lights' quadtrees are built with: give every \
-                 camera the same; no indirect light is added"
+                 first IndirectLight camera's, which the lights' quadtrees are built with: give \
+                 every camera the same; no indirect light is added"
                     .into(),
             );
             commands.entity(entity).remove::<ViewPasses>();
