@@ -128,7 +128,9 @@ shader_struct! {
         /// rgb: intensity (a spot's on its axis; the sun: irradiance facing it), w:
         /// cos(cone - falloff).
         intensity: [f32; 4],
-        /// x: 1 for parallel light (the sun, an orthographic map), 0 from a point.
+        /// x: 1 for parallel light (the sun, an orthographic map), 0 from a point; y: an RSM
+        /// texel's measure on the axis, its solid angle (it shrinks as cos^3 off the axis) or its
+        /// area across parallel light.
         parallel: [f32; 4],
     }
 }
@@ -139,9 +141,6 @@ shader_struct! {
         view_proj: [[f32; 4]; 4],
         /// The camera's position for the G-buffer (normals are turned towards the viewer).
         eye: [f32; 4],
-        /// x: an RSM texel's solid angle on the axis (it shrinks as cos^3 off the axis), or its
-        /// area across parallel light.
-        texel: [f32; 4],
     }
 }
 

@@ -129,7 +129,6 @@ impl GBufferPass {
             bytemuck::bytes_of(&RasterUniform {
                 view_proj: reversed_depth(view_proj).to_cols_array_2d(),
                 eye: [eye.x, eye.y, eye.z, 1.0],
-                texel: [0.0; 4],
             }),
         );
     }

@@ -198,8 +198,9 @@ impl fmt::Display for Validity {
 #[serde(rename_all = "kebab-case")]
 pub enum GBufferLayout {
     /// Position rebuilt from the depth buffer (the view's inverse projection), the normal
-    /// octahedral in `Rg16Float`, the albedo `Rgb10a2Unorm` and the RSM's flux `Rgba16Float`
-    /// (8 bytes of colour a pixel, 12 a texel).
+    /// octahedral in `Rg16Float`, the albedo `Rgb10a2Unorm` and the RSM's flux `Rgba16Float` as
+    /// its share of the light's intensity times the texel's measure (8 bytes of colour a pixel,
+    /// 12 a texel).
     Compact,
     /// Position, normal and albedo (the RSM: flux) each in `Rgba32Float` (48 bytes of colour
     /// a pixel or texel).

@@ -29,8 +29,9 @@ pub const NODE: &str = include_str!("light/node.wgsl");
 /// `all_finite`. Needs [`NODE`]. Accessors: none.
 pub const KERNEL: &str = include_str!("light/kernel.wgsl");
 
-/// The spot light over the prelude's `Light` uniform: `spot_intensity` and `light_depth` (the RSM's
-/// depth). Accessors: none.
+/// The spot light over the prelude's `Light` uniform: `spot_edge`, `spot_intensity`,
+/// `light_depth` (the RSM's depth) and `rsm_flux_scale` (what an RSM texel's flux is a share of).
+/// Accessors: none.
 pub const LIGHT: &str = include_str!("light/light.wgsl");
 
 /// The compact G-buffer and RSM layout's encodings ([`crate::GBufferLayout::Compact`]):

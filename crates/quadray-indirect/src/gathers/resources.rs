@@ -382,7 +382,8 @@ impl Resources {
             w * h
         };
         for (i, (view, light)) in self.views.iter().zip(lights).enumerate() {
-            queue.write_buffer(&view.light, 0, bytemuck::bytes_of(&light.uniform()));
+            let uniform = light.uniform(self.settings.rsm_size);
+            queue.write_buffer(&view.light, 0, bytemuck::bytes_of(&uniform));
             let terms = light.terms(&self.settings, r_min, i as u32 * low_samples);
             queue.write_buffer(&view.terms, 0, bytemuck::bytes_of(&terms));
         }

@@ -86,7 +86,9 @@ pub enum RsmViews<'a> {
     },
     /// The position rebuilt from the light view's depth.
     Compact {
-        /// rgb: flux, as [`RsmViews::Wide`]'s.
+        /// rgb: the texel's flux over the view's intensity times its texel measure on the axis
+        /// (the light's uniform holds both): the spot's falloff times cos^3 off the axis times
+        /// the albedo, in [0, 1], where a float keeps its precision however small the texel.
         flux: &'a wgpu::TextureView,
         /// x: the depth the light view's projection gave the texel's surface, reversed: clip
         /// (w - z) / w, 1 at the near plane, 0 at the far plane and where the light sees
@@ -302,7 +304,8 @@ impl RsmPass {
 
     /// Sets the light view the next recordings render from (per light update).
     pub fn set_light(&self, queue: &wgpu::Queue, view: &LightView) {
-        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&view.uniform()));
+        let uniform = view.uniform(self.rsm_size);
+        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&uniform));
         let p = view.position;
         queue.write_buffer(
             &self.raster,
@@ -310,7 +313,6 @@ impl RsmPass {
             bytemuck::bytes_of(&RasterUniform {
                 view_proj: reversed_depth(view.view_proj).to_cols_array_2d(),
                 eye: [p.x, p.y, p.z, 1.0],
-                texel: [view.texel_measure(self.rsm_size), 0.0, 0.0, 0.0],
             }),
         );
     }

@@ -30,7 +30,11 @@ fn load_rsm_position(t: vec2<i32>) -> vec4<f32> {
     return texel;
 }
 
-// Texel t's flux (W).
+// Texel t's flux (W; the compact layout stores its share of `rsm_flux_scale`, rsm.wgsl).
 fn load_rsm_flux(t: vec2<i32>) -> vec3<f32> {
-    return textureLoad(rsm_flux, t, 0).rgb;
+    let texel = textureLoad(rsm_flux, t, 0).rgb;
+    if (COMPACT_RSM) {
+        return texel * rsm_flux_scale(light);
+    }
+    return texel;
 }

@@ -208,7 +208,8 @@ impl LightView {
         }
     }
 
-    pub(crate) fn uniform(&self) -> LightUniform {
+    /// The view's uniform for an `rsm_size`^2 RSM.
+    pub(crate) fn uniform(&self, rsm_size: u32) -> LightUniform {
         let (p, d, i) = (self.position, self.direction, self.intensity);
         // no cone: every direction in front of the map counts (cos >= -1)
         let (outer, inner) = self.cone.map_or((-1.0, -1.0), |(cone_deg, falloff_deg)| {
@@ -222,7 +223,12 @@ impl LightView {
             position: [p.x, p.y, p.z, 1.0 / self.extent],
             direction: [d.x, d.y, d.z, outer],
             intensity: [i[0], i[1], i[2], inner],
-            parallel: [f32::from(u8::from(parallel)), 0.0, 0.0, 0.0],
+            parallel: [
+                f32::from(u8::from(parallel)),
+                self.texel_measure(rsm_size),
+                0.0,
+                0.0,
+            ],
         }
     }
 }
