@@ -5,7 +5,8 @@
 # and its synchronization validation where the machine has the layer (crates/quadray-gpu/vk_layer_settings.txt),
 # one line a pass, so that a pass that hangs or faults costs seconds and is named. Then the 1920x1080 displacement frame of every method at 0, 60 and 85
 # degrees (with the CPU ground truth's wrong-hit fraction), each indirect-light pass at 1920x1080
-# with a 512^2 RSM for every method and the gather's candidates (runtime options; run first), given --bevy-bin the Bevy frame with and without the bounce
+# with a 512^2 RSM for every method (the default one also with the wide G-buffer and RSM) and the
+# gather's candidates (runtime options; run first), given --bevy-bin the Bevy frame with and without the bounce
 # (two paired rounds, Bevy's render diagnostics), then, while the time budget lasts, the paper
 # tables of `quadray bench displace` and `quadray bench indirect`. Writes bench/<device>/ (the device's
 # name from the adapter, e.g. bench/nvidia-h200/) with every stats file (each naming the commit
@@ -130,6 +131,11 @@ for m in quadtree quadtree-passes quadtree-tiles rsm; do
     step "indirect-$m" "$bin" indirect --method $m --size $size --rsm-size $rsm \
         --frames $frames --out "$probe/i.png" --stats "$out/indirect-1080p/$m.json"
 done
+# The default method again with the wide G-buffer and RSM (--gbuffer-layout), beside the
+# compact default: the raster passes' cost by their targets' widths.
+step indirect-quadtree-tiles-wide "$bin" indirect --method quadtree-tiles --gbuffer-layout wide \
+    --size $size --rsm-size $rsm --frames $frames --out "$probe/i.png" \
+    --stats "$out/indirect-1080p/quadtree-tiles-wide.json"
 for m in quadtree quadtree-tiles; do
     step "indirect-$m-shadows" "$bin" indirect --method $m --indirect-shadows \
         --size $size --rsm-size $rsm --frames $frames --out "$probe/i.png" \
@@ -247,14 +253,15 @@ for f in sorted((out / "displace-1080p").glob("*.json")):
     lines.append(f"| {method} | {s['view_angle_deg']:g} | {s['gpu_time_ms']:.3f} | {wrong} | "
                  f"{s['mean_iterations']:.1f} | {s['max_iterations']} | {s['iteration_cap_hits']} |")
 lines += ["", "## Indirect light, per pass (GPU ms, median)", "",
-          "| run | G-buffer | direct | indirect | reconstruct | static frame | moving-light frame | VPL evaluations / pixel |",
-          "|---|---|---|---|---|---|---|---|"]
+          "| run | G-buffer layout | RSM | G-buffer | direct | indirect | reconstruct | static frame | moving-light frame | VPL evaluations / pixel |",
+          "|---|---|---|---|---|---|---|---|---|---|"]
 for f in sorted((out / "indirect-1080p").glob("*.json")):
     s = json.loads(f.read_text())
     still, moving = s["gpu_time_ms_static"] or {}, s["gpu_time_ms_moving"] or {}
     p = still.get("passes", {})
     cell = lambda v: f"{v:.3f}" if isinstance(v, (int, float)) else "-"
-    lines.append(f"| {f.stem} | {cell(p.get('gbuffer'))} | {cell(p.get('direct'))} | "
+    lines.append(f"| {f.stem} | {s['settings'].get('gbuffer_layout', '-')} | {cell(p.get('rsm'))} | "
+                 f"{cell(p.get('gbuffer'))} | {cell(p.get('direct'))} | "
                  f"{cell(p.get('indirect'))} | {cell(p.get('upsample'))} | {cell(still.get('total_ms'))} | "
                  f"{cell(moving.get('total_ms'))} | {s['vpl_evaluations_per_pixel']:.1f} |")
 # Equal error: RSM sampling's indirect time at each run's rel. L1, interpolated log-log between

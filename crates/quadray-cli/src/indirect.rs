@@ -247,7 +247,7 @@ mod tests {
     use clap::Parser;
     use proptest::prelude::*;
     use quadray_core::settings::{Limits, Size};
-    use quadray_indirect::{ClusterSettings, TileCriterion, Validity};
+    use quadray_indirect::{ClusterSettings, GBufferLayout, TileCriterion, Validity};
     use quadray_test_support::flags::assert_settings_round_trip;
 
     #[derive(Parser)]
@@ -284,6 +284,7 @@ mod tests {
                 u(Settings::SHADOW_STEPS),
                 f(Settings::SHADOW_THICKNESS, 0.0, 1.0),
                 f(Settings::TEMPORAL_WEIGHT, 0.0, 1.0),
+                proptest::sample::select(GBufferLayout::ALL.to_vec()),
             ),
             (
                 proptest::option::of(f(Settings::TILE_ERROR, 0.0, 1.0)),
@@ -309,6 +310,7 @@ mod tests {
                         steps,
                         thickness,
                         temporal,
+                        gbuffer_layout,
                     ),
                     (
                         tile_error,
@@ -335,6 +337,7 @@ mod tests {
                         rsm_size: 1 << rsm_log,
                         shadow_map_size: shadow_map_log.map(|l| 1 << l),
                         max_lights,
+                        gbuffer_layout,
                         cluster: ClusterSettings {
                             start_level,
                             limit_level,

@@ -17,7 +17,7 @@ fn the_gpu_tables_script_writes_every_table_and_packs_them() {
             "--smoke",
             "^indirect-quadtree-tiles$",
             "--runs",
-            "^(displace-.*|indirect-(quadtree|quadtree-tiles|rsm|quadtree-interleave-4)|\
+            "^(displace-.*|indirect-(quadtree|quadtree-tiles|quadtree-tiles-wide|rsm|quadtree-interleave-4)|\
              equal-error-cornell-(default|one-cut-interleave-4|rsm-64|rsm-256))$",
             "--budget",
             "0",
@@ -71,14 +71,17 @@ fn the_gpu_tables_script_writes_every_table_and_packs_them() {
             })
             .count()
     };
-    // 5 methods at the quick mode's one angle and pyramid with lod auto; 3 methods and a
-    // candidate; at equal error 2 methods against RSM sampling at 2 sample counts, each row
-    // with RSM sampling's time at its error or where it lies outside the sweep
+    // 5 methods at the quick mode's one angle and pyramid with lod auto; 3 methods, the
+    // default one with the wide G-buffer too, and a candidate; at equal error 2 methods against
+    // RSM sampling at 2 sample counts, each row with RSM sampling's time at its error or where it
+    // lies outside the sweep
     assert_eq!(rows("## Displacement frame"), 6, "{summary}");
-    assert_eq!(rows("## Indirect light"), 4, "{summary}");
+    assert_eq!(rows("## Indirect light"), 5, "{summary}");
     assert_eq!(rows("## Equal error"), 4, "{summary}");
     assert!(
-        summary.contains("| cornell | one-cut-interleave-4 |"),
+        summary.contains("| cornell | one-cut-interleave-4 |")
+            && summary.contains("| quadtree-tiles-wide | wide |")
+            && summary.contains("| compact |"),
         "{summary}"
     );
     assert!(

@@ -203,10 +203,11 @@ fn render(
 
     // quadray's passes on our device: the RSM, the quadtree over it, the gather into our G-buffer.
     let lights = LightView::of_scene(&scene, s.max_lights);
-    let rsm = RsmPass::new(device, s.rsm_size);
+    let rsm = RsmPass::new(device, &s);
     rsm.set_light(queue, &lights[0]);
     let quadtree = LightQuadtree::new(device, queue, s.rsm_size, s.cluster, rsm.views());
-    let views = GBufferViews {
+    // the wide layout: each quantity whole (a compact G-buffer gives its depth instead)
+    let views = GBufferViews::Wide {
         position: &gbuffer[0],
         normal: &gbuffer[1],
         albedo: &gbuffer[2],

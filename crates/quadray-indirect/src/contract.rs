@@ -6,6 +6,7 @@
 //! struct's size and field offsets against these.
 
 use crate::light::node::{CONE_SLACK, CUT_CLASS_SIDE, EMPTY_BOX, MAX_LEVELS};
+use crate::method::GBufferLayout;
 use crate::settings::{Shade, TILE, TILE_FRONTIER};
 use crate::shader_struct::{Layout, shader_struct};
 use crate::shadows::occupancy::{
@@ -119,6 +120,9 @@ shader_struct! {
     /// light.
     pub(crate) struct LightUniform as "Light" {
         view_proj: [[f32; 4]; 4],
+        /// Clip -> world relative to `position`: a compact RSM's positions are rebuilt from its
+        /// depth (relative, so that the translation does not cancel out in f32).
+        inv_view_proj: [[f32; 4]; 4],
         /// xyz: position (the sun: the middle of the map's near plane), w: 1 / scene extent (the
         /// RSM's depth unit).
         position: [f32; 4],
@@ -127,7 +131,9 @@ shader_struct! {
         /// rgb: intensity (a spot's on its axis; the sun: irradiance facing it), w:
         /// cos(cone - falloff).
         intensity: [f32; 4],
-        /// x: 1 for parallel light (the sun, an orthographic map), 0 from a point.
+        /// x: 1 for parallel light (the sun, an orthographic map), 0 from a point; y: an RSM
+        /// texel's measure on the axis, its solid angle (it shrinks as cos^3 off the axis) or its
+        /// area across parallel light.
         parallel: [f32; 4],
     }
 }
@@ -138,9 +144,6 @@ shader_struct! {
         view_proj: [[f32; 4]; 4],
         /// The camera's position for the G-buffer (normals are turned towards the viewer).
         eye: [f32; 4],
-        /// x: an RSM texel's solid angle on the axis (it shrinks as cos^3 off the axis), or its
-        /// area across parallel light.
-        texel: [f32; 4],
     }
 }
 
@@ -191,6 +194,9 @@ shader_struct! {
     /// The gather's per-camera values (the G-buffer's view and size), written with the camera.
     pub(crate) struct CameraUniform as "Camera" {
         view_proj: [[f32; 4]; 4],
+        /// Clip -> world relative to `eye`: a compact G-buffer's positions are rebuilt from its
+        /// depth (relative, so that the translation does not cancel out in f32).
+        inv_view_proj: [[f32; 4]; 4],
         eye: [f32; 4],
         width: u32,
         height: u32,
@@ -436,6 +442,12 @@ pub(crate) fn compute_pipeline(
         },
         cache: None,
     })
+}
+
+/// The pipeline constant `name` (`COMPACT_RSM`, `COMPACT_GBUFFER`) that says whether what a
+/// pipeline reads is in the compact layout.
+pub(crate) fn compact_constant(name: &'static str, layout: GBufferLayout) -> (&'static str, f64) {
+    (name, f64::from(u8::from(layout == GBufferLayout::Compact)))
 }
 
 pub(crate) fn whole(buffer: &wgpu::Buffer) -> wgpu::BindingResource<'_> {

@@ -1,24 +1,71 @@
 //! The camera's side: the G-buffer the gather reads ([`GBufferViews`], the caller's or quadray's),
 //! and quadray's own G-buffer pass (a renderer embedding the gather brings its own): the scene's
-//! triangles from the camera into position, normal and albedo targets.
+//! triangles from the camera into the targets of one [`GBufferLayout`].
 
 use crate::contract::{
     CameraUniform, RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry,
     whole,
 };
-use crate::light::rsm::{RASTER_WGSL, RasterTargets, raster_pipeline, record_raster};
+use crate::light::rsm::{
+    RASTER_WGSL, RasterTargets, fragment_entry, gbuffer_targets, raster_pipeline, record_raster,
+};
+use crate::light::view::{relative_inverse, reversed_depth};
+use crate::method::GBufferLayout;
 use glam::{Mat4, Vec3};
 
-/// The caller's G-buffer: three textures of the output's size, any float format `textureLoad`
-/// reads (quadray's are [`crate::FLOAT_FORMAT`]).
+/// The caller's G-buffer: textures of the output's size, any float formats `textureLoad` reads,
+/// in one of the [`GBufferLayout`]s (quadray's own pass writes the one
+/// [`crate::Settings::gbuffer_layout`] names).
 #[derive(Clone, Copy)]
-pub struct GBufferViews<'a> {
-    /// xyz: world position; w: 1 where geometry is seen, 0 elsewhere (no light there).
-    pub position: &'a wgpu::TextureView,
-    /// xyz: unit normal, turned towards the viewer.
-    pub normal: &'a wgpu::TextureView,
-    /// rgb: diffuse albedo.
-    pub albedo: &'a wgpu::TextureView,
+pub enum GBufferViews<'a> {
+    /// Each quantity whole (quadray's are [`crate::FLOAT_FORMAT`]).
+    Wide {
+        /// xyz: world position; w: 1 where geometry is seen, 0 elsewhere (no light there).
+        position: &'a wgpu::TextureView,
+        /// xyz: unit normal, turned towards the viewer.
+        normal: &'a wgpu::TextureView,
+        /// rgb: diffuse albedo.
+        albedo: &'a wgpu::TextureView,
+    },
+    /// The position rebuilt from the depth through the camera that
+    /// [`crate::Gather::set_camera`] gives (which it then needs).
+    Compact {
+        /// x: the depth the camera's `view_proj` gave the pixel's surface, reversed: clip
+        /// (w - z) / w, 1 at the near plane, 0 at the far plane and where geometry is not seen
+        /// (a depth buffer cleared to 0, as Bevy's).
+        depth: &'a wgpu::TextureView,
+        /// xy: the unit normal turned towards the viewer, in octahedral coordinates
+        /// (`octahedral_encode` of the `COMPACT` WGSL module, [`crate::wgsl::COMPACT`]).
+        normal: &'a wgpu::TextureView,
+        /// rgb: diffuse albedo.
+        albedo: &'a wgpu::TextureView,
+    },
+}
+
+impl<'a> GBufferViews<'a> {
+    /// The layout the views are in.
+    pub fn layout(&self) -> GBufferLayout {
+        match self {
+            GBufferViews::Wide { .. } => GBufferLayout::Wide,
+            GBufferViews::Compact { .. } => GBufferLayout::Compact,
+        }
+    }
+
+    /// The textures in the order the gather binds them: position (or depth), normal, albedo.
+    pub(crate) fn textures(&self) -> [&'a wgpu::TextureView; 3] {
+        match *self {
+            GBufferViews::Wide {
+                position,
+                normal,
+                albedo,
+            } => [position, normal, albedo],
+            GBufferViews::Compact {
+                depth,
+                normal,
+                albedo,
+            } => [depth, normal, albedo],
+        }
+    }
 }
 
 /// The gather's per-camera uniform: the camera a `width` x `height` G-buffer was rendered from
@@ -30,6 +77,7 @@ pub(crate) fn camera_uniform(
 ) -> CameraUniform {
     CameraUniform {
         view_proj: view_proj.to_cols_array_2d(),
+        inv_view_proj: relative_inverse(view_proj, eye).to_cols_array_2d(),
         eye: eye.extend(1.0).to_array(),
         width,
         height,
@@ -38,19 +86,21 @@ pub(crate) fn camera_uniform(
 }
 
 /// The G-buffer pass's shader, in order.
-pub(crate) const SOURCES: [&str; 2] = [RASTER_WGSL, include_str!("gbuffer.wgsl")];
+pub(crate) const SOURCES: [&str; 3] =
+    [RASTER_WGSL[0], RASTER_WGSL[1], include_str!("gbuffer.wgsl")];
 
 pub(crate) struct GBufferPass {
+    layout: GBufferLayout,
     pipeline: wgpu::RenderPipeline,
     camera: wgpu::Buffer,
     /// Per frame: the camera.
     group: wgpu::BindGroup,
-    pub targets: RasterTargets,
+    targets: RasterTargets,
 }
 
 impl GBufferPass {
-    pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
-        let group_layout = layout(
+    pub fn new(device: &wgpu::Device, size: (u32, u32), layout: GBufferLayout) -> Self {
+        let group_layout = self::layout(
             device,
             "gbuffer",
             &[uniform_entry::<RasterUniform>(
@@ -61,17 +111,21 @@ impl GBufferPass {
         );
         let module = shader_module(device, "gbuffer", &SOURCES);
         let camera = uniform_buffer::<RasterUniform>(device, "camera");
+        let targets = gbuffer_targets(layout);
+        let entry = fragment_entry("gbuffer", layout);
         Self {
-            pipeline: raster_pipeline::<3>(
+            layout,
+            pipeline: raster_pipeline(
                 device,
                 &group_layout,
                 &module,
                 "gbuffer",
-                Some("gbuffer"),
+                Some(&entry),
+                targets,
             ),
             group: bind_group(device, "gbuffer", &group_layout, vec![whole(&camera)]),
             camera,
-            targets: RasterTargets::new(device, ["g position", "g normal", "g albedo"], size),
+            targets: RasterTargets::new(device, targets, size),
         }
     }
 
@@ -80,9 +134,8 @@ impl GBufferPass {
             &self.camera,
             0,
             bytemuck::bytes_of(&RasterUniform {
-                view_proj: view_proj.to_cols_array_2d(),
+                view_proj: reversed_depth(view_proj).to_cols_array_2d(),
                 eye: [eye.x, eye.y, eye.z, 1.0],
-                texel: [0.0; 4],
             }),
         );
     }
@@ -107,11 +160,18 @@ impl GBufferPass {
     }
 
     pub fn views(&self) -> GBufferViews<'_> {
-        let [position, normal, albedo] = &self.targets.views;
-        GBufferViews {
-            position,
-            normal,
-            albedo,
+        let v = &self.targets.views;
+        match self.layout {
+            GBufferLayout::Wide => GBufferViews::Wide {
+                position: &v[0],
+                normal: &v[1],
+                albedo: &v[2],
+            },
+            GBufferLayout::Compact => GBufferViews::Compact {
+                depth: &self.targets.depth,
+                normal: &v[0],
+                albedo: &v[1],
+            },
         }
     }
 }

@@ -35,11 +35,11 @@
 //! #     [position, normal, albedo]: [&wgpu::TextureView; 3], vertices: wgpu::Buffer, vertex_count: u32,
 //! # ) -> Result<(), IndirectError> {
 //! let light = LightView::of_light(&sun, scene_bounds); // a spot or the sun: one view, a point light six
-//! let rsm = RsmPass::new(&device, s.rsm_size);
+//! let rsm = RsmPass::new(&device, &s); // in the layout s.gbuffer_layout names
 //! rsm.set_light(&queue, &light[0]);
 //! let quadtree = LightQuadtree::new(&device, &queue, s.rsm_size, s.cluster, rsm.views());
 //! let maps = [ViewMaps { rsm: rsm.views(), quadtree: &quadtree }];
-//! let gather = Gather::new(&device, &s, &maps, GBufferViews { position, normal, albedo })?;
+//! let gather = Gather::new(&device, &s, &maps, GBufferViews::Wide { position, normal, albedo })?;
 //! gather.set_lights(&queue, &light, r_min);
 //! rsm.record(&mut encoder, vertices.slice(..), vertex_count, None);
 //! quadtree.record_build(&mut encoder, None);
@@ -98,7 +98,7 @@ pub use gbuffer::GBufferViews;
 pub use light::quadtree::LightQuadtree;
 pub use light::rsm::{FLOAT_FORMAT, RsmPass, RsmViews};
 pub use light::view::{LightView, Projection};
-pub use method::{Method, TileCriterion, Validity};
+pub use method::{GBufferLayout, Method, TileCriterion, Validity};
 pub use output::pass::OutputPass;
 pub use quadray_core::settings::Size;
 pub use renderer::Renderer;

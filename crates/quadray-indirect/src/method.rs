@@ -189,3 +189,46 @@ impl fmt::Display for Validity {
         f.write_str(self.name())
     }
 }
+
+/// How quadray's raster passes store what they write ([`crate::Settings::gbuffer_layout`]): the
+/// camera's G-buffer and each light view's RSM. Raster output units write a 128-bit texel at a
+/// quarter of a 32-bit one's rate, so on a GPU with few of them (a datacenter chip) the passes
+/// take as long as their targets' widths add up to (docs/known-problems.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GBufferLayout {
+    /// Position rebuilt from the depth buffer (the view's inverse projection), the normal
+    /// octahedral in `Rg16Float`, the albedo `Rgb10a2Unorm` and the RSM's flux `Rgba16Float` as
+    /// its share of the light's intensity times the texel's measure (8 bytes of colour a pixel,
+    /// 12 a texel).
+    Compact,
+    /// Position, normal and albedo (the RSM: flux) each in `Rgba32Float` (48 bytes of colour
+    /// a pixel or texel).
+    Wide,
+}
+
+impl GBufferLayout {
+    /// Both layouts, in the order the CLI lists them.
+    pub const ALL: [GBufferLayout; 2] = [GBufferLayout::Compact, GBufferLayout::Wide];
+
+    /// The layout's name on the command line and in the stats (`--gbuffer-layout`).
+    pub fn name(self) -> &'static str {
+        match self {
+            GBufferLayout::Compact => "compact",
+            GBufferLayout::Wide => "wide",
+        }
+    }
+}
+
+impl std::str::FromStr for GBufferLayout {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "G-buffer layout")
+    }
+}
+
+impl fmt::Display for GBufferLayout {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -20,7 +20,7 @@ use crate::settings::{ClusterSettings, Settings, TILE};
 use crate::shadows::occupancy::OccupancyGrid;
 use crate::tiles::TILE_ENTRY_INDEX_BITS;
 use quadray_core::image_out::Rgba8Image;
-use quadray_gpu::{Gpu, GpuTimer, read_texture_f32};
+use quadray_gpu::{Gpu, GpuTimer};
 use std::collections::BTreeMap;
 use wgpu::util::DeviceExt;
 
@@ -76,13 +76,14 @@ impl<'g> Renderer<'g> {
         let renderer = gpu.checked(|| {
             let views: Vec<ViewPasses> = (0..view_count)
                 .map(|_| {
-                    let rsm = RsmPass::new(d, settings.rsm_size);
+                    let rsm = RsmPass::new(d, &settings);
                     let quadtree =
                         LightQuadtree::new(d, q, settings.rsm_size, settings.cluster, rsm.views());
                     ViewPasses { rsm, quadtree }
                 })
                 .collect();
-            let gbuffer = GBufferPass::new(d, (settings.size.width, settings.size.height));
+            let size = (settings.size.width, settings.size.height);
+            let gbuffer = GBufferPass::new(d, size, settings.gbuffer_layout);
             let maps: Vec<ViewMaps> = views
                 .iter()
                 .map(|v| ViewMaps {
@@ -451,14 +452,6 @@ impl<'g> Renderer<'g> {
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
-    fn read_texture(&self, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, IndirectError> {
-        let texels = read_texture_f32(self.gpu, texture, 0, 4)?;
-        Ok(texels
-            .chunks_exact(4)
-            .map(|p| [p[0], p[1], p[2], p[3]])
-            .collect())
-    }
-
     /// The last frame's indirect and direct light.
     pub fn read_frame(&self) -> Result<Frame, IndirectError> {
         let indirect = self.read_vec4(self.gather.indirect())?;
@@ -589,8 +582,8 @@ impl<'g> Renderer<'g> {
 
     /// The first light view's RSM flux per texel, row-major (what its cut clusters).
     pub fn read_rsm_flux(&self) -> Result<Vec<[f32; 3]>, IndirectError> {
-        let flux = self.read_texture(&self.first_view().rsm.textures()[0])?;
-        Ok(flux.into_iter().map(xyz).collect())
+        let texels = self.gather.read_rsm(self.gpu, 0)?;
+        Ok(texels.into_iter().map(|[flux, ..]| xyz(flux)).collect())
     }
 
     /// The first light view's quadtree as built: per node (flux rgb + texel count, position + depth, normal +
@@ -608,55 +601,36 @@ impl<'g> Renderer<'g> {
         Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
     }
 
-    /// The xyz of three same-sized textures per texel, `None` where the w of `textures[coverage]`
-    /// marks the texel empty.
-    fn read_covered(
-        &self,
-        textures: [&wgpu::Texture; 3],
-        coverage: usize,
-    ) -> Result<Vec<Option<[[f32; 3]; 3]>>, IndirectError> {
-        let texels = [
-            self.read_texture(textures[0])?,
-            self.read_texture(textures[1])?,
-            self.read_texture(textures[2])?,
-        ];
-        Ok((0..texels[0].len())
-            .map(|i| (texels[coverage][i][3] > 0.5).then(|| texels.each_ref().map(|t| xyz(t[i]))))
-            .collect())
-    }
-
     /// Every light view's VPLs (texels that see geometry), view after view, for the CPU
     /// reference: the light the frames sum.
     pub fn read_vpls(&self) -> Result<Vec<Vpl>, IndirectError> {
         let mut vpls = Vec::new();
-        for view in &self.views {
-            let [flux, pos, normal] = view.rsm.textures();
-            let texels = self.read_covered([flux, pos, normal], 2)?;
+        for view in 0..self.views.len() {
+            let texels = self.gather.read_rsm(self.gpu, view)?;
             vpls.extend(
                 texels
                     .into_iter()
-                    .flatten()
+                    .filter(|[_, _, normal]| normal[3] > 0.5)
                     .map(|[flux, position, normal]| Vpl {
-                        flux,
-                        position,
-                        normal,
+                        flux: xyz(flux),
+                        position: xyz(position),
+                        normal: xyz(normal),
                     }),
             );
         }
         Ok(vpls)
     }
 
-    /// The G-buffer, for the CPU reference.
+    /// The G-buffer as the gather reads it, for the CPU reference.
     pub fn read_receivers(&self) -> Result<Vec<Option<Receiver>>, IndirectError> {
-        let [pos, normal, albedo] = &self.gbuffer.targets.colors;
-        let texels = self.read_covered([pos, normal, albedo], 0)?;
+        let texels = self.gather.read_gbuffer(self.gpu)?;
         Ok(texels
             .into_iter()
-            .map(|texel| {
-                texel.map(|[position, normal, albedo]| Receiver {
-                    position,
-                    normal,
-                    albedo,
+            .map(|[position, normal, albedo]| {
+                (position[3] > 0.5).then(|| Receiver {
+                    position: xyz(position),
+                    normal: xyz(normal),
+                    albedo: xyz(albedo),
                 })
             })
             .collect())

@@ -8,7 +8,7 @@
 //! reproducing command line), and a round-trip test parses them again.
 
 use crate::frame::NORMAL_AGREEMENT;
-use crate::method::{TileCriterion, Validity};
+use crate::method::{GBufferLayout, TileCriterion, Validity};
 use crate::shader_struct::shader_struct;
 use quadray_core::settings::{Limits, Size};
 use serde::Serialize;
@@ -225,6 +225,16 @@ pub struct Settings {
         value_parser = Settings::MAX_LIGHTS.parser(),
     ))]
     pub max_lights: u32,
+    /// How quadray's G-buffer and RSM passes store their targets: compact (position rebuilt
+    /// from depth, the normal in 16-bit octahedral, the albedo in 10 bits, the RSM's flux in
+    /// 16-bit floats: a sixth of the G-buffer's raster output cycles on NVIDIA, a quarter of the
+    /// RSM's) or wide (each in 32-bit floats). A renderer that brings its own G-buffer or RSM
+    /// declares its layout in `GBufferViews` and `RsmViews`.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, default_value_t = Settings::DEFAULT.gbuffer_layout)
+    )]
+    pub gbuffer_layout: GBufferLayout,
     /// The quadtree's parameters, for the quadtree methods.
     #[cfg_attr(feature = "cli", command(flatten))]
     pub cluster: ClusterSettings,
@@ -389,6 +399,7 @@ impl Settings {
         rsm_size: 512,
         shadow_map_size: None,
         max_lights: 4,
+        gbuffer_layout: GBufferLayout::Compact,
         cluster: ClusterSettings::DEFAULT,
         samples: 256,
         rsm_radius: 1.0,
@@ -731,6 +742,7 @@ mod tests {
             rsm_size: 256,
             shadow_map_size: Some(512),
             max_lights: 3,
+            gbuffer_layout: GBufferLayout::Wide,
             cluster: ClusterSettings {
                 start_level: Some(5),
                 limit_level: Some(2),

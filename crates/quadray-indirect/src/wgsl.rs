@@ -29,9 +29,16 @@ pub const NODE: &str = include_str!("light/node.wgsl");
 /// `all_finite`. Needs [`NODE`]. Accessors: none.
 pub const KERNEL: &str = include_str!("light/kernel.wgsl");
 
-/// The spot light over the prelude's `Light` uniform: `spot_intensity` and `light_depth` (the RSM's
-/// depth). Accessors: none.
+/// The spot light over the prelude's `Light` uniform: `spot_edge`, `spot_intensity`,
+/// `light_depth` (the RSM's depth) and `rsm_flux_scale` (what an RSM texel's flux is a share of).
+/// Accessors: none.
 pub const LIGHT: &str = include_str!("light/light.wgsl");
+
+/// The compact G-buffer and RSM layout's encodings ([`crate::GBufferLayout::Compact`]):
+/// `octahedral_encode` and `octahedral_decode` (a unit normal in two coordinates) and `unproject`
+/// (a depth texel's world position through the inverse of its view's projection relative to its
+/// eye). Accessors: none.
+pub const COMPACT: &str = include_str!("light/compact.wgsl");
 
 /// `Receiver`, what a G-buffer texel holds (position, normal, albedo, covered); the including
 /// shader reads its G-buffer into it. Accessors: none.
@@ -125,11 +132,12 @@ fn occupancy_word(i: u32) -> u32 { return 0u; }
 ";
 
     /// Each module after the modules it needs, then the stub accessors it calls.
-    fn modules() -> [(&'static str, Vec<&'static str>); 12] {
+    fn modules() -> [(&'static str, Vec<&'static str>); 13] {
         [
             ("node", vec![NODE]),
             ("kernel", vec![NODE, KERNEL]),
             ("light", vec![LIGHT]),
+            ("compact", vec![COMPACT]),
             ("receiver", vec![RECEIVER]),
             ("cut rule", vec![NODE, CUT_RULE, NODE_ACCESSORS]),
             ("bound", vec![NODE, KERNEL, BOUND]),
@@ -185,6 +193,7 @@ fn occupancy_word(i: u32) -> u32 { return 0u; }
             NODE,
             KERNEL,
             LIGHT,
+            COMPACT,
             RECEIVER,
             CUT_RULE,
             BOUND,

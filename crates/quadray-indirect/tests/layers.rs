@@ -45,6 +45,7 @@ const LAYERS: &[&[&str]] = &[
         "tiles::pass",
         "gathers::rsm_sampling",
         "gathers::brute_force",
+        "gathers::decode",
         "output::temporal",
     ],
     &["gathers::gather"],

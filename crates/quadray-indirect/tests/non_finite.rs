@@ -5,8 +5,8 @@
 use quadray_gpu::{Gpu, read_buffer, read_texture_f32, texture_2d};
 use quadray_indirect::reference::compare;
 use quadray_indirect::{
-    DirectLight, FLOAT_FORMAT, GBufferViews, Gather, LightQuadtree, LightView, Method, OutputPass,
-    OutputTerm, Renderer, RsmPass, RsmViews, Scene, Settings, ViewMaps,
+    DirectLight, FLOAT_FORMAT, GBufferLayout, GBufferViews, Gather, LightQuadtree, LightView,
+    Method, OutputPass, OutputTerm, Renderer, RsmPass, RsmViews, Scene, Settings, ViewMaps,
 };
 use wgpu::util::DeviceExt;
 
@@ -53,7 +53,12 @@ fn clean_inputs(gpu: &Gpu, scene: &Scene) -> (Texels, Texels) {
             })
             .collect()
     });
-    let rsm = RsmPass::new(d, s.rsm_size);
+    // the wide layout, whose three targets the inputs copy
+    let wide = Settings {
+        gbuffer_layout: GBufferLayout::Wide,
+        ..s.clone()
+    };
+    let rsm = RsmPass::new(d, &wide);
     rsm.set_light(q, &LightView::of_scene(scene, 1)[0]);
     let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("vertices"),
@@ -68,8 +73,8 @@ fn clean_inputs(gpu: &Gpu, scene: &Scene) -> (Texels, Texels) {
         None,
     );
     gpu.submit("rsm", encoder.finish());
-    let rsm = rsm.textures().each_ref().map(|t| {
-        let floats = read_texture_f32(gpu, t, 0, 4).unwrap();
+    let rsm = [0, 1, 2].map(|k| {
+        let floats = read_texture_f32(gpu, &rsm.textures()[k], 0, 4).unwrap();
         floats
             .chunks_exact(4)
             .map(|c| [c[0], c[1], c[2], c[3]])
@@ -103,12 +108,12 @@ impl Passes {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let ([g_pos, g_normal, g_albedo], [flux, position, normal]) =
             (gbuffer.each_ref().map(view), rsm.each_ref().map(view));
-        let rsm_views = RsmViews {
+        let rsm_views = RsmViews::Wide {
             flux: &flux,
             position: &position,
             normal: &normal,
         };
-        let gbuffer_views = GBufferViews {
+        let gbuffer_views = GBufferViews::Wide {
             position: &g_pos,
             normal: &g_normal,
             albedo: &g_albedo,

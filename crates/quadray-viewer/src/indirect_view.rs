@@ -11,7 +11,8 @@ use quadray_gpu::Gpu;
 use quadray_indirect::picture::tone_map;
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
 use quadray_indirect::{
-    ClusterSettings, FrameTiming, Method, Renderer, Scene, Settings, TileCriterion, Validity,
+    ClusterSettings, FrameTiming, GBufferLayout, Method, Renderer, Scene, Settings, TileCriterion,
+    Validity,
 };
 use std::path::{Path, PathBuf};
 
@@ -469,6 +470,13 @@ impl IndirectView {
         if 1 << shadow_log != s.shadow_map_size_or_default() {
             s.shadow_map_size = Some(1 << shadow_log);
         }
+        named_choice_box(
+            ui,
+            "G-buffer and RSM layout",
+            &mut s.gbuffer_layout,
+            &GBufferLayout::ALL,
+            |l| l.name().into(),
+        );
         let levels = s.levels();
         let (mut start, mut limit) = (levels.start, levels.limit);
         ui.add(egui::Slider::new(&mut start, 0..=rsm_log).text("start level"));

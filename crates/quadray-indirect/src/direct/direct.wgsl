@@ -34,7 +34,8 @@ fn shadow_visibility(x: vec3<f32>, n: vec3<f32>, w: vec3<f32>) -> f32 {
     return 0.25 * taps;
 }
 
-// One bilinear comparison: the share of the four texels around uv that lie at or behind depth.
+// One bilinear comparison: the share of the four texels around uv that lie at or behind depth
+// (depths reversed, as the raster passes draw: nearer is greater).
 fn shadow_tap(uv: vec2<f32>, depth: f32) -> f32 {
     return textureSampleCompareLevel(shadow_map, shadow_sampler, uv, depth);
 }

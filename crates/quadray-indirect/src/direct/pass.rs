@@ -76,7 +76,8 @@ impl DirectLight {
             label: Some("shadow map comparison"),
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
-            compare: Some(wgpu::CompareFunction::LessEqual),
+            // reversed depth (`reversed_depth`): lit where the map's surface is at or behind
+            compare: Some(wgpu::CompareFunction::GreaterEqual),
             ..Default::default()
         });
         let shadows: Vec<wgpu::Buffer> = (0..views)

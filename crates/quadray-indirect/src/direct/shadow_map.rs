@@ -6,6 +6,7 @@ use crate::contract::{
     RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry, whole,
 };
 use crate::light::rsm::{RASTER_WGSL, RasterTargets, raster_pipeline, record_raster};
+use crate::light::view::reversed_depth;
 use crate::light::view::LightView;
 use quadray_gpu::GpuTimer;
 
@@ -13,7 +14,7 @@ use quadray_gpu::GpuTimer;
 struct ShadowMap {
     raster: wgpu::Buffer,
     group: wgpu::BindGroup,
-    targets: RasterTargets<0>,
+    targets: RasterTargets,
 }
 
 /// A depth-only shadow map of `size`^2 texels for each of a gather's light views.
@@ -41,13 +42,13 @@ impl ShadowMaps {
                 ShadowMap {
                     group: bind_group(device, "shadow map", &group_layout, vec![whole(&raster)]),
                     raster,
-                    targets: RasterTargets::new(device, [], (size, size)),
+                    targets: RasterTargets::new(device, &[], (size, size)),
                 }
             })
             .collect();
         Self {
             size,
-            pipeline: raster_pipeline::<0>(device, &group_layout, &module, "shadow map", None),
+            pipeline: raster_pipeline(device, &group_layout, &module, "shadow map", None, &[]),
             maps,
         }
     }
@@ -64,7 +65,7 @@ impl ShadowMaps {
             &self.maps[index].raster,
             0,
             bytemuck::bytes_of(&RasterUniform {
-                view_proj: view.view_proj.to_cols_array_2d(),
+                view_proj: reversed_depth(view.view_proj).to_cols_array_2d(),
                 eye: [p.x, p.y, p.z, 1.0],
                 texel: [0.0; 4],
             }),

@@ -3,6 +3,7 @@
 
 use super::brute_force::BruteForce;
 use super::cut::Cut;
+use super::decode::{Decode, Decoded};
 use super::passes::Passes;
 use super::resources::{Resources, ViewMaps};
 use super::rsm_sampling::RsmSampling;
@@ -18,7 +19,8 @@ use crate::output::temporal::Temporal;
 use crate::settings::Settings;
 use crate::shadows::occupancy::OccupancyGrid;
 use crate::tiles::pass::Tiles;
-use quadray_gpu::{GpuTimer, Limit, LimitNeed};
+use quadray_gpu::{Gpu, GpuError, GpuTimer, Limit, LimitNeed};
+use std::sync::OnceLock;
 
 /// Every gather pass's whole shader (before the prelude), by name: what the contract test parses.
 #[cfg(test)]
@@ -45,6 +47,10 @@ pub(crate) fn shaders() -> Vec<(&'static str, Vec<&'static str>)> {
             "gather temporal",
             super::resources::shader(&crate::output::temporal::WGSL),
         ),
+        (
+            "gather decode",
+            super::resources::shader(&super::decode::WGSL),
+        ),
     ]
 }
 
@@ -63,6 +69,8 @@ pub struct Gather {
     rsm_sampling: RsmSampling,
     brute_force: BruteForce,
     temporal: Temporal,
+    /// Made on the first read-back of the inputs (the CPU reference's), not for every gather.
+    decode: OnceLock<Decode>,
 }
 
 impl Gather {
@@ -108,8 +116,9 @@ impl Gather {
     }
 
     /// The gather of `settings` (sizes, samples, subsampling) summing the light views whose
-    /// `maps` (each an RSM and the quadtree built from it) it reads, on the caller's G-buffer
-    /// (`settings.size`).
+    /// `maps` (each an RSM and the quadtree built from it, all RSMs in one layout) it reads, on
+    /// the caller's G-buffer (`settings.size`; a compact one needs [`Gather::set_camera`]). The
+    /// layouts are the views' own: [`Settings::gbuffer_layout`] is the one quadray's passes write.
     pub fn new(
         device: &wgpu::Device,
         settings: &Settings,
@@ -122,6 +131,11 @@ impl Gather {
                 "a gather needs a light view".into(),
             ));
         }
+        if maps.iter().any(|m| m.rsm.layout() != maps[0].rsm.layout()) {
+            return Err(IndirectError::Settings(
+                "a gather reads its light views' RSMs in one layout".into(),
+            ));
+        }
         quadray_gpu::check_limits(&device.limits(), "the device", &Self::limit_needs(settings))?;
         let res = Resources::new(device, settings, maps, gbuffer);
         Ok(Self {
@@ -131,6 +145,7 @@ impl Gather {
             rsm_sampling: RsmSampling::new(device, &res),
             brute_force: BruteForce::new(device, &res),
             temporal: Temporal::new(device, &res),
+            decode: OnceLock::new(),
             res,
         })
     }
@@ -139,7 +154,7 @@ impl Gather {
     /// a light view as at [`Gather::new`].
     ///
     /// # Panics
-    /// With another number of views than the gather was made for.
+    /// With another number of views, or RSMs in another layout, than the gather was made for.
     pub fn bind_maps(&mut self, device: &wgpu::Device, maps: &[ViewMaps]) {
         self.reset_history();
         self.res.bind_maps(device, maps);
@@ -151,6 +166,9 @@ impl Gather {
     }
 
     /// Shades another G-buffer of the same size from now on (when the caller's targets change).
+    ///
+    /// # Panics
+    /// With a G-buffer in another layout than the gather was made for.
     pub fn bind_gbuffer(&mut self, device: &wgpu::Device, gbuffer: GBufferViews) {
         self.reset_history();
         self.res.bind_gbuffer(device, gbuffer);
@@ -267,6 +285,23 @@ impl Gather {
         if filtered {
             self.temporal.record_finish(encoder, res, method);
         }
+    }
+
+    /// The G-buffer as the passes read it (on `gpu`, the gather's device), row-major: position
+    /// (w: 1 where geometry is seen), normal, albedo a pixel.
+    pub(crate) fn read_gbuffer(&self, gpu: &Gpu) -> Result<Decoded, GpuError> {
+        self.decoder(gpu).read(gpu, &self.res, None)
+    }
+
+    /// Light view `view`'s RSM as the passes read it, row-major: flux, position (w: depth along
+    /// the light's axis), normal (w: 1 where the light sees geometry) a texel.
+    pub(crate) fn read_rsm(&self, gpu: &Gpu, view: usize) -> Result<Decoded, GpuError> {
+        self.decoder(gpu).read(gpu, &self.res, Some(view))
+    }
+
+    fn decoder(&self, gpu: &Gpu) -> &Decode {
+        self.decode
+            .get_or_init(|| Decode::new(&gpu.device, &self.res))
     }
 
     /// The settings the gather was built with.

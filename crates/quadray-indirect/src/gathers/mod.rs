@@ -12,6 +12,7 @@
 
 mod brute_force;
 mod cut;
+mod decode;
 pub(crate) mod gather;
 mod passes;
 pub(crate) mod resources;

@@ -7,16 +7,17 @@
 
 use crate::contract::{
     CameraUniform, ClusterUniform, GpuNode, GpuNodeBounds, LevelSlot, LightTermsUniform,
-    LightUniform, MAX_SLICES, OCCUPANCY_ROW, Slots, bind_group, compute_pipeline, dispatch_2d,
-    layout, pipeline_layout, shader_module, storage_buffer, storage_entry, tex, texture_entry,
-    uint_texture_entry, uniform_buffer, uniform_entry, whole,
+    LightUniform, MAX_SLICES, OCCUPANCY_ROW, Slots, bind_group, compact_constant, compute_pipeline,
+    dispatch_2d, layout, pipeline_layout, shader_module, storage_buffer, storage_entry, tex,
+    texture_entry, uint_texture_entry, uniform_buffer, uniform_entry, whole,
 };
 use crate::gathers::samples;
 use crate::gbuffer::{GBufferViews, camera_uniform};
 use crate::light::node::CutCounts;
 use crate::light::quadtree::LightQuadtree;
-use crate::light::rsm::RsmViews;
+use crate::light::rsm::{RSM_READ_WGSL, RsmViews};
 use crate::light::view::LightView;
+use crate::method::GBufferLayout;
 use crate::settings::{Settings, Shade};
 use crate::shadows::MARCH_WGSL;
 use crate::shadows::occupancy::OccupancyGrid;
@@ -24,16 +25,18 @@ use crate::wgsl;
 use wgpu::util::DeviceExt;
 
 /// What every gather pass's shader starts with (after the prelude): the node layout and kernel,
-/// the light, the receiver, the occupancy walk and the depth-map march of indirect shadows, and
-/// `shared.wgsl` (the bindings of groups 0-2, the accessors the
-/// engine-neutral modules read them with, and the helpers every pass uses).
-const SHARED_WGSL: [&str; 7] = [
+/// the light, the compact layout's encodings, the receiver, the occupancy walk and the depth-map
+/// march of indirect shadows, the RSM's reads, and `shared.wgsl` (the bindings of groups 0-2, the
+/// accessors the engine-neutral modules read them with, and the helpers every pass uses).
+const SHARED_WGSL: [&str; 9] = [
     wgsl::NODE,
     wgsl::KERNEL,
     wgsl::LIGHT,
+    wgsl::COMPACT,
     wgsl::RECEIVER,
     wgsl::OCCUPANCY,
     MARCH_WGSL,
+    RSM_READ_WGSL,
     include_str!("shared.wgsl"),
 ];
 
@@ -127,6 +130,7 @@ impl Outputs {
         layout: &wgpu::BindGroupLayout,
         gbuffer: GBufferViews,
     ) -> wgpu::BindGroup {
+        let [position, normal, albedo] = gbuffer.textures();
         bind_group(
             device,
             "gather frame",
@@ -134,9 +138,9 @@ impl Outputs {
             vec![
                 whole(&self.shade),
                 whole(&self.camera),
-                tex(gbuffer.position),
-                tex(gbuffer.normal),
-                tex(gbuffer.albedo),
+                tex(position),
+                tex(normal),
+                tex(albedo),
                 whole(&self.indirect),
                 whole(&self.direct),
                 whole(&self.low),
@@ -224,6 +228,9 @@ impl ViewGroup {
 /// The shared groups' layouts, buffers and bind groups, at one set of sizes.
 pub(crate) struct Resources {
     settings: Settings,
+    /// The layouts of the G-buffer and of the RSMs the pipelines read.
+    gbuffer_layout: GBufferLayout,
+    rsm_layout: GBufferLayout,
     light_layout: wgpu::BindGroupLayout,
     frame_layout: wgpu::BindGroupLayout,
     dispatch_layout: wgpu::BindGroupLayout,
@@ -237,7 +244,7 @@ pub(crate) struct Resources {
 
 impl Resources {
     /// The shared resources of a gather of `settings` (checked) reading the light views' `maps`
-    /// and the caller's G-buffer.
+    /// (at least one, all in one layout) and the caller's G-buffer.
     pub fn new(
         device: &wgpu::Device,
         settings: &Settings,
@@ -245,6 +252,7 @@ impl Resources {
         gbuffer: GBufferViews,
     ) -> Self {
         let s = settings;
+        let rsm_layout = maps[0].rsm.layout();
         let compute = wgpu::ShaderStages::COMPUTE;
         let light_layout = layout(
             device,
@@ -302,6 +310,8 @@ impl Resources {
         let outputs = Outputs::new(device, s, maps.len());
         Self {
             settings: s.clone(),
+            gbuffer_layout: gbuffer.layout(),
+            rsm_layout,
             views,
             frame_group: outputs.frame_group(device, &frame_layout, gbuffer),
             outputs,
@@ -323,16 +333,28 @@ impl Resources {
         self.views.len()
     }
 
-    /// Reads other quadtrees or RSMs from now on (as many as before).
+    /// Reads other quadtrees or RSMs from now on (as many as before, in the same layout).
     pub fn bind_maps(&mut self, device: &wgpu::Device, maps: &[ViewMaps]) {
         assert_eq!(maps.len(), self.views.len(), "one maps a light view");
+        for m in maps {
+            assert_eq!(
+                m.rsm.layout(),
+                self.rsm_layout,
+                "the RSMs keep their layout"
+            );
+        }
         for (view, &m) in self.views.iter_mut().zip(maps) {
             view.group = light_group(device, &self.light_layout, [&view.light, &view.terms], m);
         }
     }
 
-    /// Shades another G-buffer of the same size from now on.
+    /// Shades another G-buffer of the same size and layout from now on.
     pub fn bind_gbuffer(&mut self, device: &wgpu::Device, gbuffer: GBufferViews) {
+        assert_eq!(
+            gbuffer.layout(),
+            self.gbuffer_layout,
+            "the G-buffer keeps its layout"
+        );
         self.frame_group = self
             .outputs
             .frame_group(device, &self.frame_layout, gbuffer);
@@ -361,7 +383,8 @@ impl Resources {
             w * h
         };
         for (i, (view, light)) in self.views.iter().zip(lights).enumerate() {
-            queue.write_buffer(&view.light, 0, bytemuck::bytes_of(&light.uniform()));
+            let uniform = light.uniform(self.settings.rsm_size);
+            queue.write_buffer(&view.light, 0, bytemuck::bytes_of(&uniform));
             let terms = light.terms(&self.settings, r_min, i as u32 * low_samples);
             queue.write_buffer(&view.terms, 0, bytemuck::bytes_of(&terms));
         }
@@ -394,12 +417,16 @@ impl Resources {
         .chain(own_groups.iter().copied())
         .collect();
         let layout = pipeline_layout(device, &groups);
-        // the pipeline constant SHADOWS (shared.wgsl)
-        let shadows = [(
-            "SHADOWS",
-            f64::from(u8::from(self.settings.march_steps() > 0)),
-        )];
-        entries.map(|entry| compute_pipeline(device, &layout, &module, entry, &shadows))
+        // the pipeline constants of shared.wgsl and light/rsm_read.wgsl
+        let constants = [
+            (
+                "SHADOWS",
+                f64::from(u8::from(self.settings.march_steps() > 0)),
+            ),
+            compact_constant("COMPACT_GBUFFER", self.gbuffer_layout),
+            compact_constant("COMPACT_RSM", self.rsm_layout),
+        ];
+        entries.map(|entry| compute_pipeline(device, &layout, &module, entry, &constants))
     }
 
     /// Binds light view `view`'s group and the frame's.
@@ -451,6 +478,7 @@ fn light_group(
     [light, terms]: [&wgpu::Buffer; 2],
     ViewMaps { rsm, quadtree }: ViewMaps,
 ) -> wgpu::BindGroup {
+    let [flux, position, normal] = rsm.textures();
     bind_group(
         device,
         "gather light",
@@ -459,9 +487,9 @@ fn light_group(
             whole(quadtree.params()),
             whole(light),
             whole(terms),
-            tex(rsm.flux),
-            tex(rsm.position),
-            tex(rsm.normal),
+            tex(flux),
+            tex(position),
+            tex(normal),
             whole(quadtree.nodes()),
             whole(quadtree.cut()),
             whole(quadtree.cut_count()),

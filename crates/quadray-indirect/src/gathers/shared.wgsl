@@ -7,6 +7,10 @@
 // loop, even one that never runs, made that loop 4-11 times slower on lavapipe.
 override SHADOWS: bool;
 
+// Whether the G-buffer is compact (`GBufferLayout`): a pipeline constant, so that each layout
+// compiles its own reads (the RSM's: light/rsm_read.wgsl).
+override COMPACT_GBUFFER: bool;
+
 // The structs bound here (`Shade`, `LightTerms`, `Camera`, `Level`, `ClusterParams`, `Light`,
 // `Node`, `NodeBounds`) are declared in Rust and generated into the prelude (contract.rs; the
 // gather's settings, `Shade`, in settings.rs).
@@ -29,6 +33,7 @@ override SHADOWS: bool;
 // RSM samples.
 @group(1) @binding(0) var<uniform> shade: Shade;
 @group(1) @binding(1) var<storage, read> viewer: Camera;
+// (the compact layout: the camera's depth in g_pos, g_normal octahedral)
 @group(1) @binding(2) var g_pos: texture_2d<f32>;
 @group(1) @binding(3) var g_normal: texture_2d<f32>;
 @group(1) @binding(4) var g_albedo: texture_2d<f32>;
@@ -51,6 +56,27 @@ override SHADOWS: bool;
 @group(2) @binding(0) var<uniform> current: Level;
 @group(2) @binding(1) var<uniform> slice: Level;
 
+// A G-buffer pixel's world position (w: 1 where geometry is seen, else 0) and unit normal, in
+// either layout (`GBufferLayout`; the compact one's g_pos holds the camera's reversed depth, 0
+// where nothing is seen, its g_normal octahedral coordinates).
+fn load_g_position(t: vec2<i32>) -> vec4<f32> {
+    let texel = textureLoad(g_pos, t, 0);
+    if (COMPACT_GBUFFER) {
+        let size = vec2<f32>(f32(viewer.width), f32(viewer.height));
+        let x = unproject(viewer.inv_view_proj, viewer.eye.xyz, t, size, texel.x);
+        return vec4<f32>(x, select(0.0, 1.0, texel.x > 0.0));
+    }
+    return texel;
+}
+
+fn load_g_normal(t: vec2<i32>) -> vec3<f32> {
+    let texel = textureLoad(g_normal, t, 0);
+    if (COMPACT_GBUFFER) {
+        return octahedral_decode(texel.xy);
+    }
+    return texel.xyz;
+}
+
 // The accessors of the engine-neutral modules (src/wgsl.rs): node `i` of the pyramid, and a pixel's
 // receiver from the G-buffer.
 fn load_node(i: u32) -> Node {
@@ -60,10 +86,10 @@ fn load_node(i: u32) -> Node {
 fn receiver(pixel: vec2<u32>) -> Receiver {
     let t = vec2<i32>(pixel);
     fetches += 3u;
-    let p = textureLoad(g_pos, t, 0);
+    let p = load_g_position(t);
     var r: Receiver;
     r.x = p.xyz;
-    r.n = textureLoad(g_normal, t, 0).xyz;
+    r.n = load_g_normal(t);
     r.albedo = textureLoad(g_albedo, t, 0).rgb;
     // a texel the kernel cannot take sees no geometry: its NaN would spread through its tile's
     // cut and the neighbours that upsample or reproject from it
@@ -158,20 +184,8 @@ fn add_indirect(index: u32, value: vec4<f32>) {
     }
 }
 
-// The accessors of gather_vpls.wgsl: an RSM texel's normal (w: 1 where the light sees
-// geometry), position and flux, and RSM sampling's pattern.
-fn load_rsm_normal(t: vec2<i32>) -> vec4<f32> {
-    return textureLoad(rsm_normal, t, 0);
-}
-
-fn load_rsm_position(t: vec2<i32>) -> vec4<f32> {
-    return textureLoad(rsm_pos, t, 0);
-}
-
-fn load_rsm_flux(t: vec2<i32>) -> vec3<f32> {
-    return textureLoad(rsm_flux, t, 0).rgb;
-}
-
+// The accessors of gather_vpls.wgsl: an RSM texel's (light/rsm_read.wgsl) and RSM sampling's
+// pattern.
 fn load_rsm_sample(i: u32) -> vec4<f32> {
     return samples[i];
 }

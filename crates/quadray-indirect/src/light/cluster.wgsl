@@ -1,7 +1,8 @@
 // The light quadtree: pack the RSM into level 0, reduce level by level (summed flux, means),
 // mark valid clusters (local or recursive rule), and compact the cut into a list.
 
-// Group 0, per light update: the settings, the RSM and the quadtree.
+// Group 0, per light update: the settings, the RSM (read through light/rsm_read.wgsl), the
+// quadtree and the light.
 @group(0) @binding(0) var<uniform> params: ClusterParams;
 @group(0) @binding(1) var rsm_flux: texture_2d<f32>;
 @group(0) @binding(2) var rsm_pos: texture_2d<f32>;
@@ -15,6 +16,8 @@
 @group(0) @binding(6) var<storage, read_write> cut_count: array<atomic<u32>, CUT_CLASS_SIDE * CUT_CLASS_SIDE + 1u>;
 // per node, what bounds its contribution (reduced with the means, read by the per-tile cuts)
 @group(0) @binding(7) var<storage, read_write> bounds: array<NodeBounds>;
+// the light view the RSM was rendered from (a compact RSM's positions are rebuilt with it)
+@group(0) @binding(8) var<uniform> light: Light;
 // Group 1, per dispatch: the level (a dynamic offset into slots 0, 1, 2, ...).
 @group(1) @binding(0) var<uniform> current: Level;
 
@@ -29,9 +32,9 @@ fn pack(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let t = vec2<i32>(id.xy);
-    let flux = textureLoad(rsm_flux, t, 0).rgb;
-    let pos = textureLoad(rsm_pos, t, 0);
-    let n = textureLoad(rsm_normal, t, 0);
+    let flux = load_rsm_flux(t);
+    let pos = load_rsm_position(t);
+    let n = load_rsm_normal(t);
     // a texel the kernel cannot take (NaN, infinite, a zero normal) packs as a cleared one
     let vpl = n.w > 0.5 && kernel_vpl(flux, pos, n.xyz);
     var node: Node;

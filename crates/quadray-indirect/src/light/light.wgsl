@@ -8,13 +8,24 @@ fn is_parallel(light: Light) -> bool {
     return light.parallel.x > 0.5;
 }
 
-// Radiant intensity towards unit direction w from the light (a point or spot light).
-fn spot_intensity(light: Light, w: vec3<f32>) -> vec3<f32> {
+// The share of the light's intensity sent towards unit direction w (a spot's cone and falloff;
+// 1 from a point light).
+fn spot_edge(light: Light, w: vec3<f32>) -> f32 {
     let c = dot(w, light.direction.xyz);
     let outer = light.direction.w;
     let inner = light.intensity.w;
-    let edge = select(select(0.0, 1.0, c >= outer), smoothstep(outer, inner, c), inner > outer);
-    return light.intensity.rgb * edge;
+    return select(select(0.0, 1.0, c >= outer), smoothstep(outer, inner, c), inner > outer);
+}
+
+// Radiant intensity towards unit direction w from the light (a point or spot light).
+fn spot_intensity(light: Light, w: vec3<f32>) -> vec3<f32> {
+    return light.intensity.rgb * spot_edge(light, w);
+}
+
+// What an RSM texel's flux is a share of: the intensity (the sun: irradiance) times a texel's
+// measure on the axis (rsm.wgsl).
+fn rsm_flux_scale(light: Light) -> vec3<f32> {
+    return light.intensity.rgb * light.parallel.y;
 }
 
 // Unit direction the light travels in to reach x.

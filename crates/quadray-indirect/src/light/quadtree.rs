@@ -3,14 +3,16 @@
 //! reads.
 
 use crate::contract::{
-    ClusterUniform, GpuNode, GpuNodeBounds, LevelSlot, Slots, bind_group, compute_pass,
-    compute_pipeline, dispatch_2d, layout, pipeline_layout, shader_module, storage_buffer,
-    storage_entry, tex, texture_entry, uniform_buffer, uniform_entry, whole,
+    ClusterUniform, GpuNode, GpuNodeBounds, LevelSlot, LightUniform, Slots, bind_group,
+    compact_constant, compute_pass, compute_pipeline, dispatch_2d, layout, pipeline_layout,
+    shader_module, storage_buffer, storage_entry, tex, texture_entry, uniform_buffer,
+    uniform_entry, whole,
 };
 use crate::light::node::{
     CUT_CLASS_SIDE, CutCounts, MAX_LEVELS, cut_class_capacity, level_offset, node_count,
 };
-use crate::light::rsm::RsmViews;
+use crate::light::rsm::{RSM_READ_WGSL, RsmViews};
+use crate::method::GBufferLayout;
 use crate::method::Validity;
 use crate::settings::{ClusterSettings, Levels};
 use crate::wgsl;
@@ -18,10 +20,13 @@ use quadray_gpu::GpuTimer;
 
 /// The quadtree pass's shader, in order: `cluster.wgsl` holds its bindings, the accessor the cut
 /// rule reads nodes with, and its entry points.
-pub(crate) const SOURCES: [&str; 4] = [
+pub(crate) const SOURCES: [&str; 7] = [
     wgsl::NODE,
     wgsl::KERNEL,
+    wgsl::LIGHT,
+    wgsl::COMPACT,
     wgsl::CUT_RULE,
+    RSM_READ_WGSL,
     include_str!("cluster.wgsl"),
 ];
 
@@ -29,6 +34,10 @@ pub(crate) const SOURCES: [&str; 4] = [
 pub struct LightQuadtree {
     rsm_size: u32,
     cluster: ClusterSettings,
+    /// The layout of the RSM the pipelines read.
+    rsm_layout: GBufferLayout,
+    /// What a wide RSM's group binds for the light it does not need.
+    no_light: wgpu::Buffer,
     pack: wgpu::ComputePipeline,
     reduce: wgpu::ComputePipeline,
     validity: wgpu::ComputePipeline,
@@ -69,6 +78,7 @@ impl LightQuadtree {
                 storage_entry::<GpuNode>(5, false),
                 storage_entry::<CutCounts>(6, false),
                 storage_entry::<GpuNodeBounds>(7, false),
+                uniform_entry::<LightUniform>(8, compute, false),
             ],
         );
         let level_layout = layout(
@@ -78,7 +88,9 @@ impl LightQuadtree {
         );
         let module = shader_module(device, "quadtree", &SOURCES);
         let pipelines = pipeline_layout(device, &[&group_layout, &level_layout]);
-        let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry, &[]);
+        let rsm_layout = rsm.layout();
+        let constants = [compact_constant("COMPACT_RSM", rsm_layout)];
+        let pipeline = |entry| compute_pipeline(device, &pipelines, &module, entry, &constants);
         let node_size = size_of::<GpuNode>() as u64;
         let params = uniform_buffer::<ClusterUniform>(device, "cluster settings");
         let nodes = storage_buffer(device, "nodes", node_count(rsm_size) * node_size);
@@ -101,11 +113,14 @@ impl LightQuadtree {
             &level_layout,
             vec![levels.binding()],
         );
-        let buffers = [&params, &nodes, &cut, &cut_count, &bounds];
+        let no_light = uniform_buffer::<LightUniform>(device, "quadtree no light");
+        let buffers = [&params, &nodes, &cut, &cut_count, &bounds, &no_light];
         let group = Self::rsm_group(device, &group_layout, buffers, rsm);
         let quadtree = Self {
             rsm_size,
             cluster,
+            rsm_layout,
+            no_light,
             pack: pipeline("pack"),
             reduce: pipeline("reduce"),
             validity: pipeline("validity"),
@@ -124,39 +139,55 @@ impl LightQuadtree {
         quadtree
     }
 
-    /// The group of `buffers` (settings, nodes, cut, cut count, node bounds) and `rsm`.
+    /// The group of `buffers` (settings, nodes, cut, cut count, node bounds, and the light a
+    /// wide RSM does not need) and `rsm`.
     fn rsm_group(
         device: &wgpu::Device,
         group_layout: &wgpu::BindGroupLayout,
-        buffers: [&wgpu::Buffer; 5],
+        buffers: [&wgpu::Buffer; 6],
         rsm: RsmViews,
     ) -> wgpu::BindGroup {
-        let [params, nodes, cut, cut_count, bounds] = buffers;
+        let [params, nodes, cut, cut_count, bounds, no_light] = buffers;
+        let [flux, position, normal] = rsm.textures();
+        let light = match rsm {
+            RsmViews::Compact { light, .. } => light,
+            RsmViews::Wide { .. } => no_light,
+        };
         bind_group(
             device,
             "quadtree",
             group_layout,
             vec![
                 whole(params),
-                tex(rsm.flux),
-                tex(rsm.position),
-                tex(rsm.normal),
+                tex(flux),
+                tex(position),
+                tex(normal),
                 whole(nodes),
                 whole(cut),
                 whole(cut_count),
                 whole(bounds),
+                whole(light),
             ],
         )
     }
 
     /// Reads another RSM of the same side from now on (when the caller's RSM textures change).
+    ///
+    /// # Panics
+    /// With an RSM in another layout than the one the quadtree was made for.
     pub fn bind_rsm(&mut self, device: &wgpu::Device, rsm: RsmViews) {
+        assert_eq!(
+            rsm.layout(),
+            self.rsm_layout,
+            "the quadtree reads the RSM layout it was made for"
+        );
         let buffers = [
             &self.params,
             &self.nodes,
             &self.cut,
             &self.cut_count,
             &self.bounds,
+            &self.no_light,
         ];
         self.group = Self::rsm_group(device, &self.group_layout, buffers, rsm);
     }

@@ -1,39 +1,133 @@
 //! The RSM pass: the caller's triangles rasterised from one light view into a reflective shadow
-//! map (flux, position + depth, normal), the input of the light quadtree. Also the raster
-//! helpers quadray's own G-buffer pass and the direct light's shadow maps share.
+//! map (flux, position + depth, normal, in one of the [`GBufferLayout`]s), the input of the light
+//! quadtree. Also the raster helpers quadray's own G-buffer pass and the direct light's shadow
+//! maps share.
 
 use crate::contract::{
     LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
     uniform_buffer, uniform_entry, whole,
 };
-use crate::light::view::LightView;
+use crate::light::view::{LightView, reversed_depth};
+use crate::method::GBufferLayout;
 use crate::scene::Vertex;
+use crate::settings::Settings;
 use crate::wgsl;
-use quadray_gpu::{GpuTimer, cleared_attachment, nearest_depth, texture_2d};
+use quadray_gpu::{GpuTimer, cleared_attachment, texture_2d};
 
-/// Format of every RSM and G-buffer colour target.
+/// Format of every wide RSM and G-buffer colour target.
 pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// A compact target's normal: two octahedral coordinates (compact.wgsl).
+const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
+/// A compact G-buffer's albedo (a reflectance in [0, 1]): 10 bits a channel, for as many ROP
+/// cycles as 8, hold a dark channel to 1% (the Cornell box's red wall's 0.05: 0.3%; 8 bits, 2%).
+const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgb10a2Unorm;
+/// A compact RSM's flux: high dynamic range.
+const FLUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// A raster pass's colour target: its label and format.
+pub(crate) type ColorTarget = (&'static str, wgpu::TextureFormat);
+
+/// The G-buffer's colour targets in `layout`: position, normal and albedo, or normal and albedo.
+pub(crate) fn gbuffer_targets(layout: GBufferLayout) -> &'static [ColorTarget] {
+    match layout {
+        GBufferLayout::Wide => &[
+            ("g position", FLOAT_FORMAT),
+            ("g normal", FLOAT_FORMAT),
+            ("g albedo", FLOAT_FORMAT),
+        ],
+        GBufferLayout::Compact => &[("g normal", NORMAL_FORMAT), ("g albedo", ALBEDO_FORMAT)],
+    }
+}
+
+/// An RSM's colour targets in `layout`: flux, position and normal, or flux and normal.
+pub(crate) fn rsm_targets(layout: GBufferLayout) -> &'static [ColorTarget] {
+    match layout {
+        GBufferLayout::Wide => &[
+            ("rsm flux", FLOAT_FORMAT),
+            ("rsm position", FLOAT_FORMAT),
+            ("rsm normal", FLOAT_FORMAT),
+        ],
+        GBufferLayout::Compact => &[("rsm flux", FLUX_FORMAT), ("rsm normal", NORMAL_FORMAT)],
+    }
+}
 
 const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
 
-pub(crate) const RASTER_WGSL: &str = include_str!("raster.wgsl");
+/// The raster passes' shared modules: the vertex stage, and the compact layout's encodings.
+pub(crate) const RASTER_WGSL: [&str; 2] = [include_str!("raster.wgsl"), wgsl::COMPACT];
+/// How the quadtree and the gather read an RSM texel in either layout (`load_rsm_normal`,
+/// `load_rsm_position`, `load_rsm_flux`; needs [`wgsl::LIGHT`], [`wgsl::COMPACT`] and the
+/// including shader's `rsm_flux`, `rsm_pos`, `rsm_normal`, `light` and `params`).
+pub(crate) const RSM_READ_WGSL: &str = include_str!("rsm_read.wgsl");
 /// The RSM pass's shader, in order.
-pub(crate) const SOURCES: [&str; 3] = [wgsl::LIGHT, RASTER_WGSL, include_str!("rsm.wgsl")];
+pub(crate) const SOURCES: [&str; 4] = [
+    wgsl::LIGHT,
+    RASTER_WGSL[0],
+    RASTER_WGSL[1],
+    include_str!("rsm.wgsl"),
+];
 
-/// The RSM as the quadtree and the gather read it, whoever renders it: three square textures of
-/// the same side (a power of two), any float format `textureLoad` reads (quadray's are
-/// [`FLOAT_FORMAT`]). An empty texel has `normal.w = 0`.
+/// The RSM as the quadtree and the gather read it, whoever renders it: square textures of the
+/// same side (a power of two), any float formats `textureLoad` reads (quadray's
+/// [`RsmPass`] writes the layout [`Settings::gbuffer_layout`] names).
 #[derive(Clone, Copy)]
-pub struct RsmViews<'a> {
-    /// rgb: flux the texel's surface reflects (W), `I(w) * solid angle * albedo` (parallel
-    /// light: `E * area * albedo`); w unused.
-    pub flux: &'a wgpu::TextureView,
-    /// xyz: world position; w: depth along the light's axis in units of [`LightView::extent`].
-    pub position: &'a wgpu::TextureView,
-    /// xyz: unit normal facing the light; w: 1 where the light sees geometry, else 0.
-    pub normal: &'a wgpu::TextureView,
+pub enum RsmViews<'a> {
+    /// Each quantity whole. An empty texel has `normal.w = 0`.
+    Wide {
+        /// rgb: flux the texel's surface reflects (W), `I(w) * solid angle * albedo` (parallel
+        /// light: `E * area * albedo`); w unused.
+        flux: &'a wgpu::TextureView,
+        /// xyz: world position; w: depth along the light's axis in units of
+        /// [`LightView::extent`].
+        position: &'a wgpu::TextureView,
+        /// xyz: unit normal facing the light; w: 1 where the light sees geometry, else 0.
+        normal: &'a wgpu::TextureView,
+    },
+    /// The position rebuilt from the light view's depth.
+    Compact {
+        /// rgb: the texel's flux over the view's intensity times its texel measure on the axis
+        /// (the light's uniform holds both): the spot's falloff times cos^3 off the axis times
+        /// the albedo, in [0, 1], where a float keeps its precision however small the texel.
+        flux: &'a wgpu::TextureView,
+        /// x: the depth the light view's projection gave the texel's surface, reversed: clip
+        /// (w - z) / w, 1 at the near plane, 0 at the far plane and where the light sees
+        /// nothing (a depth buffer cleared to 0).
+        depth: &'a wgpu::TextureView,
+        /// xy: the unit normal facing the light in octahedral coordinates.
+        normal: &'a wgpu::TextureView,
+        /// The light view the RSM was rendered from, as [`RsmPass::set_light`] writes it: the
+        /// quadtree rebuilds positions and depths with it.
+        light: &'a wgpu::Buffer,
+    },
+}
+
+impl<'a> RsmViews<'a> {
+    /// The layout the views are in.
+    pub fn layout(&self) -> GBufferLayout {
+        match self {
+            RsmViews::Wide { .. } => GBufferLayout::Wide,
+            RsmViews::Compact { .. } => GBufferLayout::Compact,
+        }
+    }
+
+    /// The textures in the order the readers bind them: flux, position (or depth), normal.
+    pub(crate) fn textures(&self) -> [&'a wgpu::TextureView; 3] {
+        match *self {
+            RsmViews::Wide {
+                flux,
+                position,
+                normal,
+            } => [flux, position, normal],
+            RsmViews::Compact {
+                flux,
+                depth,
+                normal,
+                ..
+            } => [flux, depth, normal],
+        }
+    }
 }
 
 /// A render target `size` (width, height), also bound as a texture and copied from.
@@ -53,38 +147,42 @@ pub(crate) fn view(texture: &wgpu::Texture) -> wgpu::TextureView {
     texture.create_view(&Default::default())
 }
 
-/// `N` float colour targets (three for the RSM and the G-buffer, none for a shadow map) and a
-/// depth buffer of one size, as the raster passes write them.
-pub(crate) struct RasterTargets<const N: usize = 3> {
-    pub colors: [wgpu::Texture; N],
-    pub views: [wgpu::TextureView; N],
+/// The colour targets of one layout (none for a shadow map) and a depth buffer of one size, as
+/// the raster passes write them.
+pub(crate) struct RasterTargets {
+    pub colors: Vec<wgpu::Texture>,
+    pub views: Vec<wgpu::TextureView>,
     /// Also read as a texture: a shadow map's depth.
     pub depth: wgpu::TextureView,
 }
 
-impl<const N: usize> RasterTargets<N> {
-    pub fn new(device: &wgpu::Device, labels: [&str; N], size: (u32, u32)) -> Self {
-        let colors = labels.map(|l| target(device, l, size, FLOAT_FORMAT));
-        let depth = target(device, "depth", size, DEPTH_FORMAT);
+impl RasterTargets {
+    /// The colour `targets` and a depth buffer.
+    pub fn new(device: &wgpu::Device, targets: &[ColorTarget], size: (u32, u32)) -> Self {
+        let colors: Vec<wgpu::Texture> = targets
+            .iter()
+            .map(|&(label, format)| target(device, label, size, format))
+            .collect();
         Self {
-            views: colors.each_ref().map(view),
+            views: colors.iter().map(view).collect(),
             colors,
-            depth: view(&depth),
+            depth: view(&target(device, "depth", size, DEPTH_FORMAT)),
         }
     }
 }
 
-/// A raster pipeline over [`Vertex`] triangles into `N` float targets (written by the entry
+/// A raster pipeline over [`Vertex`] triangles into the colour `targets` (written by the entry
 /// point `fragment`; none: depth only) with a depth test.
-pub(crate) fn raster_pipeline<const N: usize>(
+pub(crate) fn raster_pipeline(
     device: &wgpu::Device,
     group: &wgpu::BindGroupLayout,
     module: &wgpu::ShaderModule,
     label: &str,
     fragment: Option<&str>,
+    targets: &[ColorTarget],
 ) -> wgpu::RenderPipeline {
-    let targets: [Option<wgpu::ColorTargetState>; N] =
-        std::array::from_fn(|_| Some(FLOAT_FORMAT.into()));
+    let targets: Vec<Option<wgpu::ColorTargetState>> =
+        targets.iter().map(|&(_, f)| Some(f.into())).collect();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&pipeline_layout(device, &[group])),
@@ -99,7 +197,14 @@ pub(crate) fn raster_pipeline<const N: usize>(
             }],
         },
         primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(nearest_depth(DEPTH_FORMAT)),
+        // reversed depth (`reversed_depth`): the nearest surface has the greatest
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Greater),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
         multisample: Default::default(),
         fragment: fragment.map(|entry| wgpu::FragmentState {
             module,
@@ -112,29 +217,35 @@ pub(crate) fn raster_pipeline<const N: usize>(
     })
 }
 
+/// The fragment entry point of a raster pass `name` in `layout` (`rsm_wide`, `gbuffer_compact`).
+pub(crate) fn fragment_entry(name: &str, layout: GBufferLayout) -> String {
+    format!("{name}_{}", layout.name())
+}
+
 /// Clears `targets` and draws `vertex_count` vertices of `vertices` into them.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn record_raster<const N: usize>(
+pub(crate) fn record_raster(
     encoder: &mut wgpu::CommandEncoder,
     label: &str,
-    targets: &RasterTargets<N>,
+    targets: &RasterTargets,
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
     vertices: wgpu::BufferSlice,
     vertex_count: u32,
     timestamps: Option<wgpu::RenderPassTimestampWrites>,
 ) {
-    let attachments = targets
+    let attachments: Vec<_> = targets
         .views
-        .each_ref()
-        .map(|v| cleared_attachment(v, wgpu::Color::TRANSPARENT));
+        .iter()
+        .map(|v| cleared_attachment(v, wgpu::Color::TRANSPARENT))
+        .collect();
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &attachments,
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &targets.depth,
             depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
+                load: wgpu::LoadOp::Clear(0.0),
                 store: wgpu::StoreOp::Store,
             }),
             stencil_ops: None,
@@ -148,11 +259,13 @@ pub(crate) fn record_raster<const N: usize>(
     pass.draw(0..vertex_count, 0..1);
 }
 
-/// Renders the RSM of one light view into textures it owns ([`RsmPass::views`]). Its three
-/// Rgba32Float targets take 48 bytes a sample: open the device with the adapter's limits
-/// (`max_color_attachment_bytes_per_sample` is 32 by default).
+/// Renders the RSM of one light view into textures it owns ([`RsmPass::views`]), in the layout
+/// [`Settings::gbuffer_layout`] names. The wide layout's three Rgba32Float targets take 48 bytes
+/// a sample: open the device with the adapter's limits (`max_color_attachment_bytes_per_sample`
+/// is 32 by default).
 pub struct RsmPass {
     rsm_size: u32,
+    layout: GBufferLayout,
     pipeline: wgpu::RenderPipeline,
     light: wgpu::Buffer,
     raster: wgpu::Buffer,
@@ -162,23 +275,25 @@ pub struct RsmPass {
 }
 
 impl RsmPass {
-    /// An RSM of `rsm_size`^2 texels (the size [`crate::Settings::rsm_size`] names).
-    pub fn new(device: &wgpu::Device, rsm_size: u32) -> Self {
-        let vertex_fragment = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let group_layout = layout(
-            device,
-            "rsm",
-            &[
-                uniform_entry::<RasterUniform>(0, vertex_fragment, false),
-                uniform_entry::<LightUniform>(1, vertex_fragment, false),
-            ],
-        );
+    /// An RSM of [`Settings::rsm_size`]^2 texels in [`Settings::gbuffer_layout`].
+    pub fn new(device: &wgpu::Device, settings: &Settings) -> Self {
+        let (rsm_size, layout) = (settings.rsm_size, settings.gbuffer_layout);
+        let group_layout = layout_of(device);
         let module = shader_module(device, "rsm", &SOURCES);
         let light = uniform_buffer::<LightUniform>(device, "rsm light");
         let raster = uniform_buffer::<RasterUniform>(device, "rsm projection");
+        let targets = rsm_targets(layout);
         Self {
             rsm_size,
-            pipeline: raster_pipeline::<3>(device, &group_layout, &module, "rsm", Some("rsm")),
+            layout,
+            pipeline: raster_pipeline(
+                device,
+                &group_layout,
+                &module,
+                "rsm",
+                Some(&fragment_entry("rsm", layout)),
+                targets,
+            ),
             group: bind_group(
                 device,
                 "rsm",
@@ -187,25 +302,21 @@ impl RsmPass {
             ),
             light,
             raster,
-            targets: RasterTargets::new(
-                device,
-                ["rsm flux", "rsm position", "rsm normal"],
-                (rsm_size, rsm_size),
-            ),
+            targets: RasterTargets::new(device, targets, (rsm_size, rsm_size)),
         }
     }
 
     /// Sets the light view the next recordings render from (per light update).
     pub fn set_light(&self, queue: &wgpu::Queue, view: &LightView) {
-        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&view.uniform()));
+        let uniform = view.uniform(self.rsm_size);
+        queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&uniform));
         let p = view.position;
         queue.write_buffer(
             &self.raster,
             0,
             bytemuck::bytes_of(&RasterUniform {
-                view_proj: view.view_proj.to_cols_array_2d(),
+                view_proj: reversed_depth(view.view_proj).to_cols_array_2d(),
                 eye: [p.x, p.y, p.z, 1.0],
-                texel: [view.texel_measure(self.rsm_size), 0.0, 0.0, 0.0],
             }),
         );
     }
@@ -233,16 +344,38 @@ impl RsmPass {
 
     /// The RSM's textures, for the quadtree and the gather.
     pub fn views(&self) -> RsmViews<'_> {
-        let [flux, position, normal] = &self.targets.views;
-        RsmViews {
-            flux,
-            position,
-            normal,
+        let v = &self.targets.views;
+        match self.layout {
+            GBufferLayout::Wide => RsmViews::Wide {
+                flux: &v[0],
+                position: &v[1],
+                normal: &v[2],
+            },
+            GBufferLayout::Compact => RsmViews::Compact {
+                flux: &v[0],
+                depth: &self.targets.depth,
+                normal: &v[1],
+                light: &self.light,
+            },
         }
     }
 
-    /// The RSM's textures (flux, position, normal), for reading back.
-    pub fn textures(&self) -> &[wgpu::Texture; 3] {
+    /// The RSM's colour targets, for reading back: flux, position and normal (wide), or flux and
+    /// normal (compact, whose positions lie in the depth of [`RsmViews::Compact`]).
+    pub fn textures(&self) -> &[wgpu::Texture] {
         &self.targets.colors
     }
+}
+
+/// The RSM pass's group layout: its projection and its light.
+fn layout_of(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let vertex_fragment = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    layout(
+        device,
+        "rsm",
+        &[
+            uniform_entry::<RasterUniform>(0, vertex_fragment, false),
+            uniform_entry::<LightUniform>(1, vertex_fragment, false),
+        ],
+    )
 }

@@ -6,7 +6,7 @@
 use crate::contract::{LightTermsUniform, LightUniform, ShadowUniform};
 use crate::scene::{Light, LightKind, Scene, extent_of};
 use crate::settings::Settings;
-use glam::{Mat4, Vec2, Vec3};
+use glam::{DMat4, Mat4, Vec2, Vec3, Vec4};
 
 /// How an RSM view projects the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -216,7 +216,8 @@ impl LightView {
     pub(crate) fn shadow_uniform(&self, size: u32) -> ShadowUniform {
         let parallel = matches!(self.projection, Projection::Orthographic { .. });
         ShadowUniform {
-            view_proj: self.view_proj.to_cols_array_2d(),
+            // as the shadow map was drawn (`reversed_depth`)
+            view_proj: reversed_depth(self.view_proj).to_cols_array_2d(),
             texel: [
                 self.texel_measure(size).sqrt(),
                 f32::from(u8::from(parallel)),
@@ -255,7 +256,8 @@ impl LightView {
         }
     }
 
-    pub(crate) fn uniform(&self) -> LightUniform {
+    /// The view's uniform for an `rsm_size`^2 RSM.
+    pub(crate) fn uniform(&self, rsm_size: u32) -> LightUniform {
         let (p, d, i) = (self.position, self.direction, self.intensity);
         // no cone: every direction in front of the map counts (cos >= -1)
         let (outer, inner) = self.cone.map_or((-1.0, -1.0), |(cone_deg, falloff_deg)| {
@@ -265,10 +267,16 @@ impl LightView {
         let parallel = matches!(self.projection, Projection::Orthographic { .. });
         LightUniform {
             view_proj: self.view_proj.to_cols_array_2d(),
+            inv_view_proj: relative_inverse(self.view_proj, p).to_cols_array_2d(),
             position: [p.x, p.y, p.z, 1.0 / self.extent],
             direction: [d.x, d.y, d.z, outer],
             intensity: [i[0], i[1], i[2], inner],
-            parallel: [f32::from(u8::from(parallel)), 0.0, 0.0, 0.0],
+            parallel: [
+                f32::from(u8::from(parallel)),
+                self.texel_measure(rsm_size),
+                0.0,
+                0.0,
+            ],
         }
     }
 }
@@ -349,6 +357,25 @@ fn visible_region(view_proj: Mat4, bounds: (Vec3, Vec3)) -> Vec<Vec3> {
     let from_frustum = faces(&frustum).into_iter().map(|f| clip(&f, &solid_planes));
     let from_solid = faces(&solid).into_iter().map(|f| clip(&f, &frustum_planes));
     from_frustum.chain(from_solid).flatten().collect()
+
+/// `view_proj` with its depth reversed (clip z -> w - z: 1 at the near plane, 0 at the far), as
+/// quadray's raster passes draw: a float depth then holds a surface's distance to about 1e-7 of
+/// it at any distance (not reversed, to 6e-8 times distance / near, 1.5e-5 of the far plane's
+/// distance half-way there), for the compact layout to rebuild positions from.
+pub(crate) fn reversed_depth(view_proj: Mat4) -> Mat4 {
+    let reverse = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::NEG_Z, Vec4::new(0.0, 0.0, 1.0, 1.0));
+    reverse * view_proj
+}
+
+/// The inverse of [`reversed_depth`]`(view_proj)` to world positions relative to `origin` (clip
+/// -> world - origin), the depth a raster pass wrote decoded: the view's translation is not
+/// multiplied into terms that cancel, so that f32 rounding moves a rebuilt position along its ray
+/// only (inverted in f64 from the very f32 matrix the pass drew with).
+pub(crate) fn relative_inverse(view_proj: Mat4, origin: Vec3) -> Mat4 {
+    let drawn = reversed_depth(view_proj).as_dmat4();
+    (drawn * DMat4::from_translation(origin.as_dvec3()))
+        .inverse()
+        .as_mat4()
 }
 
 #[cfg(test)]

@@ -64,7 +64,7 @@ fn camera_state(x: vec3<f32>, xp: vec3<f32>, c: array<vec4<f32>, 2>, t: f32) -> 
         return UNSEEN;
     }
     fetches++;
-    let seen = textureLoad(g_pos, texel, 0);
+    let seen = load_g_position(texel);
     if (seen.w < 0.5) {
         return UNSEEN;
     }
@@ -73,13 +73,13 @@ fn camera_state(x: vec3<f32>, xp: vec3<f32>, c: array<vec4<f32>, 2>, t: f32) -> 
         return state;
     }
     fetches++;
-    let n = textureLoad(g_normal, texel, 0).xyz;
+    let n = load_g_normal(texel);
     let at = crossing_texel(x, xp, seen.xyz, n, c, size);
     if (at.x < 0) {
         return UNSEEN;
     }
     fetches++;
-    let there = textureLoad(g_pos, at, 0);
+    let there = load_g_position(at);
     return select(UNSEEN, on_plane(there.xyz, seen.xyz, n), there.w > 0.5);
 }
 
@@ -91,7 +91,7 @@ fn light_state(x: vec3<f32>, xp: vec3<f32>, l: array<vec4<f32>, 2>, t: f32) -> u
         return UNSEEN;
     }
     fetches++;
-    let seen = textureLoad(rsm_pos, texel, 0);
+    let seen = load_rsm_position(texel);
     if (seen.w <= 0.0) {
         return UNSEEN;
     }
@@ -100,13 +100,13 @@ fn light_state(x: vec3<f32>, xp: vec3<f32>, l: array<vec4<f32>, 2>, t: f32) -> u
         return state;
     }
     fetches++;
-    let n = textureLoad(rsm_normal, texel, 0).xyz;
+    let n = load_rsm_normal(texel).xyz;
     let at = crossing_texel(x, xp, seen.xyz, n, l, size);
     if (at.x < 0) {
         return UNSEEN;
     }
     fetches++;
-    let there = textureLoad(rsm_pos, at, 0);
+    let there = load_rsm_position(at);
     return select(UNSEEN, on_plane(there.xyz, seen.xyz, n), there.w > 0.0);
 }
 

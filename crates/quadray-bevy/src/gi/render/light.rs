@@ -7,7 +7,7 @@ use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use quadray_indirect::scene::Light;
 use quadray_indirect::shadows::occupancy::OccupancyGrid;
-use quadray_indirect::{LightQuadtree, RsmPass, Settings};
+use quadray_indirect::{GBufferLayout, LightQuadtree, RsmPass, Settings};
 use quadray_indirect::{LightView, ViewMaps, scene::bounds_of};
 
 /// The lights' side, shared by every camera: an RSM over the scene's triangles and the light
@@ -28,6 +28,8 @@ pub(super) struct LightPasses {
     /// Counts the times `views` was made anew: a camera's gather reads the maps of one.
     pub(super) maps_generation: u64,
     pub(super) rsm_size: u32,
+    /// The layout the RSMs are in (the first camera's [`Settings::gbuffer_layout`]).
+    pub(super) rsm_layout: GBufferLayout,
     /// The first camera's [`Settings::max_lights`], which `lights` was taken with.
     pub(super) max_lights: u32,
     pub(super) vertices: Option<(wgpu::Buffer, u32)>,
@@ -67,7 +69,7 @@ impl LightPasses {
     ) {
         self.views = (0..count)
             .map(|_| {
-                let rsm = RsmPass::new(device, settings.rsm_size);
+                let rsm = RsmPass::new(device, settings);
                 let quadtree = LightQuadtree::new(
                     device,
                     queue,
@@ -79,6 +81,7 @@ impl LightPasses {
             })
             .collect();
         self.rsm_size = settings.rsm_size;
+        self.rsm_layout = settings.gbuffer_layout;
         self.maps_generation += 1;
         self.stale = true;
     }
@@ -114,6 +117,7 @@ pub(super) fn prepare_light(
         views: Vec::new(),
         maps_generation: 0,
         rsm_size: 0,
+        rsm_layout: settings.gbuffer_layout,
         max_lights: settings.max_lights,
         vertices: None,
         generation: u64::MAX,
@@ -165,7 +169,8 @@ pub(super) fn prepare_light(
         .take(settings.max_lights as usize)
         .copied()
         .collect();
-    if l.lights != lights || l.rsm_size != settings.rsm_size {
+    let resized = l.rsm_size != settings.rsm_size || l.rsm_layout != settings.gbuffer_layout;
+    if l.lights != lights || resized {
         let bounds = bounds_of(
             scene
                 .triangles
@@ -177,7 +182,7 @@ pub(super) fn prepare_light(
             .iter()
             .flat_map(|light| LightView::of_light(light, bounds))
             .collect();
-        if l.views.len() != l.light_views.len() || l.rsm_size != settings.rsm_size {
+        if l.views.len() != l.light_views.len() || resized {
             l.make_views(device, &queue, settings, l.light_views.len());
         }
         for (view, light_view) in l.views.iter().zip(&l.light_views) {

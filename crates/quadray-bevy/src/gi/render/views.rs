@@ -88,7 +88,8 @@ impl ViewPasses {
                 })
                 .create_view(&Default::default())
         });
-        let views = GBufferViews {
+        // the wide layout: the translation writes storage textures, which cost no raster output
+        let views = GBufferViews::Wide {
             position: &gbuffer[0],
             normal: &gbuffer[1],
             albedo: &gbuffer[2],
@@ -307,15 +308,16 @@ pub(super) fn prepare_views(
         }
         // one set of light quadtrees serves every camera: made by the first camera's settings
         if settings.rsm_size != l.rsm_size
+            || settings.gbuffer_layout != l.rsm_layout
             || settings.max_lights != l.max_lights
             || l.views
                 .iter()
                 .any(|v| v.quadtree.cluster() != settings.cluster)
         {
             warn(
-                "its RSM size, light count or cluster settings differ from the first \
-                 IndirectLight camera's, which the lights' quadtrees are built with: give every \
-                 camera the same; no indirect light is added"
+                "its RSM size, G-buffer layout, light count or cluster settings differ from the \
+                 first IndirectLight camera's, which the lights' quadtrees are built with: give \
+                 every camera the same; no indirect light is added"
                     .into(),
             );
             commands.entity(entity).remove::<ViewPasses>();
@@ -344,7 +346,7 @@ pub(super) fn prepare_views(
         };
         if passes.occupancy_generation != l.occupancy_generation {
             let [position, normal, albedo] = &passes.gbuffer;
-            let views = GBufferViews {
+            let views = GBufferViews::Wide {
                 position,
                 normal,
                 albedo,
