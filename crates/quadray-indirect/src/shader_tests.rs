@@ -88,7 +88,7 @@ fn shaders() -> Vec<(&'static str, Vec<String>)> {
         ("gbuffer", owned(&gbuffer::SOURCES)),
         ("quadtree", owned(&quadtree::SOURCES)),
         ("output", output::pass::sources("rgba16float").to_vec()),
-        ("shadow map", owned(&[rsm::RASTER_WGSL])),
+        ("shadow map", owned(&rsm::RASTER_WGSL)),
         (
             "direct",
             owned(&crate::gathers::resources::shader(

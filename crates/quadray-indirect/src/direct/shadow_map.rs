@@ -6,8 +6,8 @@ use crate::contract::{
     RasterUniform, bind_group, layout, shader_module, uniform_buffer, uniform_entry, whole,
 };
 use crate::light::rsm::{RASTER_WGSL, RasterTargets, raster_pipeline, record_raster};
-use crate::light::view::reversed_depth;
 use crate::light::view::LightView;
+use crate::light::view::reversed_depth;
 use quadray_gpu::GpuTimer;
 
 /// One light view's map: its projection and its depth.
@@ -35,7 +35,7 @@ impl ShadowMaps {
                 false,
             )],
         );
-        let module = shader_module(device, "shadow map", &[RASTER_WGSL]);
+        let module = shader_module(device, "shadow map", &RASTER_WGSL);
         let maps = (0..views)
             .map(|_| {
                 let raster = uniform_buffer::<RasterUniform>(device, "shadow map projection");
@@ -67,7 +67,6 @@ impl ShadowMaps {
             bytemuck::bytes_of(&RasterUniform {
                 view_proj: reversed_depth(view.view_proj).to_cols_array_2d(),
                 eye: [p.x, p.y, p.z, 1.0],
-                texel: [0.0; 4],
             }),
         );
     }

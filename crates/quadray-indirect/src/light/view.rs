@@ -357,6 +357,7 @@ fn visible_region(view_proj: Mat4, bounds: (Vec3, Vec3)) -> Vec<Vec3> {
     let from_frustum = faces(&frustum).into_iter().map(|f| clip(&f, &solid_planes));
     let from_solid = faces(&solid).into_iter().map(|f| clip(&f, &frustum_planes));
     from_frustum.chain(from_solid).flatten().collect()
+}
 
 /// `view_proj` with its depth reversed (clip z -> w - z: 1 at the near plane, 0 at the far), as
 /// quadray's raster passes draw: a float depth then holds a surface's distance to about 1e-7 of
