@@ -19,13 +19,25 @@ use quadray_indirect::{Frame, IndirectError, Method, Renderer, Scene, Settings};
 use std::path::{Path, PathBuf};
 
 const EXPOSURE: f32 = 1.0;
-const FRAMES: u32 = 5;
+/// Frames a timed picture's median takes (its caption's milliseconds, and RSM sampling's sample
+/// count at the quadtree's time).
+const FRAMES: u32 = 3;
 
 fn settings(gpu: &Gpu, width: u32, height: u32, samples: u32) -> Settings {
     // the brute force beside every picture costs pixels x VPLs: small RSMs on a CPU rasterizer
     let rsm_size = if gpu.is_software() { 32 } else { 512 };
     Settings {
         samples,
+        ..sized(width, height, rsm_size)
+    }
+}
+
+/// [`Settings::sized`] with the direct light's shadow maps a texel a pixel of the picture's longer
+/// side (the default takes two, for the near ground of a large frame): a point light's six maps
+/// at twice the demo's side were a tenth of the demo's time on a CPU rasterizer.
+fn sized(width: u32, height: u32, rsm_size: u32) -> Settings {
+    Settings {
+        shadow_map_size: Some(width.max(height).next_power_of_two()),
         ..Settings::sized(width, height, rsm_size)
     }
 }
@@ -229,7 +241,7 @@ fn held_apart_picture(
     let scene = Scene::load(&scenes_dir().join(format!("{name}.toml")))?;
     let side = truth_side(size);
     let (w, h) = (side * 4 / 3, side);
-    let plain = Settings::sized(w, h, truth_rsm_size(&scene));
+    let plain = sized(w, h, truth_rsm_size(&scene));
     let mut r = Renderer::new(gpu, &scene, plain.clone())?;
     let without = r.render_frame(Method::DEFAULT)?;
     let truth = ground_truth(&r.read_vpls()?, &r.read_receivers()?, &scene);
@@ -267,7 +279,7 @@ fn lights_picture(gpu: &Gpu, size: u32, name: &str, path: &Path) -> Result<PathB
     let (w, h) = (side * 4 / 3, side);
     let settings = Settings {
         indirect_shadows: true,
-        ..Settings::sized(w, h, truth_rsm_size(&scene))
+        ..sized(w, h, truth_rsm_size(&scene))
     };
     let mut r = Renderer::new(gpu, &scene, settings.clone())?;
     let frame = r.render_frame(Method::DEFAULT)?;
@@ -309,7 +321,7 @@ fn leak_picture(gpu: &Gpu, size: u32, path: &Path) -> Result<PathBuf, IndirectEr
     let scene = Scene::load(&scenes_dir().join("leak.toml"))?;
     let size = truth_side(size);
     // the defaults: the per-tile cuts with the estimate and far clusters shared
-    let settings = Settings::sized(size, size, truth_rsm_size(&scene));
+    let settings = sized(size, size, truth_rsm_size(&scene));
     // (a frame first: it renders the RSM and the G-buffer the ground truth reads)
     let mut r = Renderer::new(gpu, &scene, settings.clone())?;
     r.render_frame(Method::Quadtree)?;
