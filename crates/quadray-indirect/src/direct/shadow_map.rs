@@ -7,7 +7,6 @@ use crate::contract::{
 };
 use crate::light::rsm::{RASTER_WGSL, RasterTargets, raster_pipeline, record_raster};
 use crate::light::view::LightView;
-use crate::light::view::reversed_depth;
 use quadray_gpu::GpuTimer;
 
 /// One light view's map: its projection and its depth.
@@ -60,15 +59,8 @@ impl ShadowMaps {
 
     /// Sets map `index`'s view (its [`LightView::shadow_view`]).
     pub fn set_view(&self, queue: &wgpu::Queue, index: usize, view: &LightView) {
-        let p = view.position;
-        queue.write_buffer(
-            &self.maps[index].raster,
-            0,
-            bytemuck::bytes_of(&RasterUniform {
-                view_proj: reversed_depth(view.view_proj).to_cols_array_2d(),
-                eye: [p.x, p.y, p.z, 1.0],
-            }),
-        );
+        let uniform = view.raster_uniform();
+        queue.write_buffer(&self.maps[index].raster, 0, bytemuck::bytes_of(&uniform));
     }
 
     /// Records every map of `vertex_count` vertices of `vertices`, timed together into `timer`'s

@@ -7,7 +7,7 @@ use crate::contract::{
     LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
     uniform_buffer, uniform_entry, whole,
 };
-use crate::light::view::{LightView, reversed_depth};
+use crate::light::view::LightView;
 use crate::method::GBufferLayout;
 use crate::scene::Vertex;
 use crate::settings::Settings;
@@ -310,15 +310,7 @@ impl RsmPass {
     pub fn set_light(&self, queue: &wgpu::Queue, view: &LightView) {
         let uniform = view.uniform(self.rsm_size);
         queue.write_buffer(&self.light, 0, bytemuck::bytes_of(&uniform));
-        let p = view.position;
-        queue.write_buffer(
-            &self.raster,
-            0,
-            bytemuck::bytes_of(&RasterUniform {
-                view_proj: reversed_depth(view.view_proj).to_cols_array_2d(),
-                eye: [p.x, p.y, p.z, 1.0],
-            }),
-        );
+        queue.write_buffer(&self.raster, 0, bytemuck::bytes_of(&view.raster_uniform()));
     }
 
     /// Records the RSM of `vertex_count` vertices of `vertices`: triangle lists of [`Vertex`]

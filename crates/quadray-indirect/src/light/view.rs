@@ -3,7 +3,7 @@
 //! from its own scene, and the per-view uniforms made from them (the light itself, the gather's
 //! per-light terms).
 
-use crate::contract::{LightTermsUniform, LightUniform, ShadowUniform};
+use crate::contract::{LightTermsUniform, LightUniform, RasterUniform, ShadowUniform};
 use crate::scene::{Light, LightKind, Scene, extent_of};
 use crate::settings::Settings;
 use glam::{DMat4, Mat4, Vec2, Vec3, Vec4};
@@ -213,6 +213,16 @@ impl LightView {
     }
 
     /// The direct pass's uniform of this view as the view of a shadow map of `size`^2 texels.
+    /// The raster passes' uniform for drawing this view (the RSM, a shadow map): its
+    /// projection with depth reversed, and its position.
+    pub(crate) fn raster_uniform(&self) -> RasterUniform {
+        let p = self.position;
+        RasterUniform {
+            view_proj: reversed_depth(self.view_proj).to_cols_array_2d(),
+            eye: [p.x, p.y, p.z, 1.0],
+        }
+    }
+
     pub(crate) fn shadow_uniform(&self, size: u32) -> ShadowUniform {
         let parallel = matches!(self.projection, Projection::Orthographic { .. });
         ShadowUniform {
