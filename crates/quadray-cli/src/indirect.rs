@@ -162,6 +162,11 @@ pub fn run_indirect(args: IndirectArgs) -> Result<()> {
             anyhow::bail!("{flag} needs --frames 2 or more (a sequence)");
         }
     }
+    // the settings' own rules (a power-of-two interleave, interleave or subsample, ...) before
+    // any GPU work
+    args.settings
+        .validate()
+        .map_err(|e| anyhow::anyhow!("indirect-light options: {e}"))?;
     let gpu = Gpu::new()?;
     let outcome = run(
         &gpu,

@@ -69,7 +69,12 @@ fn bad_inputs_are_refused_before_any_work() {
     let map = map.to_str().unwrap();
     let not_a_scene = "cornell_box.obj: a mesh file, not a scene: give a scene that places it";
     let folder_missing = format!("the folder {} does not exist", missing_dir.display());
-    let cases: Vec<(Vec<&str>, String)> = vec![
+    let cases: Vec<(Vec<&str>, String)> =
+        vec![
+        (
+            vec!["indirect", "--out", out, "--method", "quadtree", "--interleave", "3"],
+            "indirect-light options: interleave 3 must be a power of two".into(),
+        ),
         (
             vec!["indirect", "--out", out, "--frames", "1000000"],
             "invalid value '1000000' for '--frames <FRAMES>': 1000000 is outside 0..=1000".into(),
