@@ -143,7 +143,9 @@ for m in quadtree quadtree-tiles; do
 done
 # The gather's candidates, each a runtime option of the same binary (name, then its flags):
 # interleaved sampling of the one cut and of RSM sampling, the one cut made finer under it, and
-# the one cut with indirect shadows, whose pixels then walk to a sixteenth of its clusters.
+# the one cut with indirect shadows: interleaved (each pixel takes a sixteenth of its clusters),
+# with each pixel walking its own rays (--shadow-corners 0) and from corner receivers farther
+# apart than the default 4 pixels.
 while read -r name flags; do
     # shellcheck disable=SC2086 # $flags is several words
     step "indirect-$name" "$bin" indirect $flags --size $size --rsm-size $rsm \
@@ -155,6 +157,11 @@ quadtree-limit-2-interleave-4 --method quadtree --limit-level 2 --interleave 4
 rsm-interleave-4 --method rsm --interleave 4
 rsm-1024-interleave-4 --method rsm --samples 1024 --interleave 4
 quadtree-shadows-interleave-4 --method quadtree --indirect-shadows --interleave 4
+quadtree-shadows-corners-0 --method quadtree --indirect-shadows --shadow-corners 0
+quadtree-shadows-corners-8 --method quadtree --indirect-shadows --shadow-corners 8
+quadtree-shadows-corners-16 --method quadtree --indirect-shadows --shadow-corners 16
+quadtree-shadows-corners-8-interleave-4 --method quadtree --indirect-shadows --shadow-corners 8 --interleave 4
+quadtree-shadows-corners-16-interleave-4 --method quadtree --indirect-shadows --shadow-corners 16 --interleave 4
 CANDIDATES
 # An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
 # each submit), to see where it stops.

@@ -299,6 +299,7 @@ mod tests {
                 u(Settings::MAX_LIGHTS),
                 u(Settings::SHADOW_GRID),
                 u(Settings::TILE_DEBLOCK),
+                u(Settings::SHADOW_CORNERS),
                 f(Settings::TILE_SHADOW_ANGLE, 0.0, 100.0),
                 proptest::option::of(4u32..=13),
             ),
@@ -325,6 +326,7 @@ mod tests {
                         max_lights,
                         shadow_grid,
                         tile_deblock,
+                        shadow_corners,
                         tile_shadow_angle,
                         shadow_map_log,
                     ),
@@ -357,6 +359,7 @@ mod tests {
                         // (the two exclude each other)
                         interleave: if subsample > 1 { 1 } else { interleave },
                         indirect_shadows: shadows,
+                        shadow_corners,
                         shadow_steps: steps,
                         shadow_thickness: thickness,
                         shadow_grid,

@@ -278,6 +278,17 @@ pub struct Settings {
     /// interpolated (a pixel off the corners' surface, across a depth edge, tests its own).
     #[cfg_attr(feature = "cli", arg(long))]
     pub indirect_shadows: bool,
+    /// The one cut's indirect shadows (method quadtree) tested from corner receivers every K
+    /// pixels across and down, each corner walking to every cluster of the cut in a pass of its
+    /// own; a pixel weighs each cluster by the visibility of the corners around it on its
+    /// surface, interpolated, and walks its own rays only where no corner lies on its surface
+    /// (0: every pixel walks to every cluster).
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.shadow_corners,
+        value_parser = Settings::SHADOW_CORNERS.parser(),
+    ))]
+    pub shadow_corners: u32,
     /// Points marched per receiver and cluster with --indirect-shadows and --shadow-grid 0.
     #[cfg_attr(feature = "cli", arg(
         long,
@@ -406,6 +417,7 @@ impl Settings {
         subsample: 1,
         interleave: 1,
         indirect_shadows: false,
+        shadow_corners: 4,
         shadow_steps: 8,
         shadow_thickness: 0.03,
         shadow_grid: 64,
@@ -441,6 +453,11 @@ impl Settings {
     /// parts holds its workgroup's pixels and 2 (N - 1) more across and down in workgroup
     /// memory (9.4 KB at 4).
     pub const INTERLEAVE: Limits<u32> = Limits::closed(1, 4);
+    /// [`Settings::shadow_corners`].
+    pub const SHADOW_CORNERS: Limits<u32> = Limits::closed(0, 64);
+    /// The clusters of a cut whose visibility each corner of [`Settings::shadow_corners`] keeps
+    /// (a pixel walks to those beyond alone): 4096 bits, 512 bytes a corner.
+    pub const SHADOW_CORNER_CLUSTERS: u32 = 4096;
     /// [`Settings::shadow_steps`].
     pub const SHADOW_STEPS: Limits<u32> = Limits::closed(1, 64);
     /// [`Settings::shadow_thickness`].
@@ -468,6 +485,8 @@ impl Settings {
 
     /// Bytes the per-tile cuts' lists may take, a storage buffer every adapter binds.
     pub const MAX_TILE_LIST_BYTES: u64 = 128 << 20;
+    /// Bytes the corners of [`Settings::shadow_corners`] may take (the same binding limit).
+    pub const MAX_SHADOW_CORNER_BYTES: u64 = 128 << 20;
 
     /// Bytes the per-tile cuts' lists take by default at most. A large picture's tiles cover
     /// less of the scene and need fewer clusters (BENCHMARKS.md, "Per-tile cuts").
@@ -511,6 +530,46 @@ impl Settings {
                 .next_power_of_two()
                 .clamp(least, most)
         })
+    }
+
+    /// The corner receivers of the one cut's indirect shadows across and down the picture
+    /// ([`Settings::shadow_corners`]; at least 1 each way, zeros when off): one every K pixels
+    /// from the first, and the last pixel.
+    pub(crate) fn shadow_corner_grid(&self) -> (u32, u32) {
+        match self.shadow_corners_or_off() {
+            0 => (0, 0),
+            k => (
+                self.size.width.saturating_sub(1).div_ceil(k) + 1,
+                self.size.height.saturating_sub(1).div_ceil(k) + 1,
+            ),
+        }
+    }
+
+    /// [`Settings::shadow_corners`] with indirect shadows, else 0.
+    pub(crate) fn shadow_corners_or_off(&self) -> u32 {
+        if self.indirect_shadows {
+            self.shadow_corners
+        } else {
+            0
+        }
+    }
+
+    /// The words of visibility bits a corner keeps: one a cluster of the cut, up to
+    /// [`Settings::SHADOW_CORNER_CLUSTERS`] and the finest cut's size (0 when off).
+    pub(crate) fn shadow_corner_words(&self) -> u32 {
+        if self.shadow_corners_or_off() == 0 {
+            return 0;
+        }
+        let finest = u64::from(self.rsm_size >> self.levels().limit).pow(2);
+        finest
+            .min(u64::from(Self::SHADOW_CORNER_CLUSTERS))
+            .div_ceil(32) as u32
+    }
+
+    /// The bytes of the corners' visibility bits and receivers ([`Settings::shadow_corners`]).
+    pub(crate) fn shadow_corner_bytes(&self) -> u64 {
+        let (x, y) = self.shadow_corner_grid();
+        u64::from(x) * u64::from(y) * (4 * u64::from(self.shadow_corner_words()) + 32)
     }
 
     /// Points marched per receiver and cluster: [`Settings::shadow_steps`] with indirect
@@ -634,6 +693,16 @@ impl Settings {
                 s.interleave, s.subsample
             ));
         }
+        Self::SHADOW_CORNERS.check("shadow corners", s.shadow_corners)?;
+        if s.shadow_corner_bytes() > Self::MAX_SHADOW_CORNER_BYTES {
+            return Err(format!(
+                "indirect shadows from corners every {} pixels of a {} picture take {} MiB, over {} MiB: raise the shadow corners' spacing",
+                s.shadow_corners,
+                s.size,
+                s.shadow_corner_bytes() >> 20,
+                Self::MAX_SHADOW_CORNER_BYTES >> 20,
+            ));
+        }
         Self::SHADOW_STEPS.check("shadow steps", s.shadow_steps)?;
         Self::SHADOW_THICKNESS.check("shadow thickness", s.shadow_thickness)?;
         Self::SHADOW_GRID.check("shadow grid", s.shadow_grid)?;
@@ -697,6 +766,12 @@ shader_struct! {
         normal_agreement: f32 = NORMAL_AGREEMENT,
         /// Indirect shadows: points marched between a receiver and a cluster (0: none).
         shadow_steps: u32 = s.march_steps(),
+        /// The one cut's indirect shadows from corner receivers every `shadow_corners` pixels
+        /// (0: each pixel walks), `corners_x` of them in a row, each keeping `corner_words`
+        /// words of visibility bits (shadows/corners.wgsl).
+        shadow_corners: u32 = s.shadow_corners_or_off(),
+        corners_x: u32 = s.shadow_corner_grid().0,
+        corner_words: u32 = s.shadow_corner_words(),
         /// Weight of this frame in the running average of the indirect light (1: no filter).
         temporal_weight: f32 = s.temporal_weight,
         /// Per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its
@@ -756,6 +831,7 @@ mod tests {
             subsample: 2,
             interleave: 4,
             indirect_shadows: true,
+            shadow_corners: 8,
             shadow_steps: 5,
             shadow_thickness: 0.1,
             shadow_grid: 0,

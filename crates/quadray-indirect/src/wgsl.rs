@@ -66,14 +66,15 @@ pub const BOUND: &str = include_str!("light/bound.wgsl");
 pub const TILE_RULE: &str = include_str!("tiles/rule.wgsl");
 
 /// The compacted cut's sum at a receiver, `cut_sum(r, range)` (method `quadtree`). Needs
-/// [`NODE`], [`RECEIVER`]. Accessors: `fn load_cut_node(i: u32) -> Node`, cluster `i` of the cut;
-/// `fn node_irradiance(node: Node, r: Receiver) -> vec3<f32>`, [`KERNEL`]'s `vpl_irradiance`
-/// with the including shader's visibility.
+/// [`NODE`], [`RECEIVER`]. Accessor: `fn cut_node_irradiance(i: u32, r: Receiver) -> vec3<f32>`,
+/// cluster `i` of the cut's irradiance at `r`: [`KERNEL`]'s `vpl_irradiance` with the including
+/// shader's visibility.
 pub const GATHER_CUT: &str = include_str!("gathers/gather_cut.wgsl");
 
 /// One level of the paper's traversal at a receiver, `level_sum(params, level, r, range)`
 /// (method `quadtree-passes`). Needs [`NODE`], [`RECEIVER`], [`CUT_RULE`]. Accessors:
-/// `load_node` (as [`CUT_RULE`]) and `node_irradiance` (as [`GATHER_CUT`]).
+/// `load_node` (as [`CUT_RULE`]) and `fn node_irradiance(node: Node, r: Receiver) -> vec3<f32>`,
+/// [`KERNEL`]'s `vpl_irradiance` with the including shader's visibility.
 pub const GATHER_LEVEL: &str = include_str!("gathers/gather_level.wgsl");
 
 /// The sums over RSM texels at a receiver: `vpl_sum` (every VPL, method `reference`) and
@@ -107,7 +108,7 @@ mod tests {
 fn load_node(i: u32) -> Node { return Node(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0)); }
 ";
     const CUT_ACCESSORS: &str = "
-fn load_cut_node(i: u32) -> Node { return load_node(i); }
+fn cut_node_irradiance(i: u32, r: Receiver) -> vec3<f32> { return node_irradiance(load_node(i), r); }
 fn node_irradiance(node: Node, r: Receiver) -> vec3<f32> {
     return vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, 0.1);
 }

@@ -1,5 +1,6 @@
 //! The compacted cut ([`Method::Quadtree`]): every pixel sums the light quadtree's cut, at full
-//! resolution or sub-sampled.
+//! resolution or sub-sampled, with indirect shadows from the pixel or from corner receivers
+//! ([`ShadowCorners`]).
 
 use super::resources::Resources;
 #[cfg(doc)]
@@ -7,29 +8,39 @@ use crate::Method;
 use crate::contract::{SLICE, slices};
 use crate::light::quadtree::LightQuadtree;
 use crate::output::upsample::{self, Upsampled};
+use crate::shadows::corners::{self, ShadowCorners};
 use crate::wgsl;
 
 /// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 3] = [wgsl::GATHER_CUT, include_str!("cut.wgsl"), upsample::WGSL];
+pub(crate) const WGSL: [&str; 4] = [
+    wgsl::GATHER_CUT,
+    include_str!("cut.wgsl"),
+    upsample::WGSL,
+    corners::WGSL,
+];
 
 pub(crate) struct Cut {
     full: wgpu::ComputePipeline,
     pub upsampled: Upsampled,
+    /// Group 3 of every pipeline here.
+    pub corners: ShadowCorners,
 }
 
 impl Cut {
     pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
         let [low, reconstruct] = upsample::entries(res.settings());
+        let corners_layout = ShadowCorners::layout(device);
         let [full, low, reconstruct] = res.pipelines(
             device,
             "gather cut",
             &WGSL,
             ["indirect_cut", low, reconstruct],
-            &[],
+            &[&corners_layout],
         );
         Self {
             full,
             upsampled: Upsampled { low, reconstruct },
+            corners: ShadowCorners::new(device, res, corners_layout, &WGSL),
         }
     }
 
@@ -40,9 +51,15 @@ impl Cut {
         slices(u64::from(finest).pow(2), SLICE)
     }
 
-    /// Records the full-resolution sum.
+    /// Records the corners' walks, then the sum: at full resolution, or where the settings
+    /// reconstruct the picture its low-resolution samples.
     pub fn record(&self, pass: &mut wgpu::ComputePass, res: &Resources, quadtree: &LightQuadtree) {
-        pass.set_pipeline(&self.full);
-        res.sliced(pass, 0, Self::slices(quadtree), res.size());
+        self.corners.record(pass, res);
+        if res.settings().reconstructs(crate::Method::Quadtree) {
+            self.upsampled.record_low(pass, res, Self::slices(quadtree));
+        } else {
+            pass.set_pipeline(&self.full);
+            res.sliced(pass, 0, Self::slices(quadtree), res.size());
+        }
     }
 }

@@ -1,10 +1,16 @@
 // Indirect light from the light quadtree's compacted cut: every pixel sums the cut's clusters
-// (the sum in gather_cut.wgsl).
+// (the sum in gather_cut.wgsl), with indirect shadows tested by the pixel itself or taken from
+// the corner receivers around it (shadows/corners.wgsl).
 
 // A part of this dispatch's slice of the cut: the segments of the part's classes, in turn, as
 // one list (the whole cut: every class). Part `part.x` of `part.y` = N^2 (an offset in an NxN
 // block) holds the classes whose offsets in the CUT_CLASS_SIDE^2 block are the same modulo N.
 fn cut_irradiance(r: Receiver, part: vec2<u32>) -> vec3<f32> {
+    from_corners = false;
+    if (SHADOWS && shade.shadow_corners > 0u && !recomputing) {
+        load_class_starts();
+        from_corners = corner_patch(r);
+    }
     let n = u32(round(sqrt(f32(part.y))));
     let offset = vec2<u32>(part.x % n, part.x / n);
     let per_side = CUT_CLASS_SIDE / n;
@@ -26,9 +32,21 @@ fn cut_irradiance(r: Receiver, part: vec2<u32>) -> vec3<f32> {
     return e;
 }
 
-// The accessor gather_cut.wgsl reads the cut with.
-fn load_cut_node(i: u32) -> Node {
-    return cut[i];
+// Whether the receiver being summed takes its clusters' visibility from its corners' patch.
+var<private> from_corners: bool;
+
+// The accessor of gather_cut.wgsl: cluster `i` of the cut at `r`, its visibility the corners'
+// where the receiver takes theirs.
+fn cut_node_irradiance(i: u32, r: Receiver) -> vec3<f32> {
+    let node = cut[i];
+    if (!from_corners) {
+        return node_irradiance(node, r);
+    }
+    let e = vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
+    if (any(e != vec3<f32>(0.0))) {
+        return e * corner_visibility(i, node, r);
+    }
+    return e;
 }
 
 @compute @workgroup_size(8, 8)

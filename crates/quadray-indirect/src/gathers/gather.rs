@@ -256,8 +256,8 @@ impl Gather {
             for (view, &quadtree) in quadtrees.iter().enumerate() {
                 res.bind_groups(&mut pass, view);
                 match (method, upsampled) {
+                    (Method::Quadtree, _) => self.cut.record(&mut pass, res, quadtree),
                     (_, Some(upsampled)) => upsampled.record_low(&mut pass, res, slices(quadtree)),
-                    (Method::Quadtree, None) => self.cut.record(&mut pass, res, quadtree),
                     (Method::QuadtreeTiles, None) => self.tiles.record(&mut pass, res),
                     (Method::QuadtreePasses, None) => self.passes.record(&mut pass, res, quadtree),
                     (Method::Rsm, None) => self.rsm_sampling.record(&mut pass, res),
@@ -274,6 +274,9 @@ impl Gather {
         if let Some(upsampled) = upsampled {
             let stamps = timer.and_then(|(t, _, slot)| t.compute_pass(slot));
             let mut pass = compute_pass(encoder, "upsample", stamps);
+            if method == Method::Quadtree {
+                self.cut.corners.bind(&mut pass, res);
+            }
             for (view, &quadtree) in quadtrees.iter().enumerate() {
                 res.bind_groups(&mut pass, view);
                 upsampled.record_upsample(&mut pass, res, slices(quadtree));

@@ -72,7 +72,11 @@ fn bilinear(pixel: vec2<u32>, r: Receiver) -> vec4<f32> {
 
 // A pixel from the samples on its surface (`e`: their weighted sum, w: the weights' sum) where
 // they are `enough`; elsewhere recomputed from the whole sum, one slice per dispatch like the
-// low-resolution pass (w: 1 there).
+// low-resolution pass (w: 1 there). It follows every light view's low-resolution pass, so
+// `recomputing` tells the including shader that what it kept of one view for that pass may be
+// another's by now (the cut's corner visibility).
+var<private> recomputing: bool;
+
 fn reconstruct_pixel(pixel: vec2<u32>, r: Receiver, e: vec4<f32>, enough: bool) {
     let index = pixel_index(pixel);
     if (!r.covered) {
@@ -82,6 +86,7 @@ fn reconstruct_pixel(pixel: vec2<u32>, r: Receiver, e: vec4<f32>, enough: bool) 
             add_indirect(index, vec4<f32>(r.albedo / PI * e.rgb / e.w, 0.0));
         }
     } else {
+        recomputing = true;
         add_indirect(index, vec4<f32>(r.albedo / PI * gathered_irradiance(r, WHOLE_SUM), 1.0));
     }
     store_counts(index);
