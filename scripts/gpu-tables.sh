@@ -144,8 +144,8 @@ done
 # The gather's candidates, each a runtime option of the same binary (name, then its flags):
 # interleaved sampling of the one cut and of RSM sampling, the one cut made finer under it, and
 # the one cut with indirect shadows: interleaved (each pixel takes a sixteenth of its clusters),
-# with each pixel walking its own rays (--shadow-corners 0) and from corner receivers farther
-# apart than the default 4 pixels.
+# with each pixel walking its own rays (--shadow-corners 0), and from corner receivers nearer and
+# farther apart than the default's 16 pixels at 1920x1080.
 while read -r name flags; do
     # shellcheck disable=SC2086 # $flags is several words
     step "indirect-$name" "$bin" indirect $flags --size $size --rsm-size $rsm \
@@ -159,9 +159,8 @@ rsm-1024-interleave-4 --method rsm --samples 1024 --interleave 4
 quadtree-shadows-interleave-4 --method quadtree --indirect-shadows --interleave 4
 quadtree-shadows-corners-0 --method quadtree --indirect-shadows --shadow-corners 0
 quadtree-shadows-corners-8 --method quadtree --indirect-shadows --shadow-corners 8
-quadtree-shadows-corners-16 --method quadtree --indirect-shadows --shadow-corners 16
+quadtree-shadows-corners-32 --method quadtree --indirect-shadows --shadow-corners 32
 quadtree-shadows-corners-8-interleave-4 --method quadtree --indirect-shadows --shadow-corners 8 --interleave 4
-quadtree-shadows-corners-16-interleave-4 --method quadtree --indirect-shadows --shadow-corners 16 --interleave 4
 CANDIDATES
 # An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
 # each submit), to see where it stops.

@@ -299,7 +299,7 @@ mod tests {
                 u(Settings::MAX_LIGHTS),
                 u(Settings::SHADOW_GRID),
                 u(Settings::TILE_DEBLOCK),
-                u(Settings::SHADOW_CORNERS),
+                proptest::option::of(u(Settings::SHADOW_CORNERS)),
                 f(Settings::TILE_SHADOW_ANGLE, 0.0, 100.0),
                 proptest::option::of(4u32..=13),
             ),

@@ -77,7 +77,8 @@ pub(crate) fn prelude() -> String {
          const DEBLOCK_PLANE: f32 = {DEBLOCK_PLANE:?};\n\
          const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};\n\
          const MAX_INTERLEAVE: u32 = {}u;\n\
-         const CUT_CLASS_SIDE: u32 = {CUT_CLASS_SIDE}u;\n",
+         const CUT_CLASS_SIDE: u32 = {CUT_CLASS_SIDE}u;\n\
+         const SHADOW_CORNER_WORDS: u32 = {}u;\n",
         std::f32::consts::PI,
         OutputTerm::Indirect as u32,
         OutputTerm::Direct as u32,
@@ -87,6 +88,7 @@ pub(crate) fn prelude() -> String {
         BRICK.y,
         BRICK.z,
         crate::Settings::INTERLEAVE.max,
+        crate::Settings::SHADOW_CORNER_CLUSTERS / 32,
     ) + &shared_structs()
         .into_iter()
         .map(|s| s.wgsl)

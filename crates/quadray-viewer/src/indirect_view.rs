@@ -555,6 +555,14 @@ impl IndirectView {
         // marching 8 points per receiver and cluster halves the error to the ground truth with
         // visibility on the leak scene and the Cornell box (BENCHMARKS.md)
         ui.checkbox(&mut s.indirect_shadows, "indirect shadows (quadtree)");
+        let mut spacing = s.shadow_corners_or_default();
+        let corners = "shadow corners every, pixels (quadtree, 0: each pixel walks)";
+        named(ui, s.indirect_shadows, corners, |ui| {
+            ui.add(limits_slider(&mut spacing, Settings::SHADOW_CORNERS, ""))
+        });
+        if spacing != s.shadow_corners_or_default() {
+            s.shadow_corners = Some(spacing);
+        }
         let shared = "shadow rays shared within, box over distance (quadtree-tiles, 0: off)";
         named(ui, s.indirect_shadows, shared, |ui| {
             let angle = Settings::TILE_SHADOW_ANGLE;

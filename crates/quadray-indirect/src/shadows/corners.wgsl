@@ -8,13 +8,12 @@
 // for the clusters past the corners' words. Part of the cut's shader: it reads the bindings of
 // gathers/shared.wgsl and `on_surface` of output/upsample.wgsl.
 
+// (SHADOW_CORNER_WORDS, the most words of bits a corner keeps, comes from the prelude)
+
 // Group 3: per corner its receiver (x, w: 1 where covered; n), then its visibility bits, bit
 // `rank % 32` of word `rank / 32` for the cluster of that rank in the cut (`cut_rank`).
 @group(3) @binding(0) var<storage, read_write> corner_receivers: array<vec4<f32>>;
 @group(3) @binding(1) var<storage, read_write> corner_bits: array<u32>;
-
-// The most words a corner keeps (Settings::SHADOW_CORNER_CLUSTERS / 32).
-const CORNER_WORDS_MAX: u32 = 128u;
 
 // The cut's clusters are kept in class segments (light/node.rs): the cluster at `i` of `cut`
 // is the one of rank `class_start[class] + i % segment` in the cut taken class by class.
@@ -59,7 +58,7 @@ fn corner_pixel(c: vec2<u32>) -> vec2<u32> {
     return min(c * shade.shadow_corners, vec2<u32>(viewer.width - 1u, viewer.height - 1u));
 }
 
-var<workgroup> corner_words: array<atomic<u32>, CORNER_WORDS_MAX>;
+var<workgroup> corner_words: array<atomic<u32>, SHADOW_CORNER_WORDS>;
 var<workgroup> corner_fetches: atomic<u32>;
 
 // One workgroup a corner: its receiver, and its view of each cluster of the cut (the grid
