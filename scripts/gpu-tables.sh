@@ -19,7 +19,7 @@
 # --smoke-only: the smoke stage alone.
 # --smoke: only the smoke cases whose names match (grep -E; `quadray smoke --list` names them).
 # --runs: only the runs after the smoke stage whose names match (bash =~; the names are the
-#   logs/NAME.log files: indirect-METHOD, indirect-CANDIDATE, equal-error-SCENE-RUN,
+#   logs/NAME.log files: indirect-METHOD, indirect-CANDIDATE, shadows-SCENE-RUN, equal-error-SCENE-RUN,
 #   displace-METHOD-ANGLE, bevy-...).
 # --quick: small frames, for trying the script on a software rasterizer (a minute on lavapipe).
 # --bin: the quadray binary (default target/release/quadray, built if missing).
@@ -169,6 +169,22 @@ if grep -qs '^indirect-' "$out/skipped.txt"; then
         --rsm-size 16 --frames 1 --out "$probe/t.png" --stats "$probe/t.json"
 fi
 
+# The bounce with indirect shadows on every visibility scene (the goal: at most 1 ms a frame at
+# 1920x1080), the default method and the one cut interleaved at 4 from its shadow corners.
+mkdir -p "$out/shadows-1080p"
+for scene in cornell leak visibility-door visibility-corridor visibility-gap visibility-shelf \
+    visibility-storeys visibility-pillars courtyard; do
+    while read -r name flags; do
+        # shellcheck disable=SC2086 # $flags is several words
+        step "shadows-$scene-$name" "$bin" indirect --scene "assets/scenes/$scene.toml" $flags \
+            --indirect-shadows --size $size --rsm-size $rsm --frames $frames --out "$probe/s.png" \
+            --stats "$out/shadows-1080p/$scene-$name.json"
+    done <<'RUNS'
+default --method quadtree-tiles
+one-cut-interleave-4 --method quadtree --interleave 4
+RUNS
+done
+
 # Equal error in GPU time: each method's rel. L1 to the GPU brute force (--reference) beside its
 # static frame's indirect passes, on the Cornell box, the atrium and the leak scene; RSM sampling
 # swept so that the summary interpolates its time at each other run's error.
@@ -270,6 +286,24 @@ for f in sorted((out / "indirect-1080p").glob("*.json")):
                  f"{cell(p.get('gbuffer'))} | {cell(p.get('direct'))} | "
                  f"{cell(p.get('indirect'))} | {cell(p.get('upsample'))} | {cell(still.get('total_ms'))} | "
                  f"{cell(moving.get('total_ms'))} | {s['vpl_evaluations_per_pixel']:.1f} |")
+# The bounce: the frame without the G-buffer, the direct light and its shadow maps.
+shadow_runs = sorted((out / "shadows-1080p").glob("*.json")) if (out / "shadows-1080p").exists() else []
+if shadow_runs:
+    lines += ["", "## The bounce with indirect shadows (GPU ms, median; the frame less the G-buffer and the direct light)", "",
+              "| scene | run | indirect | reconstruct | bounce, light still | bounce, light moving | texel fetches / pixel |",
+              "|---|---|---|---|---|---|---|"]
+    def bounce(t):
+        p = t.get("passes", {})
+        return t["total_ms"] - sum(p.get(k, 0.0) for k in ("gbuffer", "direct", "shadow-map"))
+    for f in shadow_runs:
+        s = json.loads(f.read_text())
+        still, moving = s["gpu_time_ms_static"] or {}, s["gpu_time_ms_moving"] or {}
+        p = still.get("passes", {})
+        cell = lambda v: f"{v:.3f}" if isinstance(v, (int, float)) else "-"
+        scene, name = re.match(r"(.*?)-(default|one-cut.*)$", f.stem).groups()
+        lines.append(f"| {scene} | {name} | {cell(p.get('indirect'))} | {cell(p.get('upsample'))} | "
+                     f"{cell(bounce(still) if still else None)} | {cell(bounce(moving) if moving else None)} | "
+                     f"{s['texel_fetches_per_pixel']:.0f} |")
 # Equal error: RSM sampling's indirect time at each run's rel. L1, interpolated log-log between
 # the two sample counts whose errors bracket it, over the run's own.
 def indirect_ms(s):

@@ -44,6 +44,13 @@ struct Case {
 /// A variant of the indirect settings.
 type Change = fn(&mut Settings);
 
+/// The one cut's indirect shadows from corners every 4 pixels, interleaved at 2.
+fn with_corners(s: &mut Settings) {
+    s.indirect_shadows = true;
+    s.shadow_corners = Some(4);
+    s.interleave = 2;
+}
+
 fn cases() -> Vec<Case> {
     let mut cases = vec![Case {
         name: "displace-pyramid-build".into(),
@@ -77,11 +84,18 @@ fn cases() -> Vec<Case> {
             }),
         });
     }
-    let variants: [(&str, IndirectMethod, Change); 3] = [
+    let variants: [(&str, IndirectMethod, Change); 4] = [
         // the occupancy grid walked (the depth maps marched where it cannot tell)
         ("indirect-shadows", IndirectMethod::DEFAULT, |s| {
             s.indirect_shadows = true
         }),
+        // the one cut's shadows from corner receivers, interleaved (its rejoin recomputes some
+        // pixels from their own walks)
+        (
+            "indirect-shadow-corners",
+            IndirectMethod::Quadtree,
+            with_corners,
+        ),
         // the depth maps marched alone
         ("indirect-shadows-march", IndirectMethod::Quadtree, |s| {
             s.indirect_shadows = true;
@@ -100,8 +114,14 @@ fn cases() -> Vec<Case> {
         });
     }
     // eight light views summed: the spot's, the sun's orthographic map, a point light's six faces
-    let lights: [(&str, IndirectMethod, Change); 2] = [
+    let lights: [(&str, IndirectMethod, Change); 3] = [
         ("indirect-lights", IndirectMethod::DEFAULT, |_| {}),
+        // a corners' pass a light view, each before its view's sum
+        (
+            "indirect-lights-shadow-corners",
+            IndirectMethod::Quadtree,
+            with_corners,
+        ),
         ("indirect-lights-subsample", IndirectMethod::Quadtree, |s| {
             s.subsample = 2
         }),

@@ -283,8 +283,10 @@ pub struct Settings {
     /// own; a pixel weighs each cluster by the visibility of the corners around it on its
     /// surface, interpolated, and walks its own rays only where no corner lies on its surface
     /// (0: every pixel walks to every cluster). Default: the picture's longer side over
-    /// [`Self::SHADOW_CORNERS_ACROSS`], rounded (16 at 1920x1080, 4 at 512x512, 1 at 128x128), so
-    /// that the corners lie as densely over the scene, and cost as much, at every size.
+    /// [`Self::SHADOW_CORNERS_ACROSS`], rounded (16 at 1920x1080, 4 at 512x512), so that the
+    /// corners lie as densely over the scene, and cost as much, at every size; 0 where that is
+    /// no more than `interleave` (a pixel that walks to its N^2-th of the cut walks no more than
+    /// corners every N pixels would to the whole: 0 at 128x128).
     #[cfg_attr(feature = "cli", arg(long, value_parser = Settings::SHADOW_CORNERS.parser()))]
     pub shadow_corners: Option<u32>,
     /// Points marched per receiver and cluster with --indirect-shadows and --shadow-grid 0.
@@ -457,7 +459,7 @@ impl Settings {
     /// at 128x128 with corners every 2 pixels (64 across) the one cut's FLIP to the truth was
     /// its pixels' own walks' within 1% or better on all nine visibility scenes, every 4 pixels
     /// (32 across) 30% worse on the shelf held apart from tuning (BENCHMARKS.md): this is
-    /// nearly twice the 64.
+    /// nearly twice the 64 (at 1920x1080, 8,228 corners).
     pub const SHADOW_CORNERS_ACROSS: u32 = 120;
     /// The clusters of a cut whose visibility each corner of [`Settings::shadow_corners`] keeps
     /// (a pixel walks to those beyond alone): 4096 bits, 512 bytes a corner.
@@ -550,12 +552,18 @@ impl Settings {
     }
 
     /// The spacing of the one cut's shadow corners: [`Settings::shadow_corners`], else the
-    /// picture's longer side over [`Self::SHADOW_CORNERS_ACROSS`], rounded, at least 1.
+    /// picture's longer side over [`Self::SHADOW_CORNERS_ACROSS`], rounded, or 0 (each pixel
+    /// walks) where that is no more than [`Settings::interleave`].
     pub fn shadow_corners_or_default(&self) -> u32 {
         let across = Self::SHADOW_CORNERS_ACROSS;
         self.shadow_corners.unwrap_or_else(|| {
-            ((self.size.width.max(self.size.height) + across / 2) / across)
-                .clamp(1, Self::SHADOW_CORNERS.max)
+            let spacing = ((self.size.width.max(self.size.height) + across / 2) / across)
+                .min(Self::SHADOW_CORNERS.max);
+            if spacing > self.interleave {
+                spacing
+            } else {
+                0
+            }
         })
     }
 

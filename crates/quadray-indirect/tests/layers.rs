@@ -38,7 +38,7 @@ const LAYERS: &[&[&str]] = &[
     &["gbuffer", "direct::shadow_map"],
     &["light::quadtree"],
     &["gathers::resources"],
-    &["output::upsample"],
+    &["output::upsample", "shadows::corners"],
     &[
         "gathers::cut",
         "gathers::passes",

@@ -28,18 +28,18 @@ pub(crate) struct Cut {
 
 impl Cut {
     pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
-        let [low, reconstruct] = upsample::entries(res.settings());
         let corners_layout = ShadowCorners::layout(device);
-        let [full, low, reconstruct] = res.pipelines(
+        let (full, upsampled) = upsample::pipelines(
             device,
+            res,
             "gather cut",
             &WGSL,
-            ["indirect_cut", low, reconstruct],
+            "indirect_cut",
             &[&corners_layout],
         );
         Self {
             full,
-            upsampled: Upsampled { low, reconstruct },
+            upsampled,
             corners: ShadowCorners::new(device, res, corners_layout, &WGSL),
         }
     }

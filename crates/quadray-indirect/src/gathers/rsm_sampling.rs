@@ -23,18 +23,15 @@ pub(crate) struct RsmSampling {
 
 impl RsmSampling {
     pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
-        let [low, reconstruct] = upsample::entries(res.settings());
-        let [full, low, reconstruct] = res.pipelines(
+        let (full, upsampled) = upsample::pipelines(
             device,
+            res,
             "gather rsm sampling",
             &WGSL,
-            ["rsm_sampling", low, reconstruct],
+            "rsm_sampling",
             &[],
         );
-        Self {
-            full,
-            upsampled: Upsampled { low, reconstruct },
-        }
+        Self { full, upsampled }
     }
 
     /// Dispatches the sum over the samples takes.

@@ -23,7 +23,23 @@ pub(crate) fn entries(settings: &Settings) -> [&'static str; 2] {
     ["indirect_low", reconstruct]
 }
 
-/// A sub-sampled method's two pipelines, made from its shader with [`WGSL`] and [`ENTRIES`].
+/// A sub-sampled method's pipelines from its shader `own` (with [`WGSL`]) over the shared groups
+/// and `own_groups`: its full-resolution sum's entry point `full`, and the two of [`entries`].
+pub(crate) fn pipelines(
+    device: &wgpu::Device,
+    res: &Resources,
+    label: &str,
+    own: &[&'static str],
+    full: &str,
+    own_groups: &[&wgpu::BindGroupLayout],
+) -> (wgpu::ComputePipeline, Upsampled) {
+    let [low, reconstruct] = entries(res.settings());
+    let [full, low, reconstruct] =
+        res.pipelines(device, label, own, [full, low, reconstruct], own_groups);
+    (full, Upsampled { low, reconstruct })
+}
+
+/// A sub-sampled method's two pipelines, made from its shader with [`WGSL`] and [`entries`].
 pub(crate) struct Upsampled {
     pub low: wgpu::ComputePipeline,
     /// The upsampling, or interleaved sampling's rejoin ([`entries`]).

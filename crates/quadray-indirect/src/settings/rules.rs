@@ -39,6 +39,26 @@ fn resolved_settings_render_the_same_and_write_every_default_out() {
         (s.levels(), 0.002, 256)
     );
     assert!(r.cluster.start_level.is_some() && r.tile_capacity.is_some());
+    // the one cut's shadow corners: the longer side over 120, each pixel walking where that is
+    // no more than the interleave
+    assert_eq!(r.shadow_corners, Some(16));
+    let corners = |w, h, interleave| {
+        Settings {
+            interleave,
+            ..Settings::sized(w, h, 64)
+        }
+        .shadow_corners_or_default()
+    };
+    assert_eq!(
+        [
+            corners(512, 512, 1),
+            corners(256, 192, 1),
+            corners(128, 128, 1),
+            corners(480, 270, 4),
+            corners(600, 400, 4),
+        ],
+        [4, 2, 0, 0, 5]
+    );
 }
 
 /// Each refusal names the parameter and its declared range.

@@ -2,7 +2,7 @@
 //! walk ([`occupancy`], the CPU twin of `occupancy.wgsl`'s `grid_visibility`), and the march
 //! through the camera's and the light's depth maps where the gather has no grid (`march.wgsl`,
 //! with `visible`, which picks between them, and the kernel with visibility); the one cut's
-//! visibility from corner receivers ([`corners`]).
+//! visibility from corner receivers (`corners.rs`, `corners.wgsl`).
 
 pub(crate) mod corners;
 pub mod occupancy;
