@@ -11,7 +11,7 @@ use crate::gathers::resources::ViewMaps;
 use crate::gbuffer::GBufferPass;
 use crate::light::node::{CutCounts, cut_class_capacity};
 use crate::light::quadtree::LightQuadtree;
-use crate::light::rsm::RsmPass;
+use crate::light::rsm::{RsmPass, TextureArray};
 use crate::light::view::LightView;
 use crate::method::Method;
 use crate::picture::{cut_view, cut_view_zoom};
@@ -74,16 +74,18 @@ impl<'g> Renderer<'g> {
         let view_count = LightView::of_scene(scene, settings.max_lights).len();
         let (d, q) = (&gpu.device, &gpu.queue);
         let renderer = gpu.checked(|| {
+            let textures = TextureArray::new(d, q, &scene.textures);
             let views: Vec<ViewPasses> = (0..view_count)
                 .map(|_| {
-                    let rsm = RsmPass::new(d, &settings);
+                    let mut rsm = RsmPass::new(d, &settings);
+                    rsm.set_textures(&textures);
                     let quadtree =
                         LightQuadtree::new(d, q, settings.rsm_size, settings.cluster, rsm.views());
                     ViewPasses { rsm, quadtree }
                 })
                 .collect();
             let size = (settings.size.width, settings.size.height);
-            let gbuffer = GBufferPass::new(d, size, settings.gbuffer_layout);
+            let gbuffer = GBufferPass::new(d, size, settings.gbuffer_layout, &textures);
             let maps: Vec<ViewMaps> = views
                 .iter()
                 .map(|v| ViewMaps {
