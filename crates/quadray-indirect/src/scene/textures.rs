@@ -209,3 +209,105 @@ impl SceneTextures {
         mix(top, bottom, f.y)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(width: u32, height: u32, pixels: Vec<[u8; 4]>) -> Rgba8Image {
+        Rgba8Image {
+            width,
+            height,
+            pixels,
+        }
+    }
+
+    /// A 2x1 texture, black then white, through each filter and wrap.
+    fn black_white(filter: TextureFilter, wrap: TextureWrap) -> (SceneTextures, u32) {
+        let mut collector = TextureCollector::default();
+        let texels = vec![[0, 0, 0, 255], [255, 255, 255, 255]];
+        let sampler = TextureSampler {
+            filter,
+            wrap_u: wrap,
+            wrap_v: wrap,
+        };
+        let index = collector
+            .index(&image(2, 1, texels), sampler, Path::new("a.gltf"), "m")
+            .unwrap();
+        (collector.finish().unwrap(), index)
+    }
+
+    #[test]
+    fn samples_follow_the_filter_and_the_wrap() {
+        use TextureFilter::{Linear, Nearest};
+        use TextureWrap::{ClampToEdge, MirroredRepeat, Repeat};
+        let cases = [
+            // between the texel centres (u 0.25 and 0.75): halfway in linear light
+            (Linear, Repeat, 0.5, 0.5),
+            (Linear, Repeat, 0.375, 0.25),
+            // at the left edge: the texel beyond it is the last (repeat), the first (clamp,
+            // mirrored)
+            (Linear, Repeat, 0.0, 0.5),
+            (Linear, ClampToEdge, 0.0, 0.0),
+            (Linear, MirroredRepeat, 0.0, 0.0),
+            (Nearest, Repeat, 0.49, 0.0),
+            (Nearest, Repeat, 0.51, 1.0),
+            (Nearest, Repeat, 1.0, 0.0),
+            (Nearest, ClampToEdge, 1.0, 1.0),
+            (Nearest, ClampToEdge, -7.0, 0.0),
+            (Nearest, MirroredRepeat, 1.0, 1.0),
+            (Nearest, MirroredRepeat, 1.6, 0.0),
+            (Nearest, Repeat, -0.25, 1.0),
+        ];
+        for (filter, wrap, u, expected) in cases {
+            let (textures, index) = black_white(filter, wrap);
+            let got = textures.sample(index, Vec2::new(u, 0.5));
+            assert!(
+                got.abs_diff_eq(Vec3::splat(expected), 1e-6),
+                "{filter:?} {wrap:?} at u {u}: {got}"
+            );
+        }
+        assert_eq!(
+            SceneTextures::default().sample(super::super::Vertex::UNTEXTURED, Vec2::ZERO),
+            Vec3::ONE
+        );
+    }
+
+    #[test]
+    fn textures_are_shared_resized_and_bounded() {
+        let red = image(1, 1, vec![[255, 0, 0, 255]]);
+        let wide = image(4, 1, vec![[0, 0, 255, 255]; 4]);
+        let mut collector = TextureCollector::default();
+        let file = Path::new("floor.gltf");
+        let sampler = TextureSampler::default();
+        let first = collector.index(&red, sampler, file, "a").unwrap();
+        assert_eq!(collector.index(&red, sampler, file, "b").unwrap(), first);
+        collector.index(&wide, sampler, file, "c").unwrap();
+        let textures = collector.finish().unwrap();
+        assert_eq!((textures.width, textures.height), (4, 1));
+        assert_eq!(textures.layers[0], vec![[255, 0, 0, 255]; 4]);
+        // one texture as wide as the limit, one as tall: the array is both, 512 MiB
+        let mut collector = TextureCollector::default();
+        let side = quadray_core::image_in::MAX_SIDE;
+        let row = image(side, 1, vec![[0; 4]; side as usize]);
+        let column = image(1, side, vec![[1; 4]; side as usize]);
+        collector.index(&row, sampler, file, "row").unwrap();
+        collector
+            .index(&column, sampler, Path::new("wall.gltf"), "column")
+            .unwrap();
+        let err = collector.finish().unwrap_err();
+        assert!(
+            err.contains("floor.gltf") && err.contains("wall.gltf") && err.contains("512 MiB"),
+            "{err}"
+        );
+        let mut collector = TextureCollector::default();
+        let err = (0..=MAX_TEXTURES)
+            .map(|i| {
+                let texel = [i as u8, (i >> 8) as u8, 0, 255];
+                collector.index(&image(1, 1, vec![texel]), sampler, file, "m")
+            })
+            .find_map(Result::err)
+            .expect("one over the limit");
+        assert!(err.contains("floor.gltf") && err.contains("256"), "{err}");
+    }
+}
