@@ -58,6 +58,7 @@ impl<'g> Renderer<'g> {
         settings.validate().map_err(IndirectError::Settings)?;
         let mut needs = Gather::limit_needs(&settings);
         needs.extend(DirectLight::limit_needs(&settings));
+        needs.extend(TextureArray::limit_needs(&scene.textures));
         quadray_gpu::check_limits(&gpu.device.limits(), &gpu.describe(), &needs)?;
         let left_out = scene
             .lights

@@ -180,3 +180,32 @@ fn the_bounce_takes_each_half_s_colour_and_the_default_method_is_near_the_truth(
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// A scene whose textures are wider than the device's textures may be is refused by
+/// [`Renderer::new`] naming them, before any pass is made (lavapipe held to 2048 texels a side).
+#[test]
+fn a_device_below_the_scene_s_textures_is_refused_by_name() {
+    let adapter = gpu().adapter.clone();
+    let limits = wgpu::Limits {
+        max_texture_dimension_2d: 2048,
+        ..adapter.limits()
+    };
+    let small = Gpu::with_limits(adapter, limits).unwrap();
+    let mut scene = textured_floor();
+    scene.textures = std::sync::Arc::new(quadray_indirect::scene::SceneTextures {
+        width: 4096,
+        height: 1,
+        layers: vec![vec![[255; 4]; 4096]],
+    });
+    let error = Renderer::new(&small, &scene, Settings::sized(32, 32, 16))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        error.ends_with(
+            "allows max_texture_dimension_2d = 2048, but the scene's base colour texture array \
+             (4096x1) needs 4096"
+        ),
+        "{error}"
+    );
+}

@@ -13,7 +13,7 @@ use crate::method::GBufferLayout;
 use crate::scene::{SceneTextures, Vertex};
 use crate::settings::Settings;
 use crate::wgsl;
-use quadray_gpu::{GpuTimer, cleared_attachment, texture_2d};
+use quadray_gpu::{GpuTimer, Limit, LimitNeed, cleared_attachment, texture_2d};
 
 /// Format of every wide RSM and G-buffer colour target.
 pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -127,6 +127,19 @@ impl TextureArray {
             texture.size(),
         );
         Self::of(device, &texture)
+    }
+
+    /// What the array of `textures` needs of the device: its layers' sides.
+    pub fn limit_needs(textures: &SceneTextures) -> Vec<LimitNeed> {
+        let side = textures.width.max(textures.height);
+        vec![LimitNeed {
+            limit: Limit::TextureDimension2d,
+            needed: side.into(),
+            needed_by: format!(
+                "the scene's base colour texture array ({}x{})",
+                textures.width, textures.height
+            ),
+        }]
     }
 
     /// No texture: for triangles that all have [`Vertex::UNTEXTURED`].
