@@ -167,6 +167,8 @@ pub struct Material {
     pub base_color: Vec3,
     /// Diffuse texture as stored in the file (sRGB-encoded bytes), multiplied by `base_color`.
     pub base_color_texture: Option<Rgba8Image>,
+    /// How `base_color_texture` is read between and beyond its texels.
+    pub base_color_sampler: TextureSampler,
     /// Linear RGB specular reflectance.
     pub specular: Vec3,
     /// Phong exponent.
@@ -186,6 +188,7 @@ impl Default for Material {
             name: "default".to_owned(),
             base_color: Vec3::ONE,
             base_color_texture: None,
+            base_color_sampler: TextureSampler::default(),
             specular: Vec3::ZERO,
             shininess: 0.0,
             emission: Vec3::ZERO,
@@ -193,6 +196,41 @@ impl Default for Material {
             ior: 1.5,
         }
     }
+}
+
+/// How a texture is read at a texture coordinate: glTF's sampler without mipmaps, so one filter
+/// serves magnification and minification (glTF's magnification filter, or its minification
+/// filter's where the file gives none). Without a sampler (and for OBJ): linear, repeating.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct TextureSampler {
+    pub filter: TextureFilter,
+    /// Along u (glTF's s): the texture's columns.
+    pub wrap_u: TextureWrap,
+    /// Along v (glTF's t): the texture's rows.
+    pub wrap_v: TextureWrap,
+}
+
+/// Which texels a sample reads.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum TextureFilter {
+    /// The four texels around the coordinate, weighted by distance (texel centres at
+    /// half-integers).
+    #[default]
+    Linear,
+    /// The texel the coordinate lies in.
+    Nearest,
+}
+
+/// What a coordinate outside [0, 1] reads.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum TextureWrap {
+    /// The texture tiles.
+    #[default]
+    Repeat,
+    /// The edge texels extend.
+    ClampToEdge,
+    /// The texture tiles, every other copy mirrored.
+    MirroredRepeat,
 }
 
 /// An indexed triangle mesh with one material.

@@ -7,7 +7,9 @@
 use glam::{Vec2, Vec3};
 use proptest::prelude::*;
 use quadray_core::image_out::Rgba8Image;
-use quadray_core::mesh::{Material as MeshMaterial, Mesh, Model};
+use quadray_core::mesh::{
+    Material as MeshMaterial, Mesh, Model, TextureFilter, TextureSampler, TextureWrap,
+};
 use quadray_core::scene::{
     Camera, Cone, Intensity, Light, LightKind, Material, Object, SceneDescription, Shape, Transform,
 };
@@ -294,6 +296,11 @@ fn a_textured_emissive_mesh_comes_back() {
         ],
     };
     let uvs = vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+    let sampler = TextureSampler {
+        filter: TextureFilter::Nearest,
+        wrap_u: TextureWrap::ClampToEdge,
+        wrap_v: TextureWrap::MirroredRepeat,
+    };
     let model = Model {
         meshes: vec![Mesh {
             name: "quad".into(),
@@ -308,6 +315,7 @@ fn a_textured_emissive_mesh_comes_back() {
                 name: "lamp".into(),
                 base_color: Vec3::new(0.5, 0.25, 1.0),
                 base_color_texture: Some(texture.clone()),
+                base_color_sampler: sampler,
                 emission: Vec3::new(4.0, 2.0, 1.0),
                 ..MeshMaterial::default()
             },
@@ -343,6 +351,7 @@ fn a_textured_emissive_mesh_comes_back() {
     assert_eq!(material.base_color, Vec3::new(0.5, 0.25, 1.0));
     assert_eq!(material.emission, Vec3::new(4.0, 2.0, 1.0));
     assert_eq!(material.base_color_texture.as_ref(), Some(&texture));
+    assert_eq!(material.base_color_sampler, sampler);
     assert_eq!(mesh.uvs.as_ref(), Some(&uvs));
     // scaled 2, turned so that +x becomes -z, lifted 1
     assert!(

@@ -41,11 +41,7 @@ struct GBuffer { @location(0) pos: vec4<f32>, @location(1) normal: vec4<f32>, @l
 /// Two triangles a b c, a c d with the normal of their winding.
 fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2] {
     let normal = (b - a).cross(d - a).normalize().into();
-    let v = |p: Vec3| Vertex {
-        position: p.into(),
-        normal,
-        albedo,
-    };
+    let v = |p: Vec3| Vertex::untextured(p.into(), normal, albedo);
     [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
 }
 
@@ -125,6 +121,8 @@ fn scene() -> Scene {
         }],
         r_min: 0.05,
         triangles,
+        // untextured: this G-buffer carries the albedo per vertex
+        textures: Default::default(),
     }
 }
 

@@ -7,7 +7,8 @@ use crate::contract::{
     whole,
 };
 use crate::light::rsm::{
-    RASTER_WGSL, RasterTargets, fragment_entry, gbuffer_targets, raster_pipeline, record_raster,
+    BASE_COLOUR_WGSL, RASTER_WGSL, RasterTargets, TextureArray, fragment_entry, gbuffer_targets,
+    raster_pipeline, record_raster,
 };
 use crate::light::view::{relative_inverse, reversed_depth};
 use crate::method::GBufferLayout;
@@ -86,8 +87,12 @@ pub(crate) fn camera_uniform(
 }
 
 /// The G-buffer pass's shader, in order.
-pub(crate) const SOURCES: [&str; 3] =
-    [RASTER_WGSL[0], RASTER_WGSL[1], include_str!("gbuffer.wgsl")];
+pub(crate) const SOURCES: [&str; 4] = [
+    RASTER_WGSL[0],
+    RASTER_WGSL[1],
+    BASE_COLOUR_WGSL,
+    include_str!("gbuffer.wgsl"),
+];
 
 pub(crate) struct GBufferPass {
     layout: GBufferLayout,
@@ -95,11 +100,19 @@ pub(crate) struct GBufferPass {
     camera: wgpu::Buffer,
     /// Per frame: the camera.
     group: wgpu::BindGroup,
+    /// The scene's base colour textures.
+    textures: wgpu::BindGroup,
     targets: RasterTargets,
 }
 
 impl GBufferPass {
-    pub fn new(device: &wgpu::Device, size: (u32, u32), layout: GBufferLayout) -> Self {
+    /// The G-buffer of triangles whose [`crate::scene::Vertex::texture`] refer to `textures`.
+    pub fn new(
+        device: &wgpu::Device,
+        size: (u32, u32),
+        layout: GBufferLayout,
+        textures: &TextureArray,
+    ) -> Self {
         let group_layout = self::layout(
             device,
             "gbuffer",
@@ -117,13 +130,14 @@ impl GBufferPass {
             layout,
             pipeline: raster_pipeline(
                 device,
-                &group_layout,
+                &[&group_layout, &TextureArray::layout(device)],
                 &module,
                 "gbuffer",
                 Some(&entry),
                 targets,
             ),
             group: bind_group(device, "gbuffer", &group_layout, vec![whole(&camera)]),
+            textures: textures.group().clone(),
             camera,
             targets: RasterTargets::new(device, targets, size),
         }
@@ -152,7 +166,7 @@ impl GBufferPass {
             "gbuffer",
             &self.targets,
             &self.pipeline,
-            &self.group,
+            &[&self.group, &self.textures],
             vertices,
             vertex_count,
             timestamps,

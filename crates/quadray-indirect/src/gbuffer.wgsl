@@ -23,7 +23,7 @@ fn gbuffer_wide(v: VertexOut) -> WideOut {
     var out: WideOut;
     out.pos = vec4<f32>(v.world, 1.0);
     out.normal = vec4<f32>(viewed_normal(v), 1.0);
-    out.albedo = vec4<f32>(v.albedo, 1.0);
+    out.albedo = vec4<f32>(surface_albedo(v), 1.0);
     return out;
 }
 
@@ -31,6 +31,6 @@ fn gbuffer_wide(v: VertexOut) -> WideOut {
 fn gbuffer_compact(v: VertexOut) -> CompactOut {
     var out: CompactOut;
     out.normal = octahedral_encode(viewed_normal(v));
-    out.albedo = vec4<f32>(v.albedo, 1.0);
+    out.albedo = vec4<f32>(surface_albedo(v), 1.0);
     return out;
 }

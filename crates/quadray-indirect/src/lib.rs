@@ -96,7 +96,7 @@ pub use gathers::gather::Gather;
 pub use gathers::resources::ViewMaps;
 pub use gbuffer::GBufferViews;
 pub use light::quadtree::LightQuadtree;
-pub use light::rsm::{FLOAT_FORMAT, RsmPass, RsmViews};
+pub use light::rsm::{FLOAT_FORMAT, RsmPass, RsmViews, TextureArray};
 pub use light::view::{LightView, Projection};
 pub use method::{GBufferLayout, Method, TileCriterion, Validity};
 pub use output::pass::OutputPass;

@@ -51,6 +51,49 @@ pub fn ground_truth(vpls: &[Vpl], receivers: &[Option<Receiver>], scene: &Scene)
     })
 }
 
+/// `receivers` (a G-buffer's, seen from `eye`) with each albedo found anew on the CPU: at the
+/// first triangle the ray from `eye` to the receiver meets, its vertices' albedo and texture
+/// coordinate interpolated there and its base colour texture sampled as the raster passes sample
+/// it ([`crate::scene::SceneTextures::sample`]): the albedo the G-buffer should hold, texel by
+/// texel. A receiver no ray reaches keeps its own.
+pub fn traced_receivers(
+    receivers: &[Option<Receiver>],
+    scene: &Scene,
+    eye: Vec3,
+) -> Vec<Option<Receiver>> {
+    let visibility = Visibility::new(scene);
+    receivers
+        .par_iter()
+        .map(|r| {
+            let mut r = (*r)?;
+            let to = Vec3::from(r.position) - eye;
+            let ray = Ray::new(eye, to, 0.0, 1.0 + 1e-3);
+            if let Some((id, t)) = visibility.bvh.closest(&visibility.polygons, &ray) {
+                let triangle = &scene.triangles[id as usize];
+                let w = barycentric(triangle.map(|v| Vec3::from(v.position)), eye + to * t);
+                let mix = |f: &dyn Fn(&crate::scene::Vertex) -> Vec3| {
+                    w[0] * f(&triangle[0]) + w[1] * f(&triangle[1]) + w[2] * f(&triangle[2])
+                };
+                let uv = mix(&|v| glam::Vec2::from(v.uv).extend(0.0)).truncate();
+                let albedo = mix(&|v| Vec3::from(v.albedo));
+                r.albedo = (albedo * scene.textures.sample(triangle[0].texture, uv)).to_array();
+            }
+            Some(r)
+        })
+        .collect()
+}
+
+/// The barycentric weights of `p` (in the triangle's plane) on the triangle's corners.
+fn barycentric([a, b, c]: [Vec3; 3], p: Vec3) -> [f32; 3] {
+    let (e1, e2, d) = (b - a, c - a, p - a);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d1, d2) = (d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    let v = (d22 * d1 - d12 * d2) / det;
+    let w = (d11 * d2 - d12 * d1) / det;
+    [1.0 - v - w, v, w]
+}
+
 /// The scene's triangles in a BVH, for visibility between VPLs and receivers.
 struct Visibility {
     polygons: Vec<ConvexPolygon>,
@@ -321,10 +364,8 @@ mod tests {
             normal: [0.0, 0.0, -1.0],
             albedo: [1.0; 3],
         });
-        let vertex = |x: f32, y: f32| crate::scene::Vertex {
-            position: [x, y, 1.0],
-            normal: [0.0, 0.0, 1.0],
-            albedo: [1.0; 3],
+        let vertex = |x: f32, y: f32| {
+            crate::scene::Vertex::untextured([x, y, 1.0], [0.0, 0.0, 1.0], [1.0; 3])
         };
         let mut scene = crate::Scene::cornell();
         scene.triangles = vec![

@@ -11,7 +11,7 @@ use crate::gathers::resources::ViewMaps;
 use crate::gbuffer::GBufferPass;
 use crate::light::node::{CutCounts, cut_class_capacity};
 use crate::light::quadtree::LightQuadtree;
-use crate::light::rsm::RsmPass;
+use crate::light::rsm::{RsmPass, TextureArray};
 use crate::light::view::LightView;
 use crate::method::Method;
 use crate::picture::{cut_view, cut_view_zoom};
@@ -58,6 +58,7 @@ impl<'g> Renderer<'g> {
         settings.validate().map_err(IndirectError::Settings)?;
         let mut needs = Gather::limit_needs(&settings);
         needs.extend(DirectLight::limit_needs(&settings));
+        needs.extend(TextureArray::limit_needs(&scene.textures));
         quadray_gpu::check_limits(&gpu.device.limits(), &gpu.describe(), &needs)?;
         let left_out = scene
             .lights
@@ -74,16 +75,18 @@ impl<'g> Renderer<'g> {
         let view_count = LightView::of_scene(scene, settings.max_lights).len();
         let (d, q) = (&gpu.device, &gpu.queue);
         let renderer = gpu.checked(|| {
+            let textures = TextureArray::new(d, q, &scene.textures);
             let views: Vec<ViewPasses> = (0..view_count)
                 .map(|_| {
-                    let rsm = RsmPass::new(d, &settings);
+                    let mut rsm = RsmPass::new(d, &settings);
+                    rsm.set_textures(&textures);
                     let quadtree =
                         LightQuadtree::new(d, q, settings.rsm_size, settings.cluster, rsm.views());
                     ViewPasses { rsm, quadtree }
                 })
                 .collect();
             let size = (settings.size.width, settings.size.height);
-            let gbuffer = GBufferPass::new(d, size, settings.gbuffer_layout);
+            let gbuffer = GBufferPass::new(d, size, settings.gbuffer_layout, &textures);
             let maps: Vec<ViewMaps> = views
                 .iter()
                 .map(|v| ViewMaps {

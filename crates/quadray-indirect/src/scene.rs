@@ -1,17 +1,22 @@
 //! Scenes: built from the shared scene description (`quadray_core::scene`: a TOML or glTF file)
 //! with its camera, its lights (point, spot and directional) and its objects (mesh files, the builtin meshes of
 //! `scene/builtin.rs`, boxes, polygons), flattened into one triangle list with a per-vertex
-//! albedo, which is all the RSM and G-buffer passes need.
+//! albedo and texture coordinate, and the mesh files' base colour textures as the layers of one
+//! array (`scene/textures.rs`), which is all the RSM and G-buffer passes need.
 
 mod builtin;
+mod textures;
 
 use builtin::{builtin_triangles, cuboid};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use quadray_core::FileError;
 use quadray_core::mesh::Model;
 pub use quadray_core::scene::{Camera, Cone, Intensity, Light, LightKind};
 use quadray_core::scene::{Object, SceneDescription, Shape};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use textures::TextureCollector;
+pub use textures::{MAX_TEXTURE_BYTES, MAX_TEXTURES, SceneTextures};
 
 /// One vertex as the raster passes read it.
 #[repr(C)]
@@ -21,8 +26,30 @@ pub struct Vertex {
     pub position: [f32; 3],
     /// Unit normal (the front side, which the G-buffer turns towards the viewer).
     pub normal: [f32; 3],
-    /// Diffuse albedo in [0, 1] per channel.
+    /// Diffuse albedo in [0, 1] per channel, times the texture's texel at `uv` where the
+    /// vertex has a texture.
     pub albedo: [f32; 3],
+    /// Texture coordinate ((0, 0) the texture's top-left corner).
+    pub uv: [f32; 2],
+    /// The base colour texture: a layer of [`Scene::textures`] and the sampler it is read
+    /// through, packed (the same on the triangle's three vertices), or [`Vertex::UNTEXTURED`].
+    pub texture: u32,
+}
+
+impl Vertex {
+    /// [`Vertex::texture`] of a vertex without a texture.
+    pub const UNTEXTURED: u32 = u32::MAX;
+
+    /// A vertex without a texture.
+    pub fn untextured(position: [f32; 3], normal: [f32; 3], albedo: [f32; 3]) -> Self {
+        Self {
+            position,
+            normal,
+            albedo,
+            uv: [0.0; 2],
+            texture: Self::UNTEXTURED,
+        }
+    }
 }
 
 /// Axis-aligned bounds (min, max) of `points`.
@@ -52,6 +79,8 @@ pub struct Scene {
     pub r_min: f32,
     /// Every object's triangles in world space.
     pub triangles: Vec<[Vertex; 3]>,
+    /// The base colour textures the triangles' [`Vertex::texture`] refer to.
+    pub textures: Arc<SceneTextures>,
 }
 
 impl Scene {
@@ -81,8 +110,8 @@ impl Scene {
 
     /// This renderer's scene: the camera, every light, and every object as triangles. A
     /// material gives an object its albedo (its diffuse colour; the other fields are the ray
-    /// tracer's); without one, mesh files keep their base colours (times their texture at each
-    /// vertex) and builtin meshes their own. A photometric intensity (glTF's) becomes a
+    /// tracer's); without one, mesh files keep their base colours (times their textures, sampled
+    /// per texel) and builtin meshes their own. A photometric intensity (glTF's) becomes a
     /// radiometric one: candela / 683 W/sr, lux / 683 W/m^2.
     pub fn from_description(d: &SceneDescription) -> Result<Self, String> {
         if d.lights.is_empty() {
@@ -101,10 +130,15 @@ impl Scene {
             })
             .collect();
         let mut triangles = Vec::new();
+        let mut textures = TextureCollector::default();
         for (i, object) in d.objects.iter().enumerate() {
-            triangles.extend(object_triangles(object, d).map_err(|e| format!("object {i}: {e}"))?);
+            triangles.extend(
+                object_triangles(object, d, &mut textures)
+                    .map_err(|e| format!("object {i}: {e}"))?,
+            );
         }
         let scene = Self {
+            textures: Arc::new(textures.finish()?),
             name: d.name.clone(),
             camera: d.camera,
             lights,
@@ -201,7 +235,7 @@ impl Scene {
 pub const CORNELL_TOML: &str = include_str!("../scenes/cornell.toml");
 
 /// The bundled scene files of this technique, in `scenes_dir()`.
-pub const BUNDLED_SCENES: [&str; 10] = [
+pub const BUNDLED_SCENES: [&str; 11] = [
     "cornell.toml",
     "cornell_obj.toml",
     "cornell_bunny.toml",
@@ -212,6 +246,7 @@ pub const BUNDLED_SCENES: [&str; 10] = [
     "courtyard.toml",
     "lamplit_room.toml",
     "cornell_lights.gltf",
+    "textured_floor.gltf",
 ];
 
 /// Directory of the bundled scene files.
@@ -238,47 +273,43 @@ impl Default for FileSettings {
     }
 }
 
-/// Triangles of a mesh file with per-vertex albedo: the material's base colour times its texture
-/// sampled at the vertex (the RSM and G-buffer carry albedo per vertex, not per texel).
-fn model_triangles(model: &Model) -> Vec<[Vertex; 3]> {
+/// Triangles of mesh file `path` with its materials' base colours per vertex and their textures
+/// (where the mesh has texture coordinates) as layers of `textures`, which the raster passes
+/// sample per texel.
+fn model_triangles(
+    model: &Model,
+    path: &Path,
+    textures: &mut TextureCollector,
+) -> Result<Vec<[Vertex; 3]>, String> {
     let mut out = Vec::new();
     for mesh in &model.meshes {
         let material = model.materials.get(mesh.material);
-        let base = material.map_or(Vec3::ONE, |m| m.base_color);
-        let albedo = |i: usize| -> [f32; 3] {
-            let texel = material
-                .and_then(|m| m.base_color_texture.as_ref())
-                .zip(mesh.uvs.as_ref())
-                .map_or(Vec3::ONE, |(tex, uvs)| texture_at(tex, uvs[i]));
-            (base * texel).clamp(Vec3::ZERO, Vec3::ONE).into()
+        let albedo = material
+            .map_or(Vec3::ONE, |m| m.base_color)
+            .clamp(Vec3::ZERO, Vec3::ONE)
+            .into();
+        let texture = match (material, &mesh.uvs) {
+            (Some(m), Some(_)) => match &m.base_color_texture {
+                Some(image) => textures.index(image, m.base_color_sampler, path, &m.name)?,
+                None => Vertex::UNTEXTURED,
+            },
+            _ => Vertex::UNTEXTURED,
         };
+        let uv = |i: usize| mesh.uvs.as_ref().map_or(Vec2::ZERO, |uvs| uvs[i]).into();
         for tri in &mesh.indices {
             out.push(tri.map(|i| {
                 let i = i as usize;
                 Vertex {
                     position: mesh.positions[i].into(),
                     normal: mesh.normals[i].into(),
-                    albedo: albedo(i),
+                    albedo,
+                    uv: uv(i),
+                    texture,
                 }
             }));
         }
     }
-    out
-}
-
-/// Nearest texel at `uv` (wrapping; (0, 0) is the top-left corner), decoded from sRGB.
-fn texture_at(tex: &quadray_core::image_out::Rgba8Image, uv: glam::Vec2) -> Vec3 {
-    let wrap = |t: f32, n: u32| ((t - t.floor()) * n as f32).min(n as f32 - 1.0) as u32;
-    let p = tex.pixels[(wrap(uv.y, tex.height) * tex.width + wrap(uv.x, tex.width)) as usize];
-    let linear = |c: u8| {
-        let c = f32::from(c) / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    };
-    Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))
+    Ok(out)
 }
 
 /// Convex polygons as triangle fans, each with its plane's normal (Newell's, so the winding
@@ -291,11 +322,7 @@ fn polygon_triangles(polygons: &[Vec<Vec3>]) -> Vec<[Vertex; 3]> {
         if normal == Vec3::ZERO {
             continue;
         }
-        let v = |p: Vec3| Vertex {
-            position: p.into(),
-            normal: normal.into(),
-            albedo: [1.0; 3],
-        };
+        let v = |p: Vec3| Vertex::untextured(p.into(), normal.into(), [1.0; 3]);
         for i in 1..n.saturating_sub(1) {
             out.push([v(polygon[0]), v(polygon[i]), v(polygon[i + 1])]);
         }
@@ -358,11 +385,16 @@ pub fn builtins_as_meshes(scene: &SceneDescription) -> Result<SceneDescription, 
     Ok(scene)
 }
 
-/// One object's triangles in world space, with its material's albedo when it has one.
-fn object_triangles(object: &Object, d: &SceneDescription) -> Result<Vec<[Vertex; 3]>, String> {
+/// One object's triangles in world space, with its material's albedo (and no texture) when it
+/// has one.
+fn object_triangles(
+    object: &Object,
+    d: &SceneDescription,
+    textures: &mut TextureCollector,
+) -> Result<Vec<[Vertex; 3]>, String> {
     let mut tris = match &object.shape {
         Shape::Builtin(name) => builtin_triangles(name)?,
-        Shape::Mesh { model, .. } => model_triangles(model),
+        Shape::Mesh { model, path } => model_triangles(model, path, textures)?,
         Shape::Box { min, max } => cuboid(*min, *max, [1.0; 3]),
         Shape::Polygons(polygons) => polygon_triangles(polygons),
     };
@@ -389,6 +421,7 @@ fn object_triangles(object: &Object, d: &SceneDescription) -> Result<Vec<[Vertex
         v.normal = rotation.transform_vector3(v.normal.into()).into();
         if let Some(a) = albedo {
             v.albedo = a;
+            v.texture = Vertex::UNTEXTURED;
         }
     }
     Ok(tris)

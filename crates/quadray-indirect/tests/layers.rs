@@ -12,7 +12,7 @@ const LAYERS: &[&[&str]] = &[
     &["IndirectError", "shader_struct"],
     &["method", "frame"],
     &["settings"],
-    &["scene", "scene::builtin"],
+    &["scene", "scene::builtin", "scene::textures"],
     &[
         "light",
         "light::node",

@@ -9,5 +9,6 @@ mod layers;
 mod lights;
 mod non_finite;
 mod output;
+mod textures;
 mod tile_cut;
 mod visibility;

@@ -235,11 +235,11 @@ pub(super) fn append_displaced(
                 let slope = Vec2::new(du / (2.0 * texel.x), dv / (2.0 * texel.y)) * scale;
                 let tilted =
                     (slope.x * tangent + slope.y * bitangent + normal).normalize_or(normal);
-                grid.push(Vertex {
-                    position: (polygon - normal * sunk).into(),
-                    normal: tilted.into(),
-                    albedo: albedo.at(at_uv),
-                });
+                grid.push(Vertex::untextured(
+                    (polygon - normal * sunk).into(),
+                    tilted.into(),
+                    albedo.at(at_uv),
+                ));
             }
         }
         let corner = |i: usize, j: usize| grid[row_start[i] + j];

@@ -412,14 +412,16 @@ fn append_triangles(
     };
     let affine = transform.affine();
     let normal_matrix = Mat3::from(affine.matrix3).inverse().transpose();
-    let vertex = |i: usize, face: Vec3| Vertex {
-        position: affine.transform_point3(Vec3::from(positions[i])).into(),
-        normal: normals
-            .map_or(face, |n| {
-                (normal_matrix * Vec3::from(n[i])).normalize_or_zero()
-            })
-            .into(),
-        albedo,
+    let vertex = |i: usize, face: Vec3| {
+        Vertex::untextured(
+            affine.transform_point3(Vec3::from(positions[i])).into(),
+            normals
+                .map_or(face, |n| {
+                    (normal_matrix * Vec3::from(n[i])).normalize_or_zero()
+                })
+                .into(),
+            albedo,
+        )
     };
     let corners: Vec<usize> = match mesh.indices() {
         Some(indices @ (Indices::U16(_) | Indices::U32(_))) => indices.iter().collect(),

@@ -1,6 +1,6 @@
 //! A binned-SAH bounding volume hierarchy over convex polygons, with an occlusion query that
 //! stops at the first blocking polygon (the ray tracer's baseline for shadow rays, the indirect
-//! ground truth's visibility).
+//! ground truth's visibility) and a nearest-hit query (the indirect reference's surfaces).
 
 use super::{Aabb, ConvexPolygon, Ray};
 use glam::Vec3;
@@ -69,6 +69,38 @@ impl Bvh {
             }
         }
         false
+    }
+
+    /// The nearest polygon of `polygons` (those the BVH was built on) the ray hits, and the
+    /// ray's parameter there.
+    pub fn closest(&self, polygons: &[ConvexPolygon], ray: &Ray) -> Option<(u32, f32)> {
+        let (o, d, t_min) = (ray.origin, ray.dir, ray.t_min);
+        let inv_d = d.recip();
+        let mut best: Option<(u32, f32)> = None;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let t_max = best.map_or(ray.t_max, |(_, t)| t);
+            let node = &self.nodes[stack[top] as usize];
+            if node.bounds.clip_ray(o, inv_d, t_min, t_max).is_none() {
+                continue;
+            }
+            if node.count > 0 {
+                for &id in &self.order[node.start as usize..(node.start + node.count) as usize] {
+                    let t_max = best.map_or(ray.t_max, |(_, t)| t);
+                    if let Some(t) = polygons[id as usize].intersect(o, d, t_min, t_max) {
+                        best = Some((id, t));
+                    }
+                }
+            } else {
+                let me = stack[top] as usize;
+                stack[top] = me as u32 + 1;
+                stack[top + 1] = node.start;
+                top += 2;
+            }
+        }
+        best
     }
 }
 

@@ -4,8 +4,8 @@
 //! byte ranges and strides (and panics on some bad ones): every range is checked before use.
 
 use super::{
-    Material, MeshBuilder, MeshError, Model, beside, decode_texture, finish_all, read_file,
-    reject_utf16,
+    Material, MeshBuilder, MeshError, Model, TextureFilter, TextureSampler, TextureWrap, beside,
+    decode_texture, finish_all, read_file, reject_utf16,
 };
 use base64::Engine;
 use glam::{Mat4, Vec2, Vec3};
@@ -237,6 +237,33 @@ struct File<'a> {
     buffers: &'a [Vec<u8>],
 }
 
+/// glTF's sampler as quadray reads it (no mipmaps: one filter, [`TextureSampler`]).
+fn sampler(s: &gltf::texture::Sampler) -> TextureSampler {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let nearest = match (s.mag_filter(), s.min_filter()) {
+        (Some(mag), _) => mag == MagFilter::Nearest,
+        (None, Some(min)) => matches!(
+            min,
+            MinFilter::Nearest | MinFilter::NearestMipmapNearest | MinFilter::NearestMipmapLinear
+        ),
+        (None, None) => false,
+    };
+    let wrap = |mode| match mode {
+        WrappingMode::Repeat => TextureWrap::Repeat,
+        WrappingMode::ClampToEdge => TextureWrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => TextureWrap::MirroredRepeat,
+    };
+    TextureSampler {
+        filter: if nearest {
+            TextureFilter::Nearest
+        } else {
+            TextureFilter::Linear
+        },
+        wrap_u: wrap(s.wrap_s()),
+        wrap_v: wrap(s.wrap_t()),
+    }
+}
+
 impl File<'_> {
     fn error(&self, reason: impl ToString) -> MeshError {
         MeshError::parse(self.path, FORMAT, reason)
@@ -260,8 +287,14 @@ impl File<'_> {
                 .inspect_err(|e| tracing::warn!("{e}; material `{name}` left untextured"))
                 .ok()
         });
+        let base_color_sampler = pbr
+            .base_color_texture()
+            .map_or_else(TextureSampler::default, |info| {
+                sampler(&info.texture().sampler())
+            });
         Material {
             base_color_texture,
+            base_color_sampler,
             base_color,
             specular: Vec3::splat(0.04).lerp(base_color, pbr.metallic_factor()),
             shininess: 2.0 / (alpha * alpha) - 2.0,

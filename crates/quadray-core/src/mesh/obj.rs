@@ -123,6 +123,7 @@ fn convert_material(m: &tobj::Material, path: &Path, dir: &Path) -> Material {
                 .inspect_err(|e| tracing::warn!("{e}; material `{}` left untextured", m.name))
                 .ok()
         }),
+        base_color_sampler: defaults.base_color_sampler,
         specular: m.specular.map_or(defaults.specular, Vec3::from),
         shininess: m.shininess.unwrap_or(defaults.shininess),
         // Embree's convention (used by the bundled Cornell box): Ka is the emission when there

@@ -6,6 +6,7 @@
 
 use super::{Camera, Intensity, LUMENS_PER_WATT, Light, LightKind, SceneDescription, Shape};
 use crate::image_out::Rgba8Image;
+use crate::mesh::{TextureFilter, TextureSampler, TextureWrap};
 use base64::Engine;
 use glam::{Mat3, Quat, Vec2, Vec3};
 use gltf::json;
@@ -352,7 +353,7 @@ impl Writer<'_> {
                 };
                 let m = &model.materials[material];
                 let texture = match &m.base_color_texture {
-                    Some(image) => Some(self.texture(image, &m.name)?),
+                    Some(image) => Some(self.texture(image, m.base_color_sampler, &m.name)?),
                     None => None,
                 };
                 (m.name.clone(), m.base_color, m.emission, texture)
@@ -398,10 +399,12 @@ impl Writer<'_> {
         Ok(index)
     }
 
-    /// A texture of `image` (sRGB bytes, as read), stored as PNG in the buffer.
+    /// A texture of `image` (sRGB bytes, as read), stored as PNG in the buffer, read through
+    /// `sampler` (a sampler written only where it is not glTF's default).
     fn texture(
         &mut self,
         image: &Rgba8Image,
+        sampler: TextureSampler,
         material: &str,
     ) -> Result<json::Index<json::Texture>, String> {
         let mut png = Vec::new();
@@ -423,9 +426,32 @@ impl Writer<'_> {
             extensions: None,
             extras: None,
         });
+        let sampler = (sampler != TextureSampler::default()).then(|| {
+            use json::texture::{MagFilter, MinFilter, WrappingMode};
+            let (mag, min) = match sampler.filter {
+                TextureFilter::Linear => (MagFilter::Linear, MinFilter::Linear),
+                TextureFilter::Nearest => (MagFilter::Nearest, MinFilter::Nearest),
+            };
+            let wrap = |w| {
+                Valid(match w {
+                    TextureWrap::Repeat => WrappingMode::Repeat,
+                    TextureWrap::ClampToEdge => WrappingMode::ClampToEdge,
+                    TextureWrap::MirroredRepeat => WrappingMode::MirroredRepeat,
+                })
+            };
+            self.root.push(json::texture::Sampler {
+                mag_filter: Some(Valid(mag)),
+                min_filter: Some(Valid(min)),
+                wrap_s: wrap(sampler.wrap_u),
+                wrap_t: wrap(sampler.wrap_v),
+                name: None,
+                extensions: None,
+                extras: None,
+            })
+        });
         Ok(self.root.push(json::Texture {
             name: None,
-            sampler: None,
+            sampler,
             source,
             extensions: None,
             extras: None,

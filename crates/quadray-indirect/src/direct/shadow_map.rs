@@ -47,7 +47,7 @@ impl ShadowMaps {
             .collect();
         Self {
             size,
-            pipeline: raster_pipeline(device, &group_layout, &module, "shadow map", None, &[]),
+            pipeline: raster_pipeline(device, &[&group_layout], &module, "shadow map", None, &[]),
             maps,
         }
     }
@@ -80,7 +80,7 @@ impl ShadowMaps {
                     "shadow map",
                     &map.targets,
                     &self.pipeline,
-                    &map.group,
+                    &[&map.group],
                     vertices,
                     vertex_count,
                     timer.and_then(|(t, slot)| t.render_pass(slot)),

@@ -1,7 +1,8 @@
 //! The RSM pass: the caller's triangles rasterised from one light view into a reflective shadow
 //! map (flux, position + depth, normal, in one of the [`GBufferLayout`]s), the input of the light
 //! quadtree. Also the raster helpers quadray's own G-buffer pass and the direct light's shadow
-//! maps share.
+//! maps share, and the scene's base colour textures both colour passes sample
+//! ([`TextureArray`]).
 
 use crate::contract::{
     LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
@@ -9,10 +10,10 @@ use crate::contract::{
 };
 use crate::light::view::LightView;
 use crate::method::GBufferLayout;
-use crate::scene::Vertex;
+use crate::scene::{SceneTextures, Vertex};
 use crate::settings::Settings;
 use crate::wgsl;
-use quadray_gpu::{GpuTimer, cleared_attachment, texture_2d};
+use quadray_gpu::{GpuTimer, Limit, LimitNeed, cleared_attachment, texture_2d};
 
 /// Format of every wide RSM and G-buffer colour target.
 pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -52,22 +53,156 @@ pub(crate) fn rsm_targets(layout: GBufferLayout) -> &'static [ColorTarget] {
     }
 }
 
-const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
-    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
+/// [`Vertex`]'s fields as `raster.wgsl`'s vertex stage reads them.
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 5] = {
+    use std::mem::offset_of;
+    use wgpu::VertexFormat::{Float32x2, Float32x3, Uint32};
+    const fn attribute(
+        shader_location: u32,
+        offset: usize,
+        format: wgpu::VertexFormat,
+    ) -> wgpu::VertexAttribute {
+        wgpu::VertexAttribute {
+            format,
+            offset: offset as u64,
+            shader_location,
+        }
+    }
+    [
+        attribute(0, offset_of!(Vertex, position), Float32x3),
+        attribute(1, offset_of!(Vertex, normal), Float32x3),
+        attribute(2, offset_of!(Vertex, albedo), Float32x3),
+        attribute(3, offset_of!(Vertex, uv), Float32x2),
+        attribute(4, offset_of!(Vertex, texture), Uint32),
+    ]
+};
 
 /// The raster passes' shared modules: the vertex stage, and the compact layout's encodings.
 pub(crate) const RASTER_WGSL: [&str; 2] = [include_str!("raster.wgsl"), wgsl::COMPACT];
+/// The base colour textures' sampling (`surface_albedo`; group 1, a [`TextureArray`]), for the
+/// passes that write the albedo.
+pub(crate) const BASE_COLOUR_WGSL: &str = include_str!("base_colour.wgsl");
 /// How the quadtree and the gather read an RSM texel in either layout (`load_rsm_normal`,
 /// `load_rsm_position`, `load_rsm_flux`; needs [`wgsl::LIGHT`], [`wgsl::COMPACT`] and the
 /// including shader's `rsm_flux`, `rsm_pos`, `rsm_normal`, `light` and `params`).
 pub(crate) const RSM_READ_WGSL: &str = include_str!("rsm_read.wgsl");
 /// The RSM pass's shader, in order.
-pub(crate) const SOURCES: [&str; 4] = [
+pub(crate) const SOURCES: [&str; 5] = [
     wgsl::LIGHT,
     RASTER_WGSL[0],
     RASTER_WGSL[1],
+    BASE_COLOUR_WGSL,
     include_str!("rsm.wgsl"),
 ];
+
+/// The scene's base colour textures on the GPU ([`SceneTextures`]): one `Rgba8UnormSrgb` 2D
+/// array, whose texels the RSM and G-buffer passes read per fragment (the format decodes sRGB)
+/// and filter as each triangle's sampler says.
+pub struct TextureArray {
+    /// Group 1 of the passes that sample it.
+    group: wgpu::BindGroup,
+}
+
+impl TextureArray {
+    /// `textures` uploaded (a scene without textures binds one texel that no vertex reads).
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, textures: &SceneTextures) -> Self {
+        if textures.layers.is_empty() {
+            return Self::empty(device);
+        }
+        let texture = Self::texture(
+            device,
+            textures.width,
+            textures.height,
+            textures.layers.len() as u32,
+        );
+        let texels: Vec<[u8; 4]> = textures.layers.concat();
+        queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(&texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * textures.width),
+                rows_per_image: Some(textures.height),
+            },
+            texture.size(),
+        );
+        Self::of(device, &texture)
+    }
+
+    /// What the array of `textures` needs of the device: its layers' sides.
+    pub fn limit_needs(textures: &SceneTextures) -> Vec<LimitNeed> {
+        let side = textures.width.max(textures.height);
+        vec![LimitNeed {
+            limit: Limit::TextureDimension2d,
+            needed: side.into(),
+            needed_by: format!(
+                "the scene's base colour texture array ({}x{})",
+                textures.width, textures.height
+            ),
+        }]
+    }
+
+    /// No texture: for triangles that all have [`Vertex::UNTEXTURED`].
+    pub fn empty(device: &wgpu::Device) -> Self {
+        Self::of(device, &Self::texture(device, 1, 1, 1))
+    }
+
+    fn texture(device: &wgpu::Device, width: u32, height: u32, layers: u32) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("base colours"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    }
+
+    fn of(device: &wgpu::Device, texture: &wgpu::Texture) -> Self {
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        Self {
+            group: bind_group(
+                device,
+                "base colours",
+                &Self::layout(device),
+                vec![wgpu::BindingResource::TextureView(&view)],
+            ),
+        }
+    }
+
+    /// The group layout of the passes that sample it: the array, read by the fragment stage
+    /// with `textureLoad`.
+    pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        layout(
+            device,
+            "base colours",
+            &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        )
+    }
+
+    /// The group the passes bind.
+    pub(crate) fn group(&self) -> &wgpu::BindGroup {
+        &self.group
+    }
+}
 
 /// The RSM as the quadtree and the gather read it, whoever renders it: square textures of the
 /// same side (a power of two), any float formats `textureLoad` reads (quadray's
@@ -172,10 +307,10 @@ impl RasterTargets {
 }
 
 /// A raster pipeline over [`Vertex`] triangles into the colour `targets` (written by the entry
-/// point `fragment`; none: depth only) with a depth test.
+/// point `fragment`; none: depth only) with a depth test, binding `groups`.
 pub(crate) fn raster_pipeline(
     device: &wgpu::Device,
-    group: &wgpu::BindGroupLayout,
+    groups: &[&wgpu::BindGroupLayout],
     module: &wgpu::ShaderModule,
     label: &str,
     fragment: Option<&str>,
@@ -185,7 +320,7 @@ pub(crate) fn raster_pipeline(
         targets.iter().map(|&(_, f)| Some(f.into())).collect();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
-        layout: Some(&pipeline_layout(device, &[group])),
+        layout: Some(&pipeline_layout(device, groups)),
         vertex: wgpu::VertexState {
             module,
             entry_point: Some("vertex"),
@@ -222,14 +357,14 @@ pub(crate) fn fragment_entry(name: &str, layout: GBufferLayout) -> String {
     format!("{name}_{}", layout.name())
 }
 
-/// Clears `targets` and draws `vertex_count` vertices of `vertices` into them.
+/// Clears `targets` and draws `vertex_count` vertices of `vertices` into them, binding `groups`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn record_raster(
     encoder: &mut wgpu::CommandEncoder,
     label: &str,
     targets: &RasterTargets,
     pipeline: &wgpu::RenderPipeline,
-    group: &wgpu::BindGroup,
+    groups: &[&wgpu::BindGroup],
     vertices: wgpu::BufferSlice,
     vertex_count: u32,
     timestamps: Option<wgpu::RenderPassTimestampWrites>,
@@ -254,7 +389,9 @@ pub(crate) fn record_raster(
         ..Default::default()
     });
     pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, group, &[]);
+    for (index, group) in groups.iter().enumerate() {
+        pass.set_bind_group(index as u32, *group, &[]);
+    }
     pass.set_vertex_buffer(0, vertices);
     pass.draw(0..vertex_count, 0..1);
 }
@@ -271,11 +408,14 @@ pub struct RsmPass {
     raster: wgpu::Buffer,
     /// Per light update: the light and its projection.
     group: wgpu::BindGroup,
+    /// The base colour textures.
+    textures: wgpu::BindGroup,
     targets: RasterTargets,
 }
 
 impl RsmPass {
-    /// An RSM of [`Settings::rsm_size`]^2 texels in [`Settings::gbuffer_layout`].
+    /// An RSM of [`Settings::rsm_size`]^2 texels in [`Settings::gbuffer_layout`], of triangles
+    /// without textures until [`RsmPass::set_textures`].
     pub fn new(device: &wgpu::Device, settings: &Settings) -> Self {
         let (rsm_size, layout) = (settings.rsm_size, settings.gbuffer_layout);
         let group_layout = layout_of(device);
@@ -288,7 +428,7 @@ impl RsmPass {
             layout,
             pipeline: raster_pipeline(
                 device,
-                &group_layout,
+                &[&group_layout, &TextureArray::layout(device)],
                 &module,
                 "rsm",
                 Some(&fragment_entry("rsm", layout)),
@@ -300,10 +440,16 @@ impl RsmPass {
                 &group_layout,
                 vec![whole(&raster), whole(&light)],
             ),
+            textures: TextureArray::empty(device).group().clone(),
             light,
             raster,
             targets: RasterTargets::new(device, targets, (rsm_size, rsm_size)),
         }
+    }
+
+    /// Sets the base colour textures the triangles' [`Vertex::texture`] refer to.
+    pub fn set_textures(&mut self, textures: &TextureArray) {
+        self.textures = textures.group().clone();
     }
 
     /// Sets the light view the next recordings render from (per light update).
@@ -314,7 +460,8 @@ impl RsmPass {
     }
 
     /// Records the RSM of `vertex_count` vertices of `vertices`: triangle lists of [`Vertex`]
-    /// (world position, normal, albedo; three `Float32x3`), timed into `timer`'s `slot`.
+    /// (world position, normal, albedo, texture coordinate, packed texture), timed into
+    /// `timer`'s `slot`.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -327,7 +474,7 @@ impl RsmPass {
             "rsm",
             &self.targets,
             &self.pipeline,
-            &self.group,
+            &[&self.group, &self.textures],
             vertices,
             vertex_count,
             timer.and_then(|(t, slot)| t.render_pass(slot)),

@@ -23,12 +23,13 @@ struct CompactOut {
 // the spot's falloff, cos^3 and the albedo. The compact layout stores the share: a 512^2 map's
 // flux lies below a half float's normal range (6.1e-5), where it keeps only a few bits.
 fn texel_share(v: VertexOut) -> vec3<f32> {
+    let albedo = surface_albedo(v);
     if (is_parallel(light)) {
-        return v.albedo;
+        return albedo;
     }
     let w = light_towards(light, v.world);
     let cos_axis = dot(w, light.direction.xyz);
-    return spot_edge(light, w) * cos_axis * cos_axis * cos_axis * v.albedo;
+    return spot_edge(light, w) * cos_axis * cos_axis * cos_axis * albedo;
 }
 
 fn lit_normal(v: VertexOut) -> vec3<f32> {

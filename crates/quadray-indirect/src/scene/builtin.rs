@@ -31,11 +31,7 @@ pub(super) fn builtin_triangles(name: &str) -> Result<Vec<[Vertex; 3]>, String> 
 /// Two triangles of the quad a, b, c, d (counter-clockwise seen from the side `normal` faces).
 fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, albedo: [f32; 3]) -> [[Vertex; 3]; 2] {
     let normal = (b - a).cross(d - a).normalize();
-    let v = |p: Vec3| Vertex {
-        position: p.into(),
-        normal: normal.into(),
-        albedo,
-    };
+    let v = |p: Vec3| Vertex::untextured(p.into(), normal.into(), albedo);
     [[v(a), v(b), v(c)], [v(a), v(c), v(d)]]
 }
 
@@ -111,11 +107,11 @@ fn column(base: Vec3, radius: f32, height: f32, segments: u32, rings: u32) -> Ve
     let at = |i: u32, j: u32| {
         let a = std::f32::consts::TAU * i as f32 / segments as f32;
         let n = Vec3::new(a.cos(), 0.0, a.sin());
-        Vertex {
-            position: (base + n * radius + Vec3::Y * height * j as f32 / rings as f32).into(),
-            normal: n.into(),
+        Vertex::untextured(
+            (base + n * radius + Vec3::Y * height * j as f32 / rings as f32).into(),
+            n.into(),
             albedo,
-        }
+        )
     };
     (0..segments)
         .flat_map(|i| (0..rings).map(move |j| (i, j)))

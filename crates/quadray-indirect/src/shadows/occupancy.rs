@@ -585,11 +585,7 @@ mod tests {
     use super::*;
 
     fn quad(corners: [[f32; 3]; 4]) -> [[Vertex; 3]; 2] {
-        let v = corners.map(|position| Vertex {
-            position,
-            normal: [0.0, 0.0, 1.0],
-            albedo: [0.5; 3],
-        });
+        let v = corners.map(|position| Vertex::untextured(position, [0.0, 0.0, 1.0], [0.5; 3]));
         [[v[0], v[1], v[2]], [v[0], v[2], v[3]]]
     }
 
