@@ -95,9 +95,13 @@ pub struct ObjectTriangles {
 
 impl ObjectTriangles {
     fn new(triangles: Vec<[Vertex; 3]>) -> Self {
-        let bounds = quadray_indirect::scene::bounds_of(
-            triangles.iter().flatten().map(|v| v.position.into()),
-        );
+        let mut bounds = (Vec3::MAX, Vec3::MIN);
+        for t in &triangles {
+            for v in t {
+                let p = Vec3::from(v.position);
+                bounds = (bounds.0.min(p), bounds.1.max(p));
+            }
+        }
         Self { triangles, bounds }
     }
 
@@ -547,27 +551,45 @@ fn append_triangles(
         Some(VertexAttributeValues::Float32x3(n)) if n.len() == positions.len() => Some(n),
         _ => None,
     };
+    // each vertex to world space once (an indexed mesh's is shared by several triangles)
     let affine = transform.affine();
+    let positions: Vec<Vec3> = positions
+        .iter()
+        .map(|p| affine.transform_point3(Vec3::from(*p)))
+        .collect();
     let normal_matrix = Mat3::from(affine.matrix3).inverse().transpose();
-    let vertex = |i: usize, face: Vec3| Vertex {
-        position: affine.transform_point3(Vec3::from(positions[i])).into(),
-        normal: normals
-            .map_or(face, |n| {
-                (normal_matrix * Vec3::from(n[i])).normalize_or_zero()
-            })
-            .into(),
-        albedo,
-    };
+    let normals: Option<Vec<Vec3>> = normals.map(|n| {
+        n.iter()
+            .map(|n| (normal_matrix * Vec3::from(*n)).normalize_or_zero())
+            .collect()
+    });
+    // (over the slices: Bevy's index iterator is a call an index)
     let corners: Vec<usize> = match mesh.indices() {
-        Some(indices @ (Indices::U16(_) | Indices::U32(_))) => indices.iter().collect(),
+        Some(Indices::U16(indices)) => indices.iter().map(|&i| usize::from(i)).collect(),
+        Some(Indices::U32(indices)) => indices.iter().map(|&i| i as usize).collect(),
         None => (0..positions.len()).collect(),
     };
+    out.reserve(corners.len() / 3);
+    // plain code, not array maps: this crate is built at opt-level 1
+    let vertex = |p: Vec3, n: Vec3| Vertex {
+        position: p.to_array(),
+        normal: n.to_array(),
+        albedo,
+    };
     for t in corners.chunks_exact(3) {
-        if t.iter().any(|&i| i >= positions.len()) {
+        let (a, b, c) = (t[0], t[1], t[2]);
+        if a >= positions.len() || b >= positions.len() || c >= positions.len() {
             continue;
         }
-        let p = [t[0], t[1], t[2]].map(|i| affine.transform_point3(Vec3::from(positions[i])));
-        let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-        out.push([vertex(t[0], face), vertex(t[1], face), vertex(t[2], face)]);
+        let (pa, pb, pc) = (positions[a], positions[b], positions[c]);
+        let (na, nb, nc) = match &normals {
+            Some(n) => (n[a], n[b], n[c]),
+            // the face's normal where the mesh has none
+            None => {
+                let face = (pb - pa).cross(pc - pa).normalize_or_zero();
+                (face, face, face)
+            }
+        };
+        out.push([vertex(pa, na), vertex(pb, nb), vertex(pc, nc)]);
     }
 }
