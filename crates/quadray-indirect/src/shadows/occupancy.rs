@@ -88,12 +88,40 @@ struct SubCells {
 /// cell; two levels, a count a sub-cell (at its bit in the cell's masks, `word * 32 + bit`).
 #[derive(Clone, Debug, PartialEq)]
 enum Counts {
-    Cells(HashMap<usize, u32>),
-    SubCells(HashMap<usize, [u32; SUBCELL_COUNT]>),
+    Cells(HashMap<usize, u32, CellHash>),
+    SubCells(HashMap<usize, [u32; SUBCELL_COUNT], CellHash>),
+}
+
+/// Hashes a cell's index by one multiplication (the default hasher's cost was most of an
+/// update's): the indices are the grid's own, not an adversary's.
+type CellHash = std::hash::BuildHasherDefault<CellHasher>;
+
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl std::hash::Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+
+    fn write_usize(&mut self, i: usize) {
+        // Fibonacci hashing: the high bits, which hashbrown takes, mixed from every bit
+        self.0 = (i as u64 ^ self.0).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
 }
 
 /// Sub-cells of a cell.
 const SUBCELL_COUNT: usize = MASK_WORDS * 32;
+
+/// Cells an update sets or clears before the sub-cells' words are compacted anew once at its
+/// end rather than moved at each (a move costs a word a brick and the masks after the cell).
+const FOLLOWED_FLIPS: usize = 256;
 
 impl OccupancyGrid {
     /// The grid of `triangles` with `cells` cells along the longest side of their bounds, and a
@@ -147,9 +175,9 @@ impl OccupancyGrid {
                 masks: Vec::new(),
             }),
             counts: if two_levels {
-                Counts::SubCells(HashMap::new())
+                Counts::SubCells(HashMap::default())
             } else {
-                Counts::Cells(HashMap::new())
+                Counts::Cells(HashMap::default())
             },
         }
     }
@@ -171,41 +199,88 @@ impl OccupancyGrid {
         self.update(triangles, false);
     }
 
-    /// Counts `triangles` in or out, then updates the sub-cells' words: anew where a cell was
-    /// set or cleared (the set cells after it move), else the changed cells' masks in place.
+    /// Counts `triangles` in or out, and sets and clears the cells that gained their first or
+    /// lost their last triangle. The sub-cells' words follow each change (a set cell's words
+    /// inserted at its place, the bricks after it moved on by one) while few cells are set or
+    /// cleared; past [`FOLLOWED_FLIPS`] they are compacted anew once, at the end.
     fn update(&mut self, triangles: &[[Vertex; 3]], added: bool) {
-        let mut changed = Vec::new();
-        let mut flipped = false;
+        let mut cells = Vec::new();
+        let mut flips = 0;
         for t in triangles {
             let t = t.map(|v| (Vec3::from(v.position) - self.origin) / self.cell);
-            flipped |= self.count_triangle(t, added, &mut changed);
+            self.count_triangle(t, added, &mut cells);
+            for &(index, set, masks_changed) in &cells {
+                let (word, bit) = (index / 32, (index % 32) as u32);
+                if set != (self.bits[word] >> bit & 1 == 1) {
+                    self.bits[word] ^= 1 << bit;
+                    flips += 1;
+                    if flips <= FOLLOWED_FLIPS {
+                        self.follow_flip(word, bit, set);
+                    }
+                } else if set && masks_changed && flips <= FOLLOWED_FLIPS {
+                    self.follow_masks(word, bit);
+                }
+            }
+            cells.clear();
         }
+        if flips > FOLLOWED_FLIPS {
+            self.compact();
+        }
+    }
+
+    /// A set cell's place among the set cells (its words in the sub-cells' masks).
+    fn rank(&self, sub: &SubCells, word: usize, bit: u32) -> usize {
+        (sub.first[word] + (self.bits[word] & ((1u32 << bit) - 1)).count_ones()) as usize
+    }
+
+    /// The sub-cells' words after cell (`word`, `bit`) was set (its masks inserted) or cleared.
+    fn follow_flip(&mut self, word: usize, bit: u32, set: bool) {
+        let (Some(mut sub), Counts::SubCells(counts)) = (self.sub.take(), &self.counts) else {
+            return;
+        };
+        let at = self.rank(&sub, word, bit) * MASK_WORDS;
+        if set {
+            let masks = masks_of(&counts[&(word * 32 + bit as usize)]);
+            sub.masks.splice(at..at, masks);
+            sub.first[word + 1..].iter_mut().for_each(|f| *f += 1);
+        } else {
+            sub.masks.drain(at..at + MASK_WORDS);
+            sub.first[word + 1..].iter_mut().for_each(|f| *f -= 1);
+        }
+        self.sub = Some(sub);
+    }
+
+    /// The masks of set cell (`word`, `bit`) from its counts.
+    fn follow_masks(&mut self, word: usize, bit: u32) {
+        let (Some(mut sub), Counts::SubCells(counts)) = (self.sub.take(), &self.counts) else {
+            return;
+        };
+        let at = self.rank(&sub, word, bit) * MASK_WORDS;
+        sub.masks[at..at + MASK_WORDS]
+            .copy_from_slice(&masks_of(&counts[&(word * 32 + bit as usize)]));
+        self.sub = Some(sub);
+    }
+
+    /// The sub-cells' words anew from the set cells' counts.
+    fn compact(&mut self) {
         let (Some(sub), Counts::SubCells(counts)) = (&mut self.sub, &self.counts) else {
             return;
         };
-        if flipped {
-            let mut count = 0;
-            sub.masks.clear();
-            for (word, &w) in self.bits.iter().enumerate() {
-                sub.first[word] = count;
-                count += w.count_ones();
-                let mut rest = w;
-                while rest != 0 {
-                    let bit = rest.trailing_zeros();
-                    rest &= rest - 1;
-                    sub.masks
-                        .extend(masks_of(&counts[&(word * 32 + bit as usize)]));
-                }
-            }
-        } else {
-            for index in changed {
-                let (word, bit) = (index / 32, index % 32);
-                let rank = sub.first[word] + (self.bits[word] & ((1u32 << bit) - 1)).count_ones();
-                let at = rank as usize * MASK_WORDS;
-                sub.masks[at..at + MASK_WORDS].copy_from_slice(&masks_of(&counts[&index]));
+        let mut count = 0;
+        sub.masks.clear();
+        for (word, &w) in self.bits.iter().enumerate() {
+            sub.first[word] = count;
+            count += w.count_ones();
+            let mut rest = w;
+            while rest != 0 {
+                let bit = rest.trailing_zeros();
+                rest &= rest - 1;
+                sub.masks
+                    .extend(masks_of(&counts[&(word * 32 + bit as usize)]));
             }
         }
     }
+
     /// Whether the grid has two levels ([`Self::two_level`]).
     pub fn is_two_level(&self) -> bool {
         self.sub.is_some()
@@ -379,11 +454,11 @@ impl OccupancyGrid {
     }
 
     /// Counts the triangle (in grid units) in or out of every cell it overlaps (with two
-    /// levels, of every sub-cell of those); notes in `changed` the cells whose sub-cells were
-    /// set or cleared. Whether a cell was set or cleared.
-    fn count_triangle(&mut self, t: [Vec3; 3], added: bool, changed: &mut Vec<usize>) -> bool {
+    /// levels, of every sub-cell of those); notes in `cells` each such cell, whether it is now
+    /// set (a triangle over it) and whether its sub-cells were set or cleared.
+    fn count_triangle(&mut self, t: [Vec3; 3], added: bool, cells: &mut Vec<(usize, bool, bool)>) {
         if !t.iter().all(|v| v.is_finite()) {
-            return false;
+            return;
         }
         let lo = t[0].min(t[1]).min(t[2]).floor().as_ivec3().max(IVec3::ZERO);
         let hi = t[0]
@@ -392,7 +467,6 @@ impl OccupancyGrid {
             .floor()
             .as_ivec3()
             .min(self.dims.as_ivec3() - 1);
-        let mut flipped = false;
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for x in lo.x..=hi.x {
@@ -404,36 +478,33 @@ impl OccupancyGrid {
                     }
                     let (word, bit) = self.index(c).expect("clamped to the grid");
                     let index = word * 32 + bit as usize;
-                    let set = match &mut self.counts {
+                    let (set, masks_changed) = match &mut self.counts {
                         Counts::Cells(counts) => {
                             let count = counts.entry(index).or_insert(0);
                             *count = step(*count, added);
-                            let set = *count > 0;
-                            if !set {
-                                counts.remove(&index);
-                            }
-                            set
+                            (*count > 0, false)
                         }
                         Counts::SubCells(counts) => {
                             let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
-                            if count_subcells(t, c, cell, added) {
-                                changed.push(index);
-                            }
-                            let set = cell.iter().any(|&n| n > 0);
-                            if !set {
-                                counts.remove(&index);
-                            }
-                            set
+                            let changed = count_subcells(t, c, cell, added);
+                            // no sub-cell set or cleared: the cell is as it was
+                            let set = match changed {
+                                true => cell.iter().any(|&n| n > 0),
+                                false => self.bits[word] >> bit & 1 == 1,
+                            };
+                            (set, changed)
                         }
                     };
-                    if set != (self.bits[word] >> bit & 1 == 1) {
-                        self.bits[word] ^= 1 << bit;
-                        flipped = true;
+                    if !set {
+                        match &mut self.counts {
+                            Counts::Cells(counts) => counts.remove(&index).map(|_| ()),
+                            Counts::SubCells(counts) => counts.remove(&index).map(|_| ()),
+                        };
                     }
+                    cells.push((index, set, masks_changed));
                 }
             }
         }
-        flipped
     }
 }
 
