@@ -3,6 +3,8 @@
 //! timed first, with the median of each of quadray's render diagnostics), and the window title
 //! that says what is shown.
 
+pub mod large_scene;
+
 use bevy::app::ScheduleRunnerPlugin;
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::prelude::*;
@@ -179,11 +181,15 @@ fn save_when_ready(
     }
 }
 
-/// Each of quadray's render diagnostics (`render/quadray*`): the median of its kept history.
+/// Each of quadray's diagnostics (`render/quadray*`, and the plugins' CPU times
+/// `quadray*`): the median of its kept history.
 fn print_quadray_diagnostics(diagnostics: &DiagnosticsStore) {
     let mut found: Vec<_> = diagnostics
         .iter()
-        .filter(|d| d.path().as_str().starts_with("render/quadray"))
+        .filter(|d| {
+            let path = d.path().as_str();
+            path.starts_with("render/quadray") || path.starts_with("quadray")
+        })
         .collect();
     found.sort_by_key(|d| d.path().as_str());
     for d in found {

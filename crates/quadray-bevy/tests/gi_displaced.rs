@@ -170,7 +170,8 @@ fn displaced_scene() -> (Vec<[Vertex; 3]>, HeightMap) {
         .world()
         .resource::<IndirectLightScene>()
         .triangles()
-        .to_vec();
+        .copied()
+        .collect();
     let image = app
         .world()
         .resource::<Assets<Image>>()

@@ -5,6 +5,7 @@
 mod common;
 mod gi;
 mod gi_displaced;
+mod gi_scene;
 mod hits;
 mod layers;
 mod lifecycle;

@@ -23,8 +23,13 @@
 //! texel fetches per shaded pixel): the benchmark of the bounce's cost in a Bevy frame. `--size
 //! WxH` (default 256x256) and `--rsm-size N` (default 128) size the off-screen picture and the
 //! RSM. `--ev100 EV` sets the camera's exposure (Bevy's `Exposure`; default 9.7, Bevy's): about
-//! 15 for a glTF lit by a physical sun, 2 for a 4-lux sun or a dim lamp. `--help` lists the
-//! flags; an unknown one is refused.
+//! 15 for a glTF lit by a physical sun, 2 for a 4-lux sun or a dim lamp. `--indirect-shadows`
+//! tests each cluster's view on the scene's occupancy grid. At the scale of games:
+//! `--large-scene SEED` makes and shows a scene of about a million triangles in hundreds of
+//! meshes (`large_scene.rs`), `--move-node NAME` moves a node of the scene every frame (the
+//! large scene's `mover`), and `--frames` then prints the medians of the plugin's CPU time in
+//! each world (`quadray_gi/main_world_cpu`, `quadray_gi/render_world_cpu`) beside its GPU
+//! passes'. `--help` lists the flags; an unknown one is refused.
 
 use bevy::camera::{Exposure, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -56,7 +61,8 @@ const TURN: f32 = 0.25;
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
 /// What the first frame shows (`--no-gi`, `--method`, `--cut-view`), at what size (`--size`,
-/// `--rsm-size`), interleaving (`--interleave`) and exposure (`--ev100`).
+/// `--rsm-size`), interleaving (`--interleave`), indirect shadows (`--indirect-shadows`) and
+/// exposure (`--ev100`).
 #[derive(Resource, Clone, Copy)]
 struct Shown {
     gi: bool,
@@ -66,6 +72,7 @@ struct Shown {
     size: (u32, u32),
     rsm_size: u32,
     interleave: u32,
+    indirect_shadows: bool,
     ev100: f32,
 }
 
@@ -114,6 +121,10 @@ struct Args {
     #[arg(long, default_value_t = Settings::DEFAULT.interleave,
           value_parser = Settings::INTERLEAVE.parser())]
     interleave: u32,
+    /// Indirect shadows: each receiver's view of each cluster tested on the scene's occupancy
+    /// grid (quadray's `--indirect-shadows`, at its default grid).
+    #[arg(long)]
+    indirect_shadows: bool,
     /// The camera's exposure as an EV100 (Bevy's `Exposure`; `[` and `]` step it): one less is
     /// twice as bright. About log2 of the light in lux: Bevy's default 9.7 for a room lit by lamps
     /// of a few thousand lumens or a 1,000-lux sun, 15 for a physical sun of 100,000 lux, 2 for a
@@ -125,6 +136,16 @@ struct Args {
     /// the scene directly only).
     #[arg(long, value_delimiter = ',', default_values = ["directional", "point", "spot"])]
     gi_lights: Vec<GiLight>,
+    /// Show a large scene made from this seed instead: hundreds of meshes, about a million
+    /// triangles, a few meshes shared by several nodes, a sun, and a node named `mover`
+    /// (written as a GLB into the system's temporary folder first; the benchmark at the scale
+    /// of games, with --move-node mover).
+    #[arg(long, value_name = "SEED", conflicts_with_all = ["scene", "displaced"])]
+    large_scene: Option<u64>,
+    /// Move the scene's node of this name every frame (a circle of 2 m around where it
+    /// stands), its meshes with it.
+    #[arg(long, value_name = "NAME")]
+    move_node: Option<String>,
     /// Bevy's shadow maps on the scene file's lights, which Bevy's glTF loader leaves off: the
     /// direct light's shade, where the bounce is all the light there is (a sunlit scene's).
     #[arg(long, conflicts_with = "displaced")]
@@ -155,8 +176,18 @@ enum Shows {
     Displaced,
 }
 
+/// The node `--move-node` names.
+#[derive(Resource)]
+struct MovedNode(String);
+
 fn main() {
-    let args = Args::parse();
+    let mut args = Args::parse();
+    if let Some(seed) = args.large_scene {
+        args.scene = Some(large_scene(seed).unwrap_or_else(|e| {
+            eprintln!("error: --large-scene {seed}: {e}");
+            std::process::exit(2);
+        }));
+    }
     let (assets, scene) = match &args.scene {
         None if args.displaced => (repository_assets(""), Shows::Displaced),
         None => (repository_assets(""), Shows::File(SCENE.to_string(), None)),
@@ -176,6 +207,7 @@ fn main() {
         size: (args.size.width, args.size.height),
         rsm_size: args.rsm_size,
         interleave: args.interleave,
+        indirect_shadows: args.indirect_shadows,
         ev100: args.ev100,
     };
     let mut app = App::new();
@@ -193,8 +225,55 @@ fn main() {
         })
         .insert_resource(scene)
         .add_systems(Startup, setup)
-        .add_systems(Update, (configure, keys, turn_light, show_title).chain())
-        .run();
+        .add_systems(Update, (configure, keys, turn_light, show_title).chain());
+    if let Some(name) = args.move_node {
+        app.insert_resource(MovedNode(name))
+            .add_systems(Update, move_node);
+    }
+    app.run();
+}
+
+/// Writes the large scene of `seed` into the temporary folder and says what it holds.
+fn large_scene(seed: u64) -> std::io::Result<PathBuf> {
+    let folder = std::env::temp_dir().join(format!("quadray-large-scene-{seed}"));
+    std::fs::create_dir_all(&folder)?;
+    let path = folder.join("scene.glb");
+    let made = quadray_bevy_programs::large_scene::write_large_scene(&path, seed)?;
+    println!(
+        "large scene {seed}: {} triangles, {} meshes, {} nodes with a mesh, {} triangles in \
+         `{}` ({})",
+        made.triangles,
+        made.meshes,
+        made.nodes,
+        made.mover_triangles,
+        quadray_bevy_programs::large_scene::MOVER,
+        path.display()
+    );
+    Ok(path)
+}
+
+/// Moves the node `--move-node` names a step along its circle each frame, once it is loaded.
+fn move_node(
+    moved: Res<MovedNode>,
+    mut nodes: Query<(Entity, &Name, &mut Transform)>,
+    mut found: Local<Option<(Entity, Vec3)>>,
+    mut frame: Local<u32>,
+) {
+    if found.is_none() {
+        *found = nodes
+            .iter()
+            .find(|(_, name, _)| name.as_str() == moved.0)
+            .map(|(entity, _, t)| (entity, t.translation));
+    }
+    let Some((entity, start)) = *found else {
+        return;
+    };
+    let Ok((_, _, mut transform)) = nodes.get_mut(entity) else {
+        return;
+    };
+    *frame += 1;
+    let turn = *frame as f32 * 0.1;
+    transform.translation = start + 2.0 * Vec3::new(turn.cos() - 1.0, 0.0, turn.sin());
 }
 
 /// The EV100s `--ev100` takes: from a starlit night to well beyond a sunlit snowfield.
@@ -422,6 +501,7 @@ fn configure(
                 settings: Settings {
                     rsm_size: shown.rsm_size,
                     interleave: shown.interleave,
+                    indirect_shadows: shown.indirect_shadows,
                     ..Settings::DEFAULT
                 },
                 method: shown.method,

@@ -33,16 +33,20 @@
 //! device (quadray builds on the wgpu Bevy 0.19 uses); the plugin adds only the translation of
 //! Bevy's packed G-buffer (`gbuffer.wgsl`, with Bevy's unpacking functions) and the additive
 //! composite (`composite.wgsl`). The light's RSM is rasterised from the scene's triangles,
-//! gathered on the CPU from every visible `Mesh3d` whenever a mesh, material or transform
-//! changes: a `StandardMaterial`'s polygons in its base colour (textures are not read), a
-//! [`PyramidMaterial`](crate::PyramidMaterial)'s displaced surface (its height field cut into
-//! triangles, at most [`DISPLACED_TRIANGLES_MAX`] a mesh) in its base colour times its colour
-//! texture (read on the CPU where the image keeps its data; its base colour alone where not); the
-//! same triangles make the occupancy grid of indirect shadows ([`IndirectLightScene`] holds
-//! them). A moving light rebuilds the RSM, the pyramid and the cut, a still light and a moving
+//! made on the CPU per visible `Mesh3d` entity: a `StandardMaterial`'s polygons in its base
+//! colour (textures are not read), a [`PyramidMaterial`](crate::PyramidMaterial)'s displaced
+//! surface (its height field cut into triangles, at most [`DISPLACED_TRIANGLES_MAX`] a mesh) in
+//! its base colour times its colour texture (read on the CPU where the image keeps its data; its
+//! base colour alone where not); the same triangles make the occupancy grid of indirect shadows
+//! ([`IndirectLightScene`] holds them, by entity). The scene is kept up to date by what
+//! changed: an entity's triangles are made anew when its transform, mesh, material or
+//! visibility changes (or the mesh or material asset it uses), and only those reach the render
+//! world, which writes them into the entity's range of one vertex buffer and moves them in the
+//! occupancy grid (made anew only when the scene leaves the grid's bounds); a frame in which
+//! nothing changed does no scene work ([`SceneWork`] counts the render world's). A moving light,
+//! or a change to the scene, redraws the RSM, the pyramid and the cut; a still light and a moving
 //! camera reuse them. Each camera gathers every frame: Bevy's G-buffer changes without the camera
-//! moving (a mesh's pipeline
-//! compiled frames after it loaded, render layers switched).
+//! moving (a mesh's pipeline compiled frames after it loaded, render layers switched).
 //!
 //! Units: the lights' intensities are Bevy's (a point or spot light's luminous power in lumens,
 //! its luminous intensity that over 4 pi, as Bevy lights it; a directional light's illuminance
@@ -59,24 +63,28 @@
 //! `texel_fetches_per_pixel`, its gather's work per shaded pixel. The lights' cut is every
 //! camera's: its size is `render/quadray_gi/cut_clusters`.
 //!
+//! The plugin's CPU time a frame in each world goes to Bevy's `DiagnosticsStore` as
+//! [`MAIN_WORLD_CPU`] and [`RENDER_WORLD_CPU`] (milliseconds; no other plugin needed).
+//!
 //! A camera that loses [`IndirectLight`], or is despawned or no longer rendered, frees its passes
 //! ([`ViewPasses`]); the lights' maps are freed when no rendered camera has [`IndirectLight`].
 
+mod cpu_time;
 mod displaced;
 mod render;
 mod scene;
 
+pub use cpu_time::{MAIN_WORLD_CPU, RENDER_WORLD_CPU};
 pub use displaced::DISPLACED_TRIANGLES_MAX;
-pub use render::ViewPasses;
+pub use render::{SceneWork, ViewPasses};
 pub use scene::{
-    IndirectLight, IndirectLightScene, IndirectLightSource, quadray_directional, quadray_point,
-    quadray_spot,
+    IndirectLight, IndirectLightScene, IndirectLightSource, ObjectTriangles, quadray_directional,
+    quadray_point, quadray_spot,
 };
 
 use bevy::diagnostic::DiagnosticPath;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
-use bevy::render::extract_resource::ExtractResourcePlugin;
 use scene::{collect_lights, collect_triangles};
 
 /// Adds [`IndirectLight`] to the cameras that carry it, from the lights marked
@@ -86,19 +94,19 @@ pub struct IndirectLightPlugin;
 
 impl Plugin for IndirectLightPlugin {
     fn build(&self, app: &mut App) {
-        app.add_plugins((
-            ExtractComponentPlugin::<IndirectLight>::default(),
-            ExtractResourcePlugin::<IndirectLightScene>::default(),
-        ))
-        .init_resource::<IndirectLightScene>()
-        .add_systems(
-            PostUpdate,
-            (collect_triangles, collect_lights)
-                .after(bevy::transform::TransformSystems::Propagate)
-                .after(crate::build_pyramids)
-                .after(bevy::camera::visibility::VisibilitySystems::VisibilityPropagate),
-        );
+        app.add_plugins(ExtractComponentPlugin::<IndirectLight>::default())
+            .init_resource::<IndirectLightScene>()
+            .add_systems(
+                PostUpdate,
+                (collect_triangles, collect_lights)
+                    .after(bevy::transform::TransformSystems::Propagate)
+                    .after(crate::build_pyramids)
+                    .after(bevy::camera::visibility::VisibilitySystems::VisibilityPropagate)
+                    // this frame's asset events read this frame: an entity's triangles made once
+                    .after(bevy::asset::AssetEventSystems),
+            );
         render::build(app);
+        cpu_time::build(app);
     }
 }
 

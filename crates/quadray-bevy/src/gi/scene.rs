@@ -1,6 +1,7 @@
 //! The main world's side of the plugin: the components a user adds, and the marked lights and the
 //! scene's triangles gathered each frame into [`IndirectLightScene`] for the render world.
 
+use super::cpu_time::CpuTimes;
 use super::displaced::{Albedo, ColourMap, Displacement, append_displaced};
 use crate::{PyramidMaterial, Pyramids};
 use bevy::asset::AssetEvent;
@@ -8,14 +9,14 @@ use bevy::camera::Hdr;
 use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
 use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
 use bevy::pbr::StandardMaterial;
-use bevy::platform::collections::HashMap;
+use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
-use bevy::render::extract_resource::ExtractResource;
 use bevy::render::storage::ShaderBuffer;
 use quadray_displace::heightmap::HeightMap;
 use quadray_indirect::scene::{Cone, Intensity, Light, LightKind, Vertex};
 use quadray_indirect::{Method, Scene, Settings};
+use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 
 /// On a camera: add one bounce of indirect light from the [`IndirectLightSource`] lights (to the
@@ -62,28 +63,95 @@ impl Default for IndirectLight {
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct IndirectLightSource;
 
-/// The scene the lights' RSMs and the occupancy grid are made of, gathered each time a mesh,
-/// material or transform changes: the triangles of every visible `Mesh3d` in world space (a
-/// `StandardMaterial`'s base colour as their albedo; a `PyramidMaterial`'s displaced surface,
-/// see [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX)), and the marked lights. A
-/// resource of the main world, to read.
-#[derive(Resource, Clone, Default, ExtractResource)]
+/// The scene the lights' RSMs and the occupancy grid are made of: the triangles of every
+/// visible `Mesh3d` in world space (a `StandardMaterial`'s base colour as their albedo; a
+/// `PyramidMaterial`'s displaced surface, see
+/// [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX)), kept per entity, and the marked
+/// lights. An entity's triangles are made anew only when its transform, mesh, material or
+/// visibility changes (or the mesh or material asset it uses does); the render world receives
+/// the entities that changed. A resource of the main world, to read.
+#[derive(Resource, Default)]
 pub struct IndirectLightScene {
-    pub(super) triangles: Arc<Vec<[Vertex; 3]>>,
-    /// Counts the rebuilds of `triangles`.
+    /// Every `Mesh3d` entity, its triangles empty while its mesh is not loaded or it is hidden.
+    pub(super) objects: BTreeMap<Entity, SceneObject>,
+    /// The update that made [`Self::generation`]: the entities whose triangles changed and
+    /// their triangles (`None`: gone or empty), from generation `since`.
+    pub(super) changes: Vec<(Entity, Option<Arc<ObjectTriangles>>)>,
+    pub(super) since: u64,
+    /// Counts the updates that changed triangles.
     pub(super) generation: u64,
+    /// Counts the triangles made, all updates together.
+    pub(super) triangles_made: u64,
     pub(super) lights: Vec<Light>,
 }
 
-impl IndirectLightScene {
+/// One entity's triangles in world space and their bounds, shared with the render world.
+#[derive(Debug, PartialEq)]
+pub struct ObjectTriangles {
+    pub(super) triangles: Vec<[Vertex; 3]>,
+    /// Min and max corners.
+    pub(super) bounds: (Vec3, Vec3),
+}
+
+impl ObjectTriangles {
+    fn new(triangles: Vec<[Vertex; 3]>) -> Self {
+        let mut bounds = (Vec3::MAX, Vec3::MIN);
+        for t in &triangles {
+            for v in t {
+                let p = Vec3::from(v.position);
+                bounds = (bounds.0.min(p), bounds.1.max(p));
+            }
+        }
+        Self { triangles, bounds }
+    }
+
     /// The triangles, in world space, with the normal and albedo the RSM takes.
     pub fn triangles(&self) -> &[[Vertex; 3]] {
         &self.triangles
     }
 
-    /// Counts the times the triangles were gathered anew.
+    /// Their bounds (min and max corners).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+}
+
+/// An entity of the scene: what its triangles were made from, and them.
+pub(super) struct SceneObject {
+    mesh: AssetId<Mesh>,
+    material: Option<AssetId<StandardMaterial>>,
+    displaced: bool,
+    pub(super) triangles: Option<Arc<ObjectTriangles>>,
+}
+
+impl IndirectLightScene {
+    /// The triangles, in world space, with the normal and albedo the RSM takes: each entity's
+    /// in turn, by entity.
+    pub fn triangles(&self) -> impl Iterator<Item = &[Vertex; 3]> {
+        self.objects().flat_map(|(_, o)| o.triangles.iter())
+    }
+
+    /// The entities with triangles, by entity, and theirs.
+    pub fn objects(&self) -> impl Iterator<Item = (Entity, &ObjectTriangles)> {
+        self.objects
+            .iter()
+            .filter_map(|(e, o)| Some((*e, o.triangles.as_deref()?)))
+    }
+
+    /// How many triangles the scene has.
+    pub fn triangle_count(&self) -> usize {
+        self.objects().map(|(_, o)| o.triangles.len()).sum()
+    }
+
+    /// Counts the updates that changed the triangles.
     pub fn generation(&self) -> u64 {
         self.generation
+    }
+
+    /// Counts the triangles made (transformed to world space), every update together: an update
+    /// adds the triangles of the entities that changed, not the scene's.
+    pub fn triangles_made(&self) -> u64 {
+        self.triangles_made
     }
 }
 
@@ -143,7 +211,9 @@ pub(super) fn collect_lights(
     cameras: Query<(), With<IndirectLight>>,
     mut scene: ResMut<IndirectLightScene>,
     mut warned: Local<Option<String>>,
+    times: Res<CpuTimes>,
 ) {
+    let _span = times.main();
     let mut warn = |message: String| {
         if warned.as_ref() != Some(&message) {
             warn!("{message}");
@@ -195,18 +265,43 @@ pub(super) fn collect_lights(
     }
 }
 
-/// The objects whose triangles make the RSM.
+/// The entities whose triangles make the RSM.
 type Objects<'w, 's> = Query<
     'w,
     's,
     (
-        Ref<'static, GlobalTransform>,
-        Ref<'static, Mesh3d>,
-        Option<Ref<'static, MeshMaterial3d<StandardMaterial>>>,
-        Option<Ref<'static, MeshMaterial3d<PyramidMaterial>>>,
-        Ref<'static, InheritedVisibility>,
+        &'static GlobalTransform,
+        &'static Mesh3d,
+        Option<&'static MeshMaterial3d<StandardMaterial>>,
+        Option<&'static MeshMaterial3d<PyramidMaterial>>,
+        &'static InheritedVisibility,
     ),
 >;
+
+/// The entities whose transform, mesh, material or visibility changed.
+type Changed3d<'w, 's> = Query<
+    'w,
+    's,
+    Entity,
+    (
+        With<Mesh3d>,
+        Or<(
+            Changed<GlobalTransform>,
+            Changed<Mesh3d>,
+            Changed<MeshMaterial3d<StandardMaterial>>,
+            Changed<MeshMaterial3d<PyramidMaterial>>,
+            Changed<InheritedVisibility>,
+        )>,
+    ),
+>;
+
+/// The entities that lost their mesh or a material (or were despawned).
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct Removed<'w, 's> {
+    meshes: RemovedComponents<'w, 's, Mesh3d>,
+    materials: RemovedComponents<'w, 's, MeshMaterial3d<StandardMaterial>>,
+    displaced: RemovedComponents<'w, 's, MeshMaterial3d<PyramidMaterial>>,
+}
 
 /// What the scene's triangles are made from besides the meshes: the materials, the displaced
 /// surfaces' height fields (the displacement plugin's, absent without it) and the colour
@@ -228,13 +323,18 @@ pub(super) struct Sources<'w, 's> {
     colours: Local<'s, HashMap<AssetId<Image>, Option<Arc<ColourMap>>>>,
 }
 
+/// Makes anew the triangles of the entities that changed (their transform, mesh, material or
+/// visibility, or the assets they use) and hands them to the render world; in a frame where
+/// nothing changed it does nothing more than find that out.
 pub(super) fn collect_triangles(
     objects: Objects,
+    changed: Changed3d,
     sources: Sources,
-    mut removed: RemovedComponents<Mesh3d>,
+    mut removed: Removed,
     mut scene: ResMut<IndirectLightScene>,
-    mut count: Local<usize>,
+    times: Res<CpuTimes>,
 ) {
+    let _span = times.main();
     let Sources {
         meshes,
         materials,
@@ -249,73 +349,114 @@ pub(super) fn collect_triangles(
         mut colours,
     } = sources;
     let displaced = displaced.as_deref();
-    let mut events = mesh_events.read().count()
-        + material_events.read().count()
-        + displaced_events.as_mut().map_or(0, |e| e.read().count())
-        + removed.read().count();
-    for event in image_events.read() {
-        let id = match event {
-            AssetEvent::Added { id }
-            | AssetEvent::Modified { id }
-            | AssetEvent::Removed { id }
-            | AssetEvent::LoadedWithDependencies { id } => *id,
-            AssetEvent::Unused { .. } => continue,
-        };
+    let mut dirty: BTreeSet<Entity> = changed.iter().collect();
+    dirty.extend(removed.meshes.read());
+    dirty.extend(removed.materials.read());
+    dirty.extend(removed.displaced.read());
+    let changed_meshes = changed_assets(&mut mesh_events);
+    let changed_materials = changed_assets(&mut material_events);
+    let mut every_displaced = displaced_events
+        .as_mut()
+        .is_some_and(|e| e.read().count() > 0);
+    for id in image_events.read().filter_map(changed_asset) {
         // a colour texture read, or one a displaced material waits for
-        if colours.remove(&id).is_some() || uses_image(displaced, id) {
-            events += 1;
-        }
+        every_displaced |= colours.remove(&id).is_some() || uses_image(displaced, id);
     }
-    let changed = objects.iter().any(|(t, m, mat, pyramid, v)| {
-        t.is_changed()
-            || m.is_changed()
-            || v.is_changed()
-            || mat.is_some_and(|m| m.is_changed())
-            || pyramid.is_some_and(|m| m.is_changed())
-    });
-    if events == 0 && !changed && objects.iter().len() == *count {
+    if !changed_meshes.is_empty() || !changed_materials.is_empty() || every_displaced {
+        dirty.extend(scene.objects.iter().filter_map(|(e, o)| {
+            let uses = changed_meshes.contains(&o.mesh)
+                || o.material.is_some_and(|m| changed_materials.contains(&m))
+                || (o.displaced && every_displaced);
+            uses.then_some(*e)
+        }));
+    }
+    if dirty.is_empty() {
         return;
     }
-    *count = objects.iter().len();
-    let mut triangles = Vec::new();
-    for (transform, mesh, material, pyramid, visible) in &objects {
-        let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) else {
+    let mut changes = Vec::new();
+    let mut made = 0;
+    for entity in dirty {
+        let Ok((transform, mesh, material, pyramid, visible)) = objects.get(entity) else {
+            if let Some(SceneObject {
+                triangles: Some(_), ..
+            }) = scene.objects.remove(&entity)
+            {
+                changes.push((entity, None));
+            }
             continue;
         };
-        if let Some(material) = pyramid.and_then(|m| displaced?.get(&m.0)) {
-            let colour = material
-                .base
-                .base_color_texture
-                .as_ref()
-                .and_then(|texture| {
-                    colours
-                        .entry(texture.id())
-                        .or_insert_with(|| read_colours(&images, &assets, texture))
-                        .clone()
-                });
-            let map = pyramids
-                .as_ref()
-                .and_then(|p| p.0.get(&material.extension.depth_map.id()))
-                .and_then(|built| built.as_ref())
-                .filter(|_| material.extension.pyramid.is_some())
-                .map(|(_, _, map)| map.as_ref());
-            append_displaced_mesh(
-                mesh,
-                &transform,
-                material,
-                map,
-                colour.as_deref(),
-                &mut triangles,
-            );
-            continue;
+        let mut triangles = Vec::new();
+        if let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) {
+            if let Some(material) = pyramid.and_then(|m| displaced?.get(&m.0)) {
+                let colour = material
+                    .base
+                    .base_color_texture
+                    .as_ref()
+                    .and_then(|texture| {
+                        colours
+                            .entry(texture.id())
+                            .or_insert_with(|| read_colours(&images, &assets, texture))
+                            .clone()
+                    });
+                let map = pyramids
+                    .as_ref()
+                    .and_then(|p| p.0.get(&material.extension.depth_map.id()))
+                    .and_then(|built| built.as_ref())
+                    .filter(|_| material.extension.pyramid.is_some())
+                    .map(|(_, _, map)| map.as_ref());
+                append_displaced_mesh(
+                    mesh,
+                    transform,
+                    material,
+                    map,
+                    colour.as_deref(),
+                    &mut triangles,
+                );
+            } else {
+                let albedo = material
+                    .and_then(|m| materials.get(&m.0))
+                    .map_or(Vec3::splat(0.5), base_albedo);
+                append_triangles(mesh, transform, albedo.to_array(), &mut triangles);
+            }
         }
-        let albedo = material
-            .and_then(|m| materials.get(&m.0))
-            .map_or(Vec3::splat(0.5), base_albedo);
-        append_triangles(mesh, &transform, albedo.to_array(), &mut triangles);
+        made += triangles.len() as u64;
+        let triangles = (!triangles.is_empty()).then(|| Arc::new(ObjectTriangles::new(triangles)));
+        let object = SceneObject {
+            mesh: mesh.id(),
+            material: material.map(|m| m.id()),
+            displaced: pyramid.is_some(),
+            triangles: triangles.clone(),
+        };
+        let before = scene
+            .objects
+            .insert(entity, object)
+            .and_then(|o| o.triangles);
+        if before.is_some() || triangles.is_some() {
+            changes.push((entity, triangles));
+        }
     }
-    scene.triangles = Arc::new(triangles);
-    scene.generation += 1;
+    scene.triangles_made += made;
+    if !changes.is_empty() {
+        scene.since = scene.generation;
+        scene.generation += 1;
+        scene.changes = changes;
+    }
+}
+
+/// The assets the events say were added, changed or removed.
+fn changed_assets<A: Asset>(events: &mut MessageReader<AssetEvent<A>>) -> HashSet<AssetId<A>> {
+    events.read().filter_map(changed_asset).collect()
+}
+
+/// The asset an event says was added, changed or removed.
+fn changed_asset<A: Asset>(event: &AssetEvent<A>) -> Option<AssetId<A>> {
+    match event {
+        AssetEvent::Added { id }
+        | AssetEvent::Modified { id }
+        | AssetEvent::Removed { id }
+        | AssetEvent::LoadedWithDependencies { id } => Some(*id),
+        AssetEvent::Unused { .. } => None,
+    }
 }
 
 /// Whether a displaced material uses image `id` as its depth map or colour texture.
@@ -410,29 +551,41 @@ fn append_triangles(
         Some(VertexAttributeValues::Float32x3(n)) if n.len() == positions.len() => Some(n),
         _ => None,
     };
+    // each vertex to world space once (an indexed mesh's is shared by several triangles)
     let affine = transform.affine();
+    let positions: Vec<Vec3> = positions
+        .iter()
+        .map(|p| affine.transform_point3(Vec3::from(*p)))
+        .collect();
     let normal_matrix = Mat3::from(affine.matrix3).inverse().transpose();
-    let vertex = |i: usize, face: Vec3| {
-        Vertex::untextured(
-            affine.transform_point3(Vec3::from(positions[i])).into(),
-            normals
-                .map_or(face, |n| {
-                    (normal_matrix * Vec3::from(n[i])).normalize_or_zero()
-                })
-                .into(),
-            albedo,
-        )
-    };
+    let normals: Option<Vec<Vec3>> = normals.map(|n| {
+        n.iter()
+            .map(|n| (normal_matrix * Vec3::from(*n)).normalize_or_zero())
+            .collect()
+    });
+    // (over the slices: Bevy's index iterator is a call an index)
     let corners: Vec<usize> = match mesh.indices() {
-        Some(indices @ (Indices::U16(_) | Indices::U32(_))) => indices.iter().collect(),
+        Some(Indices::U16(indices)) => indices.iter().map(|&i| usize::from(i)).collect(),
+        Some(Indices::U32(indices)) => indices.iter().map(|&i| i as usize).collect(),
         None => (0..positions.len()).collect(),
     };
+    out.reserve(corners.len() / 3);
+    // plain code, not array maps: this crate is built at opt-level 1
+    let vertex = |p: Vec3, n: Vec3| Vertex::untextured(p.to_array(), n.to_array(), albedo);
     for t in corners.chunks_exact(3) {
-        if t.iter().any(|&i| i >= positions.len()) {
+        let (a, b, c) = (t[0], t[1], t[2]);
+        if a >= positions.len() || b >= positions.len() || c >= positions.len() {
             continue;
         }
-        let p = [t[0], t[1], t[2]].map(|i| affine.transform_point3(Vec3::from(positions[i])));
-        let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-        out.push([vertex(t[0], face), vertex(t[1], face), vertex(t[2], face)]);
+        let (pa, pb, pc) = (positions[a], positions[b], positions[c]);
+        let (na, nb, nc) = match &normals {
+            Some(n) => (n[a], n[b], n[c]),
+            // the face's normal where the mesh has none
+            None => {
+                let face = (pb - pa).cross(pc - pa).normalize_or_zero();
+                (face, face, face)
+            }
+        };
+        out.push([vertex(pa, na), vertex(pb, nb), vertex(pc, nc)]);
     }
 }

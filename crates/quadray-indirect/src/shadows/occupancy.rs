@@ -12,6 +12,7 @@
 
 use crate::scene::Vertex;
 use glam::{IVec3, UVec3, Vec3};
+use std::collections::HashMap;
 
 /// Cells a segment's ends are moved off their surfaces along the normals: past every cell a
 /// plane through the end may overlap (a cell's diagonal is sqrt(3) sides).
@@ -59,16 +60,22 @@ pub struct Walk {
 }
 
 /// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell; in a grid of
-/// two levels, with the same for the [`SUBCELLS`]^3 sub-cells of each set cell.
+/// two levels, with the same for the [`SUBCELLS`]^3 sub-cells of each set cell. The grid counts
+/// the triangles over each set cell (each set sub-cell), so that triangles are added and
+/// removed ([`Self::add`], [`Self::remove`]) at a cost in proportion to them, and a grid so
+/// updated equals the one made from its triangles at once over the same bounds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OccupancyGrid {
     dims: UVec3,
     origin: Vec3,
     cell: f32,
+    /// The bounds the grid was made over (its margin around them).
+    bounds: (Vec3, Vec3),
     bits: Vec<u32>,
     /// Two levels: per brick, the index of the sub-cells of its first set cell (the set cells
     /// before it counted); then [`MASK_WORDS`] a set cell, in the order of the bricks and bits.
     sub: Option<SubCells>,
+    counts: Counts,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -77,21 +84,60 @@ struct SubCells {
     masks: Vec<u32>,
 }
 
+/// The triangles over each set cell (by its bit index, `word * 32 + bit`): one level, a count a
+/// cell; two levels, a count a sub-cell (at its bit in the cell's masks, `word * 32 + bit`).
+#[derive(Clone, Debug, PartialEq)]
+enum Counts {
+    Cells(HashMap<usize, u32, CellHash>),
+    SubCells(HashMap<usize, [u32; SUBCELL_COUNT], CellHash>),
+}
+
+/// Hashes a cell's index by one multiplication (the default hasher's cost was most of an
+/// update's): the indices are the grid's own, not an adversary's.
+type CellHash = std::hash::BuildHasherDefault<CellHasher>;
+
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl std::hash::Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+
+    fn write_usize(&mut self, i: usize) {
+        // Fibonacci hashing: the high bits, which hashbrown takes, mixed from every bit
+        self.0 = (i as u64 ^ self.0).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+}
+
+/// Sub-cells of a cell.
+const SUBCELL_COUNT: usize = MASK_WORDS * 32;
+
+/// Cells an update sets or clears before the sub-cells' words are compacted anew once at its
+/// end rather than moved at each (a move costs a word a brick and the masks after the cell).
+const FOLLOWED_FLIPS: usize = 256;
+
 impl OccupancyGrid {
     /// The grid of `triangles` with `cells` cells along the longest side of their bounds, and a
     /// margin of [`END_OFFSET_CELLS`] + 1 cells all round (so a moved end stays inside).
     pub fn of_triangles(triangles: &[[Vertex; 3]], cells: u32) -> Self {
-        Self::one_level(triangles, cells).0
+        Self::with_levels(triangles, cells, 1)
     }
 
     /// [`Self::of_triangles`] (`levels` 1) or [`Self::two_level`] (more):
     /// [`crate::Settings::shadow_grid_levels`].
     pub fn with_levels(triangles: &[[Vertex; 3]], cells: u32, levels: u32) -> Self {
-        if levels > 1 {
-            Self::two_level(triangles, cells)
-        } else {
-            Self::of_triangles(triangles, cells)
-        }
+        let bounds =
+            crate::scene::bounds_of(triangles.iter().flatten().map(|v| Vec3::from(v.position)));
+        let mut grid = Self::empty(bounds, cells, levels);
+        grid.add(triangles);
+        grid
     }
 
     /// [`Self::of_triangles`] with each set cell's [`SUBCELLS`]^3 sub-cells: a cell stays set
@@ -99,35 +145,15 @@ impl OccupancyGrid {
     /// words a set cell beyond the grid's bits ([`crate::Settings::MAX_TWO_LEVEL_SHADOW_GRID`]
     /// bounds it).
     pub fn two_level(triangles: &[[Vertex; 3]], cells: u32) -> Self {
-        let (mut grid, in_grid) = Self::one_level(triangles, cells);
-        let mut masks = std::collections::HashMap::<usize, [u32; MASK_WORDS]>::new();
-        for t in &in_grid {
-            grid.add_subcells(*t, &mut masks);
-        }
-        // a cell whose sub-cells no triangle overlaps (it touched the cell's margin) is clear
-        grid.bits.fill(0);
-        let mut cells: Vec<(usize, [u32; MASK_WORDS])> = masks.into_iter().collect();
-        cells.sort_unstable_by_key(|&(index, _)| index);
-        for &(index, _) in &cells {
-            grid.bits[index / 32] |= 1 << (index % 32);
-        }
-        let mut first = Vec::with_capacity(grid.bits.len());
-        let mut count = 0;
-        for w in &grid.bits {
-            first.push(count);
-            count += w.count_ones();
-        }
-        let masks = cells.into_iter().flat_map(|(_, m)| m).collect();
-        grid.sub = Some(SubCells { first, masks });
-        grid
+        Self::with_levels(triangles, cells, 2)
     }
 
-    /// The grid of one level, and its triangles in grid units.
-    fn one_level(triangles: &[[Vertex; 3]], cells: u32) -> (Self, Vec<[Vec3; 3]>) {
-        let (lo, hi) =
-            crate::scene::bounds_of(triangles.iter().flatten().map(|v| Vec3::from(v.position)));
-        let (lo, hi) = if lo.cmple(hi).all() {
-            (lo, hi)
+    /// A grid with no triangle yet over `bounds` (min, max; empty bounds, min above max, as a
+    /// point at the origin), `cells` cells along their longest side and `levels` levels, as
+    /// [`Self::with_levels`] makes for triangles of those bounds.
+    pub fn empty(bounds: (Vec3, Vec3), cells: u32, levels: u32) -> Self {
+        let (lo, hi) = if bounds.0.cmple(bounds.1).all() {
+            bounds
         } else {
             (Vec3::ZERO, Vec3::ZERO)
         };
@@ -136,21 +162,123 @@ impl OccupancyGrid {
         let origin = lo - Vec3::splat(margin * cell);
         let cells = (((hi - lo) / cell).ceil() + Vec3::splat(2.0 * margin + 1.0)).as_uvec3();
         let bricks = (cells + BRICK - 1) / BRICK;
-        let mut grid = Self {
+        let two_levels = levels > 1;
+        let brick_count = bricks.element_product() as usize;
+        Self {
             dims: bricks * BRICK,
             origin,
             cell,
-            bits: vec![0; bricks.element_product() as usize],
-            sub: None,
-        };
-        let in_grid: Vec<[Vec3; 3]> = triangles
-            .iter()
-            .map(|t| t.map(|v| (Vec3::from(v.position) - origin) / cell))
-            .collect();
-        for t in &in_grid {
-            grid.add_triangle(*t);
+            bounds: (lo, hi),
+            bits: vec![0; brick_count],
+            sub: two_levels.then(|| SubCells {
+                first: vec![0; brick_count],
+                masks: Vec::new(),
+            }),
+            counts: if two_levels {
+                Counts::SubCells(HashMap::default())
+            } else {
+                Counts::Cells(HashMap::default())
+            },
         }
-        (grid, in_grid)
+    }
+
+    /// The bounds the grid was made over: triangles within them are in the grid, with its
+    /// margin around them.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    /// Adds `triangles`: sets the cells (and sub-cells) they overlap.
+    pub fn add(&mut self, triangles: &[[Vertex; 3]]) {
+        self.update(triangles, true);
+    }
+
+    /// Removes `triangles`, added before ([`Self::add`] or the constructors) to this grid: a
+    /// cell (a sub-cell) no other triangle overlaps is cleared.
+    pub fn remove(&mut self, triangles: &[[Vertex; 3]]) {
+        self.update(triangles, false);
+    }
+
+    /// Counts `triangles` in or out, and sets and clears the cells that gained their first or
+    /// lost their last triangle. The sub-cells' words follow each change (a set cell's words
+    /// inserted at its place, the bricks after it moved on by one) while few cells are set or
+    /// cleared; past [`FOLLOWED_FLIPS`] they are compacted anew once, at the end.
+    fn update(&mut self, triangles: &[[Vertex; 3]], added: bool) {
+        let mut cells = Vec::new();
+        let mut flips = 0;
+        for t in triangles {
+            let t = t.map(|v| (Vec3::from(v.position) - self.origin) / self.cell);
+            self.count_triangle(t, added, &mut cells);
+            for &(index, set, masks_changed) in &cells {
+                let (word, bit) = (index / 32, (index % 32) as u32);
+                if set != (self.bits[word] >> bit & 1 == 1) {
+                    self.bits[word] ^= 1 << bit;
+                    flips += 1;
+                    if flips <= FOLLOWED_FLIPS {
+                        self.follow_flip(word, bit, set);
+                    }
+                } else if set && masks_changed && flips <= FOLLOWED_FLIPS {
+                    self.follow_masks(word, bit);
+                }
+            }
+            cells.clear();
+        }
+        if flips > FOLLOWED_FLIPS {
+            self.compact();
+        }
+    }
+
+    /// A set cell's place among the set cells (its words in the sub-cells' masks).
+    fn rank(&self, sub: &SubCells, word: usize, bit: u32) -> usize {
+        (sub.first[word] + (self.bits[word] & ((1u32 << bit) - 1)).count_ones()) as usize
+    }
+
+    /// The sub-cells' words after cell (`word`, `bit`) was set (its masks inserted) or cleared.
+    fn follow_flip(&mut self, word: usize, bit: u32, set: bool) {
+        let (Some(mut sub), Counts::SubCells(counts)) = (self.sub.take(), &self.counts) else {
+            return;
+        };
+        let at = self.rank(&sub, word, bit) * MASK_WORDS;
+        if set {
+            let masks = masks_of(&counts[&(word * 32 + bit as usize)]);
+            sub.masks.splice(at..at, masks);
+            sub.first[word + 1..].iter_mut().for_each(|f| *f += 1);
+        } else {
+            sub.masks.drain(at..at + MASK_WORDS);
+            sub.first[word + 1..].iter_mut().for_each(|f| *f -= 1);
+        }
+        self.sub = Some(sub);
+    }
+
+    /// The masks of set cell (`word`, `bit`) from its counts.
+    fn follow_masks(&mut self, word: usize, bit: u32) {
+        let (Some(mut sub), Counts::SubCells(counts)) = (self.sub.take(), &self.counts) else {
+            return;
+        };
+        let at = self.rank(&sub, word, bit) * MASK_WORDS;
+        sub.masks[at..at + MASK_WORDS]
+            .copy_from_slice(&masks_of(&counts[&(word * 32 + bit as usize)]));
+        self.sub = Some(sub);
+    }
+
+    /// The sub-cells' words anew from the set cells' counts.
+    fn compact(&mut self) {
+        let (Some(sub), Counts::SubCells(counts)) = (&mut self.sub, &self.counts) else {
+            return;
+        };
+        let mut count = 0;
+        sub.masks.clear();
+        for (word, &w) in self.bits.iter().enumerate() {
+            sub.first[word] = count;
+            count += w.count_ones();
+            let mut rest = w;
+            while rest != 0 {
+                let bit = rest.trailing_zeros();
+                rest &= rest - 1;
+                sub.masks
+                    .extend(masks_of(&counts[&(word * 32 + bit as usize)]));
+            }
+        }
     }
 
     /// Whether the grid has two levels ([`Self::two_level`]).
@@ -325,49 +453,10 @@ impl OccupancyGrid {
         Some((word as usize, l.x + BRICK.x * (l.y + BRICK.y * l.z)))
     }
 
-    /// Sets, in `masks` (by the cell's bit index), every sub-cell of a set cell that the
-    /// triangle (in grid units) overlaps.
-    fn add_subcells(
-        &self,
-        t: [Vec3; 3],
-        masks: &mut std::collections::HashMap<usize, [u32; MASK_WORDS]>,
-    ) {
-        if !t.iter().all(|v| v.is_finite()) {
-            return;
-        }
-        let k = SUBCELLS as f32;
-        let top = self.dims.as_ivec3() * SUBCELLS as i32 - 1;
-        let lo = (t[0].min(t[1]).min(t[2]) * k)
-            .floor()
-            .as_ivec3()
-            .max(IVec3::ZERO);
-        let hi = (t[0].max(t[1]).max(t[2]) * k).floor().as_ivec3().min(top);
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                for x in lo.x..=hi.x {
-                    let s = IVec3::new(x, y, z);
-                    let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
-                    let (word, bit) = self.index(c).expect("clamped to the grid");
-                    if self.bits[word] >> bit & 1 == 0 {
-                        continue;
-                    }
-                    // the cell's box's rule (a plane at a face in, one at the next out):
-                    // the sub-cells at the cell's faces end where the cell's box does
-                    let low = s.as_vec3() / k - Vec3::splat(1e-5);
-                    let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
-                    if triangle_overlaps_box(t, (low + high) * 0.5, (high - low) * 0.5) {
-                        let mask = masks.entry(word * 32 + bit as usize).or_default();
-                        let (w, b) = sub_bit(sub_cell(s));
-                        mask[w] |= 1 << b;
-                    }
-                }
-            }
-        }
-    }
-
-    /// Sets every cell the triangle (in grid units) overlaps. A cell is the half-open
-    /// [i, i + 1): a plane on a cell boundary sets the cells above it only.
-    fn add_triangle(&mut self, t: [Vec3; 3]) {
+    /// Counts the triangle (in grid units) in or out of every cell it overlaps (with two
+    /// levels, of every sub-cell of those); notes in `cells` each such cell, whether it is now
+    /// set (a triangle over it) and whether its sub-cells were set or cleared.
+    fn count_triangle(&mut self, t: [Vec3; 3], added: bool, cells: &mut Vec<(usize, bool, bool)>) {
         if !t.iter().all(|v| v.is_finite()) {
             return;
         }
@@ -384,14 +473,87 @@ impl OccupancyGrid {
                     let c = IVec3::new(x, y, z);
                     // the box [i - 1e-5, i + 1 - 1e-4]: a plane at i is in, one at i + 1 out
                     let centre = c.as_vec3() + Vec3::splat(0.5 - 5.5e-5);
-                    if triangle_overlaps_box(t, centre, Vec3::splat(0.5 - 4.5e-5)) {
-                        let (word, bit) = self.index(c).expect("clamped to the grid");
-                        self.bits[word] |= 1 << bit;
+                    if !triangle_overlaps_box(t, centre, Vec3::splat(0.5 - 4.5e-5)) {
+                        continue;
                     }
+                    let (word, bit) = self.index(c).expect("clamped to the grid");
+                    let index = word * 32 + bit as usize;
+                    let (set, masks_changed) = match &mut self.counts {
+                        Counts::Cells(counts) => {
+                            let count = counts.entry(index).or_insert(0);
+                            *count = step(*count, added);
+                            (*count > 0, false)
+                        }
+                        Counts::SubCells(counts) => {
+                            let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
+                            let changed = count_subcells(t, c, cell, added);
+                            // no sub-cell set or cleared: the cell is as it was
+                            let set = match changed {
+                                true => cell.iter().any(|&n| n > 0),
+                                false => self.bits[word] >> bit & 1 == 1,
+                            };
+                            (set, changed)
+                        }
+                    };
+                    if !set {
+                        match &mut self.counts {
+                            Counts::Cells(counts) => counts.remove(&index).map(|_| ()),
+                            Counts::SubCells(counts) => counts.remove(&index).map(|_| ()),
+                        };
+                    }
+                    cells.push((index, set, masks_changed));
                 }
             }
         }
     }
+}
+
+/// A count one up (`added`) or down.
+fn step(count: u32, added: bool) -> u32 {
+    if added {
+        count + 1
+    } else {
+        count.saturating_sub(1)
+    }
+}
+
+/// Counts the triangle (in grid units) in or out of the sub-cells of cell `c` it overlaps;
+/// whether a sub-cell was set or cleared.
+fn count_subcells(t: [Vec3; 3], c: IVec3, cell: &mut [u32; SUBCELL_COUNT], added: bool) -> bool {
+    let k = SUBCELLS as f32;
+    let first = c * SUBCELLS as i32;
+    let lo = (t[0].min(t[1]).min(t[2]) * k).floor().as_ivec3().max(first);
+    let hi = (t[0].max(t[1]).max(t[2]) * k)
+        .floor()
+        .as_ivec3()
+        .min(first + SUBCELLS as i32 - 1);
+    let mut changed = false;
+    for z in lo.z..=hi.z {
+        for y in lo.y..=hi.y {
+            for x in lo.x..=hi.x {
+                let s = IVec3::new(x, y, z);
+                // the cell's box's rule (a plane at a face in, one at the next out): the
+                // sub-cells at the cell's faces end where the cell's box does
+                let low = s.as_vec3() / k - Vec3::splat(1e-5);
+                let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
+                if triangle_overlaps_box(t, (low + high) * 0.5, (high - low) * 0.5) {
+                    let (w, b) = sub_bit(sub_cell(s));
+                    let count = &mut cell[w * 32 + b as usize];
+                    let was = *count > 0;
+                    *count = step(*count, added);
+                    changed |= was != (*count > 0);
+                }
+            }
+        }
+    }
+    changed
+}
+
+/// A set cell's [`MASK_WORDS`] words of sub-cells from its counts.
+fn masks_of(counts: &[u32; SUBCELL_COUNT]) -> [u32; MASK_WORDS] {
+    std::array::from_fn(|w| {
+        (0..32).fold(0, |mask, b| mask | (u32::from(counts[w * 32 + b] > 0) << b))
+    })
 }
 
 /// Sub-cell `l` (0..[`SUBCELLS`] each) of a cell: its word among the cell's [`MASK_WORDS`], and
@@ -768,6 +930,58 @@ mod tests {
             two.walk(slit.0, up, slit.1, up),
         );
         assert!(b.fetches > a.fetches && b.cells > a.cells, "{a:?} {b:?}");
+    }
+
+    /// A small upright quad standing on the floor at `x` (sharing the floor's cells at its
+    /// foot).
+    fn post_at(x: f32) -> [[Vertex; 3]; 2] {
+        quad([[x, 0.0, 0.2], [x, 0.3, 0.2], [x, 0.3, 0.4], [x, 0.0, 0.4]])
+    }
+
+    #[test]
+    fn an_updated_grid_equals_the_grid_made_at_once() {
+        for levels in [1, 2] {
+            let scene = wall_with_a_slit();
+            let (before, after) = (post_at(0.23), post_at(0.71));
+            let with = |post: &[[Vertex; 3]; 2]| [scene.as_slice(), post].concat();
+            let mut grid = OccupancyGrid::with_levels(&with(&before), 32, levels);
+            let old = grid.gpu_words();
+            grid.remove(&before);
+            grid.add(&after);
+            // the post's moves keep within the scene's bounds, so both grids have the same
+            let at_once = OccupancyGrid::with_levels(&with(&after), 32, levels);
+            assert_eq!(grid.bounds(), at_once.bounds(), "{levels} levels");
+            assert_eq!(grid.gpu_words(), at_once.gpu_words(), "{levels} levels");
+            // (not assert_eq: a grid's debug text is long)
+            assert!(grid == at_once, "{levels} levels: the counts too");
+            assert_ne!(grid.gpu_words(), old, "{levels} levels: the post moved");
+            // a sub-cell's mask changing in a cell that stays set (the floor's, at the post's
+            // foot) and cells set anew both happened: back again gives the first grid
+            grid.remove(&after);
+            grid.add(&before);
+            assert_eq!(grid.gpu_words(), old, "{levels} levels");
+            // a chip just above the floor, in the floor's cells: sub-cells set, no cell
+            let chip = [[0.1, 0.02, 0.1], [0.15, 0.02, 0.1], [0.1, 0.02, 0.15]]
+                .map(|position| Vertex::untextured(position, [0.0, 1.0, 0.0], [0.5; 3]));
+            let cells = grid.occupied_count();
+            grid.add(&[chip]);
+            assert_eq!(grid.occupied_count(), cells, "{levels} levels: no cell set");
+            let mut with_chip = with(&before);
+            with_chip.push(chip);
+            let chipped = OccupancyGrid::with_levels(&with_chip, 32, levels);
+            assert!(grid == chipped, "{levels} levels");
+            assert_eq!(grid.gpu_words() == old, levels == 1, "{levels} levels");
+            grid.remove(&[chip]);
+            assert_eq!(grid.gpu_words(), old, "{levels} levels");
+            // the floor under the post stays set when the post leaves
+            grid.remove(&before);
+            let foot = grid.to_grid(Vec3::new(0.23, 0.01, 0.3), Vec3::ZERO);
+            assert!(grid.occupied(foot.floor().as_ivec3()), "{levels} levels");
+            grid.remove(&scene);
+            assert_eq!(grid.occupied_count(), 0, "{levels} levels");
+            let empty = OccupancyGrid::empty(at_once.bounds(), 32, levels);
+            assert!(grid == empty, "{levels} levels");
+        }
     }
 
     #[test]

@@ -1,14 +1,16 @@
 //! Prepare, the lights' side shared by every camera: per light view an RSM over the scene's
-//! triangles and the light quadtree over it, and the scene's occupancy grid.
+//! triangles and the light quadtree over it, and the scene's vertex buffer and occupancy grid.
 
-use crate::gi::scene::{IndirectLight, IndirectLightScene};
+use super::triangles::{SceneBuffer, SceneChanges, SceneMirror, SceneWork, update_grid};
+use crate::gi::cpu_time::CpuTimes;
+use crate::gi::scene::IndirectLight;
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use quadray_indirect::scene::Light;
 use quadray_indirect::shadows::occupancy::OccupancyGrid;
 use quadray_indirect::{GBufferLayout, LightQuadtree, RsmPass, Settings};
-use quadray_indirect::{LightView, ViewMaps, scene::bounds_of};
+use quadray_indirect::{LightView, ViewMaps};
 
 /// The lights' side, shared by every camera: an RSM over the scene's triangles and the light
 /// quadtree built over it per light view.
@@ -32,8 +34,10 @@ pub(super) struct LightPasses {
     pub(super) rsm_layout: GBufferLayout,
     /// The first camera's [`Settings::max_lights`], which `lights` was taken with.
     pub(super) max_lights: u32,
-    pub(super) vertices: Option<(wgpu::Buffer, u32)>,
-    pub(super) generation: u64,
+    /// The scene's triangles, a range an entity.
+    pub(super) scene: SceneBuffer,
+    /// The scene's bounds, which the lights' views frame.
+    pub(super) bounds: (Vec3, Vec3),
     pub(super) lights: Vec<Light>,
     /// The lights' RSM views, one a `views` entry.
     pub(super) light_views: Vec<LightView>,
@@ -42,7 +46,8 @@ pub(super) struct LightPasses {
     /// The scene's occupancy grid that indirect shadows walk, at the first camera's
     /// [`Settings::shadow_grid`] cells and [`Settings::shadow_grid_levels`] (none without
     /// indirect shadows, or at 0 cells: the gathers march the depth maps), and how many times
-    /// it was made.
+    /// it changed. Updated by the entities that changed; made anew over the scene's bounds
+    /// when one leaves the grid's.
     pub(super) occupancy: Option<OccupancyGrid>,
     pub(super) occupancy_cells: (u32, u32),
     pub(super) occupancy_generation: u64,
@@ -88,19 +93,22 @@ impl LightPasses {
 }
 
 pub(super) fn prepare_light(
-    scene: Option<Res<IndirectLightScene>>,
+    mut mirror: ResMut<SceneMirror>,
     cameras: Query<&IndirectLight, With<ExtractedCamera>>,
-    device: Res<RenderDevice>,
-    queue: Res<RenderQueue>,
+    (device, queue): (Res<RenderDevice>, Res<RenderQueue>),
     mut state: ResMut<LightState>,
+    mut work: ResMut<SceneWork>,
     mut warned: Local<Option<String>>,
+    times: Res<CpuTimes>,
 ) {
+    let _span = times.render();
+    // taken every frame: the lights' side made anew takes the whole scene
+    let changes = mirror.take_changes();
     let Some(camera) = cameras.iter().next() else {
         // no camera gathers: the lights' maps are freed, and made anew for the next one
         state.0 = None;
         return;
     };
-    let Some(scene) = scene else { return };
     let device = device.wgpu_device();
     let settings = &camera.settings;
     // the light's passes are sized by the settings: refuse what the gather would refuse
@@ -113,20 +121,31 @@ pub(super) fn prepare_light(
         state.0 = None;
         return;
     }
-    let l = state.0.get_or_insert_with(|| LightPasses {
-        views: Vec::new(),
-        maps_generation: 0,
-        rsm_size: 0,
-        rsm_layout: settings.gbuffer_layout,
-        max_lights: settings.max_lights,
-        vertices: None,
-        generation: u64::MAX,
-        lights: Vec::new(),
-        light_views: Vec::new(),
-        stale: true,
-        occupancy: None,
-        occupancy_cells: (0, 0),
-        occupancy_generation: 0,
+    let work = &mut *work;
+    let cells = if settings.indirect_shadows {
+        settings.shadow_grid
+    } else {
+        0
+    };
+    let levels = settings.shadow_grid_levels;
+    let mut made = false;
+    let l = state.0.get_or_insert_with(|| {
+        made = true;
+        LightPasses {
+            views: Vec::new(),
+            maps_generation: 0,
+            rsm_size: 0,
+            rsm_layout: settings.gbuffer_layout,
+            max_lights: settings.max_lights,
+            scene: SceneBuffer::new(device, &queue, &mirror, work),
+            bounds: mirror.bounds(),
+            lights: Vec::new(),
+            light_views: Vec::new(),
+            stale: true,
+            occupancy: None,
+            occupancy_cells: (0, 0),
+            occupancy_generation: 0,
+        }
     });
     let cluster = settings.cluster;
     for view in &mut l.views {
@@ -135,35 +154,45 @@ pub(super) fn prepare_light(
             l.stale = true;
         }
     }
-    let cells = if settings.indirect_shadows {
-        settings.shadow_grid
-    } else {
-        0
-    };
-    let levels = settings.shadow_grid_levels;
-    if l.generation != scene.generation || l.occupancy_cells != (cells, levels) {
-        // (rebuilt with every change of the scene: a few milliseconds for thousands of
-        // triangles at 64 cells)
-        l.occupancy =
-            (cells > 0).then(|| OccupancyGrid::with_levels(&scene.triangles, cells, levels));
+    let mut grid_current = l.occupancy_cells == (cells, levels) && !made;
+    match &changes {
+        SceneChanges::None => {}
+        SceneChanges::All => {
+            if !made {
+                l.scene = SceneBuffer::new(device, &queue, &mirror, work);
+            }
+            grid_current = false;
+        }
+        SceneChanges::Some(changed) => {
+            if !made && !l.scene.update(&queue, &mirror, changed, work) {
+                l.scene = SceneBuffer::new(device, &queue, &mirror, work);
+            }
+            if let Some(grid) = l.occupancy.as_mut().filter(|_| grid_current) {
+                grid_current = update_grid(grid, &mirror, changed, work);
+                l.occupancy_generation += 1;
+            }
+        }
+    }
+    if !matches!(changes, SceneChanges::None) {
+        // the RSMs are drawn anew; the maps' projections follow the scene's bounds
+        l.stale = true;
+        let bounds = mirror.bounds();
+        if bounds != l.bounds {
+            l.bounds = bounds;
+            l.lights.clear();
+        }
+    }
+    if !grid_current {
+        l.occupancy = (cells > 0).then(|| {
+            work.grids_made += 1;
+            let mut grid = OccupancyGrid::empty(mirror.bounds(), cells, levels);
+            grid.add(&mirror.triangles());
+            grid
+        });
         l.occupancy_cells = (cells, levels);
         l.occupancy_generation += 1;
     }
-    if l.generation != scene.generation {
-        l.generation = scene.generation;
-        l.vertices = (!scene.triangles.is_empty()).then(|| {
-            use wgpu::util::DeviceExt;
-            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("quadray gi triangles"),
-                contents: bytemuck::cast_slice(scene.triangles.as_slice()),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
-            (buffer, scene.triangles.len() as u32 * 3)
-        });
-        // the maps' projections follow the scene's bounds
-        l.lights.clear();
-    }
-    let lights: Vec<Light> = scene
+    let lights: Vec<Light> = mirror
         .lights
         .iter()
         .take(settings.max_lights as usize)
@@ -171,16 +200,9 @@ pub(super) fn prepare_light(
         .collect();
     let resized = l.rsm_size != settings.rsm_size || l.rsm_layout != settings.gbuffer_layout;
     if l.lights != lights || resized {
-        let bounds = bounds_of(
-            scene
-                .triangles
-                .iter()
-                .flatten()
-                .map(|v| glam::Vec3::from(v.position)),
-        );
         l.light_views = lights
             .iter()
-            .flat_map(|light| LightView::of_light(light, bounds))
+            .flat_map(|light| LightView::of_light(light, l.bounds))
             .collect();
         if l.views.len() != l.light_views.len() || resized {
             l.make_views(device, &queue, settings, l.light_views.len());

@@ -2,19 +2,23 @@
 //! G-buffer translated from Bevy's, quadray's gather, the additive composite into the view and,
 //! on request, the cut over the RSM drawn into the tone-mapped picture.
 //!
-//! By render phase, as Bevy's own features: `pipelines.rs` (made at startup), `light.rs` and
-//! `views.rs` (prepare: the lights' maps, each camera's passes) and `passes.rs` (the `Core3d`
-//! systems that record them).
+//! By render phase, as Bevy's own features: `pipelines.rs` (made at startup), `triangles.rs`
+//! (extract and prepare: the scene's triangles as the main world's updates change them, their
+//! vertex buffer and occupancy grid), `light.rs` and `views.rs` (prepare: the lights' maps,
+//! each camera's passes) and `passes.rs` (the `Core3d` systems that record them).
 
 mod light;
 mod passes;
 mod pipelines;
+mod triangles;
 pub(super) mod views;
 
 use light::{LightState, prepare_light};
 pub(super) use passes::camera_diagnostics;
 use passes::{cut_view_pass, indirect_light_pass};
 use pipelines::{GBUFFER_SHADER, init_pipelines};
+pub use triangles::SceneWork;
+use triangles::{SceneMirror, extract_scene};
 pub use views::ViewPasses;
 use views::{drop_unused_views, prepare_views};
 
@@ -22,7 +26,7 @@ use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::core_pipeline::tonemapping::tonemapping;
 use bevy::prelude::*;
-use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
+use bevy::render::{ExtractSchedule, Render, RenderApp, RenderStartup, RenderSystems};
 use bevy::shader::Shader;
 
 pub(super) fn build(app: &mut App) {
@@ -35,7 +39,10 @@ pub(super) fn build(app: &mut App) {
     };
     render_app
         .init_resource::<LightState>()
+        .init_resource::<SceneMirror>()
+        .init_resource::<SceneWork>()
         .add_systems(RenderStartup, init_pipelines)
+        .add_systems(ExtractSchedule, extract_scene)
         .add_systems(
             Render,
             (drop_unused_views, prepare_light, prepare_views)

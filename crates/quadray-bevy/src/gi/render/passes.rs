@@ -4,6 +4,7 @@
 use super::light::LightState;
 use super::pipelines::Pipelines;
 use super::views::{ViewPasses, cut_view_zoom};
+use crate::gi::cpu_time::CpuTimes;
 use crate::gi::scene::IndirectLight;
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::prelude::*;
@@ -30,13 +31,15 @@ pub(super) fn indirect_light_pass(
     pipelines: Res<Pipelines>,
     pipeline_cache: Res<PipelineCache>,
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    times: Res<CpuTimes>,
     mut ctx: RenderContext,
 ) {
+    let _span = times.render();
     let (passes, target, prepass, gi, camera) = view.into_inner();
     let Some(l) = light.0.as_mut().filter(|_| gi.enabled) else {
         return;
     };
-    let (Some((vertices, vertex_count)), Some(_)) = (&l.vertices, l.views.first()) else {
+    let (Some((vertices, vertex_count)), Some(_)) = (l.scene.vertices(), l.views.first()) else {
         return;
     };
     let Some(translate) = pipeline_cache.get_compute_pipeline(pipelines.gbuffer) else {
@@ -60,7 +63,7 @@ pub(super) fn indirect_light_pass(
         let span = diagnostics.time_span(encoder, "light");
         for view in &l.views {
             view.rsm
-                .record(encoder, vertices.slice(..), *vertex_count, None);
+                .record(encoder, vertices.slice(..), vertex_count, None);
             view.quadtree.record_build(encoder, None);
             view.quadtree.record_cut(encoder, None);
         }
@@ -132,8 +135,10 @@ pub(crate) fn camera_diagnostics(camera: Entity) -> String {
 pub(super) fn cut_view_pass(
     view: ViewQuery<(&ViewPasses, &ViewTarget, &IndirectLight)>,
     light: Res<LightState>,
+    times: Res<CpuTimes>,
     mut ctx: RenderContext,
 ) {
+    let _span = times.render();
     let (passes, target, gi) = view.into_inner();
     if !(gi.cut_view && gi.enabled) || light.0.as_ref().is_none_or(|l| l.views.is_empty()) {
         return;

@@ -3,6 +3,7 @@
 
 use super::light::{LightPasses, LightState};
 use super::pipelines::{Draw, Pipelines, VIEW_UNIFORM_BYTES, composite_pipeline};
+use crate::gi::cpu_time::CpuTimes;
 use crate::gi::scene::IndirectLight;
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::platform::collections::HashMap;
@@ -23,7 +24,12 @@ pub(super) type Unused = (
 /// Frees the passes of a camera that lost [`IndirectLight`] or is no longer rendered (inactive,
 /// or its target at zero size): Bevy keeps a render-world camera from frame to frame, and its
 /// passes with it. A despawned camera's go with its render-world entity.
-pub(super) fn drop_unused_views(mut commands: Commands, unused: Query<Entity, Unused>) {
+pub(super) fn drop_unused_views(
+    mut commands: Commands,
+    unused: Query<Entity, Unused>,
+    times: Res<CpuTimes>,
+) {
+    let _span = times.render();
     for entity in &unused {
         commands.entity(entity).remove::<ViewPasses>();
     }
@@ -253,11 +259,12 @@ pub(super) fn prepare_views(
     mut commands: Commands,
     mut views: Views,
     light: Res<LightState>,
-    device: Res<RenderDevice>,
-    queue: Res<RenderQueue>,
+    (device, queue): (Res<RenderDevice>, Res<RenderQueue>),
     mut pipelines: ResMut<Pipelines>,
     mut warned: Local<HashMap<Entity, String>>,
+    times: Res<CpuTimes>,
 ) {
+    let _span = times.render();
     // (a camera that comes back after it went away warns again)
     warned.retain(|entity, _| views.contains(*entity));
     let Some(l) = light.0.as_ref() else { return };

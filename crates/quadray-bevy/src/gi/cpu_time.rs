@@ -1,0 +1,69 @@
+//! The plugin's CPU time in each world, reported to Bevy's `DiagnosticsStore` as
+//! [`MAIN_WORLD_CPU`] and [`RENDER_WORLD_CPU`]: what its systems cost a frame besides the GPU's
+//! passes.
+
+use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics, RegisterDiagnostic};
+use bevy::prelude::*;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// Milliseconds a frame in the plugin's main-world systems (gathering the scene's triangles and
+/// lights).
+pub const MAIN_WORLD_CPU: DiagnosticPath = DiagnosticPath::const_new("quadray_gi/main_world_cpu");
+
+/// Milliseconds a frame in the plugin's render-world systems (extracting the scene, updating
+/// its vertex buffer and occupancy grid, preparing and recording the passes); the render
+/// world's frame as the main world's next one reports it.
+pub const RENDER_WORLD_CPU: DiagnosticPath =
+    DiagnosticPath::const_new("quadray_gi/render_world_cpu");
+
+/// Nanoseconds spent in the plugin's systems since the last report, main world then render
+/// world; one resource shared by both worlds.
+#[derive(Resource, Clone, Default)]
+pub(crate) struct CpuTimes(Arc<[AtomicU64; 2]>);
+
+/// Adds the time from its making to its drop to one world's total.
+pub(crate) struct Span<'a>(&'a AtomicU64, Instant);
+
+impl Drop for Span<'_> {
+    fn drop(&mut self) {
+        let nanos = u64::try_from(self.1.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.0.fetch_add(nanos, Ordering::Relaxed);
+    }
+}
+
+impl CpuTimes {
+    /// Times a main-world system until the span is dropped.
+    pub(crate) fn main(&self) -> Span<'_> {
+        Span(&self.0[0], Instant::now())
+    }
+
+    /// Times a render-world system until the span is dropped.
+    pub(crate) fn render(&self) -> Span<'_> {
+        Span(&self.0[1], Instant::now())
+    }
+}
+
+/// Shares the times with the render world and registers the diagnostics.
+pub(super) fn build(app: &mut App) {
+    let times = CpuTimes::default();
+    app.insert_resource(times.clone())
+        .register_diagnostic(Diagnostic::new(MAIN_WORLD_CPU).with_suffix("ms"))
+        .register_diagnostic(Diagnostic::new(RENDER_WORLD_CPU).with_suffix("ms"))
+        .add_systems(Last, report);
+    if let Some(render_app) = app.get_sub_app_mut(bevy::render::RenderApp) {
+        render_app.insert_resource(times);
+    }
+}
+
+/// Reports the times since the last report, in milliseconds.
+fn report(times: Res<CpuTimes>, mut diagnostics: Diagnostics) {
+    for (path, total) in [
+        (&MAIN_WORLD_CPU, &times.0[0]),
+        (&RENDER_WORLD_CPU, &times.0[1]),
+    ] {
+        let nanos = total.swap(0, Ordering::Relaxed);
+        diagnostics.add_measurement(path, || nanos as f64 * 1e-6);
+    }
+}

@@ -1,0 +1,230 @@
+//! The indirect-light plugin's scene as a Bevy app changes it, headless on lavapipe: a few
+//! meshes on a floor under a spot, a 32x32 camera with indirect shadows. A still frame costs no
+//! scene work in either world; a moved mesh makes its own triangles anew, writes them alone to
+//! the vertex buffer and moves them alone in the occupancy grid, and the scene equals a fresh
+//! app's gather of the new places.
+
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::pbr::DefaultOpaqueRendererMethod;
+use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::{Render, RenderApp, RenderSystems};
+use quadray_bevy::gi::{
+    IndirectLight, IndirectLightPlugin, IndirectLightScene, IndirectLightSource, SceneWork,
+};
+use quadray_indirect::Settings;
+use quadray_indirect::scene::Vertex;
+use std::sync::{Arc, Mutex};
+
+/// The render world's [`SceneWork`] at the end of its last frame (the render world runs on its
+/// own thread).
+#[derive(Resource, Clone, Default)]
+struct RenderedWork(Arc<Mutex<SceneWork>>);
+
+fn note_work(work: Res<SceneWork>, noted: Res<RenderedWork>) {
+    *noted.0.lock().unwrap() = *work;
+}
+
+/// The meshes' places: a floor, three boxes and a ball on it.
+fn places() -> [Transform; 5] {
+    [
+        Transform::default(),
+        Transform::from_xyz(-1.0, 0.25, 0.0),
+        Transform::from_xyz(0.0, 0.25, -1.0),
+        Transform::from_xyz(1.0, 0.25, 0.5),
+        Transform::from_xyz(0.3, 0.3, 0.6),
+    ]
+}
+
+/// The box that moves, among [`places`].
+const MOVED: usize = 2;
+
+/// An app with the meshes at `places` (with a camera gathering when `camera`), and the entities.
+fn app(places: [Transform; 5], camera: bool) -> (App, Vec<Entity>) {
+    let mut app = crate::common::headless_app(|app| {
+        app.insert_resource(DefaultOpaqueRendererMethod::deferred())
+            .add_plugins(IndirectLightPlugin);
+        let work = RenderedWork::default();
+        app.insert_resource(work.clone());
+        app.sub_app_mut(RenderApp)
+            .insert_resource(work)
+            .add_systems(Render, note_work.in_set(RenderSystems::Cleanup));
+    });
+    let world = app.world_mut();
+    let (floor, cube, ball) = {
+        let mut meshes = world.resource_mut::<Assets<Mesh>>();
+        (
+            meshes.add(Plane3d::new(Vec3::Y, Vec2::splat(2.0))),
+            meshes.add(Cuboid::new(0.5, 0.5, 0.5)),
+            meshes.add(Sphere::new(0.3).mesh().ico(1).unwrap()),
+        )
+    };
+    let grey = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(Color::srgb(0.7, 0.7, 0.7));
+    let mesh_of = [floor, cube.clone(), cube.clone(), cube, ball];
+    let entities = mesh_of
+        .into_iter()
+        .zip(places)
+        .map(|(mesh, place)| {
+            world
+                .spawn((Mesh3d(mesh), MeshMaterial3d(grey.clone()), place))
+                .id()
+        })
+        .collect();
+    world.spawn((
+        SpotLight {
+            intensity: 1.0e5,
+            outer_angle: 0.8,
+            ..default()
+        },
+        IndirectLightSource,
+        Transform::from_xyz(0.0, 3.0, 0.0).looking_at(Vec3::ZERO, Vec3::Z),
+    ));
+    if camera {
+        let target = world
+            .resource_mut::<Assets<Image>>()
+            .add(Image::new_target_texture(
+                32,
+                32,
+                TextureFormat::Rgba8UnormSrgb,
+                None,
+            ));
+        world.spawn((
+            Camera3d::default(),
+            Transform::from_xyz(0.0, 2.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
+            RenderTarget::Image(target.into()),
+            Tonemapping::None,
+            Msaa::Off,
+            IndirectLight {
+                settings: Settings {
+                    indirect_shadows: true,
+                    shadow_grid: 16,
+                    ..Settings::sized(32, 32, 32)
+                },
+                ..default()
+            },
+        ));
+    }
+    (app, entities)
+}
+
+fn work(app: &App) -> SceneWork {
+    *app.world().resource::<RenderedWork>().0.lock().unwrap()
+}
+
+fn scene(app: &App) -> &IndirectLightScene {
+    app.world().resource::<IndirectLightScene>()
+}
+
+/// The scene's triangles, sorted (two apps' entities need not be the same).
+fn sorted_triangles(app: &App) -> Vec<[u32; 27]> {
+    let mut t: Vec<[u32; 27]> = scene(app)
+        .triangles()
+        .map(|t| bytemuck::cast::<[Vertex; 3], [u32; 27]>(*t))
+        .collect();
+    t.sort_unstable();
+    t
+}
+
+/// Updates `app` until its scene has not changed for three frames (and the render world has
+/// seen the last change).
+fn settle(app: &mut App) {
+    let mut still = 0;
+    for _ in 0..50 {
+        let generation = scene(app).generation();
+        app.update();
+        still = if scene(app).generation() == generation && generation > 0 {
+            still + 1
+        } else {
+            0
+        };
+        if still == 3 {
+            return;
+        }
+    }
+    panic!("the scene still changed after 50 frames");
+}
+
+/// Updates `app` a few frames: the render world's last one is done.
+fn frames(app: &mut App, n: u32) {
+    for _ in 0..n {
+        app.update();
+    }
+}
+
+#[test]
+fn a_moved_mesh_alone_is_made_anew_and_the_scene_equals_a_fresh_gather() {
+    let (mut app, entities) = app(places(), true);
+    // until the assets' first events have been read (an entity's triangles may be made again
+    // then) and the render world has taken the scene
+    settle(&mut app);
+    let first = work(&app);
+    assert_eq!(
+        (first.buffers_made, first.grids_made),
+        (1, 1),
+        "the render world took the scene: {first:?}"
+    );
+    let total = scene(&app).triangle_count() as u64;
+    assert!(first.triangles_written >= total, "{first:?}");
+    let (generation, made) = (scene(&app).generation(), scene(&app).triangles_made());
+
+    // still: no scene work in either world
+    frames(&mut app, 3);
+    assert_eq!(scene(&app).generation(), generation, "still");
+    assert_eq!(scene(&app).triangles_made(), made, "still");
+    assert_eq!(work(&app), first, "still");
+
+    // one box moves within the scene's bounds
+    let moved = entities[MOVED];
+    let box_triangles = scene(&app)
+        .objects()
+        .find(|(e, _)| *e == moved)
+        .map(|(_, o)| o.triangles().len() as u64)
+        .unwrap();
+    assert!(box_triangles * 4 < total, "a small part of the scene");
+    let mut place = places();
+    place[MOVED].translation = Vec3::new(-0.4, 0.25, 1.2);
+    *app.world_mut().get_mut::<Transform>(moved).unwrap() = place[MOVED];
+    frames(&mut app, 3);
+    assert_eq!(scene(&app).generation(), generation + 1);
+    assert_eq!(scene(&app).triangles_made(), made + box_triangles);
+    let after = work(&app);
+    assert_eq!(
+        after,
+        SceneWork {
+            triangles_written: first.triangles_written + box_triangles,
+            grid_triangles: first.grid_triangles + 2 * box_triangles,
+            ..first
+        },
+        "its triangles written, out of the grid and in again"
+    );
+    let (fresh, _) = app_fresh(place);
+    assert_eq!(sorted_triangles(&app), sorted_triangles(&fresh));
+
+    // out of the grid's bounds: the grid is made anew; despawned: its range is freed
+    *app.world_mut().get_mut::<Transform>(moved).unwrap() = Transform::from_xyz(0.0, 3.5, 0.0);
+    frames(&mut app, 3);
+    assert_eq!(work(&app).grids_made, 2, "{:?}", work(&app));
+    app.world_mut().despawn(moved);
+    frames(&mut app, 3);
+    assert_eq!(
+        scene(&app).triangle_count() as u64,
+        total - box_triangles,
+        "despawned"
+    );
+    let gone = work(&app);
+    assert_eq!(
+        gone.triangles_written,
+        after.triangles_written + box_triangles
+    );
+    assert_eq!(gone.buffers_made, 1);
+}
+
+/// A fresh app with the meshes at `places` from the start, gathered (the main world alone).
+fn app_fresh(places: [Transform; 5]) -> (App, Vec<Entity>) {
+    let (mut app, entities) = app(places, false);
+    settle(&mut app);
+    (app, entities)
+}
