@@ -119,10 +119,10 @@ fn scene(app: &App) -> &IndirectLightScene {
 }
 
 /// The scene's triangles, sorted (two apps' entities need not be the same).
-fn sorted_triangles(app: &App) -> Vec<[u32; 27]> {
-    let mut t: Vec<[u32; 27]> = scene(app)
+fn sorted_triangles(app: &App) -> Vec<Vec<u32>> {
+    let mut t: Vec<Vec<u32>> = scene(app)
         .triangles()
-        .map(|t| bytemuck::cast::<[Vertex; 3], [u32; 27]>(*t))
+        .map(|t| bytemuck::cast_slice::<Vertex, u32>(t).to_vec())
         .collect();
     t.sort_unstable();
     t
