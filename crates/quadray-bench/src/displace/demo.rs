@@ -2,7 +2,7 @@
 //! by side with the error heat maps of the searches; self-shadowing; LOD levels (figure 18).
 
 use quadray_core::image_out::{Rgba8Image, montage};
-use quadray_displace::accuracy::{Accuracy, Cost};
+use quadray_displace::accuracy::{Accuracy, Cost, GroundTruth};
 use quadray_displace::maps::BUNDLED;
 use quadray_displace::reference::Surface;
 use quadray_displace::scene::SurfaceKind;
@@ -40,10 +40,19 @@ pub fn render_demo(
             });
             let mut tiles: Vec<(String, Rgba8Image)> = Vec::new();
             let mut heat: Vec<(String, Rgba8Image)> = Vec::new();
+            // each truth surface traced once a view, for every method that searches it
+            let mut truths: Vec<(Surface, GroundTruth)> = Vec::new();
             for s in &methods {
                 let frame = renderer.render(gpu, s)?;
                 if let Some(truth) = searched_truth(s.method) {
-                    let acc = Accuracy::measure(&frame, &map, bundled.surface, s, truth);
+                    let traced = match truths.iter().position(|(t, _)| *t == truth) {
+                        Some(i) => &truths[i].1,
+                        None => {
+                            let traced = GroundTruth::trace(&map, bundled.surface, s, truth);
+                            &truths.push_mut((truth, traced)).1
+                        }
+                    };
+                    let acc = traced.measure(&frame);
                     heat.push((
                         format!("{} err {:.1}%", s.caption(), acc.wrong_hit_fraction * 100.0),
                         acc.heat_map(),
