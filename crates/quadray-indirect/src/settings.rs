@@ -792,10 +792,11 @@ shader_struct! {
         /// Indirect shadows: points marched between a receiver and a cluster (0: none).
         shadow_steps: u32 = s.march_steps(),
         /// The one cut's indirect shadows from corner receivers every `shadow_corners` pixels
-        /// (0: each pixel walks), `corners_x` of them in a row, each keeping `corner_words`
-        /// words of visibility bits (shadows/corners.wgsl).
+        /// (0: each pixel walks), `corners_x` of them in a row and `corners_y` rows, each keeping
+        /// `corner_words` words of visibility bits (shadows/corners.wgsl).
         shadow_corners: u32 = s.shadow_corners_or_off(),
         corners_x: u32 = s.shadow_corner_grid().0,
+        corners_y: u32 = s.shadow_corner_grid().1,
         corner_words: u32 = s.shadow_corner_words(),
         /// Weight of this frame in the running average of the indirect light (1: no filter).
         temporal_weight: f32 = s.temporal_weight,

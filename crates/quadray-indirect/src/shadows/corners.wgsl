@@ -118,10 +118,9 @@ fn corner_patch(r: Receiver) -> bool {
     let size = vec2<f32>(f32(viewer.width), f32(viewer.height));
     let uv = vec2<f32>(c.x / c.w * 0.5 + 0.5, 0.5 - c.y / c.w * 0.5);
     let pixel = vec2<u32>(clamp(uv * size, vec2<f32>(0.0), size - 1.0));
-    let k = shade.shadow_corners;
-    let rows = (viewer.height - 1u + k - 1u) / k + 1u;
-    let lo = min(pixel / k, vec2<u32>(shade.corners_x - 1u, rows - 1u));
-    let hi = min(lo + 1u, vec2<u32>(shade.corners_x - 1u, rows - 1u));
+    let last = vec2<u32>(shade.corners_x, shade.corners_y) - 1u;
+    let lo = min(pixel / shade.shadow_corners, last);
+    let hi = min(lo + 1u, last);
     let p0 = vec2<f32>(corner_pixel(lo));
     let span = max(vec2<f32>(corner_pixel(hi)) - p0, vec2<f32>(1.0));
     let t = clamp((vec2<f32>(pixel) - p0) / span, vec2<f32>(0.0), vec2<f32>(1.0));
