@@ -175,8 +175,10 @@ impl Gather {
     }
 
     /// Walks the scene's occupancy `grid` for indirect shadows from now on, instead of marching
-    /// the camera's and the light's depth maps (a gather starts without one); the frame's bind
-    /// group is made anew, hence the G-buffer's views.
+    /// the camera's and the light's depth maps (a gather starts without one). A grid updated
+    /// since the last ([`OccupancyGrid::add`], [`OccupancyGrid::remove`]) is uploaded in the
+    /// rows of its words that changed; where it outgrew its texture, the frame's bind group is
+    /// made anew, hence the G-buffer's views.
     pub fn set_occupancy(
         &mut self,
         device: &wgpu::Device,

@@ -62,9 +62,8 @@ pub(crate) struct Outputs {
     pub counts: wgpu::Buffer,
     /// The temporal filter's running average of the indirect light (one texel without it).
     pub history: wgpu::Buffer,
-    /// The scene's occupancy grid for indirect shadows ([`OccupancyGrid::gpu_words`], in rows
-    /// of [`OCCUPANCY_ROW`] texels; zero dimensions until one is set).
-    occupancy: wgpu::TextureView,
+    /// The scene's occupancy grid for indirect shadows ([`OccupancyGrid::gpu_words`]).
+    occupancy: OccupancyTexture,
 }
 
 impl Outputs {
@@ -120,7 +119,7 @@ impl Outputs {
                     0
                 },
             ),
-            occupancy: occupancy_texture(device, None),
+            occupancy: OccupancyTexture::new(device, 0),
         }
     }
 
@@ -147,49 +146,104 @@ impl Outputs {
                 whole(&self.samples),
                 whole(&self.counts),
                 whole(&self.history),
-                tex(&self.occupancy),
+                tex(&self.occupancy.view),
             ],
         )
     }
 }
 
-/// An R32Uint texture of `rows` x [`OCCUPANCY_ROW`] texels for an occupancy grid's words: zeros
-/// (no grid) without `words`, else the words and zeros after the last.
-fn occupancy_texture(
-    device: &wgpu::Device,
-    words: Option<(&wgpu::Queue, &[u32])>,
-) -> wgpu::TextureView {
-    let len = words.map_or(1, |(_, w)| w.len() as u32);
-    let rows = len.div_ceil(OCCUPANCY_ROW);
-    let descriptor = wgpu::TextureDescriptor {
-        label: Some("occupancy grid"),
-        size: wgpu::Extent3d {
-            width: OCCUPANCY_ROW,
-            height: rows,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Uint,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    };
-    let texture = match words {
-        // wgpu clears a new texture: zero dimensions
-        None => device.create_texture(&descriptor),
-        Some((queue, words)) => {
-            let mut texels = words.to_vec();
-            texels.resize((rows * OCCUPANCY_ROW) as usize, 0);
-            device.create_texture_with_data(
-                queue,
-                &descriptor,
-                wgpu::util::TextureDataOrder::LayerMajor,
-                bytemuck::cast_slice(&texels),
-            )
+/// The occupancy grid's words as the gather reads them: an R32Uint texture of rows of
+/// [`OCCUPANCY_ROW`] texels (zero dimensions until a grid is set), and a copy of what it holds,
+/// so that a grid updated by what moved is written in the rows that changed, not whole.
+pub(crate) struct OccupancyTexture {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    /// The texture's texels (zeros after the grid's last word).
+    held: Vec<u32>,
+}
+
+impl OccupancyTexture {
+    /// A texture of `rows` rows of zeros.
+    fn new(device: &wgpu::Device, rows: u32) -> Self {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("occupancy grid"),
+            size: wgpu::Extent3d {
+                width: OCCUPANCY_ROW,
+                height: rows.max(1),
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Uint,
+            // (read back by the tests)
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        // (wgpu clears a new texture)
+        Self {
+            view: texture.create_view(&Default::default()),
+            held: vec![0; (rows.max(1) * OCCUPANCY_ROW) as usize],
+            texture,
         }
-    };
-    texture.create_view(&Default::default())
+    }
+
+    /// Holds `words` from now on: writes the rows from the first changed word to the last, in
+    /// the texture there is, or makes a larger one (with an eighth more rows, for the grid to
+    /// grow into); whether it made one (the frame's group is then to be made anew).
+    fn write(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, words: &[u32]) -> bool {
+        let row = OCCUPANCY_ROW as usize;
+        let made = words.len() > self.held.len();
+        if made {
+            let rows = words.len().div_ceil(row) as u32;
+            *self = Self::new(device, rows + rows / 8);
+        }
+        let changed = |(i, (a, b)): (usize, (&u32, &u32))| (a != b).then_some(i);
+        let tail = std::iter::repeat(&0);
+        let mut differences = words
+            .iter()
+            .chain(tail)
+            .zip(&self.held)
+            .enumerate()
+            .filter_map(changed);
+        let Some(first) = differences.next() else {
+            return made;
+        };
+        let last = differences.last().unwrap_or(first);
+        let (first_row, end_row) = (first / row, last / row + 1);
+        for (i, held) in self.held[first_row * row..end_row * row]
+            .iter_mut()
+            .enumerate()
+        {
+            *held = words.get(first_row * row + i).copied().unwrap_or(0);
+        }
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: first_row as u32,
+                    z: 0,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&self.held[first_row * row..end_row * row]),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(OCCUPANCY_ROW * 4),
+                rows_per_image: None,
+            },
+            wgpu::Extent3d {
+                width: OCCUPANCY_ROW,
+                height: (end_row - first_row) as u32,
+                depth_or_array_layers: 1,
+            },
+        );
+        made
+    }
 }
 
 /// One light view's maps as the gather reads them: its RSM and the light quadtree built from it.
@@ -360,8 +414,9 @@ impl Resources {
             .frame_group(device, &self.frame_layout, gbuffer);
     }
 
-    /// Walks `grid` for indirect shadows from now on (the frame's group is made anew, with the
-    /// G-buffer's views).
+    /// Walks `grid` for indirect shadows from now on: the rows of its words that changed
+    /// since the last grid are written (the frame's group is made anew, with the G-buffer's
+    /// views, only where the grid outgrew its texture).
     pub fn set_occupancy(
         &mut self,
         device: &wgpu::Device,
@@ -369,9 +424,13 @@ impl Resources {
         grid: &OccupancyGrid,
         gbuffer: GBufferViews,
     ) {
-        let words = grid.gpu_words();
-        self.outputs.occupancy = occupancy_texture(device, Some((queue, &words)));
-        self.bind_gbuffer(device, gbuffer);
+        if self
+            .outputs
+            .occupancy
+            .write(device, queue, &grid.gpu_words())
+        {
+            self.bind_gbuffer(device, gbuffer);
+        }
     }
 
     /// Writes the light views and the gather's terms of them (the kernel's clamp `r_min`, world
@@ -496,4 +555,41 @@ fn light_group(
             whole(quadtree.bounds()),
         ],
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The texture's texels as words.
+    fn texels(gpu: &quadray_gpu::Gpu, occupancy: &OccupancyTexture) -> Vec<u32> {
+        let read = quadray_gpu::read_texture_f32(gpu, &occupancy.texture, 0, 1);
+        bytemuck::cast_slice(&read.expect("read back")).to_vec()
+    }
+
+    #[test]
+    fn a_grid_written_in_its_changed_rows_reads_as_one_written_whole() {
+        let gpu = quadray_gpu::Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let row = OCCUPANCY_ROW as usize;
+        let first: Vec<u32> = (1..=5 * row as u32 / 2).collect();
+        let mut occupancy = OccupancyTexture::new(d, 0);
+        assert!(
+            occupancy.write(d, q, &first),
+            "a grid larger than the texture"
+        );
+        // two words changed a row apart, and the last half row gone: rows 1 to 2 written
+        let mut shorter = first[..2 * row + 50].to_vec();
+        shorter[row + 3] = 0xdead;
+        shorter[2 * row + 7] = 0xbeef;
+        // and then one that outgrows the texture
+        let rows = occupancy.held.len() / row;
+        let longer: Vec<u32> = (0..(rows * row + 3) as u32).map(|i| i * 7).collect();
+        for (words, made) in [(&shorter, false), (&first, false), (&longer, true)] {
+            assert_eq!(occupancy.write(d, q, words), made);
+            let mut expected = words.clone();
+            expected.resize(occupancy.held.len(), 0);
+            assert_eq!(texels(&gpu, &occupancy), expected);
+        }
+    }
 }

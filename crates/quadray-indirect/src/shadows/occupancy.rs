@@ -12,6 +12,7 @@
 
 use crate::scene::Vertex;
 use glam::{IVec3, UVec3, Vec3};
+use std::cell::OnceCell;
 use std::collections::HashMap;
 
 /// Cells a segment's ends are moved off their surfaces along the normals: past every cell a
@@ -460,6 +461,7 @@ impl OccupancyGrid {
         if !t.iter().all(|v| v.is_finite()) {
             return;
         }
+        let test = TriangleBoxTest::new(t);
         let lo = t[0].min(t[1]).min(t[2]).floor().as_ivec3().max(IVec3::ZERO);
         let hi = t[0]
             .max(t[1])
@@ -473,7 +475,7 @@ impl OccupancyGrid {
                     let c = IVec3::new(x, y, z);
                     // the box [i - 1e-5, i + 1 - 1e-4]: a plane at i is in, one at i + 1 out
                     let centre = c.as_vec3() + Vec3::splat(0.5 - 5.5e-5);
-                    if !triangle_overlaps_box(t, centre, Vec3::splat(0.5 - 4.5e-5)) {
+                    if !test.overlaps(centre, Vec3::splat(0.5 - 4.5e-5)) {
                         continue;
                     }
                     let (word, bit) = self.index(c).expect("clamped to the grid");
@@ -486,7 +488,7 @@ impl OccupancyGrid {
                         }
                         Counts::SubCells(counts) => {
                             let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
-                            let changed = count_subcells(t, c, cell, added);
+                            let changed = count_subcells(t, &test, c, cell, added);
                             // no sub-cell set or cleared: the cell is as it was
                             let set = match changed {
                                 true => cell.iter().any(|&n| n > 0),
@@ -519,7 +521,13 @@ fn step(count: u32, added: bool) -> u32 {
 
 /// Counts the triangle (in grid units) in or out of the sub-cells of cell `c` it overlaps;
 /// whether a sub-cell was set or cleared.
-fn count_subcells(t: [Vec3; 3], c: IVec3, cell: &mut [u32; SUBCELL_COUNT], added: bool) -> bool {
+fn count_subcells(
+    t: [Vec3; 3],
+    test: &TriangleBoxTest,
+    c: IVec3,
+    cell: &mut [u32; SUBCELL_COUNT],
+    added: bool,
+) -> bool {
     let k = SUBCELLS as f32;
     let first = c * SUBCELLS as i32;
     let lo = (t[0].min(t[1]).min(t[2]) * k).floor().as_ivec3().max(first);
@@ -536,7 +544,7 @@ fn count_subcells(t: [Vec3; 3], c: IVec3, cell: &mut [u32; SUBCELL_COUNT], added
                 // sub-cells at the cell's faces end where the cell's box does
                 let low = s.as_vec3() / k - Vec3::splat(1e-5);
                 let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
-                if triangle_overlaps_box(t, (low + high) * 0.5, (high - low) * 0.5) {
+                if test.overlaps((low + high) * 0.5, (high - low) * 0.5) {
                     let (w, b) = sub_bit(sub_cell(s));
                     let count = &mut cell[w * 32 + b as usize];
                     let was = *count > 0;
@@ -715,31 +723,77 @@ const BRICK_SHIFT: UVec3 = UVec3::new(
     BRICK.z.trailing_zeros() + SUBCELLS.trailing_zeros(),
 );
 
-/// Whether triangle `t` overlaps the box of `centre` and `half` extents (the separating-axis
-/// test of Akenine-Möller: the box's axes, the triangle's normal, and the nine cross products
-/// of their edges).
-fn triangle_overlaps_box(t: [Vec3; 3], centre: Vec3, half: Vec3) -> bool {
-    let v = t.map(|p| p - centre);
-    let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
-    let separates = |axis: Vec3| {
-        if axis.length_squared() < 1e-12 {
+/// A triangle's separating-axis test against boxes (Akenine-Möller's: the box's axes, the
+/// triangle's normal, and the nine cross products of their edges), its axes and the triangle's
+/// extent along each found once for all the cells and sub-cells it is tested against. Lengths
+/// are taken from its first vertex, so that rounding follows the box's distance from the
+/// triangle, not the grid's coordinates.
+struct TriangleBoxTest {
+    origin: Vec3,
+    /// The triangle's vertices from `origin`, and their bounds.
+    vertices: [Vec3; 3],
+    lo: Vec3,
+    hi: Vec3,
+    /// The normal and the edges' nine axes (a zero one separates nothing), each with the
+    /// triangle's least and greatest projection; made only where a box needs them.
+    axes: OnceCell<[(Vec3, f32, f32); 10]>,
+}
+
+impl TriangleBoxTest {
+    fn new(t: [Vec3; 3]) -> Self {
+        let origin = t[0];
+        let v = t.map(|p| p - origin);
+        Self {
+            origin,
+            vertices: v,
+            lo: v[0].min(v[1]).min(v[2]),
+            hi: v[0].max(v[1]).max(v[2]),
+            axes: OnceCell::new(),
+        }
+    }
+
+    /// The normal and the edges' nine axes, made at the first box the bounds do not decide.
+    fn axes(&self) -> &[(Vec3, f32, f32); 10] {
+        self.axes.get_or_init(|| {
+            let v = self.vertices;
+            let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+            let mut axes = [(Vec3::ZERO, 0.0, 0.0); 10];
+            let directions = std::iter::once(edges[0].cross(edges[1])).chain(
+                edges
+                    .into_iter()
+                    .flat_map(|e| [Vec3::X.cross(e), Vec3::Y.cross(e), Vec3::Z.cross(e)]),
+            );
+            for (slot, axis) in axes.iter_mut().zip(directions) {
+                if axis.length_squared() >= 1e-12 {
+                    let p = v.map(|v| v.dot(axis));
+                    *slot = (axis, p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+                }
+            }
+            axes
+        })
+    }
+
+    /// Whether the triangle overlaps the box of `centre` and `half` extents.
+    fn overlaps(&self, centre: Vec3, half: Vec3) -> bool {
+        let d = centre - self.origin;
+        // the box's axes: the triangle's bounds
+        let (lo, hi) = (self.lo - d, self.hi - d);
+        if lo.cmpgt(half).any() || hi.cmplt(-half).any() {
             return false;
         }
-        let p = v.map(|p| p.dot(axis));
-        let r = half.dot(axis.abs());
-        p[0].min(p[1]).min(p[2]) > r || p[0].max(p[1]).max(p[2]) < -r
-    };
-    for e in edges {
-        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
-            if separates(axis.cross(e)) {
-                return false;
-            }
+        // a triangle well inside the box overlaps it whatever the other axes say (most of a
+        // small triangle's cells and sub-cells)
+        let inner = half * (1.0 - 1e-5);
+        if lo.cmpgt(-inner).all() && hi.cmplt(inner).all() {
+            return true;
         }
+        // the normal first: most boxes of the triangle's bounds lie off its plane
+        self.axes().iter().all(|&(axis, least, most)| {
+            let c = d.dot(axis);
+            let r = half.dot(axis.abs());
+            !(least - c > r || most - c < -r)
+        })
     }
-    if [Vec3::X, Vec3::Y, Vec3::Z].into_iter().any(separates) {
-        return false;
-    }
-    !separates(edges[0].cross(edges[1]))
 }
 
 #[cfg(test)]

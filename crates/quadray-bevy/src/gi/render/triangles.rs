@@ -265,8 +265,8 @@ impl SceneBuffer {
     }
 }
 
-/// Brings the occupancy grid up to the changed entities: their triangles before out, theirs
-/// now in; `false` where one now lies outside the grid's bounds (the grid is to be made anew).
+/// Brings the occupancy grid up to the changed entities: their triangles now in, theirs
+/// before out; `false` where one now lies outside the grid's bounds (the grid is to be made anew).
 pub(super) fn update_grid(
     grid: &mut OccupancyGrid,
     mirror: &SceneMirror,
@@ -279,14 +279,16 @@ pub(super) fn update_grid(
     if !changed.keys().filter_map(now).all(inside) {
         return false;
     }
+    // in before out: the cells an object covers before and after keep a triangle throughout,
+    // so they are not cleared and set again
     for (entity, before) in changed {
-        if let Some(before) = before {
-            grid.remove(before.triangles());
-            work.grid_triangles += before.triangles().len() as u64;
-        }
         if let Some(now) = now(entity) {
             grid.add(now.triangles());
             work.grid_triangles += now.triangles().len() as u64;
+        }
+        if let Some(before) = before {
+            grid.remove(before.triangles());
+            work.grid_triangles += before.triangles().len() as u64;
         }
     }
     true
