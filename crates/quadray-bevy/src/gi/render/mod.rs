@@ -2,7 +2,7 @@
 //! G-buffer translated from Bevy's, quadray's gather, the additive composite into the view and,
 //! on request, the cut over the RSM drawn into the tone-mapped picture.
 //!
-//! By render phase, as Bevy's own features: `pipelines.rs` (made at startup), `triangles.rs`
+//! By render phase, as Bevy's own features: `pipelines.rs` (Bevy's pipeline cache), `triangles.rs`
 //! (extract and prepare: the scene's triangles as the main world's updates change them, their
 //! vertex buffer and occupancy grid), `light.rs` and `views.rs` (prepare: the lights' maps,
 //! each camera's passes) and `passes.rs` (the `Core3d` systems that record them).
@@ -16,7 +16,9 @@ pub(super) mod views;
 use light::{LightState, prepare_light};
 pub(super) use passes::camera_diagnostics;
 use passes::{cut_view_pass, indirect_light_pass};
-use pipelines::{GBUFFER_SHADER, init_pipelines};
+use pipelines::{
+    COMPOSITE_SHADER, COUNTS_SHADER, GBUFFER_SHADER, Pipelines, composite_source, init_pipelines,
+};
 pub use triangles::SceneWork;
 use triangles::{SceneMirror, extract_scene};
 pub use views::ViewPasses;
@@ -26,13 +28,23 @@ use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::core_pipeline::tonemapping::tonemapping;
 use bevy::prelude::*;
+use bevy::render::render_resource::SpecializedRenderPipelines;
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderStartup, RenderSystems};
 use bevy::shader::Shader;
 
 pub(super) fn build(app: &mut App) {
-    let _ = app.world_mut().resource_mut::<Assets<Shader>>().insert(
+    let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
+    let _ = shaders.insert(
         &GBUFFER_SHADER,
         Shader::from_wgsl(include_str!("gbuffer.wgsl"), "quadray/gi_gbuffer.wgsl"),
+    );
+    let _ = shaders.insert(
+        &COMPOSITE_SHADER,
+        Shader::from_wgsl(composite_source(), "quadray/gi_composite.wgsl"),
+    );
+    let _ = shaders.insert(
+        &COUNTS_SHADER,
+        Shader::from_wgsl(include_str!("counts.wgsl"), "quadray/gi_counts.wgsl"),
     );
     let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
         return;
@@ -41,6 +53,7 @@ pub(super) fn build(app: &mut App) {
         .init_resource::<LightState>()
         .init_resource::<SceneMirror>()
         .init_resource::<SceneWork>()
+        .init_resource::<SpecializedRenderPipelines<Pipelines>>()
         .add_systems(RenderStartup, init_pipelines)
         .add_systems(ExtractSchedule, extract_scene)
         .add_systems(

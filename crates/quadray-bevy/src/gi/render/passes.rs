@@ -88,12 +88,13 @@ pub(super) fn indirect_light_pass(
         .gather
         .record_indirect(encoder, gi.method, &quadtrees, None);
     span.end(encoder);
-    if diagnostics.is_some() {
+    let counts = pipeline_cache.get_compute_pipeline(pipelines.counts);
+    if let Some(counts) = counts.filter(|_| diagnostics.is_some()) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("quadray gi counts"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&pipelines.counts);
+        pass.set_pipeline(counts);
         pass.set_bind_group(0, &passes.means_group, &[]);
         pass.dispatch_workgroups(1, 1, 1);
     }
@@ -103,15 +104,18 @@ pub(super) fn indirect_light_pass(
             encoder.copy_buffer_to_buffer(indirect, 0, &debug.buffer, 0, indirect.size());
         }
     }
-    let span = diagnostics.time_span(encoder, "composite");
-    draw_over(
-        encoder,
-        "quadray gi composite",
-        target.main_texture_view(),
-        (&passes.composite, &passes.composite_group),
-        None,
-    );
-    span.end(encoder);
+    // (until Bevy has compiled the composite, the bounce is gathered and not added)
+    if let Some(composite) = pipeline_cache.get_render_pipeline(passes.composite) {
+        let span = diagnostics.time_span(encoder, "composite");
+        draw_over(
+            encoder,
+            "quadray gi composite",
+            target.main_texture_view(),
+            (composite, &passes.composite_group),
+            None,
+        );
+        span.end(encoder);
+    }
     whole.end(encoder);
     if diagnostics.is_some() {
         let cut = l.views[0].quadtree.cut_count().slice(0..4);
@@ -135,6 +139,7 @@ pub(crate) fn camera_diagnostics(camera: Entity) -> String {
 pub(super) fn cut_view_pass(
     view: ViewQuery<(&ViewPasses, &ViewTarget, &IndirectLight)>,
     light: Res<LightState>,
+    pipeline_cache: Res<PipelineCache>,
     times: Res<CpuTimes>,
     mut ctx: RenderContext,
 ) {
@@ -143,13 +148,16 @@ pub(super) fn cut_view_pass(
     if !(gi.cut_view && gi.enabled) || light.0.as_ref().is_none_or(|l| l.views.is_empty()) {
         return;
     }
+    let Some(cut_view) = pipeline_cache.get_render_pipeline(passes.cut_view) else {
+        return;
+    };
     let size = passes.settings.size;
     let side = passes.settings.rsm_size * cut_view_zoom(&passes.settings);
     draw_over(
         ctx.command_encoder(),
         "quadray gi cut view",
         target.main_texture_view(),
-        (&passes.cut_view, &passes.cut_view_group),
+        (cut_view, &passes.cut_view_group),
         Some((side.min(size.width), side.min(size.height))),
     );
 }

@@ -2,14 +2,17 @@
 //! the composite and the cut view), made for its size and format and freed with it.
 
 use super::light::{LightPasses, LightState};
-use super::pipelines::{Draw, Pipelines, VIEW_UNIFORM_BYTES, composite_pipeline};
+use super::pipelines::{Draw, Pipelines, VIEW_UNIFORM_BYTES};
 use crate::gi::cpu_time::CpuTimes;
 use crate::gi::scene::IndirectLight;
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
-use bevy::render::render_resource::{TextureFormat, TextureView, TextureViewId};
+use bevy::render::render_resource::{
+    CachedRenderPipelineId, PipelineCache, SpecializedRenderPipelines, TextureFormat, TextureView,
+    TextureViewId,
+};
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::view::{ExtractedView, ViewTarget};
 use quadray_indirect::{FLOAT_FORMAT, GBufferViews, Gather, Settings};
@@ -52,11 +55,11 @@ pub struct ViewPasses {
     pub(super) gather: Gather,
     pub(super) composite_uniform: wgpu::Buffer,
     pub(super) composite_group: wgpu::BindGroup,
-    pub(super) composite: wgpu::RenderPipeline,
+    pub(super) composite: CachedRenderPipelineId,
     /// The cut view's magnification (a `u32`).
     pub(super) cut_view_uniform: wgpu::Buffer,
     pub(super) cut_view_group: wgpu::BindGroup,
-    pub(super) cut_view: wgpu::RenderPipeline,
+    pub(super) cut_view: CachedRenderPipelineId,
     /// The gather's counts as means per shaded pixel: VPL evaluations, texel fetches.
     pub(super) means: wgpu::Buffer,
     pub(super) means_group: wgpu::BindGroup,
@@ -65,13 +68,21 @@ pub struct ViewPasses {
     pub(super) gbuffer_group: Mutex<Option<([TextureViewId; 2], wgpu::BindGroup)>>,
 }
 
+/// What a camera's passes are made with: the plugin's pipelines, Bevy's pipeline cache and the
+/// composite's specialisations.
+type ViewPipelines<'a> = (
+    &'a Pipelines,
+    &'a PipelineCache,
+    &'a mut SpecializedRenderPipelines<Pipelines>,
+);
+
 impl ViewPasses {
     pub(super) fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         settings: Settings,
         light: &LightPasses,
-        pipelines: &mut Pipelines,
+        (pipelines, cache, specialized): ViewPipelines,
         format: TextureFormat,
     ) -> Result<Self, quadray_indirect::IndirectError> {
         let size = wgpu::Extent3d {
@@ -118,7 +129,7 @@ impl ViewPasses {
         let quadtree = &light.views[0].quadtree;
         let cut_view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("quadray gi cut view"),
-            layout: &pipelines.cut_view_layout,
+            layout: &cache.get_bind_group_layout(&pipelines.cut_view_layout),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 2,
@@ -136,7 +147,7 @@ impl ViewPasses {
         });
         let composite_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("quadray gi composite"),
-            layout: &pipelines.composite_layout,
+            layout: &cache.get_bind_group_layout(&pipelines.composite_layout),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -156,7 +167,7 @@ impl ViewPasses {
         });
         let means_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("quadray gi counts"),
-            layout: &pipelines.counts.get_bind_group_layout(0),
+            layout: &cache.get_bind_group_layout(&pipelines.counts_layout),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -182,10 +193,10 @@ impl ViewPasses {
             gather,
             composite_uniform,
             composite_group,
-            composite: composite_pipeline(device, pipelines, Draw::Composite, format),
+            composite: specialized.specialize(cache, pipelines, (Draw::Composite, format)),
             cut_view_uniform,
             cut_view_group,
-            cut_view: composite_pipeline(device, pipelines, Draw::CutView, format),
+            cut_view: specialized.specialize(cache, pipelines, (Draw::CutView, format)),
             means,
             means_group,
             gbuffer_group: Mutex::new(None),
@@ -260,7 +271,11 @@ pub(super) fn prepare_views(
     mut views: Views,
     light: Res<LightState>,
     (device, queue): (Res<RenderDevice>, Res<RenderQueue>),
-    mut pipelines: ResMut<Pipelines>,
+    (pipelines, pipeline_cache, mut specialized): (
+        Res<Pipelines>,
+        Res<PipelineCache>,
+        ResMut<SpecializedRenderPipelines<Pipelines>>,
+    ),
     mut warned: Local<HashMap<Entity, String>>,
     times: Res<CpuTimes>,
 ) {
@@ -342,7 +357,14 @@ pub(super) fn prepare_views(
         let mut made = None;
         let passes = match passes.filter(current) {
             Some(passes) => passes.into_inner(),
-            None => match ViewPasses::new(device, &queue, settings, l, &mut pipelines, format) {
+            None => match ViewPasses::new(
+                device,
+                &queue,
+                settings,
+                l,
+                (&pipelines, &pipeline_cache, &mut specialized),
+                format,
+            ) {
                 Ok(p) => made.insert(p),
                 Err(e) => {
                     warn(format!("{e}; no indirect light is added"));
