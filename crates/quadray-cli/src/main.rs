@@ -11,7 +11,7 @@ mod smoke;
 mod tiles;
 
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use indicatif::ProgressBar;
 use std::path::PathBuf;
 
@@ -153,7 +153,8 @@ fn spinner(what: &str) -> ProgressBar {
 }
 
 fn main() -> Result<()> {
-    let cli = Cli::parse();
+    let command = quadray_core::settings::terminal_help(Cli::command());
+    let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     if !matches!(cli.command, Command::View { .. }) {
         // SAFETY: first thing in main, before any thread starts.
         unsafe { quadray_gpu::skip_display_probing() };

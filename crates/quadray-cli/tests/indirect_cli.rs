@@ -536,3 +536,17 @@ fn a_turning_light_gives_the_temporal_figures() {
     let nan = ["indirect", "--out", out, "--light-orbit", "nan"];
     quadray_refuses(&nan, "--light-orbit");
 }
+
+#[test]
+fn help_shows_the_settings_docs_without_rustdoc_links() {
+    // the settings' docs are rustdoc: ``[`Self::SHADOW_CORNERS_ACROSS`]`` reads as its name
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_quadray"))
+        .args(["indirect", "--help"])
+        .output()
+        .expect("run quadray");
+    assert!(run.status.success());
+    let help = String::from_utf8_lossy(&run.stdout);
+    assert!(help.contains("--shadow-corners"), "{help}");
+    assert!(help.contains("`SHADOW_CORNERS_ACROSS`"), "{help}");
+    assert!(!help.contains("[`"), "{help}");
+}

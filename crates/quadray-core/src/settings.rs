@@ -18,7 +18,7 @@ use std::str::FromStr;
 #[cfg(feature = "cli")]
 mod flags;
 #[cfg(feature = "cli")]
-pub use flags::{assert_flags_round_trip, flags_at_default, from_args, to_args};
+pub use flags::{assert_flags_round_trip, flags_at_default, from_args, terminal_help, to_args};
 
 /// A number a setting can hold.
 pub trait Number: Copy + PartialOrd + fmt::Display + FromStr + Send + Sync + 'static {

@@ -126,6 +126,57 @@ pub fn assert_flags_round_trip<S>(
     }
 }
 
+/// `command` with its help written for a terminal, in it and every subcommand: settings are
+/// documented once, in rustdoc, and clap shows those docs as help, so an intra-doc link
+/// (``[`Self::SHADOW_CORNERS_ACROSS`]``, ``[`crate::Method::subsamples`]``) reads as the name it
+/// links to (`` `SHADOW_CORNERS_ACROSS` ``, `` `subsamples` ``).
+pub fn terminal_help(command: Command) -> Command {
+    command
+        .mut_args(|mut arg| {
+            if let Some(help) = arg.get_help().map(|h| unlinked(&h.to_string())) {
+                arg = arg.help(help);
+            }
+            if let Some(help) = arg.get_long_help().map(|h| unlinked(&h.to_string())) {
+                arg = arg.long_help(help);
+            }
+            arg
+        })
+        .mut_subcommands(terminal_help)
+}
+
+/// `text` with each intra-doc link ``[`a::b::Name`]`` as `` `Name` `` (a path of names only:
+/// ``"`[` and `]`"`` is text).
+fn unlinked(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(start) = rest.find("[`") {
+        let path_and_rest = &rest[start + 2..];
+        let path = path_and_rest
+            .find("`]")
+            .map(|end| &path_and_rest[..end])
+            .filter(|p| {
+                !p.is_empty()
+                    && p.chars()
+                        .all(|c| c.is_alphanumeric() || c == '_' || c == ':')
+            });
+        out.push_str(&rest[..start]);
+        match path {
+            Some(path) => {
+                out.push('`');
+                out.push_str(path.rsplit("::").next().unwrap_or(path));
+                out.push('`');
+                rest = &path_and_rest[path.len() + 2..];
+            }
+            None => {
+                out.push_str("[`");
+                rest = path_and_rest;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -218,5 +269,24 @@ mod tests {
     #[should_panic(expected = "--size: serde writes None, not the flag's text")]
     fn a_field_serde_does_not_write_by_its_name_must_be_spelled() {
         to_args(&example(), &[]);
+    }
+
+    #[test]
+    fn intra_doc_links_read_as_the_names_they_link() {
+        assert_eq!(
+            unlinked("over [`Self::ACROSS`], the [`crate::Method::subsamples`] ones, [`Size`]"),
+            "over `ACROSS`, the `subsamples` ones, `Size`"
+        );
+        assert_eq!(unlinked("a [`dangling"), "a [`dangling");
+        assert_eq!(unlinked("`[` and `]` step it"), "`[` and `]` step it");
+        #[derive(clap::Parser)]
+        struct Cli {
+            /// Every [`Self::N`]-th.
+            #[arg(long)]
+            every: u32,
+        }
+        let mut command = terminal_help(<Cli as clap::CommandFactory>::command());
+        let help = command.render_long_help().to_string();
+        assert!(help.contains("Every `N`-th"), "{help}");
     }
 }
