@@ -3,8 +3,10 @@
 //! costs no scene work in either world; a moved mesh makes its own triangles anew, writes them
 //! alone to the vertex buffer and moves them alone in the occupancy grid (the floor's texture
 //! uploaded once), and the scene equals a fresh app's gather of the new places; the floor's
-//! texture swapped for a flat colour drops its layer.
+//! texture swapped for a flat colour drops its layer. The ball's texture has no CPU-side data:
+//! it takes its flat colour.
 
+use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::pbr::DefaultOpaqueRendererMethod;
@@ -61,11 +63,18 @@ fn app(places: [Transform; 5], camera: bool) -> (App, Vec<Entity>) {
             meshes.add(Sphere::new(0.3).mesh().ico(1).unwrap()),
         )
     };
-    let checker = world.resource_mut::<Assets<Image>>().add(checker());
+    let mut images = world.resource_mut::<Assets<Image>>();
+    let checker_image = images.add(checker(RenderAssetUsages::default()));
+    let gpu_only = images.add(checker(RenderAssetUsages::RENDER_WORLD));
     let mut materials = world.resource_mut::<Assets<StandardMaterial>>();
     let grey = materials.add(Color::srgb(0.7, 0.7, 0.7));
     let textured = materials.add(StandardMaterial {
-        base_color_texture: Some(checker),
+        base_color_texture: Some(checker_image),
+        ..default()
+    });
+    let unreadable = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.7, 0.7, 0.7),
+        base_color_texture: Some(gpu_only),
         ..default()
     });
     let mesh_of = [floor, cube.clone(), cube.clone(), cube, ball];
@@ -74,7 +83,11 @@ fn app(places: [Transform; 5], camera: bool) -> (App, Vec<Entity>) {
         .zip(places)
         .enumerate()
         .map(|(i, (mesh, place))| {
-            let material = if i == 0 { &textured } else { &grey };
+            let material = match i {
+                0 => &textured,
+                BALL => &unreadable,
+                _ => &grey,
+            };
             world
                 .spawn((Mesh3d(mesh), MeshMaterial3d(material.clone()), place))
                 .id()
@@ -117,9 +130,11 @@ fn app(places: [Transform; 5], camera: bool) -> (App, Vec<Entity>) {
     (app, entities)
 }
 
-/// A 2x2 sRGB texture, red and green above, green and red below.
-fn checker() -> Image {
-    use bevy::asset::RenderAssetUsages;
+/// The ball, among [`places`].
+const BALL: usize = 4;
+
+/// A 2x2 sRGB texture, red and green above, green and red below, kept in the worlds `usage` says.
+fn checker(usage: RenderAssetUsages) -> Image {
     use bevy::render::render_resource::{Extent3d, TextureDimension};
     let (red, green) = ([200, 30, 30, 255], [30, 200, 30, 255]);
     Image::new(
@@ -131,7 +146,7 @@ fn checker() -> Image {
         TextureDimension::D2,
         [red, green, green, red].concat(),
         TextureFormat::Rgba8UnormSrgb,
-        RenderAssetUsages::default(),
+        usage,
     )
 }
 
@@ -194,13 +209,19 @@ fn a_moved_mesh_alone_is_made_anew_and_the_scene_equals_a_fresh_gather() {
     let total = scene(&app).triangle_count() as u64;
     assert!(first.triangles_written >= total, "{first:?}");
     // the floor samples its texture, the one layer, uploaded
-    let floor = entities[0];
-    let floor_texture = |app: &App| {
-        let (_, o) = scene(app).objects().find(|(e, _)| *e == floor).unwrap();
-        o.triangles()[0][0].texture
+    let first_vertex = |app: &App, entity: Entity| {
+        let (_, o) = scene(app).objects().find(|(e, _)| *e == entity).unwrap();
+        o.triangles()[0][0]
     };
+    let floor = entities[0];
+    let floor_texture = |app: &App| first_vertex(app, floor).texture;
     assert_ne!(floor_texture(&app), Vertex::UNTEXTURED);
     assert_eq!(scene(&app).textures().layers.len(), 1);
+    // the ball's texture, on the GPU alone, is left out: its flat colour
+    let ball = first_vertex(&app, entities[BALL]);
+    assert_eq!(ball.texture, Vertex::UNTEXTURED);
+    let grey = LinearRgba::from(Color::srgb(0.7, 0.7, 0.7));
+    assert_eq!(ball.albedo, [grey.red, grey.green, grey.blue]);
     assert!(first.textures_uploaded >= 1, "{first:?}");
     let (generation, made) = (scene(&app).generation(), scene(&app).triangles_made());
 

@@ -71,7 +71,7 @@ pub struct IndirectLightSource;
 /// `PyramidMaterial`'s displaced surface, see
 /// [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX)), kept per entity, and the marked
 /// lights. An entity's triangles are made anew only when its transform, mesh, material or
-/// visibility changes (or the mesh or material asset it uses does); the render world receives
+/// visibility changes (or the mesh, material or texture asset it uses does); the render world receives
 /// the entities that changed. A resource of the main world, to read.
 #[derive(Resource, Default)]
 pub struct IndirectLightScene {

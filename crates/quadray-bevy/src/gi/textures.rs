@@ -4,6 +4,7 @@
 //! image's descriptor says. The layers stay while used; the array is made anew (and uploaded by
 //! the render world) only when the set of textures changes.
 
+use bevy::asset::RenderAssetUsages;
 use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -120,9 +121,14 @@ impl BaseColours {
 }
 
 /// The image's texels as sRGB bytes, as Bevy decodes its format (an 8-bit sRGB image's bytes as
-/// they are; another format through `Image::get_color_at`); `None` without CPU-side data, for a
-/// format `get_color_at` does not read, or for an image of more than one layer.
+/// they are; another format through `Image::get_color_at`); `None` for an image not kept in the
+/// main world (its data is there only until Bevy first extracts it: taken never, rather than
+/// depending on which frame asks), without CPU-side data, of a format `get_color_at` does not
+/// read, or of more than one layer.
 fn srgb_texels(image: &Image) -> Option<Rgba8Image> {
+    if !image.asset_usage.contains(RenderAssetUsages::MAIN_WORLD) {
+        return None;
+    }
     let (width, height) = (image.width(), image.height());
     let data = image.data.as_ref()?;
     if width == 0 || height == 0 || image.texture_descriptor.size.depth_or_array_layers != 1 {
