@@ -452,6 +452,8 @@ pub(super) fn collect_triangles(
         }
         made += triangles.len() as u64;
         let triangles = (!triangles.is_empty()).then(|| Arc::new(ObjectTriangles::new(triangles)));
+        // (a layer is used by the triangles that sample it)
+        let texture = texture.filter(|_| triangles.is_some());
         let object = SceneObject {
             mesh: mesh.id(),
             material: material.map(|m| m.id()),
