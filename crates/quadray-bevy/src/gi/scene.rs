@@ -606,7 +606,8 @@ fn append_displaced_mesh(
 }
 
 /// The uv a `StandardMaterial` reads its base colour texture at, per vertex of `mesh`: the
-/// channel it names through its `uv_transform` (`None` where the mesh has no such channel).
+/// channel it names through its `uv_transform` (`None` where the mesh has no such channel, or
+/// not one a position).
 fn uvs_of(mesh: &Mesh, material: &StandardMaterial) -> Option<Vec<[f32; 2]>> {
     let channel = match material.base_color_channel {
         UvChannel::Uv0 => Mesh::ATTRIBUTE_UV_0,
@@ -615,6 +616,9 @@ fn uvs_of(mesh: &Mesh, material: &StandardMaterial) -> Option<Vec<[f32; 2]>> {
     let Some(VertexAttributeValues::Float32x2(uvs)) = mesh.attribute(channel) else {
         return None;
     };
+    if mesh.attribute(Mesh::ATTRIBUTE_POSITION).map(|p| p.len()) != Some(uvs.len()) {
+        return None;
+    }
     let transform: Affine2 = material.uv_transform;
     Some(
         uvs.iter()
@@ -625,7 +629,7 @@ fn uvs_of(mesh: &Mesh, material: &StandardMaterial) -> Option<Vec<[f32; 2]>> {
 
 /// Appends `mesh`'s triangles in world space (a triangle list with positions; face normals where
 /// it has none); other topologies add nothing. With `texture` (a packed texture and a uv per
-/// vertex of the mesh), the triangles sample it.
+/// position of the mesh, [`uvs_of`]), the triangles sample it.
 fn append_triangles(
     mesh: &Mesh,
     transform: &GlobalTransform,
@@ -665,7 +669,6 @@ fn append_triangles(
     };
     out.reserve(corners.len() / 3);
     // plain code, not array maps: this crate is built at opt-level 1
-    let texture = texture.filter(|(_, uvs)| uvs.len() == positions.len());
     let vertex = |i: usize, p: Vec3, n: Vec3| {
         let plain = Vertex::untextured(p.to_array(), n.to_array(), albedo);
         match &texture {
