@@ -78,6 +78,10 @@ pub(crate) type Case = (Method, bool, bool);
 /// The Cornell box lit by a spot, a point light and the sun through its open front.
 pub(crate) const LIGHTS_SCENE: &str = "scenes/cornell_lights.gltf";
 
+/// A white room under a spot whose floor is red on its left half and green on its right by its
+/// base colour texture alone.
+pub(crate) const TEXTURED_SCENE: &str = "scenes/textured_floor.gltf";
+
 const CASES: [Case; 5] = [
     (Method::Reference, true, false),
     (Method::Quadtree, true, false),
@@ -144,11 +148,12 @@ type Lights<'a> = (
 type AnyLight = Or<(With<SpotLight>, With<PointLight>, With<DirectionalLight>)>;
 
 /// Once the glTF's camera and lights exist: one camera per case with the file's projection (once:
-/// a glTF spawned later keeps the probes' cameras), and the file's lights marked as the bounce's
-/// sources.
+/// a glTF spawned later keeps the probes' cameras and gives them its projection), and the file's
+/// lights marked as the bounce's sources.
 fn configure(
     mut commands: Commands,
     cameras: Query<(Entity, &Projection, &Transform), FileCamera>,
+    mut probe_projections: Query<&mut Projection, With<IndirectLight>>,
     lights: Query<Lights, AnyLight>,
     probes: Res<Probes>,
     setup: Res<Setup>,
@@ -174,6 +179,9 @@ fn configure(
             ..default()
         });
         if std::mem::replace(&mut *spawned, true) {
+            for mut probe in &mut probe_projections {
+                *probe = projection.clone();
+            }
             continue;
         }
         let place = setup.view.map_or(*file_place, |(eye, target)| {
@@ -390,6 +398,54 @@ fn scene_from(file: &str, view: Option<([f32; 3], [f32; 3])>) -> Scene {
 fn in_candela(image: Vec<[f32; 3]>) -> Vec<[f32; 3]> {
     let cd = quadray_core::scene::LUMENS_PER_WATT;
     image.into_iter().map(|p| p.map(|c| c * cd)).collect()
+}
+
+/// The plugin's bounce on [`TEXTURED_SCENE`] (the tests' view and sizes, the default method)
+/// against quadray's: within 0.05 rel. L1, and the ceiling above the red half of the floor
+/// redder than above the green half, as in quadray's (the RSM reads the floor's texture).
+pub(crate) fn check_textured_floor(bounce: &[[f32; 3]]) {
+    let gpu = quadray_gpu::Gpu::new().expect("an adapter (scripts/setup.sh installs lavapipe)");
+    let (scene, mut renderer) = quadray_renderer(&gpu, TEXTURED_SCENE);
+    let quadray = in_candela(renderer.render_frame(Method::DEFAULT).unwrap().indirect);
+    let agreement = compare(bounce, &quadray);
+    // the ceiling's pixels (y = 1 inside the room) by the side of the floor below them
+    let camera = scene.camera;
+    let forward = (camera.target - camera.position).normalize();
+    let right = forward.cross(camera.up).normalize();
+    let up = right.cross(forward);
+    let tan = (camera.fov_y_deg.to_radians() / 2.0).tan();
+    let mut sides = [[0.0f64; 2]; 2];
+    for (i, (plugin, quadray)) in bounce.iter().zip(&quadray).enumerate() {
+        let ndc = |p: u32| 2.0 * (p as f32 + 0.5) / SIZE as f32 - 1.0;
+        let (x, y) = (ndc(i as u32 % SIZE), -ndc(i as u32 / SIZE));
+        let ray = forward + right * x * tan + up * y * tan;
+        let hit = camera.position + ray * (1.0 - camera.position.y) / ray.y;
+        if ray.y <= 0.0 || !(0.1..0.9).contains(&hit.z) {
+            continue;
+        }
+        let side = match hit.x {
+            x if (0.1..0.4).contains(&x) => 0,
+            x if (0.6..0.9).contains(&x) => 1,
+            _ => continue,
+        };
+        // red over green, the plugin's and quadray's
+        for (k, p) in [plugin, quadray].into_iter().enumerate() {
+            sides[k][side] += f64::from(p[0] - p[1]) / f64::from(p[0] + p[1]).max(1e-9);
+        }
+    }
+    println!(
+        "textured floor: the plugin's bounce against quadray's {agreement:?}; the ceiling's \
+         (red - green) / (red + green) summed over the red and the green half: plugin {:?}, \
+         quadray {:?}",
+        sides[0], sides[1]
+    );
+    assert!(agreement.rel_l1 <= 0.05, "{agreement:?}");
+    for (who, [red_half, green_half]) in ["plugin", "quadray"].iter().zip(sides) {
+        assert!(
+            red_half > 0.0 && green_half < 0.0,
+            "{who}: the ceiling over the red half {red_half}, over the green half {green_half}"
+        );
+    }
 }
 
 #[test]

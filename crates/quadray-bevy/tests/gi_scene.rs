@@ -1,9 +1,12 @@
 //! The indirect-light plugin's scene as a Bevy app changes it, headless on lavapipe: a few
-//! meshes on a floor under a spot, a 32x32 camera with indirect shadows. A still frame costs no
-//! scene work in either world; a moved mesh makes its own triangles anew, writes them alone to
-//! the vertex buffer and moves them alone in the occupancy grid, and the scene equals a fresh
-//! app's gather of the new places.
+//! meshes on a textured floor under a spot, a 32x32 camera with indirect shadows. A still frame
+//! costs no scene work in either world; a moved mesh makes its own triangles anew, writes them
+//! alone to the vertex buffer and moves them alone in the occupancy grid (the floor's texture
+//! uploaded once), and the scene equals a fresh app's gather of the new places; the floor's
+//! texture swapped for a flat colour drops its layer. The ball's texture has no CPU-side data:
+//! it takes its flat colour.
 
+use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::pbr::DefaultOpaqueRendererMethod;
@@ -60,16 +63,33 @@ fn app(places: [Transform; 5], camera: bool) -> (App, Vec<Entity>) {
             meshes.add(Sphere::new(0.3).mesh().ico(1).unwrap()),
         )
     };
-    let grey = world
-        .resource_mut::<Assets<StandardMaterial>>()
-        .add(Color::srgb(0.7, 0.7, 0.7));
+    let mut images = world.resource_mut::<Assets<Image>>();
+    let checker_image = images.add(checker(RenderAssetUsages::default()));
+    let gpu_only = images.add(checker(RenderAssetUsages::RENDER_WORLD));
+    let mut materials = world.resource_mut::<Assets<StandardMaterial>>();
+    let grey = materials.add(Color::srgb(0.7, 0.7, 0.7));
+    let textured = materials.add(StandardMaterial {
+        base_color_texture: Some(checker_image),
+        ..default()
+    });
+    let unreadable = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.7, 0.7, 0.7),
+        base_color_texture: Some(gpu_only),
+        ..default()
+    });
     let mesh_of = [floor, cube.clone(), cube.clone(), cube, ball];
     let entities = mesh_of
         .into_iter()
         .zip(places)
-        .map(|(mesh, place)| {
+        .enumerate()
+        .map(|(i, (mesh, place))| {
+            let material = match i {
+                0 => &textured,
+                BALL => &unreadable,
+                _ => &grey,
+            };
             world
-                .spawn((Mesh3d(mesh), MeshMaterial3d(grey.clone()), place))
+                .spawn((Mesh3d(mesh), MeshMaterial3d(material.clone()), place))
                 .id()
         })
         .collect();
@@ -108,6 +128,26 @@ fn app(places: [Transform; 5], camera: bool) -> (App, Vec<Entity>) {
         ));
     }
     (app, entities)
+}
+
+/// The ball, among [`places`].
+const BALL: usize = 4;
+
+/// A 2x2 sRGB texture, red and green above, green and red below, kept in the worlds `usage` says.
+fn checker(usage: RenderAssetUsages) -> Image {
+    use bevy::render::render_resource::{Extent3d, TextureDimension};
+    let (red, green) = ([200, 30, 30, 255], [30, 200, 30, 255]);
+    Image::new(
+        Extent3d {
+            width: 2,
+            height: 2,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        [red, green, green, red].concat(),
+        TextureFormat::Rgba8UnormSrgb,
+        usage,
+    )
 }
 
 fn work(app: &App) -> SceneWork {
@@ -168,6 +208,21 @@ fn a_moved_mesh_alone_is_made_anew_and_the_scene_equals_a_fresh_gather() {
     );
     let total = scene(&app).triangle_count() as u64;
     assert!(first.triangles_written >= total, "{first:?}");
+    // the floor samples its texture, the one layer, uploaded
+    let first_vertex = |app: &App, entity: Entity| {
+        let (_, o) = scene(app).objects().find(|(e, _)| *e == entity).unwrap();
+        o.triangles()[0][0]
+    };
+    let floor = entities[0];
+    let floor_texture = |app: &App| first_vertex(app, floor).texture;
+    assert_ne!(floor_texture(&app), Vertex::UNTEXTURED);
+    assert_eq!(scene(&app).textures().layers.len(), 1);
+    // the ball's texture, on the GPU alone, is left out: its flat colour
+    let ball = first_vertex(&app, entities[BALL]);
+    assert_eq!(ball.texture, Vertex::UNTEXTURED);
+    let grey = LinearRgba::from(Color::srgb(0.7, 0.7, 0.7));
+    assert_eq!(ball.albedo, [grey.red, grey.green, grey.blue]);
+    assert!(first.textures_uploaded >= 1, "{first:?}");
     let (generation, made) = (scene(&app).generation(), scene(&app).triangles_made());
 
     // still: no scene work in either world
@@ -220,6 +275,18 @@ fn a_moved_mesh_alone_is_made_anew_and_the_scene_equals_a_fresh_gather() {
         after.triangles_written + box_triangles
     );
     assert_eq!(gone.buffers_made, 1);
+
+    // the floor's texture swapped for a flat colour: its layer dropped, the array uploaded anew
+    let grey = app
+        .world()
+        .get::<MeshMaterial3d<StandardMaterial>>(entities[1])
+        .unwrap()
+        .clone();
+    app.world_mut().entity_mut(floor).insert(grey);
+    frames(&mut app, 3);
+    assert_eq!(floor_texture(&app), Vertex::UNTEXTURED);
+    assert!(scene(&app).textures().layers.is_empty());
+    assert_eq!(work(&app).textures_uploaded, gone.textures_uploaded + 1);
 }
 
 /// A fresh app with the meshes at `places` from the start, gathered (the main world alone).

@@ -21,8 +21,8 @@ use quadray_indirect::{Method, Settings};
 use std::sync::{Arc, Mutex};
 
 use crate::gi::{
-    Case, LIGHTS_SCENE, Probe, Probes, RSM, SCENE, SIZE, app, app_with, app_without_plugin,
-    cameras_with_passes, compiling, floats, gathered,
+    Case, Probe, Probes, RSM, SCENE, SIZE, TEXTURED_SCENE, app, app_with, app_without_plugin,
+    cameras_with_passes, check_textured_floor, compiling, floats, gathered,
 };
 
 /// A picture read back every frame, the latest kept.
@@ -502,12 +502,15 @@ fn a_camera_without_the_plugin_for_a_while_or_respawned_gathers_as_a_fresh_app()
     );
 }
 
-/// The glTF scene's root despawned and another bundled glTF spawned (the Cornell box with a
-/// spot, a point light and the sun; `configure` marks its lights): once the new scene has
-/// loaded, the bounce is a fresh app's on it, far from the first scene's.
+/// The glTF scene's root despawned and another bundled glTF spawned (the room whose floor is red
+/// and green by its texture alone; `configure` marks its light and gives the cameras its
+/// projection): once the new scene has loaded, the bounce is a fresh app's on it, far from the
+/// first scene's; the fresh app's is quadray's, the floor's texture in it
+/// ([`check_textured_floor`]).
 #[test]
 fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
-    let expected = fresh(LIGHTS_SCENE, SIZE, SIZE);
+    let expected = fresh(TEXTURED_SCENE, SIZE, SIZE);
+    check_textured_floor(&expected);
     let mut app = app(SCENE, &GI);
     let (probes, first) = gathered(&mut app);
     let world = app.world_mut();
@@ -518,7 +521,7 @@ fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     world.despawn(root);
     let second = world
         .resource::<AssetServer>()
-        .load(GltfAssetLabel::Scene(0).from_asset(LIGHTS_SCENE));
+        .load(GltfAssetLabel::Scene(0).from_asset(TEXTURED_SCENE));
     world.spawn(WorldAssetRoot(second));
     let changed = compare(&first[0], &expected);
     assert!(changed.rel_l1 > 0.1, "the scenes bounce alike: {changed:?}");

@@ -15,8 +15,7 @@ pub use quadray_core::scene::{Camera, Cone, Intensity, Light, LightKind};
 use quadray_core::scene::{Object, SceneDescription, Shape};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use textures::TextureCollector;
-pub use textures::{MAX_TEXTURE_BYTES, MAX_TEXTURES, SceneTextures};
+pub use textures::{MAX_TEXTURE_BYTES, MAX_TEXTURES, Relayering, SceneTextures, TextureCollector};
 
 /// One vertex as the raster passes read it.
 #[repr(C)]
@@ -138,7 +137,7 @@ impl Scene {
             );
         }
         let scene = Self {
-            textures: Arc::new(textures.finish()?),
+            textures: Arc::new(textures.textures()),
             name: d.name.clone(),
             camera: d.camera,
             lights,
@@ -290,7 +289,11 @@ fn model_triangles(
             .into();
         let texture = match (material, &mesh.uvs) {
             (Some(m), Some(_)) => match &m.base_color_texture {
-                Some(image) => textures.index(image, m.base_color_sampler, path, &m.name)?,
+                Some(image) => textures.index(
+                    image,
+                    m.base_color_sampler,
+                    &format!("{} (material `{}`)", path.display(), m.name),
+                )?,
                 None => Vertex::UNTEXTURED,
             },
             _ => Vertex::UNTEXTURED,

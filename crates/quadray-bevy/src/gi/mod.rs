@@ -34,13 +34,16 @@
 //! Bevy's packed G-buffer (`gbuffer.wgsl`, with Bevy's unpacking functions) and the additive
 //! composite (`composite.wgsl`). The light's RSM is rasterised from the scene's triangles,
 //! made on the CPU per visible `Mesh3d` entity: a `StandardMaterial`'s polygons in its base
-//! colour (textures are not read), a [`PyramidMaterial`](crate::PyramidMaterial)'s displaced
+//! colour times its `base_color_texture`, sampled per texel (the distinct images, read on the
+//! CPU where they keep their data, are the layers of quadray's texture array, uploaded when that
+//! set changes; a mesh takes its flat base colour where its image cannot be read, with one
+//! warning), a [`PyramidMaterial`](crate::PyramidMaterial)'s displaced
 //! surface (its height field cut into triangles, at most [`DISPLACED_TRIANGLES_MAX`] a mesh) in
 //! its base colour times its colour texture (read on the CPU where the image keeps its data; its
 //! base colour alone where not); the same triangles make the occupancy grid of indirect shadows
 //! ([`IndirectLightScene`] holds them, by entity). The scene is kept up to date by what
 //! changed: an entity's triangles are made anew when its transform, mesh, material or
-//! visibility changes (or the mesh or material asset it uses), and only those reach the render
+//! visibility changes (or the mesh, material or texture asset it uses), and only those reach the render
 //! world, which writes them into the entity's range of one vertex buffer and moves them in the
 //! occupancy grid (made anew only when the scene leaves the grid's bounds); a frame in which
 //! nothing changed does no scene work ([`SceneWork`] counts the render world's). A moving light,
@@ -73,6 +76,7 @@ mod cpu_time;
 mod displaced;
 mod render;
 mod scene;
+mod textures;
 
 pub use cpu_time::{MAIN_WORLD_CPU, RENDER_WORLD_CPU};
 pub use displaced::DISPLACED_TRIANGLES_MAX;

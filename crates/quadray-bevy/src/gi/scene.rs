@@ -3,18 +3,20 @@
 
 use super::cpu_time::CpuTimes;
 use super::displaced::{Albedo, ColourMap, Displacement, append_displaced};
+use super::textures::BaseColours;
 use crate::{PyramidMaterial, Pyramids};
 use bevy::asset::AssetEvent;
 use bevy::camera::Hdr;
 use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
-use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
+use bevy::math::Affine2;
+use bevy::mesh::{Indices, PrimitiveTopology, UvChannel, VertexAttributeValues};
 use bevy::pbr::StandardMaterial;
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::storage::ShaderBuffer;
 use quadray_displace::heightmap::HeightMap;
-use quadray_indirect::scene::{Cone, Intensity, Light, LightKind, Vertex};
+use quadray_indirect::scene::{Cone, Intensity, Light, LightKind, SceneTextures, Vertex};
 use quadray_indirect::{Method, Scene, Settings};
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
@@ -64,11 +66,12 @@ impl Default for IndirectLight {
 pub struct IndirectLightSource;
 
 /// The scene the lights' RSMs and the occupancy grid are made of: the triangles of every
-/// visible `Mesh3d` in world space (a `StandardMaterial`'s base colour as their albedo; a
+/// visible `Mesh3d` in world space (a `StandardMaterial`'s base colour as their albedo, times its
+/// base colour texture at their uv, the textures kept as the layers of one array; a
 /// `PyramidMaterial`'s displaced surface, see
 /// [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX)), kept per entity, and the marked
 /// lights. An entity's triangles are made anew only when its transform, mesh, material or
-/// visibility changes (or the mesh or material asset it uses does); the render world receives
+/// visibility changes (or the mesh, material or texture asset it uses does); the render world receives
 /// the entities that changed. A resource of the main world, to read.
 #[derive(Resource, Default)]
 pub struct IndirectLightScene {
@@ -83,6 +86,8 @@ pub struct IndirectLightScene {
     /// Counts the triangles made, all updates together.
     pub(super) triangles_made: u64,
     pub(super) lights: Vec<Light>,
+    /// The `StandardMaterial`s' base colour textures the triangles sample.
+    pub(super) base_colours: BaseColours,
 }
 
 /// One entity's triangles in world space and their bounds, shared with the render world.
@@ -121,6 +126,10 @@ pub(super) struct SceneObject {
     mesh: AssetId<Mesh>,
     material: Option<AssetId<StandardMaterial>>,
     displaced: bool,
+    /// Its material's base colour texture (read or not), and the packed texture its triangles
+    /// sample where read.
+    image: Option<AssetId<Image>>,
+    texture: Option<u32>,
     pub(super) triangles: Option<Arc<ObjectTriangles>>,
 }
 
@@ -152,6 +161,11 @@ impl IndirectLightScene {
     /// adds the triangles of the entities that changed, not the scene's.
     pub fn triangles_made(&self) -> u64 {
         self.triangles_made
+    }
+
+    /// The base colour textures the triangles' [`Vertex::texture`] sample.
+    pub fn textures(&self) -> &SceneTextures {
+        &self.base_colours.textures
     }
 }
 
@@ -358,15 +372,23 @@ pub(super) fn collect_triangles(
     let mut every_displaced = displaced_events
         .as_mut()
         .is_some_and(|e| e.read().count() > 0);
-    for id in image_events.read().filter_map(changed_asset) {
+    let changed_images: HashSet<AssetId<Image>> =
+        image_events.read().filter_map(changed_asset).collect();
+    for &id in &changed_images {
         // a colour texture read, or one a displaced material waits for
         every_displaced |= colours.remove(&id).is_some() || uses_image(displaced, id);
+        scene.base_colours.forget(id);
     }
-    if !changed_meshes.is_empty() || !changed_materials.is_empty() || every_displaced {
+    if !changed_meshes.is_empty()
+        || !changed_materials.is_empty()
+        || every_displaced
+        || !changed_images.is_empty()
+    {
         dirty.extend(scene.objects.iter().filter_map(|(e, o)| {
             let uses = changed_meshes.contains(&o.mesh)
                 || o.material.is_some_and(|m| changed_materials.contains(&m))
-                || (o.displaced && every_displaced);
+                || (o.displaced && every_displaced)
+                || o.image.is_some_and(|i| changed_images.contains(&i));
             uses.then_some(*e)
         }));
     }
@@ -375,17 +397,22 @@ pub(super) fn collect_triangles(
     }
     let mut changes = Vec::new();
     let mut made = 0;
+    // a texture no longer sampled by an entity, whose layer may be unused
+    let mut released = false;
     for entity in dirty {
         let Ok((transform, mesh, material, pyramid, visible)) = objects.get(entity) else {
-            if let Some(SceneObject {
-                triangles: Some(_), ..
-            }) = scene.objects.remove(&entity)
-            {
-                changes.push((entity, None));
+            if let Some(before) = scene.objects.remove(&entity) {
+                released |= before.texture.is_some();
+                if before.triangles.is_some() {
+                    changes.push((entity, None));
+                }
             }
             continue;
         };
         let mut triangles = Vec::new();
+        let standard = material.and_then(|m| materials.get(&m.0));
+        let image = standard.and_then(|m| m.base_color_texture.as_ref());
+        let mut texture = None;
         if let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) {
             if let Some(material) = pyramid.and_then(|m| displaced?.get(&m.0)) {
                 let colour = material
@@ -413,33 +440,80 @@ pub(super) fn collect_triangles(
                     &mut triangles,
                 );
             } else {
-                let albedo = material
-                    .and_then(|m| materials.get(&m.0))
-                    .map_or(Vec3::splat(0.5), base_albedo);
-                append_triangles(mesh, transform, albedo.to_array(), &mut triangles);
+                let albedo = standard.map_or(Vec3::splat(0.5), base_albedo);
+                // (no layer for a texture that a mesh without uvs would not sample)
+                let uvs = standard.and_then(|m| {
+                    let (image, uvs) = (image?, uvs_of(mesh, m)?);
+                    Some((scene.base_colours.packed(&images, &assets, image)?, uvs))
+                });
+                texture = uvs.as_ref().map(|(packed, _)| *packed);
+                append_triangles(mesh, transform, albedo.to_array(), uvs, &mut triangles);
             }
         }
         made += triangles.len() as u64;
         let triangles = (!triangles.is_empty()).then(|| Arc::new(ObjectTriangles::new(triangles)));
+        // (a layer is used by the triangles that sample it)
+        let texture = texture.filter(|_| triangles.is_some());
         let object = SceneObject {
             mesh: mesh.id(),
             material: material.map(|m| m.id()),
             displaced: pyramid.is_some(),
+            image: image.map(Handle::id),
+            texture,
             triangles: triangles.clone(),
         };
-        let before = scene
-            .objects
-            .insert(entity, object)
-            .and_then(|o| o.triangles);
-        if before.is_some() || triangles.is_some() {
+        let before = scene.objects.insert(entity, object);
+        released |= before
+            .as_ref()
+            .is_some_and(|o| o.texture.is_some_and(|t| texture != Some(t)));
+        if before.and_then(|o| o.triangles).is_some() || triangles.is_some() {
             changes.push((entity, triangles));
         }
     }
+    if released {
+        relayer_unused(&mut scene, &mut changes);
+    }
+    scene.base_colours.publish();
     scene.triangles_made += made;
     if !changes.is_empty() {
         scene.since = scene.generation;
         scene.generation += 1;
         scene.changes = changes;
+    }
+}
+
+/// Drops the texture layers no entity samples any more: the entities that sample a layer after
+/// them take its new place (their triangles' textures renumbered, not made anew).
+fn relayer_unused(
+    scene: &mut IndirectLightScene,
+    changes: &mut Vec<(Entity, Option<Arc<ObjectTriangles>>)>,
+) {
+    let used: Vec<u32> = scene.objects.values().filter_map(|o| o.texture).collect();
+    let Some(moved) = scene.base_colours.drop_unused(used) else {
+        return;
+    };
+    for (entity, object) in &mut scene.objects {
+        let Some(before) = object.texture else {
+            continue;
+        };
+        let now = moved.packed(before);
+        if now == before {
+            continue;
+        }
+        object.texture = Some(now);
+        let triangles = object.triangles.as_ref().map(|o| {
+            let renumbered = o
+                .triangles
+                .iter()
+                .map(|t| t.map(|v| Vertex { texture: now, ..v }))
+                .collect();
+            Arc::new(ObjectTriangles::new(renumbered))
+        });
+        object.triangles.clone_from(&triangles);
+        match changes.iter_mut().find(|(e, _)| e == entity) {
+            Some(change) => change.1 = triangles,
+            None => changes.push((*entity, triangles)),
+        }
     }
 }
 
@@ -527,16 +601,40 @@ fn append_displaced_mesh(
         addressing: material.extension.addressing(),
     };
     if !append_displaced(mesh, transform, &displacement, &albedo, out) {
-        append_triangles(mesh, transform, albedo.base.to_array(), out);
+        append_triangles(mesh, transform, albedo.base.to_array(), None, out);
     }
 }
 
+/// The uv a `StandardMaterial` reads its base colour texture at, per vertex of `mesh`: the
+/// channel it names through its `uv_transform` (`None` where the mesh has no such channel, or
+/// not one a position).
+fn uvs_of(mesh: &Mesh, material: &StandardMaterial) -> Option<Vec<[f32; 2]>> {
+    let channel = match material.base_color_channel {
+        UvChannel::Uv0 => Mesh::ATTRIBUTE_UV_0,
+        UvChannel::Uv1 => Mesh::ATTRIBUTE_UV_1,
+    };
+    let Some(VertexAttributeValues::Float32x2(uvs)) = mesh.attribute(channel) else {
+        return None;
+    };
+    if mesh.attribute(Mesh::ATTRIBUTE_POSITION).map(|p| p.len()) != Some(uvs.len()) {
+        return None;
+    }
+    let transform: Affine2 = material.uv_transform;
+    Some(
+        uvs.iter()
+            .map(|uv| transform.transform_point2(Vec2::from(*uv)).to_array())
+            .collect(),
+    )
+}
+
 /// Appends `mesh`'s triangles in world space (a triangle list with positions; face normals where
-/// it has none); other topologies add nothing.
+/// it has none); other topologies add nothing. With `texture` (a packed texture and a uv per
+/// position of the mesh, [`uvs_of`]), the triangles sample it.
 fn append_triangles(
     mesh: &Mesh,
     transform: &GlobalTransform,
     albedo: [f32; 3],
+    texture: Option<(u32, Vec<[f32; 2]>)>,
     out: &mut Vec<[Vertex; 3]>,
 ) {
     if mesh.primitive_topology() != PrimitiveTopology::TriangleList {
@@ -571,7 +669,17 @@ fn append_triangles(
     };
     out.reserve(corners.len() / 3);
     // plain code, not array maps: this crate is built at opt-level 1
-    let vertex = |p: Vec3, n: Vec3| Vertex::untextured(p.to_array(), n.to_array(), albedo);
+    let vertex = |i: usize, p: Vec3, n: Vec3| {
+        let plain = Vertex::untextured(p.to_array(), n.to_array(), albedo);
+        match &texture {
+            Some((packed, uvs)) => Vertex {
+                uv: uvs[i],
+                texture: *packed,
+                ..plain
+            },
+            None => plain,
+        }
+    };
     for t in corners.chunks_exact(3) {
         let (a, b, c) = (t[0], t[1], t[2]);
         if a >= positions.len() || b >= positions.len() || c >= positions.len() {
@@ -586,6 +694,6 @@ fn append_triangles(
                 (face, face, face)
             }
         };
-        out.push([vertex(pa, na), vertex(pb, nb), vertex(pc, nc)]);
+        out.push([vertex(a, pa, na), vertex(b, pb, nb), vertex(c, pc, nc)]);
     }
 }

@@ -7,7 +7,6 @@
 use glam::{Vec2, Vec3};
 use quadray_core::image_out::Rgba8Image;
 use quadray_core::mesh::{TextureFilter, TextureSampler, TextureWrap};
-use std::path::Path;
 
 /// The most distinct textures a scene may have: the layers of a texture array every WebGPU
 /// device offers (`max_texture_array_layers`).
@@ -20,6 +19,14 @@ pub const MAX_TEXTURE_BYTES: u64 = 256 << 20;
 /// Bits of a packed [`Vertex::texture`](super::Vertex::texture) that hold the layer; the
 /// sampler's filter and wraps lie above them.
 const LAYER_BITS: u32 = 16;
+
+/// The layer's bits of a packed texture.
+const LAYER_MASK: u32 = (1 << LAYER_BITS) - 1;
+
+/// The layer of packed texture `texture`.
+fn layer_of(texture: u32) -> usize {
+    (texture & LAYER_MASK) as usize
+}
 
 /// The scene's base colour textures, as sRGB bytes (decoded when sampled, as the GPU's
 /// `Rgba8UnormSrgb` decodes them), every layer `width` x `height`: a texture of another size is
@@ -35,58 +42,66 @@ pub struct SceneTextures {
     pub layers: Vec<Vec<[u8; 4]>>,
 }
 
-/// A texture of a mesh file as the scene takes it.
+/// A texture as the scene takes it.
 #[derive(Debug)]
 struct Source {
     image: Rgba8Image,
-    /// The mesh file and material it comes from, for the error of a scene over the limits.
+    /// Where it comes from (a mesh file and material, say), for the error of a scene over the
+    /// limits.
     origin: String,
 }
 
-/// Collects the distinct textures of a scene's mesh files while their triangles are made, then
-/// resizes them to one size ([`TextureCollector::finish`]).
+/// Collects the distinct textures of a scene while its triangles are made, and gives them at one
+/// size ([`TextureCollector::textures`]). A scene that changes (the Bevy plugin's) keeps one:
+/// a texture's layer stays while it is used, and [`TextureCollector::retain_used`] drops the
+/// layers no longer used.
 #[derive(Debug, Default)]
-pub(super) struct TextureCollector {
+pub struct TextureCollector {
     sources: Vec<Source>,
 }
 
 impl TextureCollector {
-    /// The packed texture index of `image` read through `sampler` (material `material` of mesh
-    /// file `file`): its layer, a new one where no texture before it has the same texels.
+    /// The packed [`Vertex::texture`](super::Vertex::texture) of `image` read through `sampler`:
+    /// its layer, a new one where no texture before it has the same texels. `origin` says where
+    /// it comes from (a mesh file and material) in the error of a texture over the limits: over
+    /// [`MAX_TEXTURES`] distinct textures, or layers (at the size of the widest and the tallest
+    /// texture) that would take over [`MAX_TEXTURE_BYTES`]; the collector is then as it was.
     pub fn index(
         &mut self,
         image: &Rgba8Image,
         sampler: TextureSampler,
-        file: &Path,
-        material: &str,
+        origin: &str,
     ) -> Result<u32, String> {
         let layer = match self.sources.iter().position(|s| s.image == *image) {
             Some(layer) => layer,
             None => {
                 if self.sources.len() == MAX_TEXTURES {
                     return Err(format!(
-                        "{}: material `{material}`: over {MAX_TEXTURES} distinct base colour \
-                         textures in the scene (the layers of one texture array)",
-                        file.display()
+                        "{origin}: over {MAX_TEXTURES} distinct base colour textures in the \
+                         scene (the layers of one texture array)"
                     ));
                 }
                 self.sources.push(Source {
                     image: image.clone(),
-                    origin: format!("{} (material `{material}`)", file.display()),
+                    origin: origin.to_string(),
                 });
+                if let Err(e) = self.check_bytes() {
+                    self.sources.pop();
+                    return Err(e);
+                }
                 self.sources.len() - 1
             }
         };
         Ok(pack(layer as u32, sampler))
     }
 
-    /// Every texture resized to the width of the widest and the height of the tallest; an error
-    /// names the files of those two when the layers would take over [`MAX_TEXTURE_BYTES`].
-    pub fn finish(self) -> Result<SceneTextures, String> {
+    /// An error naming the widest and the tallest texture when the layers at their size take
+    /// over [`MAX_TEXTURE_BYTES`].
+    fn check_bytes(&self) -> Result<(), String> {
         let widest = self.sources.iter().max_by_key(|s| s.image.width);
         let tallest = self.sources.iter().max_by_key(|s| s.image.height);
         let (Some(widest), Some(tallest)) = (widest, tallest) else {
-            return Ok(SceneTextures::default());
+            return Ok(());
         };
         let (width, height) = (widest.image.width, tallest.image.height);
         let bytes = u64::from(width) * u64::from(height) * 4 * self.sources.len() as u64;
@@ -102,7 +117,55 @@ impl TextureCollector {
                 MAX_TEXTURE_BYTES >> 20
             ));
         }
-        Ok(SceneTextures {
+        Ok(())
+    }
+
+    /// How many layers the textures take.
+    pub fn len(&self) -> usize {
+        self.sources.len()
+    }
+
+    /// Whether no texture was collected.
+    pub fn is_empty(&self) -> bool {
+        self.sources.is_empty()
+    }
+
+    /// Drops the layers that no packed texture of `used` reads, keeping the others in order;
+    /// `None` where every layer is used, else what each packed texture becomes
+    /// ([`Relayering::packed`]).
+    pub fn retain_used(&mut self, used: impl IntoIterator<Item = u32>) -> Option<Relayering> {
+        let mut kept = vec![false; self.sources.len()];
+        for texture in used {
+            if let Some(k) = kept.get_mut(layer_of(texture)) {
+                *k = true;
+            }
+        }
+        if kept.iter().all(|k| *k) {
+            return None;
+        }
+        let mut next = 0;
+        let layers = kept
+            .iter()
+            .map(|&k| {
+                k.then(|| {
+                    next += 1;
+                    next - 1
+                })
+            })
+            .collect();
+        let mut kept = kept.into_iter();
+        self.sources.retain(|_| kept.next() == Some(true));
+        Some(Relayering { layers })
+    }
+
+    /// Every texture resized to the width of the widest and the height of the tallest.
+    pub fn textures(&self) -> SceneTextures {
+        let width = self.sources.iter().map(|s| s.image.width).max();
+        let height = self.sources.iter().map(|s| s.image.height).max();
+        let (Some(width), Some(height)) = (width, height) else {
+            return SceneTextures::default();
+        };
+        SceneTextures {
             width,
             height,
             layers: self
@@ -110,7 +173,27 @@ impl TextureCollector {
                 .iter()
                 .map(|s| resized(&s.image, width, height))
                 .collect(),
-        })
+        }
+    }
+}
+
+/// The layers a [`TextureCollector::retain_used`] moved or dropped.
+#[derive(Debug)]
+pub struct Relayering {
+    /// Each layer before: its layer now, or `None` where dropped.
+    layers: Vec<Option<u32>>,
+}
+
+impl Relayering {
+    /// What packed texture `texture` (of a layer kept) is now, with the same sampler;
+    /// [`Vertex::UNTEXTURED`](super::Vertex::UNTEXTURED) where its layer was dropped (or it had
+    /// none).
+    pub fn packed(&self, texture: u32) -> u32 {
+        // (an untextured vertex's layer bits are past every layer)
+        match self.layers.get(layer_of(texture)).copied().flatten() {
+            Some(layer) => (texture & !LAYER_MASK) | layer,
+            None => super::Vertex::UNTEXTURED,
+        }
     }
 }
 
@@ -177,7 +260,7 @@ impl SceneTextures {
         if texture == super::Vertex::UNTEXTURED {
             return Vec3::ONE;
         }
-        let layer = &self.layers[(texture & ((1 << LAYER_BITS) - 1)) as usize];
+        let layer = &self.layers[layer_of(texture)];
         let nearest = (texture >> LAYER_BITS) & 1 == 1;
         let (wrap_u, wrap_v) = (
             (texture >> (LAYER_BITS + 1)) & 3,
@@ -231,10 +314,8 @@ mod tests {
             wrap_u: wrap,
             wrap_v: wrap,
         };
-        let index = collector
-            .index(&image(2, 1, texels), sampler, Path::new("a.gltf"), "m")
-            .unwrap();
-        (collector.finish().unwrap(), index)
+        let index = collector.index(&image(2, 1, texels), sampler, "a").unwrap();
+        (collector.textures(), index)
     }
 
     #[test]
@@ -278,36 +359,74 @@ mod tests {
         let red = image(1, 1, vec![[255, 0, 0, 255]]);
         let wide = image(4, 1, vec![[0, 0, 255, 255]; 4]);
         let mut collector = TextureCollector::default();
-        let file = Path::new("floor.gltf");
         let sampler = TextureSampler::default();
-        let first = collector.index(&red, sampler, file, "a").unwrap();
-        assert_eq!(collector.index(&red, sampler, file, "b").unwrap(), first);
-        collector.index(&wide, sampler, file, "c").unwrap();
-        let textures = collector.finish().unwrap();
+        let first = collector.index(&red, sampler, "floor.gltf (a)").unwrap();
+        assert_eq!(
+            collector.index(&red, sampler, "floor.gltf (b)").unwrap(),
+            first
+        );
+        collector.index(&wide, sampler, "floor.gltf (c)").unwrap();
+        let textures = collector.textures();
         assert_eq!((textures.width, textures.height), (4, 1));
         assert_eq!(textures.layers[0], vec![[255, 0, 0, 255]; 4]);
-        // one texture as wide as the limit, one as tall: the array is both, 512 MiB
+        // one texture as wide as the limit, one as tall: the array would be both, 512 MiB
         let mut collector = TextureCollector::default();
         let side = quadray_core::image_in::MAX_SIDE;
         let row = image(side, 1, vec![[0; 4]; side as usize]);
         let column = image(1, side, vec![[1; 4]; side as usize]);
-        collector.index(&row, sampler, file, "row").unwrap();
-        collector
-            .index(&column, sampler, Path::new("wall.gltf"), "column")
-            .unwrap();
-        let err = collector.finish().unwrap_err();
+        collector.index(&row, sampler, "floor.gltf (row)").unwrap();
+        let err = collector
+            .index(&column, sampler, "wall.gltf (column)")
+            .unwrap_err();
         assert!(
             err.contains("floor.gltf") && err.contains("wall.gltf") && err.contains("512 MiB"),
             "{err}"
         );
+        assert_eq!(collector.len(), 1, "the refused texture is not kept");
         let mut collector = TextureCollector::default();
         let err = (0..=MAX_TEXTURES)
             .map(|i| {
                 let texel = [i as u8, (i >> 8) as u8, 0, 255];
-                collector.index(&image(1, 1, vec![texel]), sampler, file, "m")
+                collector.index(&image(1, 1, vec![texel]), sampler, "floor.gltf (m)")
             })
             .find_map(Result::err)
             .expect("one over the limit");
         assert!(err.contains("floor.gltf") && err.contains("256"), "{err}");
+    }
+
+    #[test]
+    fn unused_layers_are_dropped_and_the_others_renumbered() {
+        let texel = |c: u8| image(1, 1, vec![[c, c, c, 255]]);
+        let nearest = TextureSampler {
+            filter: TextureFilter::Nearest,
+            ..TextureSampler::default()
+        };
+        let mut collector = TextureCollector::default();
+        let a = collector.index(&texel(10), nearest, "a").unwrap();
+        let b = collector.index(&texel(20), nearest, "b").unwrap();
+        let c = collector
+            .index(&texel(30), TextureSampler::default(), "c")
+            .unwrap();
+        assert!(collector.retain_used([a, b, c]).is_none());
+        let moved = collector.retain_used([c, a]).expect("b dropped");
+        assert_eq!(collector.len(), 2);
+        assert_eq!(moved.packed(a), a);
+        assert_eq!(moved.packed(b), super::super::Vertex::UNTEXTURED);
+        assert_eq!(
+            moved.packed(super::super::Vertex::UNTEXTURED),
+            super::super::Vertex::UNTEXTURED
+        );
+        // c now reads layer 1, through its own sampler still
+        let textures = collector.textures();
+        assert_eq!(
+            textures.sample(moved.packed(c), Vec2::splat(0.5)),
+            Vec3::splat(srgb_to_linear(30))
+        );
+        assert_eq!(
+            moved.packed(c),
+            collector
+                .index(&texel(30), TextureSampler::default(), "c")
+                .unwrap()
+        );
     }
 }

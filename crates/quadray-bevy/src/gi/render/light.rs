@@ -9,7 +9,7 @@ use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use quadray_indirect::scene::Light;
 use quadray_indirect::shadows::occupancy::OccupancyGrid;
-use quadray_indirect::{GBufferLayout, LightQuadtree, RsmPass, Settings};
+use quadray_indirect::{GBufferLayout, LightQuadtree, RsmPass, Settings, TextureArray};
 use quadray_indirect::{LightView, ViewMaps};
 
 /// The lights' side, shared by every camera: an RSM over the scene's triangles and the light
@@ -36,6 +36,8 @@ pub(super) struct LightPasses {
     pub(super) max_lights: u32,
     /// The scene's triangles, a range an entity.
     pub(super) scene: SceneBuffer,
+    /// The base colour textures the triangles sample, which every RSM binds.
+    pub(super) textures: TextureArray,
     /// The scene's bounds, which the lights' views frame.
     pub(super) bounds: (Vec3, Vec3),
     pub(super) lights: Vec<Light>,
@@ -74,7 +76,8 @@ impl LightPasses {
     ) {
         self.views = (0..count)
             .map(|_| {
-                let rsm = RsmPass::new(device, settings);
+                let mut rsm = RsmPass::new(device, settings);
+                rsm.set_textures(&self.textures);
                 let quadtree = LightQuadtree::new(
                     device,
                     queue,
@@ -129,9 +132,12 @@ pub(super) fn prepare_light(
     };
     let levels = settings.shadow_grid_levels;
     let mut made = false;
+    // taken every frame, as the changes
+    let textures_changed = std::mem::take(&mut mirror.textures_changed);
     let l = state.0.get_or_insert_with(|| {
         made = true;
         LightPasses {
+            textures: upload_textures(device, &queue, &mirror, work),
             views: Vec::new(),
             maps_generation: 0,
             rsm_size: 0,
@@ -172,6 +178,14 @@ pub(super) fn prepare_light(
                 l.occupancy_generation += 1;
             }
         }
+    }
+    if textures_changed && !made {
+        // (every layer's side at most quadray's MAX_SIDE, wgpu's default limit)
+        l.textures = upload_textures(device, &queue, &mirror, work);
+        for view in &mut l.views {
+            view.rsm.set_textures(&l.textures);
+        }
+        l.stale = true;
     }
     if !matches!(changes, SceneChanges::None) {
         // the RSMs are drawn anew; the maps' projections follow the scene's bounds
@@ -214,4 +228,15 @@ pub(super) fn prepare_light(
         l.stale = true;
     }
     l.max_lights = settings.max_lights;
+}
+
+/// The scene's base colour textures on the GPU.
+fn upload_textures(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mirror: &SceneMirror,
+    work: &mut SceneWork,
+) -> TextureArray {
+    work.textures_uploaded += 1;
+    TextureArray::new(device, queue, &mirror.textures)
 }

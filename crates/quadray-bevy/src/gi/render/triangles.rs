@@ -7,7 +7,7 @@ use crate::gi::scene::{IndirectLightScene, ObjectTriangles};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::Extract;
-use quadray_indirect::scene::{Light, Vertex};
+use quadray_indirect::scene::{Light, SceneTextures, Vertex};
 use quadray_indirect::shadows::occupancy::OccupancyGrid;
 use std::ops::Range;
 use std::sync::Arc;
@@ -24,6 +24,11 @@ pub(super) struct SceneMirror {
     /// Every entity is to be taken anew (an update was missed).
     replaced: bool,
     pub(super) lights: Vec<Light>,
+    /// The base colour textures, the main world's count of their changes last extracted, and
+    /// whether they changed since the lights' side last took them.
+    pub(super) textures: Arc<SceneTextures>,
+    textures_generation: u64,
+    pub(super) textures_changed: bool,
 }
 
 /// What changed in the scene since the last take.
@@ -78,6 +83,12 @@ pub(super) fn extract_scene(
     let Some(scene) = scene.as_ref() else { return };
     if scene.lights != mirror.lights {
         mirror.lights.clone_from(&scene.lights);
+    }
+    let textures = &scene.base_colours;
+    if textures.generation != mirror.textures_generation {
+        mirror.textures = textures.textures.clone();
+        mirror.textures_generation = textures.generation;
+        mirror.textures_changed = true;
     }
     if scene.generation == mirror.generation {
         return;
@@ -136,6 +147,9 @@ pub struct SceneWork {
     /// Times the occupancy grid was made anew from every triangle (the first time, new grid
     /// settings, or the scene grown out of the grid's bounds).
     pub grids_made: u64,
+    /// Times the base colour textures were uploaded (the first time, and when the set of
+    /// textures changed).
+    pub textures_uploaded: u64,
 }
 
 impl SceneBuffer {
