@@ -144,8 +144,10 @@ done
 # The gather's candidates, each a runtime option of the same binary (name, then its flags):
 # interleaved sampling of the one cut and of RSM sampling, the one cut made finer under it, and
 # the one cut with indirect shadows: interleaved (each pixel takes a sixteenth of its clusters),
-# with each pixel walking its own rays (--shadow-corners 0), and from corner receivers nearer and
-# farther apart than the default's 16 pixels at 1920x1080.
+# with each pixel walking its own rays (--shadow-corners 0), from corner receivers nearer and
+# farther apart than the default's 16 pixels at 1920x1080, and with 16 or 8 threads walking a
+# corner's rays instead of 64 (each lane walks 4 or 8 times the rays: do a wave's lanes end
+# closer together?).
 while read -r name flags; do
     # shellcheck disable=SC2086 # $flags is several words
     step "indirect-$name" "$bin" indirect $flags --size $size --rsm-size $rsm \
@@ -161,6 +163,8 @@ quadtree-shadows-corners-0 --method quadtree --indirect-shadows --shadow-corners
 quadtree-shadows-corners-8 --method quadtree --indirect-shadows --shadow-corners 8
 quadtree-shadows-corners-32 --method quadtree --indirect-shadows --shadow-corners 32
 quadtree-shadows-corners-8-interleave-4 --method quadtree --indirect-shadows --shadow-corners 8 --interleave 4
+quadtree-shadows-corner-lanes-16 --method quadtree --indirect-shadows --shadow-corner-lanes 16
+quadtree-shadows-corner-lanes-8 --method quadtree --indirect-shadows --shadow-corner-lanes 8
 CANDIDATES
 # An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
 # each submit), to see where it stops.

@@ -302,6 +302,8 @@ mod tests {
                 proptest::option::of(u(Settings::SHADOW_CORNERS)),
                 f(Settings::TILE_SHADOW_ANGLE, 0.0, 100.0),
                 proptest::option::of(4u32..=13),
+                // (powers of two)
+                proptest::sample::select(vec![8u32, 16, 32, 64]),
             ),
         )
             .prop_map(
@@ -329,6 +331,7 @@ mod tests {
                         shadow_corners,
                         tile_shadow_angle,
                         shadow_map_log,
+                        shadow_corner_lanes,
                     ),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
@@ -360,6 +363,7 @@ mod tests {
                         interleave: if subsample > 1 { 1 } else { interleave },
                         indirect_shadows: shadows,
                         shadow_corners,
+                        shadow_corner_lanes,
                         shadow_steps: steps,
                         shadow_thickness: thickness,
                         shadow_grid,

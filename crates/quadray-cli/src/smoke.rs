@@ -116,11 +116,14 @@ fn cases() -> Vec<Case> {
     // eight light views summed: the spot's, the sun's orthographic map, a point light's six faces
     let lights: [(&str, IndirectMethod, Change); 3] = [
         ("indirect-lights", IndirectMethod::DEFAULT, |_| {}),
-        // a corners' pass a light view, each before its view's sum
+        // a corners' pass a light view, each before its view's sum, eight corners a workgroup
         (
             "indirect-lights-shadow-corners",
             IndirectMethod::Quadtree,
-            with_corners,
+            |s| {
+                with_corners(s);
+                s.shadow_corner_lanes = 8;
+            },
         ),
         ("indirect-lights-subsample", IndirectMethod::Quadtree, |s| {
             s.subsample = 2

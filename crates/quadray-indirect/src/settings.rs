@@ -289,6 +289,15 @@ pub struct Settings {
     /// corners every N pixels would to the whole: 0 at 128x128).
     #[cfg_attr(feature = "cli", arg(long, value_parser = Settings::SHADOW_CORNERS.parser()))]
     pub shadow_corners: Option<u32>,
+    /// The threads that walk one shadow corner's rays (a power of two, 8 to 64; 64: a workgroup
+    /// a corner). Fewer lanes a corner give each lane more rays to walk, so that a wave's lanes
+    /// end closer together, with several corners a workgroup; the picture is the same.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.shadow_corner_lanes,
+        value_parser = Settings::SHADOW_CORNER_LANES.parser(),
+    ))]
+    pub shadow_corner_lanes: u32,
     /// Points marched per receiver and cluster with --indirect-shadows and --shadow-grid 0.
     #[cfg_attr(feature = "cli", arg(
         long,
@@ -418,6 +427,7 @@ impl Settings {
         interleave: 1,
         indirect_shadows: false,
         shadow_corners: None,
+        shadow_corner_lanes: 64,
         shadow_steps: 8,
         shadow_thickness: 0.03,
         shadow_grid: 64,
@@ -464,6 +474,8 @@ impl Settings {
     /// The clusters of a cut whose visibility each corner of [`Settings::shadow_corners`] keeps
     /// (a pixel walks to those beyond alone): 4096 bits, 512 bytes a corner.
     pub const SHADOW_CORNER_CLUSTERS: u32 = 4096;
+    /// [`Settings::shadow_corner_lanes`]: a workgroup of 64 threads holds one to eight corners.
+    pub const SHADOW_CORNER_LANES: Limits<u32> = Limits::closed(8, 64);
     /// [`Settings::shadow_steps`].
     pub const SHADOW_STEPS: Limits<u32> = Limits::closed(1, 64);
     /// [`Settings::shadow_thickness`].
@@ -719,6 +731,13 @@ impl Settings {
         if let Some(spacing) = s.shadow_corners {
             Self::SHADOW_CORNERS.check("shadow corners", spacing)?;
         }
+        Self::SHADOW_CORNER_LANES.check("shadow corner lanes", s.shadow_corner_lanes)?;
+        if !s.shadow_corner_lanes.is_power_of_two() {
+            return Err(format!(
+                "shadow corner lanes {} must be a power of two (a workgroup of 64 threads holds a whole number of corners)",
+                s.shadow_corner_lanes
+            ));
+        }
         if s.shadow_corner_bytes() > Self::MAX_SHADOW_CORNER_BYTES {
             return Err(format!(
                 "indirect shadows from corners every {} pixels of a {} picture take {} MiB, over {} MiB: raise the shadow corners' spacing",
@@ -798,6 +817,8 @@ shader_struct! {
         corners_x: u32 = s.shadow_corner_grid().0,
         corners_y: u32 = s.shadow_corner_grid().1,
         corner_words: u32 = s.shadow_corner_words(),
+        /// The threads walking one corner's rays (a workgroup holds 64 / `corner_lanes` corners).
+        corner_lanes: u32 = s.shadow_corner_lanes,
         /// Weight of this frame in the running average of the indirect light (1: no filter).
         temporal_weight: f32 = s.temporal_weight,
         /// Per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its
@@ -858,6 +879,7 @@ mod tests {
             interleave: 4,
             indirect_shadows: true,
             shadow_corners: Some(8),
+            shadow_corner_lanes: 16,
             shadow_steps: 5,
             shadow_thickness: 0.1,
             shadow_grid: 0,

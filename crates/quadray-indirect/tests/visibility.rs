@@ -180,6 +180,18 @@ fn indirect_shadows_bring_the_cut_closer_to_the_ground_truth() {
                     flip_after <= 1.1 * flip_walked,
                     "{what}: FLIP {flip_walked} -> {flip_after}"
                 );
+                // eight corners a workgroup, eight lanes each, walk the same rays: the same
+                // picture (to the order the cut's atomics sum in)
+                let narrow = Settings {
+                    shadow_corner_lanes: 8,
+                    ..shadowed(&tiled)
+                };
+                let narrow = Renderer::new(&gpu, &scene, narrow)
+                    .unwrap()
+                    .render_frame(method)
+                    .unwrap();
+                let apart = compare(&narrow.indirect, &after.indirect).rel_max;
+                assert!(apart < 1e-4, "{what}: 8 lanes a corner: {apart}");
                 // the per-level passes shadow the same clusters the same way as the pixels' own
                 // walks
                 let passes = with.render_frame(Method::QuadtreePasses).unwrap();

@@ -8,6 +8,9 @@ use crate::contract::{bind_group, layout, storage_buffer, storage_entry, whole};
 use crate::gathers::resources::Resources;
 use std::sync::OnceLock;
 
+/// The threads of the corners' workgroup (`CORNER_GROUP` in `corners.wgsl`).
+const CORNER_GROUP: u32 = 64;
+
 /// The corners' pass and shader part: appended to the cut's shader.
 pub(crate) const WGSL: &str = include_str!("corners.wgsl");
 
@@ -96,10 +99,12 @@ impl ShadowCorners {
     pub fn record(&self, pass: &mut wgpu::ComputePass, res: &Resources) {
         self.bind(pass, res);
         if let Some(pipeline) = &self.pipeline {
-            let (x, y) = res.settings().shadow_corner_grid();
+            let s = res.settings();
+            let (x, y) = s.shadow_corner_grid();
+            let corners_a_group = CORNER_GROUP / s.shadow_corner_lanes;
             pass.set_pipeline(pipeline);
             res.bind_dispatch(pass, 0, 0);
-            pass.dispatch_workgroups(x, y, 1);
+            pass.dispatch_workgroups(x.div_ceil(corners_a_group), y, 1);
         }
     }
 }

@@ -58,41 +58,60 @@ fn corner_pixel(c: vec2<u32>) -> vec2<u32> {
     return min(c * shade.shadow_corners, vec2<u32>(viewer.width - 1u, viewer.height - 1u));
 }
 
-var<workgroup> corner_words: array<atomic<u32>, SHADOW_CORNER_WORDS>;
-var<workgroup> corner_fetches: atomic<u32>;
+// A workgroup's corners (64 / `shade.corner_lanes` of them, at most CORNERS_A_GROUP), their
+// words of bits and their walks' fetches.
+const CORNER_GROUP: u32 = 64u;
+const CORNERS_A_GROUP: u32 = 8u;
+var<workgroup> corner_words: array<atomic<u32>, SHADOW_CORNER_WORDS * CORNERS_A_GROUP>;
+var<workgroup> corner_fetches: array<atomic<u32>, CORNERS_A_GROUP>;
 
-// One workgroup a corner: its receiver, and its view of each cluster of the cut (the grid
-// walked, or the depth maps marched, as a pixel's own test).
-@compute @workgroup_size(64)
+// `shade.corner_lanes` threads a corner, 64 / `shade.corner_lanes` corners of a row a
+// workgroup: each corner's receiver, and its view of each cluster of the cut (the grid walked,
+// or the depth maps marched, as a pixel's own test).
+@compute @workgroup_size(CORNER_GROUP)
 fn shadow_corners(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let pixel = corner_pixel(group.xy);
-    let corner = group.y * shade.corners_x + group.x;
+    let lanes = shade.corner_lanes;
+    let slot = local / lanes;
+    let lane = local % lanes;
+    let across = group.x * (CORNER_GROUP / lanes) + slot;
+    // (a row's last workgroup may hold fewer corners than it has room for)
+    let in_row = across < shade.corners_x;
+    let c = vec2<u32>(min(across, shade.corners_x - 1u), group.y);
+    let pixel = corner_pixel(c);
+    let corner = c.y * shade.corners_x + c.x;
     let r = receiver(pixel);
     load_class_starts();
     let clusters = min(class_start[CUT_CLASS_SIDE * CUT_CLASS_SIDE], 32u * shade.corner_words);
-    for (var w = local; w < shade.corner_words; w += 64u) {
-        atomicStore(&corner_words[w], 0u);
+    let words = slot * SHADOW_CORNER_WORDS;
+    for (var w = lane; w < shade.corner_words; w += lanes) {
+        atomicStore(&corner_words[words + w], 0u);
+    }
+    if (lane == 0u) {
+        atomicStore(&corner_fetches[slot], 0u);
     }
     workgroupBarrier();
-    if (r.covered) {
-        for (var rank = local; rank < clusters; rank += 64u) {
+    if (in_row && r.covered) {
+        for (var rank = lane; rank < clusters; rank += lanes) {
             fetches++;
             let node = cut[cut_index(rank)];
             if (lights(node.pos.xyz, node.normal.xyz, r.x, r.n) && visible(r.x, r.n, node.pos.xyz, node.normal.xyz)) {
-                atomicOr(&corner_words[rank / 32u], 1u << (rank % 32u));
+                atomicOr(&corner_words[words + rank / 32u], 1u << (rank % 32u));
             }
         }
     }
-    atomicAdd(&corner_fetches, fetches);
+    atomicAdd(&corner_fetches[slot], fetches);
     workgroupBarrier();
-    for (var w = local; w < shade.corner_words; w += 64u) {
-        corner_bits[corner * shade.corner_words + w] = atomicLoad(&corner_words[w]);
+    if (!in_row) {
+        return;
     }
-    if (local == 0u) {
+    for (var w = lane; w < shade.corner_words; w += lanes) {
+        corner_bits[corner * shade.corner_words + w] = atomicLoad(&corner_words[words + w]);
+    }
+    if (lane == 0u) {
         corner_receivers[2u * corner] = vec4<f32>(r.x, select(0.0, 1.0, r.covered));
         corner_receivers[2u * corner + 1u] = vec4<f32>(r.n, 0.0);
         // (the corner's walks count at its pixel: the gather adds its own after)
-        counts[pixel_index(pixel)] += vec4<u32>(0u, atomicLoad(&corner_fetches), 0u, 0u);
+        counts[pixel_index(pixel)] += vec4<u32>(0u, atomicLoad(&corner_fetches[slot]), 0u, 0u);
     }
 }
 
