@@ -73,6 +73,7 @@ mod cpu_time;
 mod displaced;
 mod render;
 mod scene;
+mod skinned;
 
 pub use cpu_time::{MAIN_WORLD_CPU, RENDER_WORLD_CPU};
 pub use displaced::DISPLACED_TRIANGLES_MAX;

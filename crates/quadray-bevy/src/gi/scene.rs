@@ -3,6 +3,7 @@
 
 use super::cpu_time::CpuTimes;
 use super::displaced::{Albedo, ColourMap, Displacement, append_displaced};
+use super::skinned::Skins;
 use crate::{PyramidMaterial, Pyramids};
 use bevy::asset::AssetEvent;
 use bevy::camera::Hdr;
@@ -66,9 +67,10 @@ pub struct IndirectLightSource;
 /// The scene the lights' RSMs and the occupancy grid are made of: the triangles of every
 /// visible `Mesh3d` in world space (a `StandardMaterial`'s base colour as their albedo; a
 /// `PyramidMaterial`'s displaced surface, see
-/// [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX)), kept per entity, and the marked
-/// lights. An entity's triangles are made anew only when its transform, mesh, material or
-/// visibility changes (or the mesh or material asset it uses does); the render world receives
+/// [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX); a `SkinnedMesh` posed by its
+/// joints as Bevy poses it), kept per entity, and the marked lights. An entity's triangles are
+/// made anew only when its transform, mesh, material or visibility changes (or the mesh or
+/// material asset it uses does, or a joint of its skin moves); the render world receives
 /// the entities that changed. A resource of the main world, to read.
 #[derive(Resource, Default)]
 pub struct IndirectLightScene {
@@ -324,12 +326,13 @@ pub(super) struct Sources<'w, 's> {
 }
 
 /// Makes anew the triangles of the entities that changed (their transform, mesh, material or
-/// visibility, or the assets they use) and hands them to the render world; in a frame where
+/// visibility, their skin's joints, or the assets they use) and hands them to the render world; in a frame where
 /// nothing changed it does nothing more than find that out.
 pub(super) fn collect_triangles(
     objects: Objects,
     changed: Changed3d,
     sources: Sources,
+    mut skins: Skins,
     mut removed: Removed,
     mut scene: ResMut<IndirectLightScene>,
     times: Res<CpuTimes>,
@@ -353,6 +356,7 @@ pub(super) fn collect_triangles(
     dirty.extend(removed.meshes.read());
     dirty.extend(removed.materials.read());
     dirty.extend(removed.displaced.read());
+    dirty.extend(skins.changed());
     let changed_meshes = changed_assets(&mut mesh_events);
     let changed_materials = changed_assets(&mut material_events);
     let mut every_displaced = displaced_events
@@ -387,6 +391,11 @@ pub(super) fn collect_triangles(
         };
         let mut triangles = Vec::new();
         if let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) {
+            let posed = skins.posed(entity, mesh);
+            let (mesh, transform) = match &posed {
+                Some(posed) => (posed, &GlobalTransform::IDENTITY),
+                None => (mesh, transform),
+            };
             if let Some(material) = pyramid.and_then(|m| displaced?.get(&m.0)) {
                 let colour = material
                     .base
@@ -449,7 +458,7 @@ fn changed_assets<A: Asset>(events: &mut MessageReader<AssetEvent<A>>) -> HashSe
 }
 
 /// The asset an event says was added, changed or removed.
-fn changed_asset<A: Asset>(event: &AssetEvent<A>) -> Option<AssetId<A>> {
+pub(super) fn changed_asset<A: Asset>(event: &AssetEvent<A>) -> Option<AssetId<A>> {
     match event {
         AssetEvent::Added { id }
         | AssetEvent::Modified { id }
