@@ -356,7 +356,8 @@ pub(super) fn collect_triangles(
     dirty.extend(removed.meshes.read());
     dirty.extend(removed.materials.read());
     dirty.extend(removed.displaced.read());
-    dirty.extend(skins.changed());
+    let changed_bindposes = changed_assets(&mut skins.bindpose_events);
+    dirty.extend(skins.changed(&changed_bindposes));
     let changed_meshes = changed_assets(&mut mesh_events);
     let changed_materials = changed_assets(&mut material_events);
     let mut every_displaced = displaced_events
@@ -458,7 +459,7 @@ fn changed_assets<A: Asset>(events: &mut MessageReader<AssetEvent<A>>) -> HashSe
 }
 
 /// The asset an event says was added, changed or removed.
-pub(super) fn changed_asset<A: Asset>(event: &AssetEvent<A>) -> Option<AssetId<A>> {
+fn changed_asset<A: Asset>(event: &AssetEvent<A>) -> Option<AssetId<A>> {
     match event {
         AssetEvent::Added { id }
         | AssetEvent::Modified { id }

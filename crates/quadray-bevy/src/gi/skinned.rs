@@ -16,22 +16,21 @@ pub(super) struct Skins<'w, 's> {
     joints: Query<'w, 's, Ref<'static, GlobalTransform>>,
     removed: RemovedComponents<'w, 's, SkinnedMesh>,
     bindposes: Res<'w, Assets<SkinnedMeshInverseBindposes>>,
-    bindpose_events: MessageReader<'w, 's, AssetEvent<SkinnedMeshInverseBindposes>>,
+    pub(super) bindpose_events: MessageReader<'w, 's, AssetEvent<SkinnedMeshInverseBindposes>>,
 }
 
 impl Skins<'_, '_> {
     /// The entities to pose anew: a joint's transform changed, their skin was added, changed or
-    /// taken off, or its inverse bindposes changed (a frame where nothing moved finds none).
-    pub(super) fn changed(&mut self) -> Vec<Entity> {
-        let bindposes: HashSet<AssetId<SkinnedMeshInverseBindposes>> = self
-            .bindpose_events
-            .read()
-            .filter_map(super::scene::changed_asset)
-            .collect();
+    /// taken off, or its inverse bindposes are among the `changed_bindposes` (a frame where
+    /// nothing moved finds none).
+    pub(super) fn changed(
+        &mut self,
+        changed_bindposes: &HashSet<AssetId<SkinnedMeshInverseBindposes>>,
+    ) -> Vec<Entity> {
         let mut changed: Vec<Entity> = self.removed.read().collect();
         changed.extend(self.skins.iter().filter_map(|(entity, skin)| {
             let moved = skin.is_changed()
-                || bindposes.contains(&skin.inverse_bindposes.id())
+                || changed_bindposes.contains(&skin.inverse_bindposes.id())
                 || skin
                     .joints
                     .iter()
