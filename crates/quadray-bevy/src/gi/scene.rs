@@ -326,8 +326,8 @@ pub(super) struct Sources<'w, 's> {
 }
 
 /// Makes anew the triangles of the entities that changed (their transform, mesh, material or
-/// visibility, their skin's joints, or the assets they use) and hands them to the render world; in a frame where
-/// nothing changed it does nothing more than find that out.
+/// visibility, their skin's joints, or the assets they use) and hands them to the render world;
+/// in a frame where nothing changed it does nothing more than find that out.
 pub(super) fn collect_triangles(
     objects: Objects,
     changed: Changed3d,
