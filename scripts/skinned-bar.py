@@ -4,7 +4,8 @@ skinned to two joints (`root` at its foot, `bend` 0.3 up it), under a spot light
 camera in front. The bar's vertices up to 0.2 follow `root`, from 0.4 up `bend`, the ring at 0.3
 half each: turning `bend` bends the bar there. The skinned node `bar` has no transform, so at
 the bind pose its vertices are where the mesh places them (as a reader that ignores skins sees
-the file).
+the file). One morph target, `flare`, widens the bar's top (its top ring and cap 0.05 further out
+along x and z; its weight 0 in the file).
 
     python3 scripts/skinned-bar.py [OUT]
 """
@@ -17,6 +18,7 @@ from pathlib import Path
 
 FOOT = (0.5, 0.0, 0.45)
 HALF_WIDTH = 0.1
+FLARE = 0.05
 RINGS = [i / 10 for i in range(8)]  # 0 to 0.7
 BEND_AT = 0.3
 
@@ -77,7 +79,14 @@ def bar():
     indices += [base, base + 1, base + 2, base, base + 2, base + 3]
     joints = [(0, 1, 0, 0)] * len(positions)
     joint_weights = [(1.0 - w, w, 0.0, 0.0) for w in weights]
-    return positions, normals, joints, joint_weights, indices
+    # the morph target: the top's vertices moved out from the bar's axis
+    flare = [
+        (math.copysign(FLARE, p[0] - x0), 0.0, math.copysign(FLARE, p[2] - z0))
+        if p[1] == top
+        else (0.0, 0.0, 0.0)
+        for p in positions
+    ]
+    return positions, normals, joints, joint_weights, indices, flare
 
 
 class Buffer:
@@ -122,7 +131,7 @@ def main():
         "indices": buffer.add("H", [(k,) for k in i], 5123, "SCALAR", indices),
         "material": 0,
     }
-    p, n, j, w, i = bar()
+    p, n, j, w, i, flare = bar()
     bar_primitive = {
         "attributes": {
             "POSITION": buffer.add("3f", p, 5126, "VEC3", vertices, True),
@@ -132,6 +141,7 @@ def main():
         },
         "indices": buffer.add("H", [(k,) for k in i], 5123, "SCALAR", indices),
         "material": 1,
+        "targets": [{"POSITION": buffer.add("3f", flare, 5126, "VEC3", vertices, True)}],
     }
     # column-major inverses of the joints' bind transforms (translations alone)
     def inverse_translation(t):
@@ -156,7 +166,8 @@ def main():
         "asset": {
             "version": "2.0",
             "generator": "written for quadray by scripts/skinned-bar.py: a red bar skinned to "
-            "two joints (root, bend) in a white room open at the front, under a spot light",
+            "two joints (root, bend), with a morph target (flare), in a white room open at the "
+            "front, under a spot light",
         },
         "extensionsUsed": ["KHR_lights_punctual"],
         "extensions": {
@@ -191,7 +202,12 @@ def main():
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.872664626, "znear": 0.01}}],
         "meshes": [
             {"name": "room", "primitives": [room_primitive]},
-            {"name": "bar", "primitives": [bar_primitive]},
+            {
+                "name": "bar",
+                "primitives": [bar_primitive],
+                "weights": [0.0],
+                "extras": {"targetNames": ["flare"]},
+            },
         ],
         "materials": [
             {

@@ -3,9 +3,11 @@
 //! spot. At the bind pose the plugin's bounce is quadray's own on the same file; with the joint
 //! `bend` turned, the plugin poses the bar as Bevy draws it (its triangles the bar turned about the
 //! joint by each vertex's weight), makes it alone anew, and its bounce is quadray's over the posed
-//! bar: the red it casts on the wall it bent away from fades as in quadray's.
+//! bar: the red it casts on the wall it bent away from fades as in quadray's. Its morph target's
+//! weight set, the bar alone is made anew again, morphed and then bent.
 
 use bevy::mesh::VertexAttributeValues;
+use bevy::mesh::morph::MorphWeights;
 use bevy::mesh::skinning::SkinnedMesh;
 use bevy::prelude::*;
 use quadray_bevy::gi::IndirectLightScene;
@@ -24,10 +26,17 @@ const RSM: u32 = 32;
 /// The turn of the joint `bend` about its z axis: the bar's top bends towards +x.
 const BEND_DEG: f32 = -60.0;
 
-/// The bar's triangles as the bind pose's mesh turned by `turn` about `pivot`, each vertex by its
-/// weight on the joint `bend` (the skin's second joint; the first, `root`, stays still): the
-/// positions blended, the normals by the inverse transpose of the blended matrix. With `albedo`.
-fn bent_bar(mesh: &Mesh, pivot: Vec3, turn: Quat, albedo: [f32; 3]) -> Vec<[Vertex; 3]> {
+/// The bar's triangles as the bind pose's mesh, its morph target `flare` added `flare` times,
+/// turned by `turn` about `pivot`, each vertex by its weight on the joint `bend` (the skin's second
+/// joint; the first, `root`, stays still): the positions blended, the normals by the inverse
+/// transpose of the blended matrix. With `albedo`.
+fn bent_bar(
+    mesh: &Mesh,
+    flare: f32,
+    pivot: Vec3,
+    turn: Quat,
+    albedo: [f32; 3],
+) -> Vec<[Vertex; 3]> {
     let Some(VertexAttributeValues::Float32x3(positions)) =
         mesh.attribute(Mesh::ATTRIBUTE_POSITION)
     else {
@@ -42,8 +51,12 @@ fn bent_bar(mesh: &Mesh, pivot: Vec3, turn: Quat, albedo: [f32; 3]) -> Vec<[Vert
     else {
         panic!("the bar has joint weights")
     };
+    let targets = mesh
+        .get_morph_targets()
+        .expect("the bar has a morph target");
     let vertex = |i: usize| {
-        let (p, w) = (Vec3::from(positions[i]), weights[i][1]);
+        let p = Vec3::from(positions[i]) + flare * targets[i].position;
+        let w = weights[i][1];
         let turned = pivot + turn * (p - pivot);
         let blend = Mat3::IDENTITY * (1.0 - w) + Mat3::from_quat(turn) * w;
         let n = (blend.inverse().transpose() * Vec3::from(normals[i])).normalize();
@@ -118,7 +131,7 @@ fn a_skinned_mesh_s_bounce_moves_with_its_joints() {
     };
     let bind_triangles = held(&app);
     let red = bind_triangles[0][0].albedo;
-    let unbent = bent_bar(&mesh, pivot, Quat::IDENTITY, red);
+    let unbent = bent_bar(&mesh, 0.0, pivot, Quat::IDENTITY, red);
     let (position, normal) = largest_differences(&bind_triangles, &unbent);
     assert!(position < 1e-5 && normal < 1e-5, "{position} {normal}");
 
@@ -149,7 +162,7 @@ fn a_skinned_mesh_s_bounce_moves_with_its_joints() {
         made + bind_triangles.len() as u64,
         "the bar alone made anew"
     );
-    let bent = bent_bar(&mesh, pivot, turn, red);
+    let bent = bent_bar(&mesh, 0.0, pivot, turn, red);
     let posed = held(&app);
     let (moved, _) = largest_differences(&posed, &bind_triangles);
     let (position, normal) = largest_differences(&posed, &bent);
@@ -181,4 +194,28 @@ fn a_skinned_mesh_s_bounce_moves_with_its_joints() {
         fades < 0.9 && (fades - quadray_fades).abs() < 0.02,
         "{fades} {quadray_fades}"
     );
+
+    // the morph target `flare` weighed in (on the glTF node the mesh refers to): the bar alone
+    // made anew, morphed, then bent
+    let world = app.world_mut();
+    let scene = world.resource::<IndirectLightScene>();
+    let (generation, made) = (scene.generation(), scene.triangles_made());
+    let mut weights = world.query::<(&Name, &mut MorphWeights)>();
+    let (_, mut node) = weights
+        .iter_mut(world)
+        .find(|(name, _)| name.as_str() == "bar")
+        .unwrap();
+    node.weights_mut()[0] = 1.0;
+    app.update();
+    let scene = app.world().resource::<IndirectLightScene>();
+    assert_eq!(scene.generation(), generation + 1, "one update");
+    assert_eq!(scene.triangles_made(), made + posed.len() as u64);
+    let flared = held(&app);
+    let (moved, _) = largest_differences(&flared, &posed);
+    let (position, normal) = largest_differences(&flared, &bent_bar(&mesh, 1.0, pivot, turn, red));
+    println!(
+        "flared: moved up to {moved:.3}, off the reference by {position:.2e} (positions) and \
+         {normal:.2e} (normals)"
+    );
+    assert!(moved > 0.05 && position < 1e-5 && normal < 1e-5);
 }

@@ -4,14 +4,14 @@
 use quadray_test_support::layering::assert_layered;
 
 /// Every module, by layer, bottom first: the pyramid image, the material at the root, the
-/// displaced surfaces' triangles, the skinned meshes' poses and the indirect light's CPU times,
+/// displaced surfaces' triangles, the skinned and morphed meshes' poses and the indirect light's CPU times,
 /// its main-world side (which reads the materials and those), then its render-world side by
 /// phase (the pipelines made at startup, the scene's triangles, the lights' and the cameras'
 /// prepare, the passes), and the plugin that adds both.
 const LAYERS: &[&[&str]] = &[
     &["pyramid_image"],
     &[""],
-    &["gi::cpu_time", "gi::displaced", "gi::skinned"],
+    &["gi::cpu_time", "gi::displaced", "gi::posed"],
     &["gi::scene"],
     &["gi::render::pipelines"],
     &["gi::render::triangles"],

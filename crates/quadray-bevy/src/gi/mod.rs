@@ -37,12 +37,12 @@
 //! colour (textures are not read), a [`PyramidMaterial`](crate::PyramidMaterial)'s displaced
 //! surface (its height field cut into triangles, at most [`DISPLACED_TRIANGLES_MAX`] a mesh) in
 //! its base colour times its colour texture (read on the CPU where the image keeps its data; its
-//! base colour alone where not); a skinned mesh (`SkinnedMesh`) posed by its joints as Bevy's
-//! vertex shader poses it (linear blend skinning in world space; morph targets are not applied:
-//! a morphed mesh enters at its base shape); the same triangles make the occupancy grid of
-//! indirect shadows ([`IndirectLightScene`] holds them, by entity). The scene is kept up to date
-//! by what changed: an entity's triangles are made anew when its transform, mesh, material or
-//! visibility changes (or the mesh or material asset it uses, or a joint of its skin moves), and
+//! base colour alone where not); a skinned or morphed mesh posed as Bevy's vertex shader poses
+//! it (its `MeshMorphWeights` applied, then linear blend skinning in world space); the same
+//! triangles make the occupancy grid of indirect shadows ([`IndirectLightScene`] holds them, by
+//! entity). The scene is kept up to date by what changed: an entity's triangles are made anew
+//! when its transform, mesh, material or visibility changes (or the mesh or material asset it
+//! uses, a joint of its skin moves or its morph weights change), and
 //! only those reach the render world, which writes them into the entity's range of one vertex
 //! buffer and moves them in the occupancy grid (made anew only when the scene leaves the grid's
 //! bounds); a frame in which nothing changed does no scene work ([`SceneWork`] counts the render
@@ -74,9 +74,9 @@
 
 mod cpu_time;
 mod displaced;
+mod posed;
 mod render;
 mod scene;
-mod skinned;
 
 pub use cpu_time::{MAIN_WORLD_CPU, RENDER_WORLD_CPU};
 pub use displaced::DISPLACED_TRIANGLES_MAX;
