@@ -148,6 +148,11 @@ fn the_gi_program_renders_a_users_gltf_and_refuses_what_it_cannot_use() {
         &["--gi-lights", "area"],
         "invalid value 'area' for '--gi-lights",
     );
+    refused(&["--turn-node", "bend"], "\"bend\" is not NAME:DEGREES");
+    refused(
+        &["--turn-node", "bend:inf"],
+        "\"inf\" in \"bend:inf\" is not a finite number of degrees",
+    );
 }
 
 /// `--ev100` exposes the picture as Bevy's `Exposure` does, for Bevy's light and the bounce

@@ -228,7 +228,7 @@ pub(crate) fn app_without_plugin(scene: &'static str, cases: &[Case]) -> App {
     )
 }
 
-fn app_of(
+pub(crate) fn app_of(
     scene: &'static str,
     cases: &[Case],
     settings: Settings,
@@ -385,7 +385,7 @@ fn quadray_renderer_from<'g>(
 }
 
 /// quadray's scene of `file` seen from `view` (`None`: the file's camera).
-fn scene_from(file: &str, view: Option<([f32; 3], [f32; 3])>) -> Scene {
+pub(crate) fn scene_from(file: &str, view: Option<([f32; 3], [f32; 3])>) -> Scene {
     let mut scene = Scene::load(&std::path::Path::new(ASSETS).join(file)).unwrap();
     if let Some((eye, target)) = view {
         scene.camera.position = eye.into();
@@ -395,7 +395,7 @@ fn scene_from(file: &str, view: Option<([f32; 3], [f32; 3])>) -> Scene {
 }
 
 /// quadray's radiance in the plugin's units: candela (Bevy's) where quadray's are W/sr (cd / 683).
-fn in_candela(image: Vec<[f32; 3]>) -> Vec<[f32; 3]> {
+pub(crate) fn in_candela(image: Vec<[f32; 3]>) -> Vec<[f32; 3]> {
     let cd = quadray_core::scene::LUMENS_PER_WATT;
     image.into_iter().map(|p| p.map(|c| c * cd)).collect()
 }

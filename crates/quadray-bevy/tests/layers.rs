@@ -4,14 +4,15 @@
 use quadray_test_support::layering::assert_layered;
 
 /// Every module, by layer, bottom first: the pyramid image, the material at the root, the
-/// displaced surfaces' triangles and the base colour textures, the indirect light's main-world
-/// side (which reads the materials) and its CPU times, then its render-world side by phase (the
-/// pipelines made at startup, the scene's triangles, the lights' and the cameras' prepare, the
-/// passes), and the plugin that adds both.
+/// displaced surfaces' triangles, the base colour textures, the skinned and morphed meshes'
+/// poses and the indirect light's CPU times, its main-world side (which reads the materials and
+/// those), then its render-world side by phase (the pipelines, the scene's triangles, the
+/// lights' and the cameras' prepare, the passes), and the plugin that adds both.
 const LAYERS: &[&[&str]] = &[
     &["pyramid_image"],
     &[""],
-    &["gi::cpu_time", "gi::displaced", "gi::textures", "gi::scene"],
+    &["gi::cpu_time", "gi::displaced", "gi::textures", "gi::posed"],
+    &["gi::scene"],
     &["gi::render::pipelines"],
     &["gi::render::triangles"],
     &["gi::render::light"],

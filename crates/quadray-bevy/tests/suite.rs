@@ -6,6 +6,7 @@ mod common;
 mod gi;
 mod gi_displaced;
 mod gi_scene;
+mod gi_skinned;
 mod hits;
 mod layers;
 mod lifecycle;

@@ -39,6 +39,7 @@ fn every_bundled_scene_file_loads() {
         ("shadows-bunny.toml", 3, 0, 2, 1),
         ("shadows-cornell.toml", 3, 0, 1, 0),
         ("shadows-demo.toml", 2, 0, 4, 3),
+        ("skinned_bar.gltf", 1, 1, 1, 0),
         ("textured_floor.gltf", 1, 1, 1, 0),
         ("visibility-corridor.toml", 1, 1, 10, 3),
         ("visibility-door.gltf", 1, 1, 1, 0),

@@ -29,7 +29,10 @@
 //! meshes (`large_scene.rs`), `--move-node NAME` moves a node of the scene every frame (the
 //! large scene's `mover`), and `--frames` then prints the medians of the plugin's CPU time in
 //! each world (`quadray_gi/main_world_cpu`, `quadray_gi/render_world_cpu`) beside its GPU
-//! passes'. `--help` lists the flags; an unknown one is refused.
+//! passes'. `--turn-node NAME:DEGREES` turns a node about its own z axis once it is loaded: a
+//! joint of a skinned mesh bends the mesh, and the bounce with it
+//! (`--scene assets/scenes/skinned_bar.gltf --turn-node bend:-60`). `--help` lists the flags; an
+//! unknown one is refused.
 
 use bevy::camera::{Exposure, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -146,6 +149,11 @@ struct Args {
     /// stands), its meshes with it.
     #[arg(long, value_name = "NAME")]
     move_node: Option<String>,
+    /// Turn the scene's node of this name about its own z axis by this many degrees (counter-
+    /// clockwise seen from its +z), once it is loaded: a joint of a skinned mesh bends the mesh
+    /// (`skinned_bar.gltf`'s `bend`).
+    #[arg(long, value_name = "NAME:DEGREES", value_parser = parse_turned_node)]
+    turn_node: Option<TurnedNode>,
     /// Bevy's shadow maps on the scene file's lights, which Bevy's glTF loader leaves off: the
     /// direct light's shade, where the bounce is all the light there is (a sunlit scene's).
     #[arg(long, conflicts_with = "displaced")]
@@ -179,6 +187,29 @@ enum Shows {
 /// The node `--move-node` names.
 #[derive(Resource)]
 struct MovedNode(String);
+
+/// The node `--turn-node` names and its turn.
+#[derive(Resource, Clone)]
+struct TurnedNode {
+    name: String,
+    degrees: f32,
+}
+
+fn parse_turned_node(text: &str) -> Result<TurnedNode, String> {
+    let (name, degrees) = text
+        .rsplit_once(':')
+        .filter(|(name, _)| !name.is_empty())
+        .ok_or_else(|| format!("{text:?} is not NAME:DEGREES"))?;
+    let degrees: f32 = degrees
+        .parse()
+        .ok()
+        .filter(|d: &f32| d.is_finite())
+        .ok_or_else(|| format!("{degrees:?} in {text:?} is not a finite number of degrees"))?;
+    Ok(TurnedNode {
+        name: name.to_string(),
+        degrees,
+    })
+}
 
 fn main() {
     let mut args = Args::parse();
@@ -230,6 +261,9 @@ fn main() {
         app.insert_resource(MovedNode(name))
             .add_systems(Update, move_node);
     }
+    if let Some(turned) = args.turn_node {
+        app.insert_resource(turned).add_systems(Update, turn_node);
+    }
     app.run();
 }
 
@@ -274,6 +308,23 @@ fn move_node(
     *frame += 1;
     let turn = *frame as f32 * 0.1;
     transform.translation = start + 2.0 * Vec3::new(turn.cos() - 1.0, 0.0, turn.sin());
+}
+
+/// Turns the nodes `--turn-node` names about their z axis, in the first frame they are there.
+fn turn_node(
+    turned: Res<TurnedNode>,
+    mut nodes: Query<(&Name, &mut Transform)>,
+    mut done: Local<bool>,
+) {
+    if *done {
+        return;
+    }
+    for (name, mut transform) in &mut nodes {
+        if name.as_str() == turned.name {
+            transform.rotate_local_z(turned.degrees.to_radians());
+            *done = true;
+        }
+    }
 }
 
 /// The EV100s `--ev100` takes: from a starlit night to well beyond a sunlit snowfield.

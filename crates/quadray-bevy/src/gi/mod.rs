@@ -40,16 +40,19 @@
 //! warning), a [`PyramidMaterial`](crate::PyramidMaterial)'s displaced
 //! surface (its height field cut into triangles, at most [`DISPLACED_TRIANGLES_MAX`] a mesh) in
 //! its base colour times its colour texture (read on the CPU where the image keeps its data; its
-//! base colour alone where not); the same triangles make the occupancy grid of indirect shadows
-//! ([`IndirectLightScene`] holds them, by entity). The scene is kept up to date by what
-//! changed: an entity's triangles are made anew when its transform, mesh, material or
-//! visibility changes (or the mesh, material or texture asset it uses), and only those reach the render
-//! world, which writes them into the entity's range of one vertex buffer and moves them in the
-//! occupancy grid (made anew only when the scene leaves the grid's bounds); a frame in which
-//! nothing changed does no scene work ([`SceneWork`] counts the render world's). A moving light,
-//! or a change to the scene, redraws the RSM, the pyramid and the cut; a still light and a moving
-//! camera reuse them. Each camera gathers every frame: Bevy's G-buffer changes without the camera
-//! moving (a mesh's pipeline compiled frames after it loaded, render layers switched).
+//! base colour alone where not); a skinned or morphed mesh posed as Bevy's vertex shader poses
+//! it (its `MeshMorphWeights` applied, then linear blend skinning in world space); the same
+//! triangles make the occupancy grid of indirect shadows ([`IndirectLightScene`] holds them, by
+//! entity). The scene is kept up to date by what changed: an entity's triangles are made anew
+//! when its transform, mesh, material or visibility changes (or the mesh, material or texture
+//! asset it uses, a joint of its skin moves or its morph weights change), and only those reach
+//! the render world, which writes them into the entity's range of one vertex buffer and moves
+//! them in the occupancy grid (made anew only when the scene leaves the grid's bounds); a frame
+//! in which nothing changed does no scene work ([`SceneWork`] counts the render world's). A
+//! moving light, or a change to the scene, redraws the RSM, the pyramid and the cut; a still
+//! light and a moving camera reuse them. Each camera gathers every frame: Bevy's G-buffer
+//! changes without the camera moving (a mesh's pipeline compiled frames after it loaded, render
+//! layers switched).
 //!
 //! Units: the lights' intensities are Bevy's (a point or spot light's luminous power in lumens,
 //! its luminous intensity that over 4 pi, as Bevy lights it; a directional light's illuminance
@@ -74,6 +77,7 @@
 
 mod cpu_time;
 mod displaced;
+mod posed;
 mod render;
 mod scene;
 mod textures;

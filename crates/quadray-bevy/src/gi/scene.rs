@@ -3,6 +3,7 @@
 
 use super::cpu_time::CpuTimes;
 use super::displaced::{Albedo, ColourMap, Displacement, append_displaced};
+use super::posed::Poses;
 use super::textures::BaseColours;
 use crate::{PyramidMaterial, Pyramids};
 use bevy::asset::AssetEvent;
@@ -69,10 +70,11 @@ pub struct IndirectLightSource;
 /// visible `Mesh3d` in world space (a `StandardMaterial`'s base colour as their albedo, times its
 /// base colour texture at their uv, the textures kept as the layers of one array; a
 /// `PyramidMaterial`'s displaced surface, see
-/// [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX)), kept per entity, and the marked
-/// lights. An entity's triangles are made anew only when its transform, mesh, material or
-/// visibility changes (or the mesh, material or texture asset it uses does); the render world receives
-/// the entities that changed. A resource of the main world, to read.
+/// [`DISPLACED_TRIANGLES_MAX`](super::DISPLACED_TRIANGLES_MAX); a skinned or morphed mesh posed
+/// as Bevy poses it), kept per entity, and the marked lights. An entity's triangles are made
+/// anew only when its transform, mesh, material or visibility changes (or the mesh, material or
+/// texture asset it uses does, a joint of its skin moves or its morph weights change); the
+/// render world receives the entities that changed. A resource of the main world, to read.
 #[derive(Resource, Default)]
 pub struct IndirectLightScene {
     /// Every `Mesh3d` entity, its triangles empty while its mesh is not loaded or it is hidden.
@@ -338,12 +340,13 @@ pub(super) struct Sources<'w, 's> {
 }
 
 /// Makes anew the triangles of the entities that changed (their transform, mesh, material or
-/// visibility, or the assets they use) and hands them to the render world; in a frame where
-/// nothing changed it does nothing more than find that out.
+/// visibility, their skin's joints or morph weights, or the assets they use) and hands them to
+/// the render world; in a frame where nothing changed it does nothing more than find that out.
 pub(super) fn collect_triangles(
     objects: Objects,
     changed: Changed3d,
     sources: Sources,
+    mut poses: Poses,
     mut removed: Removed,
     mut scene: ResMut<IndirectLightScene>,
     times: Res<CpuTimes>,
@@ -367,6 +370,8 @@ pub(super) fn collect_triangles(
     dirty.extend(removed.meshes.read());
     dirty.extend(removed.materials.read());
     dirty.extend(removed.displaced.read());
+    let changed_bindposes = changed_assets(&mut poses.bindpose_events);
+    dirty.extend(poses.changed(&changed_bindposes));
     let changed_meshes = changed_assets(&mut mesh_events);
     let changed_materials = changed_assets(&mut material_events);
     let mut every_displaced = displaced_events
@@ -414,6 +419,12 @@ pub(super) fn collect_triangles(
         let image = standard.and_then(|m| m.base_color_texture.as_ref());
         let mut texture = None;
         if let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) {
+            let posed = poses.posed(entity, mesh);
+            let (mesh, transform) = match &posed {
+                Some(posed) if posed.in_world => (&posed.mesh, &GlobalTransform::IDENTITY),
+                Some(posed) => (&posed.mesh, transform),
+                None => (mesh, transform),
+            };
             if let Some(material) = pyramid.and_then(|m| displaced?.get(&m.0)) {
                 let colour = material
                     .base
