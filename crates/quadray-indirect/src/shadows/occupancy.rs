@@ -79,6 +79,13 @@ pub struct OccupancyGrid {
     counts: Counts,
 }
 
+/// What [`OccupancyGrid::add_tracked`] counted: per cell (by its bit index) and, with two
+/// levels, per sub-cell (its bit in the cell's masks), how many of the triangles overlap it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Footprint {
+    counts: Vec<(usize, u8, u32)>,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 struct SubCells {
     first: Vec<u32>,
@@ -200,33 +207,116 @@ impl OccupancyGrid {
         self.update(triangles, false);
     }
 
+    /// Adds `triangles` as [`Self::add`] does, and returns what they counted in each cell (each
+    /// sub-cell), so that [`Self::remove_footprint`] takes them out again without testing them
+    /// against the cells anew: an object that moves costs its new triangles' tests alone.
+    pub fn add_tracked(&mut self, triangles: &[[Vertex; 3]]) -> Footprint {
+        let mut hits = Vec::new();
+        self.counted(triangles, true, Some(&mut hits));
+        hits.sort_unstable();
+        let mut footprint = Footprint::default();
+        for hit in hits {
+            match footprint.counts.last_mut() {
+                Some((cell, sub, n)) if (*cell, *sub) == hit => *n += 1,
+                _ => footprint.counts.push((hit.0, hit.1, 1)),
+            }
+        }
+        footprint
+    }
+
+    /// Takes out of this grid the triangles [`Self::add_tracked`] added to it and returned
+    /// `footprint` for: a cell (a sub-cell) no other triangle overlaps is cleared, as
+    /// [`Self::remove`] of those triangles would.
+    pub fn remove_footprint(&mut self, footprint: &Footprint) {
+        let mut flips = 0;
+        for same_cell in footprint.counts.chunk_by(|a, b| a.0 == b.0) {
+            let index = same_cell[0].0;
+            let (word, bit) = (index / 32, (index % 32) as u32);
+            let (set, masks_changed) = match &mut self.counts {
+                Counts::Cells(counts) => {
+                    let count = counts.entry(index).or_insert(0);
+                    *count = count.saturating_sub(same_cell.iter().map(|h| h.2).sum());
+                    (*count > 0, false)
+                }
+                Counts::SubCells(counts) => {
+                    let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
+                    let mut changed = false;
+                    for &(_, sub, n) in same_cell {
+                        let count = &mut cell[usize::from(sub)];
+                        let was = *count > 0;
+                        *count = count.saturating_sub(n);
+                        changed |= was != (*count > 0);
+                    }
+                    let set = match changed {
+                        true => cell.iter().any(|&n| n > 0),
+                        false => self.bits[word] >> bit & 1 == 1,
+                    };
+                    (set, changed)
+                }
+            };
+            if !set {
+                self.forget(index);
+            }
+            self.follow(index, set, masks_changed, &mut flips);
+        }
+        if flips > FOLLOWED_FLIPS {
+            self.compact();
+        }
+    }
+
     /// Counts `triangles` in or out, and sets and clears the cells that gained their first or
     /// lost their last triangle. The sub-cells' words follow each change (a set cell's words
     /// inserted at its place, the bricks after it moved on by one) while few cells are set or
     /// cleared; past [`FOLLOWED_FLIPS`] they are compacted anew once, at the end.
     fn update(&mut self, triangles: &[[Vertex; 3]], added: bool) {
+        self.counted(triangles, added, None);
+    }
+
+    /// [`Self::update`], noting in `hits` each cell (one level) or sub-cell (two levels, its
+    /// bit in the cell's masks) each triangle was counted in.
+    fn counted(
+        &mut self,
+        triangles: &[[Vertex; 3]],
+        added: bool,
+        mut hits: Option<&mut Vec<(usize, u8)>>,
+    ) {
         let mut cells = Vec::new();
         let mut flips = 0;
         for t in triangles {
             let t = t.map(|v| (Vec3::from(v.position) - self.origin) / self.cell);
-            self.count_triangle(t, added, &mut cells);
+            self.count_triangle(t, added, &mut cells, hits.as_deref_mut());
             for &(index, set, masks_changed) in &cells {
-                let (word, bit) = (index / 32, (index % 32) as u32);
-                if set != (self.bits[word] >> bit & 1 == 1) {
-                    self.bits[word] ^= 1 << bit;
-                    flips += 1;
-                    if flips <= FOLLOWED_FLIPS {
-                        self.follow_flip(word, bit, set);
-                    }
-                } else if set && masks_changed && flips <= FOLLOWED_FLIPS {
-                    self.follow_masks(word, bit);
-                }
+                self.follow(index, set, masks_changed, &mut flips);
             }
             cells.clear();
         }
         if flips > FOLLOWED_FLIPS {
             self.compact();
         }
+    }
+
+    /// Sets or clears cell `index`'s bit to `set` and, while `flips` (the cells set or cleared
+    /// so far) is at most [`FOLLOWED_FLIPS`], the sub-cells' words with it (its masks anew where
+    /// `masks_changed`).
+    fn follow(&mut self, index: usize, set: bool, masks_changed: bool, flips: &mut usize) {
+        let (word, bit) = (index / 32, (index % 32) as u32);
+        if set != (self.bits[word] >> bit & 1 == 1) {
+            self.bits[word] ^= 1 << bit;
+            *flips += 1;
+            if *flips <= FOLLOWED_FLIPS {
+                self.follow_flip(word, bit, set);
+            }
+        } else if set && masks_changed && *flips <= FOLLOWED_FLIPS {
+            self.follow_masks(word, bit);
+        }
+    }
+
+    /// Drops cell `index`'s counts (no triangle over it any more).
+    fn forget(&mut self, index: usize) {
+        match &mut self.counts {
+            Counts::Cells(counts) => counts.remove(&index).map(|_| ()),
+            Counts::SubCells(counts) => counts.remove(&index).map(|_| ()),
+        };
     }
 
     /// A set cell's place among the set cells (its words in the sub-cells' masks).
@@ -456,8 +546,15 @@ impl OccupancyGrid {
 
     /// Counts the triangle (in grid units) in or out of every cell it overlaps (with two
     /// levels, of every sub-cell of those); notes in `cells` each such cell, whether it is now
-    /// set (a triangle over it) and whether its sub-cells were set or cleared.
-    fn count_triangle(&mut self, t: [Vec3; 3], added: bool, cells: &mut Vec<(usize, bool, bool)>) {
+    /// set (a triangle over it) and whether its sub-cells were set or cleared; and in `hits`
+    /// each cell (sub-cell) counted.
+    fn count_triangle(
+        &mut self,
+        t: [Vec3; 3],
+        added: bool,
+        cells: &mut Vec<(usize, bool, bool)>,
+        mut hits: Option<&mut Vec<(usize, u8)>>,
+    ) {
         if !t.iter().all(|v| v.is_finite()) {
             return;
         }
@@ -484,11 +581,19 @@ impl OccupancyGrid {
                         Counts::Cells(counts) => {
                             let count = counts.entry(index).or_insert(0);
                             *count = step(*count, added);
+                            if let Some(hits) = hits.as_deref_mut() {
+                                hits.push((index, 0));
+                            }
                             (*count > 0, false)
                         }
                         Counts::SubCells(counts) => {
                             let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
-                            let changed = count_subcells(t, &test, c, cell, added);
+                            let counted = |sub: usize| {
+                                if let Some(hits) = hits.as_deref_mut() {
+                                    hits.push((index, sub as u8));
+                                }
+                            };
+                            let changed = count_subcells(t, &test, c, cell, added, counted);
                             // no sub-cell set or cleared: the cell is as it was
                             let set = match changed {
                                 true => cell.iter().any(|&n| n > 0),
@@ -498,10 +603,7 @@ impl OccupancyGrid {
                         }
                     };
                     if !set {
-                        match &mut self.counts {
-                            Counts::Cells(counts) => counts.remove(&index).map(|_| ()),
-                            Counts::SubCells(counts) => counts.remove(&index).map(|_| ()),
-                        };
+                        self.forget(index);
                     }
                     cells.push((index, set, masks_changed));
                 }
@@ -527,6 +629,7 @@ fn count_subcells(
     c: IVec3,
     cell: &mut [u32; SUBCELL_COUNT],
     added: bool,
+    mut counted: impl FnMut(usize),
 ) -> bool {
     let k = SUBCELLS as f32;
     let first = c * SUBCELLS as i32;
@@ -546,6 +649,7 @@ fn count_subcells(
                 let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
                 if test.overlaps((low + high) * 0.5, (high - low) * 0.5) {
                     let (w, b) = sub_bit(sub_cell(s));
+                    counted(w * 32 + b as usize);
                     let count = &mut cell[w * 32 + b as usize];
                     let was = *count > 0;
                     *count = step(*count, added);
@@ -1035,6 +1139,19 @@ mod tests {
             assert_eq!(grid.occupied_count(), 0, "{levels} levels");
             let empty = OccupancyGrid::empty(at_once.bounds(), 32, levels);
             assert!(grid == empty, "{levels} levels");
+            // the post taken out by its footprint, not its triangles: the same grids
+            let mut tracked = empty.clone();
+            tracked.add(&scene);
+            let footprint = tracked.add_tracked(&before);
+            let mut removed = tracked.clone();
+            removed.remove(&before);
+            tracked.remove_footprint(&footprint);
+            assert!(tracked == removed, "{levels} levels: out by its footprint");
+            let footprint = tracked.add_tracked(&after);
+            assert!(tracked == at_once, "{levels} levels: in again");
+            tracked.remove_footprint(&footprint);
+            tracked.add(&before);
+            assert_eq!(tracked.gpu_words(), old, "{levels} levels: back");
         }
     }
 

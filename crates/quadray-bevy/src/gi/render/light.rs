@@ -1,14 +1,13 @@
 //! Prepare, the lights' side shared by every camera: per light view an RSM over the scene's
 //! triangles and the light quadtree over it, and the scene's vertex buffer and occupancy grid.
 
-use super::triangles::{SceneBuffer, SceneChanges, SceneMirror, SceneWork, update_grid};
+use super::triangles::{SceneBuffer, SceneChanges, SceneGrid, SceneMirror, SceneWork};
 use crate::gi::cpu_time::CpuTimes;
 use crate::gi::scene::IndirectLight;
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use quadray_indirect::scene::Light;
-use quadray_indirect::shadows::occupancy::OccupancyGrid;
 use quadray_indirect::{GBufferLayout, LightQuadtree, RsmPass, Settings, TextureArray};
 use quadray_indirect::{LightView, ViewMaps};
 
@@ -50,7 +49,7 @@ pub(super) struct LightPasses {
     /// indirect shadows, or at 0 cells: the gathers march the depth maps), and how many times
     /// it changed. Updated by the entities that changed; made anew over the scene's bounds
     /// when one leaves the grid's.
-    pub(super) occupancy: Option<OccupancyGrid>,
+    pub(super) occupancy: Option<SceneGrid>,
     pub(super) occupancy_cells: (u32, u32),
     pub(super) occupancy_generation: u64,
 }
@@ -174,7 +173,7 @@ pub(super) fn prepare_light(
                 l.scene = SceneBuffer::new(device, &queue, &mirror, work);
             }
             if let Some(grid) = l.occupancy.as_mut().filter(|_| grid_current) {
-                grid_current = update_grid(grid, &mirror, changed, work);
+                grid_current = grid.update(&mirror, changed, work);
                 l.occupancy_generation += 1;
             }
         }
@@ -199,9 +198,7 @@ pub(super) fn prepare_light(
     if !grid_current {
         l.occupancy = (cells > 0).then(|| {
             work.grids_made += 1;
-            let mut grid = OccupancyGrid::empty(mirror.bounds(), cells, levels);
-            grid.add(&mirror.triangles());
-            grid
+            SceneGrid::new(&mirror, cells, levels)
         });
         l.occupancy_cells = (cells, levels);
         l.occupancy_generation += 1;

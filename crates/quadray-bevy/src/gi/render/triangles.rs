@@ -8,7 +8,7 @@ use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::Extract;
 use quadray_indirect::scene::{Light, SceneTextures, Vertex};
-use quadray_indirect::shadows::occupancy::OccupancyGrid;
+use quadray_indirect::shadows::occupancy::{Footprint, OccupancyGrid};
 use std::ops::Range;
 use std::sync::Arc;
 
@@ -60,14 +60,6 @@ impl SceneMirror {
             .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), o| {
                 (lo.min(o.bounds().0), hi.max(o.bounds().1))
             })
-    }
-
-    /// Every triangle, entity after entity (for a grid made anew).
-    pub(super) fn triangles(&self) -> Vec<[Vertex; 3]> {
-        self.objects
-            .values()
-            .flat_map(|o| o.triangles().iter().copied())
-            .collect()
     }
 }
 
@@ -279,31 +271,55 @@ impl SceneBuffer {
     }
 }
 
-/// Brings the occupancy grid up to the changed entities: their triangles now in, theirs
-/// before out; `false` where one now lies outside the grid's bounds (the grid is to be made anew).
-pub(super) fn update_grid(
-    grid: &mut OccupancyGrid,
-    mirror: &SceneMirror,
-    changed: &HashMap<Entity, Option<Arc<ObjectTriangles>>>,
-    work: &mut SceneWork,
-) -> bool {
-    let (lo, hi) = grid.bounds();
-    let inside = |o: &ObjectTriangles| o.bounds().0.cmpge(lo).all() && o.bounds().1.cmple(hi).all();
-    let now = |entity| mirror.objects.get(entity).map(|o| o.as_ref());
-    if !changed.keys().filter_map(now).all(inside) {
-        return false;
+/// The scene's occupancy grid, and what each entity's triangles counted in it, so that an
+/// entity that changed is taken out by its footprint, not tested against the cells again.
+pub(super) struct SceneGrid {
+    pub(super) grid: OccupancyGrid,
+    footprints: HashMap<Entity, Footprint>,
+}
+
+impl SceneGrid {
+    /// The grid of every triangle of `mirror`, `cells` cells along its bounds' longest side.
+    pub(super) fn new(mirror: &SceneMirror, cells: u32, levels: u32) -> Self {
+        let mut grid = OccupancyGrid::empty(mirror.bounds(), cells, levels);
+        let footprints = mirror
+            .objects
+            .iter()
+            .map(|(entity, object)| (*entity, grid.add_tracked(object.triangles())))
+            .collect();
+        Self { grid, footprints }
     }
-    // in before out: the cells an object covers before and after keep a triangle throughout,
-    // so they are not cleared and set again
-    for (entity, before) in changed {
-        if let Some(now) = now(entity) {
-            grid.add(now.triangles());
-            work.grid_triangles += now.triangles().len() as u64;
+
+    /// Brings the grid up to the changed entities: their triangles now in, their footprints
+    /// before out; `false` where one now lies outside the grid's bounds (the grid is to be made
+    /// anew).
+    pub(super) fn update(
+        &mut self,
+        mirror: &SceneMirror,
+        changed: &HashMap<Entity, Option<Arc<ObjectTriangles>>>,
+        work: &mut SceneWork,
+    ) -> bool {
+        let (lo, hi) = self.grid.bounds();
+        let inside =
+            |o: &ObjectTriangles| o.bounds().0.cmpge(lo).all() && o.bounds().1.cmple(hi).all();
+        let now = |entity| mirror.objects.get(entity).map(|o| o.as_ref());
+        if !changed.keys().filter_map(now).all(inside) {
+            return false;
         }
-        if let Some(before) = before {
-            grid.remove(before.triangles());
-            work.grid_triangles += before.triangles().len() as u64;
+        // in before out: the cells an object covers before and after keep a triangle
+        // throughout, so they are not cleared and set again
+        for (entity, before) in changed {
+            let footprint = self.footprints.remove(entity);
+            if let Some(now) = now(entity) {
+                let footprint = self.grid.add_tracked(now.triangles());
+                self.footprints.insert(*entity, footprint);
+                work.grid_triangles += now.triangles().len() as u64;
+            }
+            if let Some(footprint) = footprint {
+                self.grid.remove_footprint(&footprint);
+                work.grid_triangles += before.as_ref().map_or(0, |b| b.triangles().len()) as u64;
+            }
         }
+        true
     }
-    true
 }

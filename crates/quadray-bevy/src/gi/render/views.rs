@@ -113,7 +113,7 @@ impl ViewPasses {
         };
         let mut gather = Gather::new(device, &settings, &light.maps(), views)?;
         if let Some(grid) = &light.occupancy {
-            gather.set_occupancy(device, queue, grid, views);
+            gather.set_occupancy(device, queue, &grid.grid, views);
         }
         let uniform = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -381,7 +381,9 @@ pub(super) fn prepare_views(
                 albedo,
             };
             if let Some(grid) = &l.occupancy {
-                passes.gather.set_occupancy(device, &queue, grid, views);
+                passes
+                    .gather
+                    .set_occupancy(device, &queue, &grid.grid, views);
             }
             passes.occupancy_generation = l.occupancy_generation;
         }
