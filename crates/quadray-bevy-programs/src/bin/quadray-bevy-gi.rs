@@ -141,9 +141,10 @@ struct Args {
     #[arg(long, value_delimiter = ',', default_values = ["directional", "point", "spot"])]
     gi_lights: Vec<GiLight>,
     /// Show a large scene made from this seed instead: hundreds of meshes, about a million
-    /// triangles, a few meshes shared by several nodes, a sun, and a node named `mover`
-    /// (written as a GLB into the system's temporary folder first; the benchmark at the scale
-    /// of games, with --move-node mover).
+    /// triangles, a few meshes shared by several nodes, most materials textured, a tube skinned
+    /// to three joints (the middle one `bend`), a sun, and a node named `mover` (written as a
+    /// GLB into the system's temporary folder first; the benchmark at the scale of games, with
+    /// --move-node mover or --bend-node bend).
     #[arg(long, value_name = "SEED", conflicts_with_all = ["scene", "displaced"])]
     large_scene: Option<u64>,
     /// Move the scene's node of this name every frame (a circle of 2 m around where it
