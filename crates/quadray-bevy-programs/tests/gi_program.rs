@@ -238,3 +238,130 @@ fn the_gi_program_refuses_a_scene_that_reads_outside_its_folder() {
         );
     }
 }
+
+/// The large scene has what games have beside its million triangles: its counts are the file's,
+/// most of its lumps' materials take their base colour from one of its three 64x64 sRGB PNG
+/// textures (the lumps with uvs), and one tube is skinned to three joints, the middle one the
+/// `bend` that `--bend-node` bends, with a joint and weights for every vertex summing to one.
+#[test]
+fn the_large_scene_has_textures_and_a_skinned_mesh() {
+    use quadray_bevy_programs::large_scene::{BENDER, write_large_scene};
+    use serde_json::Value;
+    let dir = std::env::temp_dir().join(format!("quadray-large-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("scene.glb");
+    let made = write_large_scene(&path, 3).unwrap();
+    let glb = std::fs::read(&path).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let word = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
+    let json_end = 20 + word(12);
+    let gltf: Value = serde_json::from_slice(&glb[20..json_end]).unwrap();
+    let bin = &glb[json_end + 8..];
+    let list = |key: &str| gltf[key].as_array().cloned().unwrap_or_default();
+    let view = |index: &Value| {
+        let v = &gltf["bufferViews"][index.as_u64().unwrap() as usize];
+        let start = v["byteOffset"].as_u64().unwrap() as usize;
+        &bin[start..start + v["byteLength"].as_u64().unwrap() as usize]
+    };
+    let accessor_bytes =
+        |index: &Value| view(&gltf["accessors"][index.as_u64().unwrap() as usize]["bufferView"]);
+
+    assert!(made.triangles >= 1_000_000, "{made:?}");
+    assert_eq!(list("meshes").len(), made.meshes);
+    assert_eq!(list("materials").len(), made.materials);
+    let with_mesh = list("nodes")
+        .iter()
+        .filter(|n| n.get("mesh").is_some())
+        .count();
+    assert_eq!(with_mesh, made.nodes);
+
+    assert_eq!(list("images").len(), 3);
+    assert_eq!(made.images, 3);
+    for image in list("images") {
+        assert_eq!(image["mimeType"], "image/png");
+        let png = image::load_from_memory(view(&image["bufferView"])).unwrap();
+        assert_eq!((png.width(), png.height()), (64, 64));
+    }
+    let textured: Vec<usize> = list("materials")
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m["pbrMetallicRoughness"]["baseColorTexture"]["index"].is_u64())
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(textured.len(), made.textured_materials);
+    // every mesh but the ground (the first) and the skinned tube (the last)
+    let lumps: Vec<Value> = list("meshes")[1..made.meshes - 1].to_vec();
+    let textured_lumps = lumps
+        .iter()
+        .filter(|m| {
+            let primitive = &m["primitives"][0];
+            primitive["attributes"]["TEXCOORD_0"].is_u64()
+                && textured.contains(&(primitive["material"].as_u64().unwrap() as usize))
+        })
+        .count();
+    println!("{textured_lumps} of {} lumps textured", lumps.len());
+    assert!(
+        textured_lumps * 2 > lumps.len(),
+        "only {textured_lumps} of {} lumps textured",
+        lumps.len()
+    );
+
+    let skins = list("skins");
+    assert_eq!(skins.len(), 1);
+    let joints = skins[0]["joints"].as_array().unwrap();
+    assert_eq!(joints.len(), 3);
+    assert_eq!(
+        gltf["nodes"][joints[1].as_u64().unwrap() as usize]["name"],
+        BENDER
+    );
+    assert_eq!(
+        accessor_bytes(&skins[0]["inverseBindMatrices"]).len(),
+        3 * 64
+    );
+    let skinned: Vec<Value> = list("nodes")
+        .into_iter()
+        .filter(|n| n.get("skin").is_some())
+        .collect();
+    assert_eq!(skinned.len(), 1);
+    let mesh = &gltf["meshes"][skinned[0]["mesh"].as_u64().unwrap() as usize];
+    let attributes = &mesh["primitives"][0]["attributes"];
+    let vertices = gltf["accessors"][attributes["POSITION"].as_u64().unwrap() as usize]["count"]
+        .as_u64()
+        .unwrap() as usize;
+    let index_count = gltf["accessors"][mesh["primitives"][0]["indices"].as_u64().unwrap() as usize]
+        ["count"]
+        .as_u64()
+        .unwrap() as usize;
+    assert_eq!(index_count / 3, made.skinned_triangles);
+    assert!(made.skinned_triangles >= 2000, "{made:?}");
+    let joint_bytes = accessor_bytes(&attributes["JOINTS_0"]);
+    assert_eq!(joint_bytes.len(), vertices * 8);
+    assert!(
+        joint_bytes
+            .chunks_exact(2)
+            .all(|j| u16::from_le_bytes([j[0], j[1]]) < 3)
+    );
+    let weights: Vec<f32> = accessor_bytes(&attributes["WEIGHTS_0"])
+        .chunks_exact(4)
+        .map(|w| f32::from_le_bytes(w.try_into().unwrap()))
+        .collect();
+    assert_eq!(weights.len(), vertices * 4);
+    assert!(
+        weights
+            .chunks_exact(4)
+            .all(|w| (w.iter().sum::<f32>() - 1.0).abs() < 1e-5),
+        "a skinned vertex's weights do not sum to one"
+    );
+    // the middle joint moves some of the tube
+    let bent = weights
+        .chunks_exact(4)
+        .zip(joint_bytes.chunks_exact(8))
+        .filter(|(w, j)| {
+            (0..4).any(|k| w[k] > 0.0 && u16::from_le_bytes([j[2 * k], j[2 * k + 1]]) == 1)
+        })
+        .count();
+    assert!(
+        bent * 2 > vertices,
+        "only {bent} of {vertices} vertices follow `{BENDER}`"
+    );
+}

@@ -27,7 +27,8 @@
 //! tests each cluster's view on the scene's occupancy grid. At the scale of games:
 //! `--large-scene SEED` makes and shows a scene of about a million triangles in hundreds of
 //! meshes (`large_scene.rs`), `--move-node NAME` moves a node of the scene every frame (the
-//! large scene's `mover`), and `--frames` then prints the medians of the plugin's CPU time in
+//! large scene's `mover`), `--bend-node NAME` bends a node to and fro every frame (the large
+//! scene's `bend`, a joint of its skinned tube), and `--frames` then prints the medians of the plugin's CPU time in
 //! each world (`quadray_gi/main_world_cpu`, `quadray_gi/render_world_cpu`) beside its GPU
 //! passes'. `--turn-node NAME:DEGREES` turns a node about its own z axis once it is loaded: a
 //! joint of a skinned mesh bends the mesh, and the bounce with it
@@ -140,15 +141,21 @@ struct Args {
     #[arg(long, value_delimiter = ',', default_values = ["directional", "point", "spot"])]
     gi_lights: Vec<GiLight>,
     /// Show a large scene made from this seed instead: hundreds of meshes, about a million
-    /// triangles, a few meshes shared by several nodes, a sun, and a node named `mover`
-    /// (written as a GLB into the system's temporary folder first; the benchmark at the scale
-    /// of games, with --move-node mover).
+    /// triangles, a few meshes shared by several nodes, most materials textured, a tube skinned
+    /// to three joints (the middle one `bend`), a sun, and a node named `mover` (written as a
+    /// GLB into the system's temporary folder first; the benchmark at the scale of games, with
+    /// --move-node mover or --bend-node bend).
     #[arg(long, value_name = "SEED", conflicts_with_all = ["scene", "displaced"])]
     large_scene: Option<u64>,
     /// Move the scene's node of this name every frame (a circle of 2 m around where it
     /// stands), its meshes with it.
     #[arg(long, value_name = "NAME")]
     move_node: Option<String>,
+    /// Bend the scene's node of this name every frame: turn it to and fro about its own z axis
+    /// (up to 30 degrees either way), the meshes skinned to it with it (the large scene's `bend`,
+    /// the middle joint of its skinned tube).
+    #[arg(long, value_name = "NAME")]
+    bend_node: Option<String>,
     /// Turn the scene's node of this name about its own z axis by this many degrees (counter-
     /// clockwise seen from its +z), once it is loaded: a joint of a skinned mesh bends the mesh
     /// (`skinned_bar.gltf`'s `bend`).
@@ -187,6 +194,10 @@ enum Shows {
 /// The node `--move-node` names.
 #[derive(Resource)]
 struct MovedNode(String);
+
+/// The node `--bend-node` names.
+#[derive(Resource)]
+struct BentNode(String);
 
 /// The node `--turn-node` names and its turn.
 #[derive(Resource, Clone)]
@@ -261,6 +272,10 @@ fn main() {
         app.insert_resource(MovedNode(name))
             .add_systems(Update, move_node);
     }
+    if let Some(name) = args.bend_node {
+        app.insert_resource(BentNode(name))
+            .add_systems(Update, bend_node);
+    }
     if let Some(turned) = args.turn_node {
         app.insert_resource(turned).add_systems(Update, turn_node);
     }
@@ -275,15 +290,37 @@ fn large_scene(seed: u64) -> std::io::Result<PathBuf> {
     let made = quadray_bevy_programs::large_scene::write_large_scene(&path, seed)?;
     println!(
         "large scene {seed}: {} triangles, {} meshes, {} nodes with a mesh, {} triangles in \
-         `{}` ({})",
+         `{}`, {} skinned to `{}`, {} of {} materials textured ({} textures) ({})",
         made.triangles,
         made.meshes,
         made.nodes,
         made.mover_triangles,
         quadray_bevy_programs::large_scene::MOVER,
+        made.skinned_triangles,
+        quadray_bevy_programs::large_scene::BENDER,
+        made.textured_materials,
+        made.materials,
+        made.images,
         path.display()
     );
     Ok(path)
+}
+
+/// The node named `name` and `keep` of its transform as loaded: looked for until it is there
+/// (the scene loads over several frames), then kept in `found`.
+fn find_node<T: Copy>(
+    found: &mut Option<(Entity, T)>,
+    nodes: &Query<(Entity, &Name, &mut Transform)>,
+    name: &str,
+    keep: impl Fn(&Transform) -> T,
+) -> Option<(Entity, T)> {
+    if found.is_none() {
+        *found = nodes
+            .iter()
+            .find(|(_, node, _)| node.as_str() == name)
+            .map(|(entity, _, t)| (entity, keep(t)));
+    }
+    *found
 }
 
 /// Moves the node `--move-node` names a step along its circle each frame, once it is loaded.
@@ -293,13 +330,7 @@ fn move_node(
     mut found: Local<Option<(Entity, Vec3)>>,
     mut frame: Local<u32>,
 ) {
-    if found.is_none() {
-        *found = nodes
-            .iter()
-            .find(|(_, name, _)| name.as_str() == moved.0)
-            .map(|(entity, _, t)| (entity, t.translation));
-    }
-    let Some((entity, start)) = *found else {
+    let Some((entity, start)) = find_node(&mut found, &nodes, &moved.0, |t| t.translation) else {
         return;
     };
     let Ok((_, _, mut transform)) = nodes.get_mut(entity) else {
@@ -308,6 +339,25 @@ fn move_node(
     *frame += 1;
     let turn = *frame as f32 * 0.1;
     transform.translation = start + 2.0 * Vec3::new(turn.cos() - 1.0, 0.0, turn.sin());
+}
+
+/// Turns the node `--bend-node` names to and fro about its z axis each frame, once it is
+/// loaded.
+fn bend_node(
+    bent: Res<BentNode>,
+    mut nodes: Query<(Entity, &Name, &mut Transform)>,
+    mut found: Local<Option<(Entity, Quat)>>,
+    mut frame: Local<u32>,
+) {
+    let Some((entity, start)) = find_node(&mut found, &nodes, &bent.0, |t| t.rotation) else {
+        return;
+    };
+    let Ok((_, _, mut transform)) = nodes.get_mut(entity) else {
+        return;
+    };
+    *frame += 1;
+    let angle = 30f32.to_radians() * (*frame as f32 * 0.3).sin();
+    transform.rotation = start * Quat::from_rotation_z(angle);
 }
 
 /// Turns the nodes `--turn-node` names about their z axis, in the first frame they are there.
