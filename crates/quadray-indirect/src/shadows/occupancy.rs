@@ -247,10 +247,7 @@ impl OccupancyGrid {
                         *count = count.saturating_sub(n);
                         changed |= was != (*count > 0);
                     }
-                    let set = match changed {
-                        true => cell.iter().any(|&n| n > 0),
-                        false => self.bits[word] >> bit & 1 == 1,
-                    };
+                    let set = still_set(cell, changed, self.bits[word] >> bit & 1 == 1);
                     (set, changed)
                 }
             };
@@ -594,11 +591,7 @@ impl OccupancyGrid {
                                 }
                             };
                             let changed = count_subcells(t, &test, c, cell, added, counted);
-                            // no sub-cell set or cleared: the cell is as it was
-                            let set = match changed {
-                                true => cell.iter().any(|&n| n > 0),
-                                false => self.bits[word] >> bit & 1 == 1,
-                            };
+                            let set = still_set(cell, changed, self.bits[word] >> bit & 1 == 1);
                             (set, changed)
                         }
                     };
@@ -609,6 +602,16 @@ impl OccupancyGrid {
                 }
             }
         }
+    }
+}
+
+/// Whether a cell of two levels is set after its sub-cells' counts changed: where no sub-cell
+/// was set or cleared (`changed`), the cell is as it `was`.
+fn still_set(cell: &[u32; SUBCELL_COUNT], changed: bool, was: bool) -> bool {
+    if changed {
+        cell.iter().any(|&n| n > 0)
+    } else {
+        was
     }
 }
 
