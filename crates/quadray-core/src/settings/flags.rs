@@ -128,8 +128,8 @@ pub fn assert_flags_round_trip<S>(
 
 /// `command` with its help written for a terminal, in it and every subcommand: settings are
 /// documented once, in rustdoc, and clap shows those docs as help, so an intra-doc link
-/// (``[`Self::SHADOW_CORNERS_ACROSS`]``, ``[`crate::Method::subsamples`]``) reads as the name it
-/// links to (`` `SHADOW_CORNERS_ACROSS` ``, `` `subsamples` ``).
+/// (``[`Self::SHADOW_CORNERS_ACROSS`]``, ``[`quadray::Kind::item`]``) reads as the name it
+/// links to (`` `SHADOW_CORNERS_ACROSS` ``, `` `item` ``).
 pub fn terminal_help(command: Command) -> Command {
     command
         .mut_args(|mut arg| {
@@ -274,8 +274,8 @@ mod tests {
     #[test]
     fn intra_doc_links_read_as_the_names_they_link() {
         assert_eq!(
-            unlinked("over [`Self::ACROSS`], the [`crate::Method::subsamples`] ones, [`Size`]"),
-            "over `ACROSS`, the `subsamples` ones, `Size`"
+            unlinked("over [`Self::ACROSS`], the [`quadray::Kind::item`] ones, [`Size`]"),
+            "over `ACROSS`, the `item` ones, `Size`"
         );
         assert_eq!(unlinked("a [`dangling"), "a [`dangling");
         assert_eq!(unlinked("`[` and `]` step it"), "`[` and `]` step it");
