@@ -3,6 +3,7 @@
 
 use quadray_core::image_out::{Rgba8Image, montage};
 use quadray_displace::accuracy::{Accuracy, Cost, GroundTruth};
+use quadray_displace::cone::ConeMap;
 use quadray_displace::maps::BUNDLED;
 use quadray_displace::reference::Surface;
 use quadray_displace::scene::SurfaceKind;
@@ -31,6 +32,9 @@ pub fn render_demo(
         let map = bundled.load()?;
         let color = bundled.load_color()?;
         let mut renderer = Renderer::new(gpu, &map, color.as_ref(), bundled.surface);
+        // one cone map for the surface and the torus where both address the map alike
+        let cones = ConeMap::build(&map, bundled.surface.addressing());
+        renderer.set_cone_map(gpu, &cones, None)?;
         for angle in [35.0, 65.0, 80.0] {
             progress(&format!("{name}: every method at {angle:.0} degrees"));
             let methods = Method::ALL.map(|m| Settings {
@@ -68,6 +72,9 @@ pub fn render_demo(
         // A curved mesh whose tangents MikkTSpace generated.
         progress(&format!("{name}: a torus"));
         let mut torus = Renderer::new(gpu, &map, color.as_ref(), SurfaceKind::Torus);
+        if SurfaceKind::Torus.addressing() == bundled.surface.addressing() {
+            torus.set_cone_map(gpu, &cones, None)?;
+        }
         let mut tiles = Vec::new();
         for (method, truth) in Method::ALL
             .into_iter()

@@ -67,6 +67,8 @@ pub struct Renderer {
     /// Built the first time the cone method draws (or handed in): the group binding the cone
     /// map, and the CPU build's seconds where known.
     cone: Option<(wgpu::BindGroup, Option<f64>)>,
+    /// The mesh baseline's repeats of the map in the last frame's view (`Plane::tiles_in_view`).
+    mesh_tiles_in_view: Vec<u32>,
     triangles: wgpu::Buffer,
     vertex_count: u32,
 }
@@ -151,6 +153,7 @@ impl Renderer {
             point_group,
             conservative_group,
             cone: None,
+            mesh_tiles_in_view: Vec::new(),
             triangles,
             vertex_count: vertices.len() as u32,
         }
@@ -244,9 +247,16 @@ impl Renderer {
         }
     }
 
-    fn write_frame(&self, gpu: &Gpu, s: &Settings, view: &View) {
+    fn write_frame(&mut self, gpu: &Gpu, s: &Settings, view: &View) {
         let params = FrameParams::new(s, view, self.map.levels());
         self.pass.write_frame(&gpu.queue, &params);
+        if s.method == Method::Mesh {
+            self.mesh_tiles_in_view = Plane::of(self.surface).tiles_in_view(
+                self.surface.tiles(),
+                s.depth_scale * self.surface.tile_world(),
+                view.view_proj,
+            );
+        }
     }
 
     fn targets(gpu: &Gpu, s: &Settings, debug_outputs: bool) -> Vec<wgpu::Texture> {
@@ -287,7 +297,7 @@ impl Renderer {
         let geometry = if method == Method::Mesh {
             Geometry::MeshGrid {
                 grid: mesh_grid(self.map.width, self.map.height),
-                tiles: self.surface.tiles(),
+                tiles: &self.mesh_tiles_in_view,
             }
         } else {
             Geometry::Triangles(&self.triangles, self.vertex_count)

@@ -84,13 +84,14 @@ fn vs_surface(v: VertexIn) -> VertexOut {
 }
 
 // The baseline of figure 20: a grid of 2 * mesh_grid^2 triangles per tile whose vertices sit on
-// the bilinear surface, instanced over the tiles.
+// the bilinear surface, drawn a row of quads at a time as a triangle strip (each vertex shaded
+// twice, not six times as a list would: the bilinear reads are most of a vertex's cost), one
+// instance a row of a tile. A quad's diagonal runs from its (0, 1) corner to its (1, 0) one.
 @vertex
-fn vs_mesh(@builtin(vertex_index) vid: u32, @builtin(instance_index) tile: u32) -> VertexOut {
-    let quad = vid / 6u;
-    let corner = array<vec2u, 6>(vec2u(0u, 0u), vec2u(1u, 0u), vec2u(0u, 1u), vec2u(0u, 1u), vec2u(1u, 0u), vec2u(1u, 1u))[vid % 6u];
+fn vs_mesh(@builtin(vertex_index) vid: u32, @builtin(instance_index) row_of_tile: u32) -> VertexOut {
     let g = surface.mesh_grid;
-    let cell = vec2u(quad % g, quad / g) + corner;
+    let tile = row_of_tile / g;
+    let cell = vec2u(vid / 2u, row_of_tile % g + vid % 2u);
     let tile_xy = vec2f(f32(tile % surface.tiles), f32(tile / surface.tiles));
     let uv = tile_xy + vec2f(cell) / f32(g);
     let d = depth_bilinear(depth_map, surface.pyramid, uv);

@@ -123,10 +123,11 @@ pub(super) struct MapTextures<'a> {
     pub color_map: &'a wgpu::TextureView,
 }
 
-/// What a draw covers: the surface's triangles, or the mesh baseline's grid instanced per tile.
+/// What a draw covers: the surface's triangles, or the mesh baseline's grid instanced over the
+/// tiles listed (those in view, ascending).
 pub(super) enum Geometry<'a> {
     Triangles(&'a wgpu::Buffer, u32),
-    MeshGrid { grid: u32, tiles: u32 },
+    MeshGrid { grid: u32, tiles: &'a [u32] },
 }
 
 pub(super) struct SurfacePass {
@@ -287,6 +288,11 @@ impl SurfacePass {
                         buffers: if mesh { &[] } else { &vertex_layouts },
                     },
                     primitive: wgpu::PrimitiveState {
+                        topology: if mesh {
+                            wgpu::PrimitiveTopology::TriangleStrip
+                        } else {
+                            wgpu::PrimitiveTopology::TriangleList
+                        },
                         cull_mode: None,
                         ..Default::default()
                     },
@@ -364,7 +370,15 @@ impl SurfacePass {
         pass.set_bind_group(0, &self.frame_group, &[]);
         pass.set_bind_group(1, map_group, &[]);
         match geometry {
-            Geometry::MeshGrid { grid, tiles } => pass.draw(0..6 * grid * grid, 0..tiles * tiles),
+            Geometry::MeshGrid { grid, tiles } => {
+                // one draw a run of consecutive tiles, an instance a row of quads
+                for run in tiles.chunk_by(|a, b| a + 1 == *b) {
+                    pass.draw(
+                        0..2 * grid + 2,
+                        run[0] * grid..(run[run.len() - 1] + 1) * grid,
+                    );
+                }
+            }
             Geometry::Triangles(buffer, count) => {
                 pass.set_vertex_buffer(0, buffer.slice(..));
                 pass.draw(0..count, 0..1);
