@@ -4,7 +4,8 @@
 //! alone to the vertex buffer and moves them alone in the occupancy grid (the floor's texture
 //! uploaded once), and the scene equals a fresh app's gather of the new places; the floor's
 //! texture swapped for a flat colour drops its layer. The ball's texture has no CPU-side data:
-//! it takes its flat colour.
+//! it takes its flat colour. The app's default sampler is nearest, and the floor's texture
+//! (`ImageSampler::Default`) is read through it.
 
 use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
@@ -45,7 +46,9 @@ const MOVED: usize = 2;
 
 /// An app with the meshes at `places` (with a camera gathering when `camera`), and the entities.
 fn app(places: [Transform; 5], camera: bool) -> (App, Vec<Entity>) {
-    let mut app = crate::common::headless_app(|app| {
+    // nearest by default: the floor's texture, whose sampler is `ImageSampler::Default`, is
+    // read through it
+    let mut app = crate::common::headless_app_with_images(ImagePlugin::default_nearest(), |app| {
         app.insert_resource(DefaultOpaqueRendererMethod::deferred())
             .add_plugins(IndirectLightPlugin);
         let work = RenderedWork::default();
@@ -217,6 +220,16 @@ fn a_moved_mesh_alone_is_made_anew_and_the_scene_equals_a_fresh_gather() {
     let floor_texture = |app: &App| first_vertex(app, floor).texture;
     assert_ne!(floor_texture(&app), Vertex::UNTEXTURED);
     assert_eq!(scene(&app).textures().layers.len(), 1);
+    // through the app's default sampler, nearest: a tenth of a texel from the top-left texel's
+    // edge is that texel alone (linear would take a tenth of its green neighbour)
+    let red = Vec3::new(200.0, 30.0, 30.0).map(|c| Color::srgb_u8(c as u8, 0, 0).to_linear().red);
+    let sampled = scene(&app)
+        .textures()
+        .sample(floor_texture(&app), Vec2::new(0.3, 0.3));
+    assert!(
+        (sampled - red).abs().max_element() < 1e-6,
+        "the floor's texture read through {sampled}, not the app's nearest default ({red})"
+    );
     // the ball's texture, on the GPU alone, is left out: its flat colour
     let ball = first_vertex(&app, entities[BALL]);
     assert_eq!(ball.texture, Vertex::UNTEXTURED);

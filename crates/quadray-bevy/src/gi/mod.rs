@@ -116,6 +116,18 @@ impl Plugin for IndirectLightPlugin {
         render::build(app);
         cpu_time::build(app);
     }
+
+    fn finish(&self, app: &mut App) {
+        // what a texture with `ImageSampler::Default` is read through (`ImagePlugin` is added
+        // by then, with `DefaultPlugins`)
+        if let Some(image_plugin) = app.get_added_plugins::<bevy::image::ImagePlugin>().first() {
+            let default_sampler = image_plugin.default_sampler.clone();
+            app.world_mut()
+                .resource_mut::<IndirectLightScene>()
+                .base_colours
+                .default_sampler = default_sampler;
+        }
+    }
 }
 
 /// The path in Bevy's `DiagnosticsStore` of `camera`'s diagnostic `name`: `elapsed_gpu`,

@@ -18,7 +18,6 @@ use quadray_indirect::scene::{
 use std::sync::Arc;
 
 /// The scene's base colour textures, kept across updates.
-#[derive(Default)]
 pub(super) struct BaseColours {
     collector: TextureCollector,
     /// Each image asked for: its packed texture, or `None` (not loaded yet; or not readable on
@@ -30,6 +29,22 @@ pub(super) struct BaseColours {
     pub(super) textures: Arc<SceneTextures>,
     /// Counts the changes to [`Self::textures`].
     pub(super) generation: u64,
+    /// What `ImageSampler::Default` stands for: the app's `ImagePlugin::default_sampler`
+    /// (Bevy's linear default until the plugin is finished).
+    pub(super) default_sampler: ImageSamplerDescriptor,
+}
+
+impl Default for BaseColours {
+    fn default() -> Self {
+        Self {
+            collector: TextureCollector::default(),
+            read: HashMap::default(),
+            changed: false,
+            textures: Arc::default(),
+            generation: 0,
+            default_sampler: ImageSamplerDescriptor::linear(),
+        }
+    }
 }
 
 impl BaseColours {
@@ -71,9 +86,11 @@ impl BaseColours {
             ))
         } else if let Some(texels) = srgb_texels(image) {
             let before = self.collector.len();
-            let packed = self
-                .collector
-                .index(&texels, sampler_of(&image.sampler), &name());
+            let packed = self.collector.index(
+                &texels,
+                sampler_of(&image.sampler, &self.default_sampler),
+                &name(),
+            );
             self.changed |= self.collector.len() != before;
             packed
         } else {
@@ -155,12 +172,12 @@ fn srgb_texels(image: &Image) -> Option<Rgba8Image> {
 }
 
 /// Bevy's sampler as quadray's: its magnification filter (quadray reads no mipmaps) and its
-/// wraps, a border clamp as a clamp to the edge. `ImageSampler::Default` is taken as Bevy's
-/// default `ImagePlugin`'s (linear, clamped).
-fn sampler_of(sampler: &ImageSampler) -> TextureSampler {
+/// wraps, a border clamp as a clamp to the edge. `ImageSampler::Default` is the app's
+/// `ImagePlugin::default_sampler`, `default`.
+fn sampler_of(sampler: &ImageSampler, default: &ImageSamplerDescriptor) -> TextureSampler {
     let descriptor = match sampler {
-        ImageSampler::Descriptor(d) => d.clone(),
-        ImageSampler::Default => ImageSamplerDescriptor::linear(),
+        ImageSampler::Descriptor(d) => d,
+        ImageSampler::Default => default,
     };
     let wrap = |mode| match mode {
         ImageAddressMode::Repeat => TextureWrap::Repeat,

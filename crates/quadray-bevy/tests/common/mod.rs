@@ -87,9 +87,15 @@ pub fn child_log(tests: &[&str]) -> String {
 
 /// The app with `add` applied (plugins, resources, systems), ready to `update`.
 pub fn headless_app(add: impl FnOnce(&mut App)) -> App {
+    headless_app_with_images(ImagePlugin::default(), add)
+}
+
+/// [`headless_app`] with `images` as its `ImagePlugin` (its default sampler, say).
+pub fn headless_app_with_images(images: ImagePlugin, add: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
+            .set(images)
             .set(AssetPlugin {
                 file_path: ASSETS.into(),
                 ..default()
