@@ -7,7 +7,7 @@
 
 use crate::light::node::{CONE_SLACK, CUT_CLASS_SIDE, EMPTY_BOX, MAX_LEVELS};
 use crate::method::GBufferLayout;
-use crate::settings::{Shade, TILE, TILE_FRONTIER};
+use crate::settings::{Shade, TILE, TILE_FRONTIER, TILE_SHADOW_HEADER};
 use crate::shader_struct::{Layout, shader_struct};
 use crate::shadows::occupancy::{
     BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS, SUBCELLS,
@@ -17,7 +17,7 @@ use crate::tiles::deblock::{
 };
 use crate::tiles::{
     MIXED_TARGET_ANGLE, NEAR_FIELD_SIZE, PARALLEL_TARGET_COS, SPLIT_BINS, TILE_ENTRY_INDEX_BITS,
-    TILE_SHADOW_HEADER, TILE_WALK_LANES, ZERO_ESTIMATE_SHARE,
+    TILE_WALK_LANES, ZERO_ESTIMATE_SHARE,
 };
 use wgpu::util::DeviceExt;
 

@@ -19,6 +19,12 @@ pub(crate) const TILE: u32 = 8;
 /// most a tile's list may hold ([`Settings::tile_capacity`]).
 pub(crate) const TILE_FRONTIER: u32 = 1024;
 
+/// Split per-tile passes ([`Settings::tile_passes`]): the words of a tile's shadow record
+/// before its targets' visibility words: how many targets, the anchor sets and the shared
+/// nodes, then each of the eight anchors' receivers, position and normal (wgsl
+/// `TILE_SHADOW_HEADER`, tiles/split.wgsl).
+pub(crate) const TILE_SHADOW_HEADER: u32 = 3 + 8 * 6;
+
 /// The levels a cut spans on a given RSM, its settings' choices or their defaults.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Levels {
@@ -692,15 +698,14 @@ impl Settings {
         self.tile_passes == TilePasses::Split && self.march_steps() > 0
     }
 
-    /// Bytes the split per-tile passes' shadow records take ([`crate::tiles::TILE_SHADOW_HEADER`]
-    /// words a tile, then a word a list slot; 4 where the passes are fused).
+    /// Bytes the split per-tile passes' shadow records take ([`TILE_SHADOW_HEADER`] words a
+    /// tile, then a word a list slot; 4 where the passes are fused).
     pub(crate) fn tile_shadow_bytes(&self) -> u64 {
         if !self.splits_tiles() {
             return 4;
         }
         let (tx, ty) = self.tiles();
-        let words = u64::from(crate::tiles::TILE_SHADOW_HEADER)
-            + u64::from(self.tile_capacity_or_default());
+        let words = u64::from(TILE_SHADOW_HEADER) + u64::from(self.tile_capacity_or_default());
         u64::from(tx) * u64::from(ty) * words * 4
     }
 

@@ -43,8 +43,8 @@ fn indirect_tiles(
 ) {
     let inside = id.x < viewer.width && id.y < viewer.height;
     let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
-    let t = open_tile(id.xy, inside, local);
-    if (t.empty) {
+    let r = load_tile(id.xy, inside, local);
+    if (tile_is_empty(local, r)) {
         // nothing to light: no light either (the last frame's may be there)
         if (inside) {
             add_indirect(pixel_index(id.xy), vec4<f32>(0.0));
@@ -55,6 +55,7 @@ fn indirect_tiles(
         store_tile_counts(id.xy, inside, local);
         return;
     }
+    let t = open_tile(local, r);
     let shared_nodes = build_list(local, tile, t);
     sum_tile(id.xy, inside, local, tile, t, atomicLoad(&list_len), shared_nodes);
     store_tile_sizes(tile, local);

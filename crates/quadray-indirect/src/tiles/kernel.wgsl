@@ -130,29 +130,23 @@ fn store_tile_sizes(tile: u32, local: u32) {
     }
 }
 
-// Phases 0 and 1 of every pass over a tile's pixels: the pixel's receiver, whether the tile has
-// none, and where it has some, the pixel's patch and the tile's shadow anchors (both sets).
-// Every invocation calls it.
+// Phase 1, then, of every pass over a tile that has receivers (`tile_is_empty` false): the
+// pixel's patch and the tile's shadow anchors (both sets). Every invocation calls it.
 struct OpenTile {
     r: Receiver,
-    empty: bool,
     corners_covered: bool,
     shape: PixelPatch,
     // the pixels off the first anchor set's surfaces (`second_anchors`)
     off_anchor: u32,
 }
 
-fn open_tile(pixel: vec2<u32>, inside: bool, local: u32) -> OpenTile {
+fn open_tile(local: u32, r: Receiver) -> OpenTile {
     var t: OpenTile;
-    t.r = load_tile(pixel, inside, local);
-    t.empty = tile_is_empty(local, t.r);
-    if (t.empty) {
-        return t;
-    }
+    t.r = r;
     t.corners_covered = all_corners_covered();
-    t.shape = pixel_patch(local, t.r, t.corners_covered);
+    t.shape = pixel_patch(local, r, t.corners_covered);
     if (SHADOWS) {
-        t.off_anchor = second_anchors(local, t.r, t.shape);
+        t.off_anchor = second_anchors(local, r, t.shape);
     }
     return t;
 }

@@ -21,11 +21,6 @@ pub(crate) const TILE_ENTRY_INDEX_BITS: u32 = 21;
 const _: () =
     assert!(4 * Settings::RSM_SIZE.max * Settings::RSM_SIZE.max / 3 < 1 << TILE_ENTRY_INDEX_BITS);
 const _: () = assert!(TILE_FRONTIER <= 1 << (31 - TILE_ENTRY_INDEX_BITS));
-/// Split per-tile passes ([`Settings::tile_passes`]): the words of a tile's shadow record
-/// before its targets' visibility words: how many targets, the anchor sets and the shared
-/// nodes, then each of the eight anchors' receivers, position and normal (wgsl
-/// `TILE_SHADOW_HEADER`, split.wgsl).
-pub(crate) const TILE_SHADOW_HEADER: u32 = 3 + 8 * 6;
 /// Split per-tile passes: the threads that walk one tile's shadow rays, each a target at a
 /// time (all its anchors' rays), four tiles a workgroup of 64: a lane walks a sixteenth of the
 /// tile's targets, four or eight rays each, where the fused kernel's 64 threads walked about

@@ -75,8 +75,8 @@ fn tile_lists(
 ) {
     let inside = id.x < viewer.width && id.y < viewer.height;
     let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
-    let t = open_tile(id.xy, inside, local);
-    if (t.empty) {
+    let r = load_tile(id.xy, inside, local);
+    if (tile_is_empty(local, r)) {
         if (local == 0u) {
             tile_sizes[tile] = vec4<u32>(0u);
             // (no target to walk to)
@@ -85,6 +85,7 @@ fn tile_lists(
         store_tile_counts(id.xy, inside, local);
         return;
     }
+    let t = open_tile(local, r);
     let shared_nodes = build_list(local, tile, t);
     if (local == 0u) {
         tile_shadows[shadow_record(tile) + 2u] = shared_nodes;
@@ -143,14 +144,15 @@ fn tile_sums(
 ) {
     let inside = id.x < viewer.width && id.y < viewer.height;
     let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
-    let t = open_tile(id.xy, inside, local);
-    if (t.empty) {
+    let r = load_tile(id.xy, inside, local);
+    if (tile_is_empty(local, r)) {
         if (inside) {
             add_indirect(pixel_index(id.xy), vec4<f32>(0.0));
         }
         store_tile_counts(id.xy, inside, local);
         return;
     }
+    let t = open_tile(local, r);
     // what the list's pass found of the tile, for `sum_tile` and `lone_sums`
     if (local == 0u) {
         let record = shadow_record(tile);
