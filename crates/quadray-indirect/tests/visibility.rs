@@ -231,7 +231,8 @@ fn lone_pixels_are_shadowed_as_the_anchored_ones() {
 #[test]
 fn pixels_off_the_anchors_surfaces_walk_from_a_second_set() {
     let scene = Scene::load(&scenes_dir().join("leak.toml")).unwrap();
-    let [plain, with] = per_tile_frames_at_32(&scene);
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let [plain, with] = per_tile_frames_at_32(&gpu, &scene);
     let (plain_fetches, with_fetches) = (plain.counts.texel_fetches, with.counts.texel_fetches);
     let ratio = with_fetches as f64 / plain_fetches as f64;
     println!("leak: fetches {plain_fetches} -> {with_fetches} with shadows ({ratio:.2}x)");
@@ -243,7 +244,7 @@ fn pixels_off_the_anchors_surfaces_walk_from_a_second_set() {
         tile_passes: TilePasses::Split,
         ..shadowed(&at_32())
     };
-    let split = Renderer::new(&Gpu::new().unwrap(), &scene, split)
+    let split = Renderer::new(&gpu, &scene, split)
         .unwrap()
         .render_frame(Method::QuadtreeTiles)
         .unwrap();
@@ -304,7 +305,8 @@ fn targets_behind_every_anchor_get_no_shadow_ray() {
     scene.camera.position = Vec3::new(1.9, 0.8, 0.3);
     scene.camera.target = Vec3::new(1.03, 0.8, 0.3);
     scene.camera.fov_y_deg = 20.0;
-    let [plain, with] = per_tile_frames_at_32(&scene);
+    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+    let [plain, with] = per_tile_frames_at_32(&gpu, &scene);
     let (fetches, fetches_shadowed) = (plain.counts.texel_fetches, with.counts.texel_fetches);
     println!("partition: fetches {fetches} -> {fetches_shadowed} with shadows");
     assert!(
@@ -321,11 +323,10 @@ fn at_32() -> Settings {
 
 /// The per-tile cuts' frame of `scene` at 32x32 with a 64^2 RSM, without and with indirect
 /// shadows.
-fn per_tile_frames_at_32(scene: &Scene) -> [Frame; 2] {
-    let gpu = Gpu::new().expect("an adapter (run scripts/setup.sh for lavapipe)");
+fn per_tile_frames_at_32(gpu: &Gpu, scene: &Scene) -> [Frame; 2] {
     let settings = at_32();
     [settings.clone(), shadowed(&settings)].map(|s| {
-        Renderer::new(&gpu, scene, s)
+        Renderer::new(gpu, scene, s)
             .unwrap()
             .render_frame(Method::QuadtreeTiles)
             .unwrap()
