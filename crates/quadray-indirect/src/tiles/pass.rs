@@ -46,9 +46,9 @@ struct TileLists {
     /// With indirect shadows, per tile the nodes its shadow rays go to (`tile_capacity` slots a
     /// tile; one word without shadows). Only the shader reads it.
     _targets: wgpu::Buffer,
-    /// The split passes' shadow records ([`crate::Settings::tile_shadow_bytes`]; one word when fused).
-    /// Only the shaders read it.
-    _shadows: wgpu::Buffer,
+    /// The split passes' shadow records ([`crate::Settings::tile_shadow_bytes`]), none when
+    /// fused. Only the shaders read them.
+    _shadows: Option<wgpu::Buffer>,
     group: wgpu::BindGroup,
 }
 
@@ -135,15 +135,12 @@ impl Tiles {
                 4
             };
             let targets = storage_buffer(&self.device, "per-tile shadow targets", target_bytes);
-            let shadows = storage_buffer(
-                &self.device,
-                "per-tile shadow records",
-                s.tile_shadow_bytes(),
-            );
+            let shadows = matches!(self.kernel, Kernel::Split(_)).then(|| {
+                let bytes = s.tile_shadow_bytes();
+                storage_buffer(&self.device, "per-tile shadow records", bytes)
+            });
             let mut buffers = vec![whole(&cuts), whole(&sizes), whole(&targets)];
-            if matches!(self.kernel, Kernel::Split(_)) {
-                buffers.push(whole(&shadows));
-            }
+            buffers.extend(shadows.as_ref().map(whole));
             let group = bind_group(&self.device, "per-tile cuts", &self.lists_layout, buffers);
             TileLists {
                 cuts,
