@@ -147,7 +147,9 @@ done
 # with each pixel walking its own rays (--shadow-corners 0), from corner receivers nearer and
 # farther apart than the default's 16 pixels at 1920x1080, and with 16 or 8 threads walking a
 # corner's rays instead of 64 (each lane walks 4 or 8 times the rays: do a wave's lanes end
-# closer together?).
+# closer together?); the per-tile cuts with shadows in split passes (--tile-passes split: the
+# walks in a pass of their own, with almost no workgroup memory), paired with
+# indirect-quadtree-tiles-shadows, the fused kernel (docs/known-problems.md predicts the split).
 while read -r name flags; do
     # shellcheck disable=SC2086 # $flags is several words
     step "indirect-$name" "$bin" indirect $flags --size $size --rsm-size $rsm \
@@ -165,6 +167,7 @@ quadtree-shadows-corners-32 --method quadtree --indirect-shadows --shadow-corner
 quadtree-shadows-corners-8-interleave-4 --method quadtree --indirect-shadows --shadow-corners 8 --interleave 4
 quadtree-shadows-corner-lanes-16 --method quadtree --indirect-shadows --shadow-corner-lanes 16
 quadtree-shadows-corner-lanes-8 --method quadtree --indirect-shadows --shadow-corner-lanes 8
+quadtree-tiles-shadows-split --method quadtree-tiles --indirect-shadows --tile-passes split
 CANDIDATES
 # An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
 # each submit), to see where it stops.
@@ -174,7 +177,8 @@ if grep -qs '^indirect-' "$out/skipped.txt"; then
 fi
 
 # The bounce with indirect shadows on every visibility scene (the goal: at most 1 ms a frame at
-# 1920x1080), the default method and the one cut interleaved at 4 from its shadow corners.
+# 1920x1080), the default method, its split passes (--tile-passes split) and the one cut
+# interleaved at 4 from its shadow corners.
 mkdir -p "$out/shadows-1080p"
 for scene in cornell leak visibility-door visibility-corridor visibility-gap visibility-shelf \
     visibility-storeys visibility-pillars courtyard; do
@@ -185,6 +189,7 @@ for scene in cornell leak visibility-door visibility-corridor visibility-gap vis
             --stats "$out/shadows-1080p/$scene-$name.json"
     done <<'RUNS'
 default --method quadtree-tiles
+split --method quadtree-tiles --tile-passes split
 one-cut-interleave-4 --method quadtree --interleave 4
 RUNS
 done
@@ -304,7 +309,7 @@ if shadow_runs:
         still, moving = s["gpu_time_ms_static"] or {}, s["gpu_time_ms_moving"] or {}
         p = still.get("passes", {})
         cell = lambda v: f"{v:.3f}" if isinstance(v, (int, float)) else "-"
-        scene, name = re.match(r"(.*?)-(default|one-cut.*)$", f.stem).groups()
+        scene, name = re.match(r"(.*?)-(default|split|one-cut.*)$", f.stem).groups()
         lines.append(f"| {scene} | {name} | {cell(p.get('indirect'))} | {cell(p.get('upsample'))} | "
                      f"{cell(bounce(still) if still else None)} | {cell(bounce(moving) if moving else None)} | "
                      f"{s['texel_fetches_per_pixel']:.0f} |")

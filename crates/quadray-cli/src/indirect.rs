@@ -252,7 +252,7 @@ mod tests {
     use clap::Parser;
     use proptest::prelude::*;
     use quadray_core::settings::{Limits, Size};
-    use quadray_indirect::{ClusterSettings, GBufferLayout, TileCriterion, Validity};
+    use quadray_indirect::{ClusterSettings, GBufferLayout, TileCriterion, TilePasses, Validity};
     use quadray_test_support::flags::assert_settings_round_trip;
 
     #[derive(Parser)]
@@ -304,6 +304,7 @@ mod tests {
                 proptest::option::of(4u32..=13),
                 // (powers of two)
                 proptest::sample::select(vec![8u32, 16, 32, 64]),
+                proptest::sample::select(TilePasses::ALL.to_vec()),
             ),
         )
             .prop_map(
@@ -332,6 +333,7 @@ mod tests {
                         tile_shadow_angle,
                         shadow_map_log,
                         shadow_corner_lanes,
+                        tile_passes,
                     ),
                 )| {
                     // levels within the RSM's, the limit at or below the start (given or not)
@@ -374,6 +376,7 @@ mod tests {
                         tile_capacity,
                         tile_share,
                         tile_shadow_angle,
+                        tile_passes,
                         tile_deblock,
                     }
                 },

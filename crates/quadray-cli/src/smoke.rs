@@ -13,7 +13,9 @@ use quadray_displace::pyramid::Addressing;
 use quadray_displace::{Lod, PyramidKind, Renderer as DisplaceRenderer};
 use quadray_gpu::Gpu;
 use quadray_indirect::scene::{Intensity, Light, LightKind};
-use quadray_indirect::{Method as IndirectMethod, Renderer as IndirectRenderer, Scene, Settings};
+use quadray_indirect::{
+    Method as IndirectMethod, Renderer as IndirectRenderer, Scene, Settings, TilePasses,
+};
 use std::time::{Duration, Instant};
 
 #[derive(Args)]
@@ -114,8 +116,17 @@ fn cases() -> Vec<Case> {
         });
     }
     // eight light views summed: the spot's, the sun's orthographic map, a point light's six faces
-    let lights: [(&str, IndirectMethod, Change); 3] = [
+    let lights: [(&str, IndirectMethod, Change); 4] = [
         ("indirect-lights", IndirectMethod::DEFAULT, |_| {}),
+        // the per-tile cuts' split passes, lists, walks and sums, each view's after the last's
+        (
+            "indirect-lights-shadows-split",
+            IndirectMethod::DEFAULT,
+            |s| {
+                s.indirect_shadows = true;
+                s.tile_passes = TilePasses::Split;
+            },
+        ),
         // a corners' pass a light view, each before its view's sum, eight corners a workgroup
         (
             "indirect-lights-shadow-corners",

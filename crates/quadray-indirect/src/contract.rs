@@ -7,7 +7,7 @@
 
 use crate::light::node::{CONE_SLACK, CUT_CLASS_SIDE, EMPTY_BOX, MAX_LEVELS};
 use crate::method::GBufferLayout;
-use crate::settings::{Shade, TILE, TILE_FRONTIER};
+use crate::settings::{Shade, TILE, TILE_FRONTIER, TILE_SHADOW_HEADER};
 use crate::shader_struct::{Layout, shader_struct};
 use crate::shadows::occupancy::{
     BRICK, END_CLEARANCE_CELLS, END_OFFSET_CELLS, HEADER_WORDS, SUBCELLS,
@@ -17,7 +17,7 @@ use crate::tiles::deblock::{
 };
 use crate::tiles::{
     MIXED_TARGET_ANGLE, NEAR_FIELD_SIZE, PARALLEL_TARGET_COS, SPLIT_BINS, TILE_ENTRY_INDEX_BITS,
-    ZERO_ESTIMATE_SHARE,
+    TILE_WALK_LANES, ZERO_ESTIMATE_SHARE,
 };
 use wgpu::util::DeviceExt;
 
@@ -55,6 +55,8 @@ pub(crate) fn prelude() -> String {
          const MAX_LEVELS: u32 = {MAX_LEVELS}u;\n\
          const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;\n\
          const TILE_ENTRY_INDEX_BITS: u32 = {TILE_ENTRY_INDEX_BITS}u;\n\
+         const TILE_SHADOW_HEADER: u32 = {TILE_SHADOW_HEADER}u;\n\
+         const TILE_WALK_LANES: u32 = {TILE_WALK_LANES}u;\n\
          const TILE: u32 = {TILE}u;\n\
          const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};\n\
          const EMPTY_BOX: f32 = {EMPTY_BOX:?};\n\
@@ -513,6 +515,8 @@ mod tests {
             format!("const MAX_LEVELS: u32 = {MAX_LEVELS}u;"),
             format!("const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;"),
             format!("const TILE_ENTRY_INDEX_BITS: u32 = {TILE_ENTRY_INDEX_BITS}u;"),
+            format!("const TILE_SHADOW_HEADER: u32 = {TILE_SHADOW_HEADER}u;"),
+            format!("const TILE_WALK_LANES: u32 = {TILE_WALK_LANES}u;"),
             format!("const TILE: u32 = {TILE}u;"),
             format!("const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};"),
             format!("const EMPTY_BOX: f32 = {EMPTY_BOX:?};"),

@@ -98,7 +98,7 @@ pub use gbuffer::GBufferViews;
 pub use light::quadtree::LightQuadtree;
 pub use light::rsm::{FLOAT_FORMAT, RsmPass, RsmViews, TextureArray};
 pub use light::view::{LightView, Projection};
-pub use method::{GBufferLayout, Method, TileCriterion, Validity};
+pub use method::{GBufferLayout, Method, TileCriterion, TilePasses, Validity};
 pub use output::pass::OutputPass;
 pub use quadray_core::settings::Size;
 pub use renderer::Renderer;

@@ -1,6 +1,7 @@
 //! The named choices of the settings: the method that computes the indirect term, when a
-//! per-tile cut splits a node, and which clusters count as valid. Each has its name on the
-//! command line and in the stats, and its list in the order the CLI gives it.
+//! per-tile cut splits a node, how the per-tile cuts' passes are laid out, and which clusters
+//! count as valid. Each has its name on the command line and in the stats, and its list in the
+//! order the CLI gives it.
 
 use serde::Serialize;
 use std::fmt;
@@ -149,6 +150,46 @@ impl std::str::FromStr for TileCriterion {
 }
 
 impl fmt::Display for TileCriterion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How the per-tile cuts' work is laid out on the GPU with indirect shadows
+/// ([`crate::Settings::tile_passes`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TilePasses {
+    /// One kernel a tile: it builds the cut in workgroup memory, walks the shadow rays from the
+    /// tile's anchors and sums, phases between barriers.
+    Fused,
+    /// Three passes: the kernel builds the cut and its shadow targets into storage, a walk pass
+    /// with almost no workgroup memory walks the anchors' rays to them, several a lane, and a
+    /// per-pixel pass sums the list with the visibility the walks left.
+    Split,
+}
+
+impl TilePasses {
+    /// Both, in the order the CLI lists them.
+    pub const ALL: [TilePasses; 2] = [TilePasses::Fused, TilePasses::Split];
+
+    /// The layout's name on the command line and in the stats (`--tile-passes`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TilePasses::Fused => "fused",
+            TilePasses::Split => "split",
+        }
+    }
+}
+
+impl std::str::FromStr for TilePasses {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "tile passes")
+    }
+}
+
+impl fmt::Display for TilePasses {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }

@@ -8,7 +8,7 @@
 //! reproducing command line), and a round-trip test parses them again.
 
 use crate::frame::NORMAL_AGREEMENT;
-use crate::method::{GBufferLayout, TileCriterion, Validity};
+use crate::method::{GBufferLayout, TileCriterion, TilePasses, Validity};
 use crate::shader_struct::shader_struct;
 use quadray_core::settings::{Limits, Size};
 use serde::Serialize;
@@ -18,6 +18,12 @@ pub(crate) const TILE: u32 = 8;
 /// Nodes a tile's frontier holds in workgroup memory (per-tile cuts, two levels of it): the
 /// most a tile's list may hold ([`Settings::tile_capacity`]).
 pub(crate) const TILE_FRONTIER: u32 = 1024;
+
+/// Split per-tile passes ([`Settings::tile_passes`]): the words of a tile's shadow record
+/// before its targets' visibility words: how many targets, the anchor sets and the shared
+/// nodes, then each of the eight anchors' receivers, position and normal (wgsl
+/// `TILE_SHADOW_HEADER`, tiles/split.wgsl).
+pub(crate) const TILE_SHADOW_HEADER: u32 = 3 + 8 * 6;
 
 /// The levels a cut spans on a given RSM, its settings' choices or their defaults.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -366,7 +372,8 @@ pub struct Settings {
     pub tile_criterion: TileCriterion,
     /// quadtree-tiles: the most clusters a tile's cut holds; past it refinement stops (counted
     /// as [`crate::WorkCounts::refused_splits`]). The lists take 4 bytes a node and tile of GPU
-    /// memory (8 with --indirect-shadows, for the shadow rays' targets), each buffer at most
+    /// memory (8 with --indirect-shadows, for the shadow rays' targets, 12 and 204 a tile with
+    /// --tile-passes split, for their visibility and the tile's anchors), each buffer at most
     /// [`Self::MAX_TILE_LIST_BYTES`]; default: 1024, less where the picture's
     /// lists would take over [`Self::DEFAULT_TILE_LIST_BYTES`] (256 at 1920x1080).
     #[cfg_attr(feature = "cli", arg(long, value_parser = Settings::TILE_CAPACITY.parser()))]
@@ -394,6 +401,19 @@ pub struct Settings {
         value_parser = Settings::TILE_SHADOW_ANGLE.parser(),
     ))]
     pub tile_shadow_angle: f32,
+    /// quadtree-tiles with --indirect-shadows: fused (one kernel a tile builds the tile's cut in
+    /// workgroup memory, walks the shadow rays from the tile's anchors and sums, between
+    /// barriers) or split (that kernel builds the cut and its shadow targets into storage, a pass
+    /// with almost no workgroup memory walks the rays, several a lane, and a per-pixel pass
+    /// sums). The same picture; the split is a candidate for the GPU, where the fused kernel's
+    /// walks cost five times a per-pixel pass's a fetch: its kilobytes of workgroup memory leave
+    /// few waves resident to hide their latency (docs/known-problems.md). Without indirect
+    /// shadows the kernel is fused either way.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, default_value_t = Settings::DEFAULT.tile_passes)
+    )]
+    pub tile_passes: TilePasses,
     /// quadtree-tiles: pixels on either side of each tile boundary over which a step in the
     /// indirect light that the neighbours' slopes do not explain is spread, where those pixels
     /// lie on one surface (neighbouring tiles' cuts differ, so their light steps where the truth
@@ -438,6 +458,7 @@ impl Settings {
         tile_capacity: None,
         tile_share: 2.0,
         tile_shadow_angle: 0.3,
+        tile_passes: TilePasses::Fused,
         tile_deblock: 3,
     };
 
@@ -671,6 +692,23 @@ impl Settings {
         u64::from(tx) * u64::from(ty) * u64::from(self.tile_capacity_or_default()) * 4
     }
 
+    /// Whether the per-tile cuts run as three passes ([`Settings::tile_passes`] split, with
+    /// indirect shadows).
+    pub(crate) fn splits_tiles(&self) -> bool {
+        self.tile_passes == TilePasses::Split && self.march_steps() > 0
+    }
+
+    /// Bytes the split per-tile passes' shadow records take ([`TILE_SHADOW_HEADER`] words a
+    /// tile, then a word a list slot; 4 where the passes are fused).
+    pub(crate) fn tile_shadow_bytes(&self) -> u64 {
+        if !self.splits_tiles() {
+            return 4;
+        }
+        let (tx, ty) = self.tiles();
+        let words = u64::from(TILE_SHADOW_HEADER) + u64::from(self.tile_capacity_or_default());
+        u64::from(tx) * u64::from(ty) * words * 4
+    }
+
     /// The level whose nodes make a tile's coarse estimate of its irradiance (per-tile cuts): the
     /// quadtree's start level, or a coarser one where its nodes would outnumber a tile's list.
     pub(crate) fn tile_start_level(&self) -> u32 {
@@ -779,6 +817,15 @@ impl Settings {
                 bytes >> 20,
                 Self::MAX_TILE_LIST_BYTES >> 20,
                 Self::tile_capacity_within(s.size, Self::MAX_TILE_LIST_BYTES),
+            ));
+        }
+        if s.tile_shadow_bytes() > Self::MAX_TILE_LIST_BYTES {
+            return Err(format!(
+                "split per-tile passes' shadow records for {} nodes a tile of a {} picture take {} MiB, over {} MiB: lower the tile capacity",
+                s.tile_capacity_or_default(),
+                s.size,
+                s.tile_shadow_bytes() >> 20,
+                Self::MAX_TILE_LIST_BYTES >> 20,
             ));
         }
         Ok(())
@@ -890,6 +937,7 @@ mod tests {
             tile_capacity: Some(64),
             tile_share: 0.0,
             tile_shadow_angle: 0.5,
+            tile_passes: TilePasses::Split,
             tile_deblock: 1,
         };
         // (interleave and subsample exclude each other: each is checked alone)

@@ -80,6 +80,46 @@ fn the_declared_limit_needs_are_the_shaders() {
     );
 }
 
+/// The split per-tile passes' workgroup memory (the variables each entry point uses) against
+/// the fused kernel's: the walks run beside 16 bytes of counters instead of the kernel's
+/// kilobytes, and the sums hold less than half of them (the list stays in storage).
+#[test]
+fn the_split_tile_passes_hold_less_workgroup_memory() {
+    use crate::gathers::resources::shader;
+    use crate::tiles::pass::{SPLIT_WGSL, WGSL};
+    let bytes = |own: &[&'static str], entry: &str| -> u64 {
+        let source = shader_source(&shader(own));
+        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        let info =
+            naga::valid::Validator::new(Default::default(), naga::valid::Capabilities::all())
+                .validate(&module)
+                .unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let index = module
+            .entry_points
+            .iter()
+            .position(|e| e.name == entry)
+            .unwrap();
+        let used = info.get_entry_point(index);
+        module
+            .global_variables
+            .iter()
+            .filter(|(h, v)| v.space == naga::AddressSpace::WorkGroup && !used[*h].is_empty())
+            .map(|(_, v)| u64::from(layouter[v.ty].size))
+            .sum()
+    };
+    let fused = bytes(&WGSL, "indirect_tiles");
+    let [lists, walks, sums] =
+        ["tile_lists", "tile_walks", "tile_sums"].map(|e| bytes(&SPLIT_WGSL, e));
+    println!("workgroup bytes: fused {fused}, split lists {lists}, walks {walks}, sums {sums}");
+    assert!(
+        lists <= fused && sums < fused / 2,
+        "{lists}, {sums} of {fused}"
+    );
+    assert_eq!(walks, 16);
+}
+
 /// Every shader's parts (before the prelude), by pass.
 fn shaders() -> Vec<(&'static str, Vec<String>)> {
     let owned = |parts: &[&str]| parts.iter().map(|p| p.to_string()).collect();

@@ -12,7 +12,7 @@ use quadray_indirect::picture::tone_map;
 use quadray_indirect::scene::{BUNDLED_SCENES, scenes_dir};
 use quadray_indirect::{
     ClusterSettings, FrameTiming, GBufferLayout, Method, Renderer, Scene, Settings, TileCriterion,
-    Validity,
+    TilePasses, Validity,
 };
 use std::path::{Path, PathBuf};
 
@@ -568,6 +568,13 @@ impl IndirectView {
             let angle = Settings::TILE_SHADOW_ANGLE;
             ui.add(limits_slider(&mut s.tile_shadow_angle, angle, ""))
         });
+        named_choice_box(
+            ui,
+            "tile passes (quadtree-tiles with shadows)",
+            &mut s.tile_passes,
+            &TilePasses::ALL,
+            |p| p.name().into(),
+        );
         let mut temporal = s.temporal_weight < 1.0;
         ui.checkbox(&mut temporal, "temporal filter (reprojected)");
         s.temporal_weight = if temporal {

@@ -36,6 +36,10 @@ pub(crate) fn shaders() -> Vec<(&'static str, Vec<&'static str>)> {
             super::resources::shader(&crate::tiles::pass::WGSL),
         ),
         (
+            "gather tiles split",
+            super::resources::shader(&crate::tiles::pass::SPLIT_WGSL),
+        ),
+        (
             "gather rsm sampling",
             super::resources::shader(&super::rsm_sampling::WGSL),
         ),
@@ -99,6 +103,15 @@ impl Gather {
                 s.tile_list_bytes(),
                 &format!(
                     "{size} with --tile-capacity {}",
+                    s.tile_capacity_or_default()
+                ),
+            ),
+            need(
+                Limit::StorageBufferBindingSize,
+                s.tile_shadow_bytes(),
+                &format!(
+                    "{size} with --tile-passes {} and --tile-capacity {}",
+                    s.tile_passes,
                     s.tile_capacity_or_default()
                 ),
             ),

@@ -34,31 +34,39 @@ fn second_anchors(local: u32, r: Receiver, shape: PixelPatch) -> u32 {
 // sees it (`visible`, shadows/march.wgsl), one invocation a target, set and corner; a pixel on an
 // anchor's surface weighs each of its tile's nodes by its target's visibility from the anchors
 // of its set the target faces, interpolated, so that a tile walks at most four shadow rays a
-// target and set instead of one a pixel and node. (An anchor behind the target's plane
+// target and set instead of one a pixel and node. The fused kernel's walks; the split passes'
+// walk their targets a lane each (split.wgsl). (An anchor behind the target's plane
 // gets no light from it and no ray: 1-22% fewer fetches on the visibility scenes, the same
 // pictures or better. Skipping the anchors whose plane the target is behind too made the door
 // scene's shadows blocky, 0.87 -> 1.35; a target behind every anchor's plane walks none:
 // BENCHMARKS.md.)
-fn corner_visibility(local: u32, base: u32, targets: u32, sets: u32) {
+fn corner_visibility(local: u32, tile: u32, targets: u32, sets: u32) {
+    let base = tile * shade.tile_capacity;
     for (var k = local; k < 4u * sets * targets; k += TILE_PIXELS) {
         let slot = k / (4u * sets);
         let anchor_set = (k / 4u) % sets;
         let c = k % 4u;
-        fetches++;
-        let index = tile_targets[base + slot];
-        let node = nodes[index];
-        let a = shadow_anchor(4u * anchor_set + c);
-        let x = tile_x[a];
-        var seen = 0u;
-        if (dot(node.normal.xyz, x - node.pos.xyz) > 0.0) {
-            seen = 1u << (c + 4u);
-            if (!behind_every_anchor(node.pos.xyz, anchor_set) && visible(x, tile_n[a], shadow_end(index, node, x), node.normal.xyz)) {
-                seen |= 1u << c;
-            }
-        }
+        let seen = anchor_bits(tile, tile_targets[base + slot], anchor_set, c);
         let byte = slot * sets + anchor_set;
         atomicOr(&verdicts[byte / 4u], seen << (8u * (byte % 4u)));
     }
+}
+
+// One shadow ray of `corner_visibility`: target `index`'s bits from corner c's anchor of set
+// `anchor_set` (bit c + 4: the target faces it; bit c: and the anchor's receiver sees it).
+fn anchor_bits(tile: u32, index: u32, anchor_set: u32, c: u32) -> u32 {
+    fetches++;
+    let node = nodes[index];
+    let a = 4u * anchor_set + c;
+    let x = anchor_position(tile, a);
+    var seen = 0u;
+    if (dot(node.normal.xyz, x - node.pos.xyz) > 0.0) {
+        seen = 1u << (c + 4u);
+        if (!behind_every_anchor(tile, node.pos.xyz, anchor_set) && visible(x, anchor_normal(tile, a), shadow_end(index, node, x), node.normal.xyz)) {
+            seen |= 1u << c;
+        }
+    }
+    return seen;
 }
 
 // The point a shadow ray from receiver `x` walks to: the target's mean; with the occupancy grid,
@@ -88,10 +96,10 @@ fn shadow_end(index: u32, node: Node, x: vec3<f32>) -> vec3<f32> {
 // the receivers on the anchors' surfaces get no light from it, and a ray from an anchor would
 // pass through the anchor's own surface, so it counts as hidden without one.
 // (of set `anchor_set`)
-fn behind_every_anchor(p: vec3<f32>, anchor_set: u32) -> bool {
+fn behind_every_anchor(tile: u32, p: vec3<f32>, anchor_set: u32) -> bool {
     for (var c = 0u; c < 4u; c++) {
-        let a = shadow_anchor(4u * anchor_set + c);
-        if (dot(tile_n[a], p - tile_x[a]) >= -terms.plane_agreement) {
+        let a = 4u * anchor_set + c;
+        if (dot(anchor_normal(tile, a), p - anchor_position(tile, a)) >= -terms.plane_agreement) {
             return false;
         }
     }
@@ -215,10 +223,10 @@ fn lone_sums(local: u32, tile: u32, r: Receiver, listed: u32, lone: bool) -> vec
         if (mine) {
             for (var i = 0u; i < listed; i++) {
                 fetches++;
-                let node = nodes[frontier[0][i] & ~SHARED];
+                let node = nodes[list_node(tile, i) & ~SHARED];
                 let d = r.x - node.pos.xyz;
                 if (dot(node.normal.xyz, d) > 0.0 && dot(r.n, d) < 0.0) {
-                    let bit = (row - first) * targets + (frontier[1][i] >> 16u);
+                    let bit = (row - first) * targets + (list_shadow(tile, i) >> 16u);
                     atomicOr(&verdicts[bit / 32u], 1u << (bit % 32u));
                 }
             }
@@ -241,8 +249,8 @@ fn lone_sums(local: u32, tile: u32, r: Receiver, listed: u32, lone: bool) -> vec
         if (mine) {
             for (var i = 0u; i < listed; i++) {
                 fetches++;
-                let node = nodes[frontier[0][i] & ~SHARED];
-                let bit = (row - first) * targets + (frontier[1][i] >> 16u);
+                let node = nodes[list_node(tile, i) & ~SHARED];
+                let bit = (row - first) * targets + (list_shadow(tile, i) >> 16u);
                 let seen = f32((atomicLoad(&verdicts[bit / 32u]) >> (bit % 32u)) & 1u);
                 irradiance += seen * vpl_irradiance(node.flux.rgb, node.pos.xyz, node.normal.xyz, r.x, r.n, terms.r_min);
             }

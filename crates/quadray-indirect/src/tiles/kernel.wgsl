@@ -1,9 +1,14 @@
 // Per-tile cuts: one workgroup a tile of TILE x TILE receivers refines the light quadtree level
 // by level from its root by the rules of rule.wgsl, down to single VPLs where needed,
-// then every pixel of the tile sums the tile's list. `indirect_tiles` calls one function a phase:
-// the receivers' box and groups, the coarse estimate (the threshold), the refinement, the far
-// clusters shared at the tile's corners, the per-pixel sum. Every invocation calls every phase
-// that holds a barrier, and each loop around a barrier counts to a workgroup-uniform bound.
+// then every pixel of the tile sums the tile's list. One function a phase: the receivers' box
+// and groups, the coarse estimate (the threshold), the refinement, the far clusters shared at
+// the tile's corners, the per-pixel sum. The fused kernel (`indirect_tiles`, fused.wgsl) runs
+// them all in one workgroup, the list in workgroup memory; the split passes (split.wgsl) build
+// the list into storage, walk its shadow rays in a pass of their own and sum it in a third. Each
+// defines the accessors of the list these phases read (`list_node`, `list_shadow`), of the
+// shadow anchors' receivers (`anchor_position`, `anchor_normal`) and what becomes of each
+// tile's shadow targets (`see_targets`). Every invocation calls every phase that holds a
+// barrier, and each loop around a barrier counts to a workgroup-uniform bound.
 
 // Group 3, this pass's own: the per-tile cuts' lists (allocated by the first frame that draws
 // them): each tile's entries (`tile_capacity` slots a tile: a node's index, with indirect
@@ -42,7 +47,8 @@ var<workgroup> anchor_sets: u32;
 // indirect pass with shadows on the courtyard, leak and shelf scenes, the second set took the
 // pass to 0.89-0.94x the time).
 const SECOND_ANCHORS_FROM: u32 = 4u;
-// the nodes of the level being refined and of the next (pyramid indices)
+// the nodes of the level being refined and of the next (pyramid indices); then the list as the
+// gather reads it (`list_for_gather`)
 var<workgroup> frontier: array<array<u32, TILE_FRONTIER>, 2>;
 var<workgroup> frontier_len: array<atomic<u32>, 2>;
 var<workgroup> list_len: atomic<u32>;
@@ -112,6 +118,76 @@ fn store_tile_counts(pixel: vec2<u32>, inside: bool, local: u32) {
     }
     if (inside) {
         store_counts(pixel_index(pixel));
+    }
+}
+
+// The tile's list length, refused splits and estimates (`tile_sizes`); its refused splits count
+// with its first pixel.
+fn store_tile_sizes(tile: u32, local: u32) {
+    if (local == 0u) {
+        refused_splits = atomicLoad(&refused);
+        tile_sizes[tile] = vec4<u32>(atomicLoad(&list_len), refused_splits, atomicLoad(&estimated_nodes), atomicLoad(&estimate_evaluations));
+    }
+}
+
+// Phase 1, then, of every pass over a tile that has receivers (`tile_is_empty` false): the
+// pixel's patch and the tile's shadow anchors (both sets). Every invocation calls it.
+struct OpenTile {
+    r: Receiver,
+    corners_covered: bool,
+    shape: PixelPatch,
+    // the pixels off the first anchor set's surfaces (`second_anchors`)
+    off_anchor: u32,
+}
+
+fn open_tile(local: u32, r: Receiver) -> OpenTile {
+    var t: OpenTile;
+    t.r = r;
+    t.corners_covered = all_corners_covered();
+    t.shape = pixel_patch(local, r, t.corners_covered);
+    if (SHADOWS) {
+        t.off_anchor = second_anchors(local, r, t.shape);
+    }
+    return t;
+}
+
+// Phases 1 to 4 of a tile that has receivers: its cut refined into `tile_cuts` (`list_len`
+// entries), then the list for the gather (`list_for_gather`); how many nodes it shares at the
+// corners. Every invocation calls it.
+fn build_list(local: u32, tile: u32, t: OpenTile) -> u32 {
+    let groups = receiver_groups(local, t.r);
+    let threshold = coarse_threshold(local, groups);
+    refine(local, tile, groups, threshold);
+    storageBarrier();
+    let listed = atomicLoad(&list_len);
+    let sharing = shade.tile_share > 0.0 && t.corners_covered;
+    return list_for_gather(local, tile, listed, groups, sharing, t.off_anchor);
+}
+
+// Phase 5: the pixel's indirect light from its tile's list of `listed` nodes, `shared_nodes`
+// of them shared at the corners, its visibility known (`anchor_sets` and `target_count` set).
+// Every invocation calls it.
+fn sum_tile(pixel: vec2<u32>, inside: bool, local: u32, tile: u32, t: OpenTile, listed: u32, shared_nodes: u32) {
+    let r = t.r;
+    var shape = t.shape;
+    var corner_vectors: array<mat3x3<f32>, 4>;
+    if (shared_nodes > 0u) {
+        corner_vectors = gather_at_corners(local, tile, listed);
+    }
+    let sets = workgroupUniformLoad(&anchor_sets);
+    if (SHADOWS && sets == 2u && is_lone(r, shape)) {
+        shape = second_patch(local, r, shape);
+    }
+    let lone = is_lone(r, shape);
+    var irradiance = vec3<f32>(0.0);
+    if (SHADOWS) {
+        irradiance = lone_sums(local, tile, r, listed, lone);
+    }
+    if (r.covered && !lone) {
+        irradiance = pixel_sum(tile, r, listed, shared_nodes > 0u, shape, corner_vectors);
+    }
+    if (inside) {
+        add_indirect(pixel_index(pixel), vec4<f32>(r.albedo / PI * irradiance, 0.0));
     }
 }
 
@@ -382,11 +458,10 @@ fn apply_verdicts(local: u32, tile: u32, level: u32, current: u32, count: u32) {
 }
 
 // Phase 4: the list copied once into workgroup memory (the frontier's, free now), far nodes
-// marked to be shared; with indirect shadows every listed node without a target its own, each
-// target's visibility from the tile's anchors (`corner_visibility`; the second set's too where
-// more than SECOND_ANCHORS_FROM pixels are off the first set's surfaces, `off_anchor`), and per
-// node its target's slot << 16 and its visibility bytes (the second set's in bits 8-15); how
-// many nodes are shared. Every invocation calls it.
+// marked to be shared; with indirect shadows every listed node without a target its own (its
+// slot in frontier[1]), and the tile's targets seen from its anchors (`see_targets`: one set,
+// or the second too where more than SECOND_ANCHORS_FROM pixels are off the first set's
+// surfaces, `off_anchor`); how many nodes are shared. Every invocation calls it.
 fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: bool, off_anchor: u32) -> u32 {
     let base = tile * shade.tile_capacity;
     let lo = min(g.lo[0], g.lo[1]);
@@ -426,22 +501,20 @@ fn list_for_gather(local: u32, tile: u32, listed: u32, g: TileGroups, sharing: b
         if (local == 0u) {
             anchor_sets = sets;
         }
-        corner_visibility(local, base, targets, sets);
-        workgroupBarrier();
-        for (var i = local; i < listed; i += TILE_PIXELS) {
-            let slot = frontier[1][i];
-            var bytes = verdict_byte(slot * sets);
-            if (sets == 2u) {
-                bytes |= verdict_byte(2u * slot + 1u) << 8u;
-            }
-            frontier[1][i] = (slot << 16u) | bytes;
-        }
+        see_targets(local, tile, listed, targets, sets);
     }
     workgroupBarrier();
     if (local == 0u) {
         shared_total = atomicLoad(&shared_count);
     }
     return workgroupUniformLoad(&shared_total);
+}
+
+// A listed node's visibility as `list_shadow` gives it: its target's slot << 16, then its
+// target's visibility byte from each anchor set (`corner_visibility`, the second set's in bits
+// 8-15).
+fn list_shadow_word(slot: u32, bytes: u32) -> u32 {
+    return (slot << 16u) | bytes;
 }
 
 // Byte `i` of `verdicts`.
@@ -453,17 +526,17 @@ fn verdict_byte(i: u32) -> u32 {
 // shadows, those the corner sees): a quarter of the workgroup per corner, each thread a share of
 // the nodes, then summed per corner (one colour channel in each of the reduction arrays). Every
 // invocation calls it.
-fn gather_at_corners(local: u32, listed: u32) -> array<mat3x3<f32>, 4> {
+fn gather_at_corners(local: u32, tile: u32, listed: u32) -> array<mat3x3<f32>, 4> {
     let x = tile_x[CORNERS[local % 4u]];
     var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var i = local / 4u; i < listed; i += TILE_PIXELS / 4u) {
-        let entry = frontier[0][i];
+        let entry = list_node(tile, i);
         if ((entry & SHARED) != 0u) {
             fetches++;
             let node = nodes[entry & ~SHARED];
             // (evaluated either way, as a pixel's own sum does before its shadow test; a corner
             // the node does not face had no ray, and gets no light from it)
-            let seen = !SHADOWS || ((frontier[1][i] >> (local % 4u)) & 1u) == 1u;
+            let seen = !SHADOWS || ((list_shadow(tile, i) >> (local % 4u)) & 1u) == 1u;
             v += vpl_vector(node.flux.rgb, node.pos.xyz, node.normal.xyz, x, terms.r_min) * f32(seen);
         }
     }
@@ -489,7 +562,7 @@ fn gather_at_corners(local: u32, listed: u32) -> array<mat3x3<f32>, 4> {
 // Phase 5: a covered pixel's sum of its tile's list (a lone one's is `lone_sums`'). On the
 // corners' patch it takes the shared nodes interpolated from `corner_vectors`, and with shadows
 // each node's target's visibility from the anchors on its own surface, interpolated.
-fn pixel_sum(r: Receiver, listed: u32, shared_nodes: bool, shape: PixelPatch, corner_vectors: array<mat3x3<f32>, 4>) -> vec3<f32> {
+fn pixel_sum(tile: u32, r: Receiver, listed: u32, shared_nodes: bool, shape: PixelPatch, corner_vectors: array<mat3x3<f32>, 4>) -> vec3<f32> {
     var irradiance = vec3<f32>(0.0);
     if (shared_nodes && shape.on_patch) {
         var v = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
@@ -499,13 +572,13 @@ fn pixel_sum(r: Receiver, listed: u32, shared_nodes: bool, shape: PixelPatch, co
         irradiance += max(vec3<f32>(0.0), r.n * v);
     }
     for (var i = 0u; i < listed; i++) {
-        let entry = frontier[0][i];
+        let entry = list_node(tile, i);
         if ((entry & SHARED) == 0u || !shape.on_patch) {
             fetches++;
             let node = nodes[entry & ~SHARED];
             var seen = 1.0;
             if (SHADOWS) {
-                let bits = vec4<u32>((frontier[1][i] >> (8u * shape.anchor_set)) & 255u) >> vec4<u32>(0u, 1u, 2u, 3u);
+                let bits = vec4<u32>((list_shadow(tile, i) >> (8u * shape.anchor_set)) & 255u) >> vec4<u32>(0u, 1u, 2u, 3u);
                 let lit = shape.seen_weights * vec4<f32>((bits >> vec4<u32>(4u)) & vec4<u32>(1u));
                 let lit_total = lit.x + lit.y + lit.z + lit.w;
                 // (no corner on the pixel's surface faces the node: the node lies nearly in
@@ -518,63 +591,4 @@ fn pixel_sum(r: Receiver, listed: u32, shared_nodes: bool, shape: PixelPatch, co
         }
     }
     return irradiance;
-}
-
-@compute @workgroup_size(TILE, TILE)
-fn indirect_tiles(
-    @builtin(global_invocation_id) id: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-    @builtin(workgroup_id) tile_xy: vec3<u32>,
-) {
-    let inside = id.x < viewer.width && id.y < viewer.height;
-    let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
-    let r = load_tile(id.xy, inside, local);
-    if (tile_is_empty(local, r)) {
-        // nothing to light: no light either (the last frame's may be there)
-        if (inside) {
-            add_indirect(pixel_index(id.xy), vec4<f32>(0.0));
-        }
-        if (local == 0u) {
-            tile_sizes[tile] = vec4<u32>(0u);
-        }
-        store_tile_counts(id.xy, inside, local);
-        return;
-    }
-    let corners_covered = all_corners_covered();
-    var shape = pixel_patch(local, r, corners_covered);
-    var off_anchor = 0u;
-    if (SHADOWS) {
-        off_anchor = second_anchors(local, r, shape);
-    }
-    let groups = receiver_groups(local, r);
-    let threshold = coarse_threshold(local, groups);
-    refine(local, tile, groups, threshold);
-    storageBarrier();
-    let listed = atomicLoad(&list_len);
-    let sharing = shade.tile_share > 0.0 && corners_covered;
-    let shared_nodes = list_for_gather(local, tile, listed, groups, sharing, off_anchor);
-    var corner_vectors: array<mat3x3<f32>, 4>;
-    if (shared_nodes > 0u) {
-        corner_vectors = gather_at_corners(local, listed);
-    }
-    let sets = workgroupUniformLoad(&anchor_sets);
-    if (SHADOWS && sets == 2u && is_lone(r, shape)) {
-        shape = second_patch(local, r, shape);
-    }
-    let lone = is_lone(r, shape);
-    var irradiance = vec3<f32>(0.0);
-    if (SHADOWS) {
-        irradiance = lone_sums(local, tile, r, listed, lone);
-    }
-    if (r.covered && !lone) {
-        irradiance = pixel_sum(r, listed, shared_nodes > 0u, shape, corner_vectors);
-    }
-    if (inside) {
-        add_indirect(pixel_index(id.xy), vec4<f32>(r.albedo / PI * irradiance, 0.0));
-    }
-    if (local == 0u) {
-        refused_splits = atomicLoad(&refused);
-        tile_sizes[tile] = vec4<u32>(listed, refused_splits, atomicLoad(&estimated_nodes), atomicLoad(&estimate_evaluations));
-    }
-    store_tile_counts(id.xy, inside, local);
 }

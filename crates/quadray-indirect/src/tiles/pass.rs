@@ -1,22 +1,37 @@
 //! Per-tile cuts ([`Method::QuadtreeTiles`]): one workgroup a tile of 8x8 pixels refines
 //! its own cut of the light quadtree against a bound of each node's contribution, then its pixels
 //! sum it, and the light's steps at the tiles' boundaries are smoothed where the pixels lie on
-//! one surface (`deblock.wgsl`). The tiles' lists are this pass's own group 3.
+//! one surface (`deblock.wgsl`). With indirect shadows and [`TilePasses::Split`] the kernel runs
+//! as three dispatches (`split.wgsl`): the lists, the shadow walks, the sums. The tiles' lists
+//! are this pass's own group 3.
 
-#[cfg(doc)]
-use crate::Method;
 use crate::contract::{bind_group, dispatch_2d, layout, storage_buffer, storage_entry, whole};
 use crate::gathers::resources::Resources;
+use crate::tiles::TILE_WALK_LANES;
 use crate::wgsl;
+#[cfg(doc)]
+use crate::{Method, TilePasses};
 use std::sync::OnceLock;
 
-/// The pass's own shader parts, after the shared ones.
-pub(crate) const WGSL: [&str; 5] = [
+/// The fused kernel's shader parts, after the shared ones ([`TilePasses::Fused`]).
+pub(crate) const WGSL: [&str; 6] = [
     wgsl::BOUND,
     wgsl::TILE_RULE,
     include_str!("kernel.wgsl"),
     include_str!("anchors.wgsl"),
     include_str!("deblock.wgsl"),
+    include_str!("fused.wgsl"),
+];
+
+/// The split passes' shader parts ([`TilePasses::Split`]): the same phases, their own entry
+/// points and accessors.
+pub(crate) const SPLIT_WGSL: [&str; 6] = [
+    wgsl::BOUND,
+    wgsl::TILE_RULE,
+    include_str!("kernel.wgsl"),
+    include_str!("anchors.wgsl"),
+    include_str!("deblock.wgsl"),
+    include_str!("split.wgsl"),
 ];
 
 /// The per-tile cuts' lists and their bind group (group 3).
@@ -31,11 +46,22 @@ struct TileLists {
     /// With indirect shadows, per tile the nodes its shadow rays go to (`tile_capacity` slots a
     /// tile; one word without shadows). Only the shader reads it.
     _targets: wgpu::Buffer,
+    /// The split passes' shadow records ([`crate::Settings::tile_shadow_bytes`]), none when
+    /// fused. Only the shaders read them.
+    _shadows: Option<wgpu::Buffer>,
     group: wgpu::BindGroup,
 }
 
+/// The per-tile kernel's pipelines.
+enum Kernel {
+    /// One dispatch a light view.
+    Fused(wgpu::ComputePipeline),
+    /// Three: the lists, the shadow walks, the sums.
+    Split([wgpu::ComputePipeline; 3]),
+}
+
 pub(crate) struct Tiles {
-    pipeline: wgpu::ComputePipeline,
+    kernel: Kernel,
     /// The deblocking filter across the columns' boundaries, then across the rows'.
     deblock: [wgpu::ComputePipeline; 2],
     lists_layout: wgpu::BindGroupLayout,
@@ -48,24 +74,45 @@ pub(crate) struct Tiles {
 
 impl Tiles {
     pub fn new(device: &wgpu::Device, res: &Resources) -> Self {
-        let lists_layout = layout(
-            device,
-            "per-tile cuts",
-            &[
-                storage_entry::<u32>(0, false),
-                storage_entry::<[u32; 4]>(1, false),
-                storage_entry::<u32>(2, false),
-            ],
-        );
-        let [pipeline, columns, rows] = res.pipelines(
-            device,
-            "gather tiles",
-            &WGSL,
-            ["indirect_tiles", "deblock_columns", "deblock_rows"],
-            &[&lists_layout],
-        );
+        let split = res.settings().splits_tiles();
+        let mut entries = vec![
+            storage_entry::<u32>(0, false),
+            storage_entry::<[u32; 4]>(1, false),
+            storage_entry::<u32>(2, false),
+        ];
+        if split {
+            entries.push(storage_entry::<u32>(3, false));
+        }
+        let lists_layout = layout(device, "per-tile cuts", &entries);
+        let layouts = [&lists_layout];
+        let deblock = ["deblock_columns", "deblock_rows"];
+        let (kernel, columns, rows) = if split {
+            let [lists, walks, sums, columns, rows] = res.pipelines(
+                device,
+                "gather tiles split",
+                &SPLIT_WGSL,
+                [
+                    "tile_lists",
+                    "tile_walks",
+                    "tile_sums",
+                    deblock[0],
+                    deblock[1],
+                ],
+                &layouts,
+            );
+            (Kernel::Split([lists, walks, sums]), columns, rows)
+        } else {
+            let [kernel, columns, rows] = res.pipelines(
+                device,
+                "gather tiles",
+                &WGSL,
+                ["indirect_tiles", deblock[0], deblock[1]],
+                &layouts,
+            );
+            (Kernel::Fused(kernel), columns, rows)
+        };
         Self {
-            pipeline,
+            kernel,
             deblock: [columns, rows],
             lists_layout,
             lists: OnceLock::new(),
@@ -74,7 +121,7 @@ impl Tiles {
     }
 
     /// Records one workgroup a tile (a list of at most `TILE_FRONTIER` nodes fits a slice), the
-    /// lists allocated first.
+    /// lists allocated first; split, the lists', the walks' and the sums' dispatches in turn.
     pub fn record(&self, pass: &mut wgpu::ComputePass, res: &Resources) {
         let s = res.settings();
         let (tx, ty) = s.tiles();
@@ -88,23 +135,37 @@ impl Tiles {
                 4
             };
             let targets = storage_buffer(&self.device, "per-tile shadow targets", target_bytes);
-            let group = bind_group(
-                &self.device,
-                "per-tile cuts",
-                &self.lists_layout,
-                vec![whole(&cuts), whole(&sizes), whole(&targets)],
-            );
+            let shadows = matches!(self.kernel, Kernel::Split(_)).then(|| {
+                let bytes = s.tile_shadow_bytes();
+                storage_buffer(&self.device, "per-tile shadow records", bytes)
+            });
+            let mut buffers = vec![whole(&cuts), whole(&sizes), whole(&targets)];
+            buffers.extend(shadows.as_ref().map(whole));
+            let group = bind_group(&self.device, "per-tile cuts", &self.lists_layout, buffers);
             TileLists {
                 cuts,
                 sizes,
                 _targets: targets,
+                _shadows: shadows,
                 group,
             }
         });
         pass.set_bind_group(3, &lists.group, &[]);
-        pass.set_pipeline(&self.pipeline);
         res.bind_dispatch(pass, 0, 0);
-        pass.dispatch_workgroups(tx, ty, 1);
+        match &self.kernel {
+            Kernel::Fused(kernel) => {
+                pass.set_pipeline(kernel);
+                pass.dispatch_workgroups(tx, ty, 1);
+            }
+            Kernel::Split([lists, walks, sums]) => {
+                pass.set_pipeline(lists);
+                pass.dispatch_workgroups(tx, ty, 1);
+                pass.set_pipeline(walks);
+                pass.dispatch_workgroups(tx.div_ceil(64 / TILE_WALK_LANES), ty, 1);
+                pass.set_pipeline(sums);
+                pass.dispatch_workgroups(tx, ty, 1);
+            }
+        }
     }
 
     /// Records the deblocking filter over the light every view's tiles summed, where
