@@ -79,8 +79,9 @@ fn tile_lists(
     if (tile_is_empty(local, r)) {
         if (local == 0u) {
             tile_sizes[tile] = vec4<u32>(0u);
-            // (no target to walk to)
+            // (no target to walk to; no anchor set, the sum pass's sign of an empty tile)
             tile_shadows[shadow_record(tile)] = 0u;
+            tile_shadows[shadow_record(tile) + 1u] = 0u;
         }
         store_tile_counts(id.xy, inside, local);
         return;
@@ -136,6 +137,22 @@ fn tile_walks(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation
     }
 }
 
+// The sum pass's phase 1: each covered pixel offered as its corners' anchor (as
+// `tile_is_empty` does), and whether the list's pass found the tile empty (it left no anchor
+// set): read from the record, not reduced again over the tile (2 barriers, not 8). Every
+// invocation calls it.
+fn listed_tile_is_empty(local: u32, tile: u32, r: Receiver) -> bool {
+    if (local == 0u) {
+        anchor_sets = tile_shadows[shadow_record(tile) + 1u];
+    }
+    // (also publishes load_tile's stores before the atomics below)
+    workgroupBarrier();
+    if (r.covered) {
+        offer_anchor(local, 0u);
+    }
+    return workgroupUniformLoad(&anchor_sets) == 0u;
+}
+
 @compute @workgroup_size(TILE, TILE)
 fn tile_sums(
     @builtin(global_invocation_id) id: vec3<u32>,
@@ -145,7 +162,7 @@ fn tile_sums(
     let inside = id.x < viewer.width && id.y < viewer.height;
     let tile = tile_xy.y * shade.tiles_x + tile_xy.x;
     let r = load_tile(id.xy, inside, local);
-    if (tile_is_empty(local, r)) {
+    if (listed_tile_is_empty(local, tile, r)) {
         if (inside) {
             add_indirect(pixel_index(id.xy), vec4<f32>(0.0));
         }
