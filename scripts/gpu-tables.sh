@@ -149,7 +149,8 @@ done
 # corner's rays instead of 64 (each lane walks 4 or 8 times the rays: do a wave's lanes end
 # closer together?); the per-tile cuts with shadows in split passes (--tile-passes split: the
 # walks in a pass of their own, with almost no workgroup memory), paired with
-# indirect-quadtree-tiles-shadows, the fused kernel (docs/known-problems.md predicts the split).
+# indirect-quadtree-tiles-shadows, the fused kernel (docs/known-problems.md predicts the split),
+# with 16 threads walking a tile's rays, and with 4 or 64.
 while read -r name flags; do
     # shellcheck disable=SC2086 # $flags is several words
     step "indirect-$name" "$bin" indirect $flags --size $size --rsm-size $rsm \
@@ -168,6 +169,8 @@ quadtree-shadows-corners-8-interleave-4 --method quadtree --indirect-shadows --s
 quadtree-shadows-corner-lanes-16 --method quadtree --indirect-shadows --shadow-corner-lanes 16
 quadtree-shadows-corner-lanes-8 --method quadtree --indirect-shadows --shadow-corner-lanes 8
 quadtree-tiles-shadows-split --method quadtree-tiles --indirect-shadows --tile-passes split
+quadtree-tiles-shadows-split-walk-lanes-4 --method quadtree-tiles --indirect-shadows --tile-passes split --tile-walk-lanes 4
+quadtree-tiles-shadows-split-walk-lanes-64 --method quadtree-tiles --indirect-shadows --tile-passes split --tile-walk-lanes 64
 CANDIDATES
 # An indirect run that failed or hung: one tiny frame again with wgpu's trace (pipelines created,
 # each submit), to see where it stops.

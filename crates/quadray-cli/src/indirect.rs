@@ -302,8 +302,11 @@ mod tests {
                 proptest::option::of(u(Settings::SHADOW_CORNERS)),
                 f(Settings::TILE_SHADOW_ANGLE, 0.0, 100.0),
                 proptest::option::of(4u32..=13),
-                // (powers of two)
-                proptest::sample::select(vec![8u32, 16, 32, 64]),
+                // (powers of two: the shadow corners' and the split tiles' walk lanes)
+                (
+                    proptest::sample::select(vec![8u32, 16, 32, 64]),
+                    proptest::sample::select(vec![4u32, 8, 16, 32, 64]),
+                ),
                 proptest::sample::select(TilePasses::ALL.to_vec()),
             ),
         )
@@ -332,7 +335,7 @@ mod tests {
                         shadow_corners,
                         tile_shadow_angle,
                         shadow_map_log,
-                        shadow_corner_lanes,
+                        (shadow_corner_lanes, tile_walk_lanes),
                         tile_passes,
                     ),
                 )| {
@@ -377,6 +380,7 @@ mod tests {
                         tile_share,
                         tile_shadow_angle,
                         tile_passes,
+                        tile_walk_lanes,
                         tile_deblock,
                     }
                 },

@@ -118,13 +118,15 @@ fn cases() -> Vec<Case> {
     // eight light views summed: the spot's, the sun's orthographic map, a point light's six faces
     let lights: [(&str, IndirectMethod, Change); 4] = [
         ("indirect-lights", IndirectMethod::DEFAULT, |_| {}),
-        // the per-tile cuts' split passes, lists, walks and sums, each view's after the last's
+        // the per-tile cuts' split passes, lists, walks and sums, each view's after the last's,
+        // sixteen tiles' walks a workgroup
         (
             "indirect-lights-shadows-split",
             IndirectMethod::DEFAULT,
             |s| {
                 s.indirect_shadows = true;
                 s.tile_passes = TilePasses::Split;
+                s.tile_walk_lanes = 4;
             },
         ),
         // a corners' pass a light view, each before its view's sum, eight corners a workgroup

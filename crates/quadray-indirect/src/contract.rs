@@ -16,8 +16,8 @@ use crate::tiles::deblock::{
     ALBEDO as DEBLOCK_ALBEDO, LIMIT as DEBLOCK_LIMIT, PLANE as DEBLOCK_PLANE,
 };
 use crate::tiles::{
-    MIXED_TARGET_ANGLE, NEAR_FIELD_SIZE, PARALLEL_TARGET_COS, SPLIT_BINS, TILE_ENTRY_INDEX_BITS,
-    TILE_WALK_LANES, ZERO_ESTIMATE_SHARE,
+    MIXED_TARGET_ANGLE, MOST_WALKED_TILES, NEAR_FIELD_SIZE, PARALLEL_TARGET_COS, SPLIT_BINS,
+    TILE_ENTRY_INDEX_BITS, ZERO_ESTIMATE_SHARE,
 };
 use wgpu::util::DeviceExt;
 
@@ -56,7 +56,7 @@ pub(crate) fn prelude() -> String {
          const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;\n\
          const TILE_ENTRY_INDEX_BITS: u32 = {TILE_ENTRY_INDEX_BITS}u;\n\
          const TILE_SHADOW_HEADER: u32 = {TILE_SHADOW_HEADER}u;\n\
-         const TILE_WALK_LANES: u32 = {TILE_WALK_LANES}u;\n\
+         const MOST_WALKED_TILES: u32 = {MOST_WALKED_TILES}u;\n\
          const TILE: u32 = {TILE}u;\n\
          const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};\n\
          const EMPTY_BOX: f32 = {EMPTY_BOX:?};\n\
@@ -516,7 +516,7 @@ mod tests {
             format!("const TILE_FRONTIER: u32 = {TILE_FRONTIER}u;"),
             format!("const TILE_ENTRY_INDEX_BITS: u32 = {TILE_ENTRY_INDEX_BITS}u;"),
             format!("const TILE_SHADOW_HEADER: u32 = {TILE_SHADOW_HEADER}u;"),
-            format!("const TILE_WALK_LANES: u32 = {TILE_WALK_LANES}u;"),
+            format!("const MOST_WALKED_TILES: u32 = {MOST_WALKED_TILES}u;"),
             format!("const TILE: u32 = {TILE}u;"),
             format!("const NEAR_FIELD_SIZE: f32 = {NEAR_FIELD_SIZE:?};"),
             format!("const EMPTY_BOX: f32 = {EMPTY_BOX:?};"),

@@ -414,6 +414,17 @@ pub struct Settings {
         arg(long, default_value_t = Settings::DEFAULT.tile_passes)
     )]
     pub tile_passes: TilePasses,
+    /// quadtree-tiles with --tile-passes split: the threads that walk one tile's shadow rays (a
+    /// power of two, 4 to 64), each whole targets at a time (all their anchors' rays), 64 /
+    /// N tiles a workgroup of 64. Fewer lanes a tile give each lane more rays, so that a
+    /// wave's lanes end closer together; more spread a tile's walks over more of the GPU. The
+    /// same picture.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        default_value_t = Settings::DEFAULT.tile_walk_lanes,
+        value_parser = Settings::TILE_WALK_LANES.parser(),
+    ))]
+    pub tile_walk_lanes: u32,
     /// quadtree-tiles: pixels on either side of each tile boundary over which a step in the
     /// indirect light that the neighbours' slopes do not explain is spread, where those pixels
     /// lie on one surface (neighbouring tiles' cuts differ, so their light steps where the truth
@@ -459,6 +470,7 @@ impl Settings {
         tile_share: 2.0,
         tile_shadow_angle: 0.3,
         tile_passes: TilePasses::Fused,
+        tile_walk_lanes: 16,
         tile_deblock: 3,
     };
 
@@ -495,6 +507,9 @@ impl Settings {
     /// The clusters of a cut whose visibility each corner of [`Settings::shadow_corners`] keeps
     /// (a pixel walks to those beyond alone): 4096 bits, 512 bytes a corner.
     pub const SHADOW_CORNER_CLUSTERS: u32 = 4096;
+    /// [`Settings::tile_walk_lanes`]: a workgroup of 64 threads holds one to sixteen tiles' walks
+    /// (wgsl `MOST_WALKED_TILES`, sixteen).
+    pub const TILE_WALK_LANES: Limits<u32> = Limits::closed(4, 64);
     /// [`Settings::shadow_corner_lanes`]: a workgroup of 64 threads holds one to eight corners.
     pub const SHADOW_CORNER_LANES: Limits<u32> = Limits::closed(8, 64);
     /// [`Settings::shadow_steps`].
@@ -769,6 +784,13 @@ impl Settings {
         if let Some(spacing) = s.shadow_corners {
             Self::SHADOW_CORNERS.check("shadow corners", spacing)?;
         }
+        Self::TILE_WALK_LANES.check("tile walk lanes", s.tile_walk_lanes)?;
+        if !s.tile_walk_lanes.is_power_of_two() {
+            return Err(format!(
+                "tile walk lanes {} must be a power of two (a workgroup of 64 threads holds a whole number of tiles)",
+                s.tile_walk_lanes
+            ));
+        }
         Self::SHADOW_CORNER_LANES.check("shadow corner lanes", s.shadow_corner_lanes)?;
         if !s.shadow_corner_lanes.is_power_of_two() {
             return Err(format!(
@@ -866,6 +888,9 @@ shader_struct! {
         corner_words: u32 = s.shadow_corner_words(),
         /// The threads walking one corner's rays (a workgroup holds 64 / `corner_lanes` corners).
         corner_lanes: u32 = s.shadow_corner_lanes,
+        /// Split per-tile passes: the threads walking one tile's shadow rays (a workgroup holds
+        /// 64 / `tile_walk_lanes` tiles).
+        tile_walk_lanes: u32 = s.tile_walk_lanes,
         /// Weight of this frame in the running average of the indirect light (1: no filter).
         temporal_weight: f32 = s.temporal_weight,
         /// Per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its
@@ -938,6 +963,7 @@ mod tests {
             tile_share: 0.0,
             tile_shadow_angle: 0.5,
             tile_passes: TilePasses::Split,
+            tile_walk_lanes: 4,
             tile_deblock: 1,
         };
         // (interleave and subsample exclude each other: each is checked alone)

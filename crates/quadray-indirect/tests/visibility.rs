@@ -240,8 +240,10 @@ fn pixels_off_the_anchors_surfaces_walk_from_a_second_set() {
         ratio <= 1.9,
         "{plain_fetches} -> {with_fetches}: {ratio:.2}x"
     );
+    // (32 threads a tile's walks: two of the row's four tiles a workgroup)
     let split = Settings {
         tile_passes: TilePasses::Split,
+        tile_walk_lanes: 32,
         ..shadowed(&at_32())
     };
     let split = Renderer::new(&gpu, &scene, split)

@@ -21,13 +21,9 @@ pub(crate) const TILE_ENTRY_INDEX_BITS: u32 = 21;
 const _: () =
     assert!(4 * Settings::RSM_SIZE.max * Settings::RSM_SIZE.max / 3 < 1 << TILE_ENTRY_INDEX_BITS);
 const _: () = assert!(TILE_FRONTIER <= 1 << (31 - TILE_ENTRY_INDEX_BITS));
-/// Split per-tile passes: the threads that walk one tile's shadow rays, each a target at a
-/// time (all its anchors' rays), four tiles a workgroup of 64: a lane walks a sixteenth of the
-/// tile's targets, four or eight rays each, where the fused kernel's 64 threads walked about
-/// ten rays each between barriers (docs/known-problems.md); a divisor of 64 (wgsl
-/// `TILE_WALK_LANES`).
-pub(crate) const TILE_WALK_LANES: u32 = 16;
-const _: () = assert!(64 % TILE_WALK_LANES == 0);
+/// Split per-tile passes: the most tiles a walks' workgroup of 64 threads holds, at the fewest
+/// [`Settings::tile_walk_lanes`] (wgsl `MOST_WALKED_TILES`: the workgroup's fetch counters).
+pub(crate) const MOST_WALKED_TILES: u32 = 64 / Settings::TILE_WALK_LANES.min;
 /// Per-tile cuts: a node more than this many times `r_min` across, with a receiver of the tile
 /// within `r_min` of its box, holds the kernel's near field, where its children's sum agrees
 /// with it however far both are from its VPLs'; the bound, not the estimate, decides it

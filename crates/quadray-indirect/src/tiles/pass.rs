@@ -7,7 +7,6 @@
 
 use crate::contract::{bind_group, dispatch_2d, layout, storage_buffer, storage_entry, whole};
 use crate::gathers::resources::Resources;
-use crate::tiles::TILE_WALK_LANES;
 use crate::wgsl;
 #[cfg(doc)]
 use crate::{Method, TilePasses};
@@ -161,7 +160,7 @@ impl Tiles {
                 pass.set_pipeline(lists);
                 pass.dispatch_workgroups(tx, ty, 1);
                 pass.set_pipeline(walks);
-                pass.dispatch_workgroups(tx.div_ceil(64 / TILE_WALK_LANES), ty, 1);
+                pass.dispatch_workgroups(tx.div_ceil(64 / res.settings().tile_walk_lanes), ty, 1);
                 pass.set_pipeline(sums);
                 pass.dispatch_workgroups(tx, ty, 1);
             }

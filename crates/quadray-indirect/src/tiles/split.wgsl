@@ -4,8 +4,8 @@
 // the kernel's barriers beside its kilobytes of workgroup memory.
 // - `tile_lists`: the kernel up to the list, each listed node's target slot and shared mark
 //   written back into `tile_cuts`, and the tile's shadow record (`tile_shadows`), no walk.
-// - `tile_walks`: TILE_WALK_LANES threads a tile, each walking a target's rays from every anchor
-//   (`anchor_bits`, the fused kernel's rays) and writing its visibility word.
+// - `tile_walks`: `tile_walk_lanes` threads a tile, each walking a target's rays from every
+//   anchor (`anchor_bits`, the fused kernel's rays) and writing its visibility word.
 // - `tile_sums`: each pixel's sum of the list from storage (every invocation reads the same
 //   words), the receivers, anchors and patches recomputed as the first pass found them, the lone
 //   pixels' walks as the fused kernel's.
@@ -96,16 +96,17 @@ fn tile_lists(
 }
 
 // The walks' fetches of each of the workgroup's tiles, counted with the tile's first pixel.
-var<workgroup> walk_fetches: array<atomic<u32>, 64u / TILE_WALK_LANES>;
+var<workgroup> walk_fetches: array<atomic<u32>, MOST_WALKED_TILES>;
 
-// 64 / TILE_WALK_LANES tiles of a row a workgroup, TILE_WALK_LANES threads a tile: each thread
-// walks every TILE_WALK_LANES-th of its tile's targets, from each anchor of each set, and writes
-// the target's visibility word.
+// 64 / `tile_walk_lanes` tiles of a row a workgroup, `tile_walk_lanes` threads a tile: each
+// thread walks every `tile_walk_lanes`-th of its tile's targets, from each anchor of each set,
+// and writes the target's visibility word.
 @compute @workgroup_size(64)
 fn tile_walks(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let held = local / TILE_WALK_LANES;
-    let lane = local % TILE_WALK_LANES;
-    let across = group.x * (64u / TILE_WALK_LANES) + held;
+    let lanes = shade.tile_walk_lanes;
+    let held = local / lanes;
+    let lane = local % lanes;
+    let across = group.x * (64u / lanes) + held;
     // (a row's last workgroup may hold fewer tiles than it has room for)
     let in_row = across < shade.tiles_x;
     let tile = group.y * shade.tiles_x + min(across, shade.tiles_x - 1u);
@@ -118,7 +119,7 @@ fn tile_walks(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation
         let targets = min(tile_shadows[record], shade.tile_capacity);
         let sets = min(tile_shadows[record + 1u], 2u);
         let base = tile * shade.tile_capacity;
-        for (var slot = lane; slot < targets; slot += TILE_WALK_LANES) {
+        for (var slot = lane; slot < targets; slot += lanes) {
             let index = tile_targets[base + slot];
             var bytes = 0u;
             for (var anchor_set = 0u; anchor_set < sets; anchor_set++) {
