@@ -7,11 +7,15 @@
 //! `quadray indirect`'s clap arguments; `Settings::to_args` spells them back (the viewer's
 //! reproducing command line), and a round-trip test parses them again.
 
-use crate::frame::NORMAL_AGREEMENT;
-use crate::method::{GBufferLayout, TileCriterion, TilePasses, Validity};
-use crate::shader_struct::shader_struct;
+use crate::method::{GBufferLayout, TileCriterion, TilePasses};
 use quadray_core::settings::{Limits, Size};
 use serde::Serialize;
+
+mod cluster;
+mod shade;
+
+pub use cluster::{ClusterSettings, Levels};
+pub(crate) use shade::Shade;
 
 /// Side of a tile of receivers that shares one per-tile cut (the gather's workgroup).
 pub(crate) const TILE: u32 = 8;
@@ -24,126 +28,6 @@ pub(crate) const TILE_FRONTIER: u32 = 1024;
 /// nodes, then each of the eight anchors' receivers, position and normal (wgsl
 /// `TILE_SHADOW_HEADER`, tiles/split.wgsl).
 pub(crate) const TILE_SHADOW_HEADER: u32 = 3 + 8 * 6;
-
-/// The levels a cut spans on a given RSM, its settings' choices or their defaults.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Levels {
-    /// The coarsest level a cluster may be (the cut starts from its nodes).
-    pub start: u32,
-    /// The finest level a cluster may be.
-    pub limit: u32,
-}
-
-/// The light quadtree's parameters. Levels are mip levels: 0 is the RSM itself (one VPL per
-/// node), each level halves the side.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::Args))]
-pub struct ClusterSettings {
-    /// Level the cut starts from (mip level: 0 is the RSM, each level halves the side); default:
-    /// the level of 8x8 nodes, as in the paper.
-    #[cfg_attr(feature = "cli", arg(long, value_parser = ClusterSettings::LEVEL.parser()))]
-    pub start_level: Option<u32>,
-    /// Level where every cluster is accepted: nodes below it are never visited (0: single VPLs);
-    /// default: the level of 64x64 nodes.
-    #[cfg_attr(feature = "cli", arg(long, value_parser = ClusterSettings::LEVEL.parser()))]
-    pub limit_level: Option<u32>,
-    /// Max |child depth - mean depth| of a valid cluster (depth along the light's axis, in units
-    /// of the spot's extent).
-    #[cfg_attr(feature = "cli", arg(
-        long,
-        default_value_t = ClusterSettings::DEFAULT.depth_threshold,
-        value_parser = ClusterSettings::DEPTH_THRESHOLD.parser(),
-    ))]
-    pub depth_threshold: f32,
-    /// Min dot(child normal, mean normal) of a valid cluster.
-    #[cfg_attr(feature = "cli", arg(
-        long,
-        default_value_t = ClusterSettings::DEFAULT.normal_threshold,
-        value_parser = ClusterSettings::NORMAL_THRESHOLD.parser(),
-        allow_negative_numbers = true,
-    ))]
-    pub normal_threshold: f32,
-    /// Which nodes' validity a node's own depends on: recursive (every child valid too) or local
-    /// (the paper's).
-    #[cfg_attr(
-        feature = "cli",
-        arg(long, default_value_t = ClusterSettings::DEFAULT.validity)
-    )]
-    pub validity: Validity,
-    /// Cluster means weighted by flux luminance (`--unweighted-means`: by texel count).
-    #[cfg_attr(
-        feature = "cli",
-        arg(long = "unweighted-means", action = clap::ArgAction::SetFalse)
-    )]
-    pub flux_weighted: bool,
-}
-
-impl ClusterSettings {
-    /// The defaults: the paper's thresholds (depth 0.05, normal 0.9), start at 8x8 nodes as in
-    /// the paper, limit at 64x64 (the paper's level 4; its 32x32 limit leaves about 7% rel. L1
-    /// error on the Cornell box, most of it at the limit level), and the recursive rule: on a
-    /// 512^2 RSM the local rule leaves 5.1% with 360 clusters, the recursive 3.8% with 633, less
-    /// than the local rule reaches with the same time at a finer limit (4.4% with 589); on the
-    /// 256^2 RSM of the test that holds the README's figures, 5.1% and 3.7%.
-    pub const DEFAULT: ClusterSettings = ClusterSettings {
-        start_level: None,
-        limit_level: None,
-        depth_threshold: 0.05,
-        normal_threshold: 0.9,
-        validity: Validity::Recursive,
-        flux_weighted: true,
-    };
-
-    /// Nodes across the default start level.
-    pub const DEFAULT_START_NODES: u32 = 8;
-    /// Nodes across the default limit level.
-    pub const DEFAULT_LIMIT_NODES: u32 = 64;
-
-    /// [`ClusterSettings::start_level`] and [`ClusterSettings::limit_level`] (the RSM's own
-    /// levels bound them further in [`Settings::validate`]).
-    pub const LEVEL: Limits<u32> = Limits::closed(0, 10);
-    /// [`ClusterSettings::depth_threshold`].
-    pub const DEPTH_THRESHOLD: Limits<f32> = Limits::closed(0.0, f32::MAX).interactive(0.001, 0.5);
-    /// [`ClusterSettings::normal_threshold`].
-    pub const NORMAL_THRESHOLD: Limits<f32> = Limits::closed(-1.0, 1.0);
-
-    /// The levels these settings span on an `rsm_size`^2 RSM: the given ones, else the levels of
-    /// [`Self::DEFAULT_START_NODES`] and [`Self::DEFAULT_LIMIT_NODES`] nodes across.
-    pub fn levels(&self, rsm_size: u32) -> Levels {
-        let top = rsm_size.max(1).ilog2();
-        let of = |nodes: u32| top.saturating_sub(nodes.ilog2());
-        Levels {
-            start: self.start_level.unwrap_or(of(Self::DEFAULT_START_NODES)),
-            limit: self.limit_level.unwrap_or(of(Self::DEFAULT_LIMIT_NODES)),
-        }
-    }
-
-    /// The paper's settings (local rule) with the limit level where nodes are `side` x `side`
-    /// (16, 32, 64 in table 1).
-    pub fn with_limit_side(rsm_size: u32, side: u32) -> Self {
-        let top = rsm_size.ilog2();
-        Self {
-            limit_level: Some(top.saturating_sub(side.max(1).ilog2())),
-            validity: Validity::Local,
-            ..Self::DEFAULT
-        }
-    }
-
-    /// Every cluster a single VPL: the cut is the whole RSM.
-    pub fn every_vpl() -> Self {
-        Self {
-            limit_level: Some(0),
-            depth_threshold: 0.0,
-            ..Self::DEFAULT
-        }
-    }
-}
-
-impl Default for ClusterSettings {
-    fn default() -> Self {
-        Self::DEFAULT
-    }
-}
 
 /// The size check `validate()` and `--size` share.
 fn check_size(size: &Size) -> Result<(), String> {
@@ -863,65 +747,13 @@ impl Settings {
     }
 }
 
-shader_struct! {
-    /// The settings as the gather's shaders read them (WGSL `Shade`), written once: a gather's
-    /// settings are fixed. A setting a shader reads is a field here and nowhere else on the Rust
-    /// side; the WGSL struct is generated from this list.
-    pub(crate) struct Shade as "Shade" (s: &Settings) {
-        sample_count: u32 = s.samples,
-        /// Sub-sampled indirect: one sample per `subsample` x `subsample` pixels.
-        subsample: u32 = s.subsample,
-        /// Interleaved sampling: a pixel sums one of `interleave`^2 parts (1: all).
-        interleave: u32 = s.interleave,
-        low_width: u32 = s.low_size().0,
-        low_height: u32 = s.low_size().1,
-        /// Geometry agreement for upsampling, corner sharing and deblocking: normals' dot.
-        normal_agreement: f32 = NORMAL_AGREEMENT,
-        /// Indirect shadows: points marched between a receiver and a cluster (0: none).
-        shadow_steps: u32 = s.march_steps(),
-        /// The one cut's indirect shadows from corner receivers every `shadow_corners` pixels
-        /// (0: each pixel walks), `corners_x` of them in a row and `corners_y` rows, each keeping
-        /// `corner_words` words of visibility bits (shadows/corners.wgsl).
-        shadow_corners: u32 = s.shadow_corners_or_off(),
-        corners_x: u32 = s.shadow_corner_grid().0,
-        corners_y: u32 = s.shadow_corner_grid().1,
-        corner_words: u32 = s.shadow_corner_words(),
-        /// The threads walking one corner's rays (a workgroup holds 64 / `corner_lanes` corners).
-        corner_lanes: u32 = s.shadow_corner_lanes,
-        /// Split per-tile passes: the threads walking one tile's shadow rays (a workgroup holds
-        /// 64 / `tile_walk_lanes` tiles).
-        tile_walk_lanes: u32 = s.tile_walk_lanes,
-        /// Weight of this frame in the running average of the indirect light (1: no filter).
-        temporal_weight: f32 = s.temporal_weight,
-        /// Per-tile cuts: a node is split while its bound (or with `tile_estimate` 1, its
-        /// estimated error) exceeds `tile_error` of the tile's irradiance estimated from the
-        /// nodes of level `tile_start`; at most `tile_capacity` nodes a tile.
-        tile_error: f32 = s.tile_error_or_default(),
-        tile_capacity: u32 = s.tile_capacity_or_default(),
-        tile_start: u32 = s.tile_start_level(),
-        /// Tiles in a row of the picture.
-        tiles_x: u32 = s.tiles().0,
-        tile_estimate: u32 = u32::from(s.tile_criterion == TileCriterion::Estimate),
-        /// Per-tile cuts: nodes farther than this times the tile's receivers' diagonal are
-        /// gathered at the tile's corners and interpolated (0: every pixel evaluates every node).
-        tile_share: f32 = s.tile_share,
-        /// Per-tile cuts: pixels on either side of a tile boundary its unexplained step is
-        /// spread over (0: none; deblock.wgsl).
-        tile_deblock: u32 = s.tile_deblock,
-        /// Per-tile cuts with indirect shadows: a cluster takes the visibility of its highest
-        /// ancestor whose box's diagonal is at most this times its distance from the tile's
-        /// receivers, `MIXED_TARGET_ANGLE` of it for an ancestor of several surfaces (0: each
-        /// its own; tiles/kernel.wgsl).
-        tile_shadow_angle: f32 = s.tile_shadow_angle,
-    }
-}
-
 #[cfg(test)]
 mod rules;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::method::Validity;
 
     /// Settings with every field off its default, every `Option` given and every switch
     /// flipped, and the defaults, come back through `to_args` and the clap arguments: a field
