@@ -10,7 +10,7 @@ use crate::gi::cpu_time::CpuTimes;
 use crate::gi::scene::RsmSource;
 use bevy::asset::{AssetEvent, uuid_handle};
 use bevy::math::{Affine2, Affine3, Affine3Ext};
-use bevy::mesh::{MeshVertexBufferLayoutRef, UvChannel};
+use bevy::mesh::{MeshVertexBufferLayoutRef, PrimitiveTopology, UvChannel};
 use bevy::pbr::{
     MeshInputUniform, MeshLayouts, MeshPipeline, MeshPipelineKey, MeshUniform,
     RenderMaterialInstances, RenderMeshInstances, SkinUniforms, StandardMaterial,
@@ -349,7 +349,12 @@ pub(super) fn prepare_mesh_rsm(
         let Some(vertices) = sources.allocator.mesh_vertex_slice(&mesh_id) else {
             continue;
         };
-        if !mesh.layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
+        // triangles with normals, as the triangles' RSM takes them
+        let triangles = matches!(
+            mesh.primitive_topology(),
+            PrimitiveTopology::TriangleList | PrimitiveTopology::TriangleStrip
+        );
+        if !triangles || !mesh.layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
             continue;
         }
         let material_id = sources
