@@ -21,14 +21,16 @@ use bevy::render::storage::ShaderBuffer;
 use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::world_serialization::WorldAssetRoot;
 use quadray_bevy::gi::{
-    IndirectLight, IndirectLightPlugin, IndirectLightSource, ViewPasses, camera_diagnostic_path,
+    IndirectLight, IndirectLightPlugin, IndirectLightSource, RsmSource, SceneWork, ViewPasses,
+    camera_diagnostic_path,
 };
 use quadray_indirect::reference::compare;
 use quadray_indirect::{Method, Renderer, Scene, Settings};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use crate::common::ASSETS;
+use crate::gi_meshes::{MESHES_RSM_TOLERANCE, meshes_against_triangles, switched};
 
 pub(crate) const SCENE: &str = "scenes/cornell_spot.gltf";
 pub(crate) const SIZE: u32 = 64;
@@ -273,18 +275,31 @@ pub(crate) fn floats(bytes: &[u8]) -> Vec<[f32; 3]> {
 
 /// What Bevy's render world held at the end of its last frame, shared by both worlds (the render
 /// world runs on its own thread): whether a pipeline was left to compile (a mesh drawn with it is
-/// missing from the picture until then), and how many cameras held the plugin's passes.
+/// missing from the picture until then), how many cameras held the plugin's passes, and how many
+/// meshes it had drawn into the RSMs ([`SceneWork::meshes_drawn`]).
 #[derive(Resource, Clone, Default)]
-struct RenderWorldNotes(Arc<(AtomicBool, AtomicUsize)>);
+struct RenderWorldNotes(Arc<(AtomicBool, AtomicUsize, AtomicU64)>);
 
 fn take_notes(
     pipelines: Res<PipelineCache>,
     passes: Query<(), With<ViewPasses>>,
+    work: Option<Res<SceneWork>>,
     notes: Res<RenderWorldNotes>,
 ) {
     let waiting = pipelines.waiting_pipelines().next().is_some();
     notes.0.0.store(waiting, Ordering::Relaxed);
     notes.0.1.store(passes.iter().count(), Ordering::Relaxed);
+    let drawn = work.map_or(0, |w| w.meshes_drawn);
+    notes.0.2.store(drawn, Ordering::Relaxed);
+}
+
+/// The meshes the render world had drawn into the RSMs by its last rendered frame.
+pub(crate) fn meshes_drawn(app: &App) -> u64 {
+    app.world()
+        .resource::<RenderWorldNotes>()
+        .0
+        .2
+        .load(Ordering::Relaxed)
 }
 
 /// Whether Bevy still compiles a pipeline, as its last rendered frame saw it.
@@ -623,6 +638,17 @@ fn plugin_matches_quadray_and_adds_light_only_where_it_should() {
             .zip(&off[ceiling..ceiling + 3])
             .all(|(a, b)| a > b)
     );
+
+    // (d) the RSM drawn from Bevy's meshes by the plugin's mesh pipeline: every gathering
+    // camera's bounce as from the CPU's triangles
+    let from_meshes = switched(&mut app, &probes, RsmSource::Meshes);
+    for (i, (meshes, triangles)) in from_meshes.iter().zip(&indirect).enumerate() {
+        if !probes[i].enabled {
+            continue;
+        }
+        let error = meshes_against_triangles(&format!("camera {i}"), meshes, triangles);
+        assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
+    }
 }
 
 /// The sun, a point light and a spot from the same glTF file, all three marked and then each

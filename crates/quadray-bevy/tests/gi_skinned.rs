@@ -10,12 +10,13 @@ use bevy::mesh::VertexAttributeValues;
 use bevy::mesh::morph::MorphWeights;
 use bevy::mesh::skinning::SkinnedMesh;
 use bevy::prelude::*;
-use quadray_bevy::gi::IndirectLightScene;
+use quadray_bevy::gi::{IndirectLightScene, RsmSource};
 use quadray_indirect::reference::compare;
 use quadray_indirect::scene::Vertex;
 use quadray_indirect::{Method, Renderer, Settings};
 
 use crate::gi::{SIZE, app_of, floats, gathered, in_candela, scene_from};
+use crate::gi_meshes::{MESHES_RSM_TOLERANCE, meshes_against_triangles, switched};
 
 const SKINNED_SCENE: &str = "scenes/skinned_bar.gltf";
 /// A camera looking at the room's left wall past the bar, which it never sees (standing or bent
@@ -194,6 +195,14 @@ fn a_skinned_mesh_s_bounce_moves_with_its_joints() {
         fades < 0.9 && (fades - quadray_fades).abs() < 0.02,
         "{fades} {quadray_fades}"
     );
+
+    // the RSM drawn from Bevy's meshes, the bar skinned by Bevy's vertex stage: the bent bar's
+    // bounce as from the triangles posed on the CPU; then from the triangles again, made anew
+    let meshes = switched(&mut app, &probes, RsmSource::Meshes);
+    let error = meshes_against_triangles("the bent bar", &meshes[0], &last);
+    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
+    let triangles = switched(&mut app, &probes, RsmSource::Triangles);
+    assert_eq!(triangles[0], last);
 
     // the morph target `flare` weighed in (on the glTF node the mesh refers to): the bar alone
     // made anew, morphed, then bent

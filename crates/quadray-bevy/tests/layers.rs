@@ -7,7 +7,8 @@ use quadray_test_support::layering::assert_layered;
 /// displaced surfaces' triangles, the base colour textures, the skinned and morphed meshes'
 /// poses and the indirect light's CPU times, its main-world side (which reads the materials and
 /// those), then its render-world side by phase (the pipelines, the scene's triangles, the
-/// lights' and the cameras' prepare, the passes), and the plugin that adds both.
+/// lights' prepare, the RSM drawn from Bevy's meshes, the cameras' prepare, the passes), and the
+/// plugin that adds both.
 const LAYERS: &[&[&str]] = &[
     &["pyramid_image"],
     &[""],
@@ -16,6 +17,7 @@ const LAYERS: &[&[&str]] = &[
     &["gi::render::pipelines"],
     &["gi::render::triangles"],
     &["gi::render::light"],
+    &["gi::render::meshes"],
     &["gi::render::views"],
     &["gi::render::passes"],
     &["gi::render"],

@@ -6,6 +6,7 @@
 //! is), and each test checks that the change matters (a stale bounce would differ). The apps are
 //! `gi.rs`'s: the bundled Cornell box, 64x64, 64^2 RSM.
 
+use bevy::asset::RenderAssetUsages;
 use bevy::camera::{Hdr, RenderTarget};
 use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -15,7 +16,7 @@ use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{Extent3d, TextureFormat, TextureUsages};
 use bevy::render::storage::ShaderBuffer;
 use bevy::world_serialization::WorldAssetRoot;
-use quadray_bevy::gi::IndirectLight;
+use quadray_bevy::gi::{IndirectLight, RsmSource};
 use quadray_indirect::reference::{ImageError, compare};
 use quadray_indirect::{Method, Settings};
 use std::sync::{Arc, Mutex};
@@ -24,6 +25,7 @@ use crate::gi::{
     Case, Probe, Probes, RSM, SCENE, SIZE, TEXTURED_SCENE, app, app_with, app_without_plugin,
     cameras_with_passes, check_textured_floor, compiling, floats, gathered,
 };
+use crate::gi_meshes::{MESHES_RSM_TOLERANCE, meshes_against_triangles, switched};
 
 /// A picture read back every frame, the latest kept.
 type Read = Arc<Mutex<Option<Vec<u8>>>>;
@@ -533,6 +535,43 @@ fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     );
     assert!(replaced.error.rel_l1 < SAME, "{:?}", replaced.error);
     assert_eq!(replaced.after, 0, "a gather differed once the scene was in");
+
+    // the RSM drawn from Bevy's meshes: the floor's texture as the triangles' RSM samples it
+    let pixels = (SIZE * SIZE) as usize;
+    let meshes = switched(&mut app, &probes, RsmSource::Meshes);
+    let error = meshes_against_triangles("textured floor", &meshes[0], &replaced.last[..pixels]);
+    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
+
+    // a red box on the floor whose mesh only the render world keeps: the RSM from Bevy's meshes
+    // draws it as the triangles' RSM draws the same box readable on the CPU; the triangles'
+    // misses it
+    let world = app.world_mut();
+    let mut mesh = Cuboid::new(0.2, 0.3, 0.2).mesh().build();
+    mesh.asset_usage = RenderAssetUsages::RENDER_WORLD;
+    let render_world_only = world.resource_mut::<Assets<Mesh>>().add(mesh);
+    let readable = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Cuboid::new(0.2, 0.3, 0.2));
+    let red = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(Color::srgb(0.9, 0.1, 0.1));
+    let place = Transform::from_xyz(0.5, 0.15, 0.5);
+    let red_box = world
+        .spawn((Mesh3d(render_world_only), MeshMaterial3d(red), place))
+        .id();
+    let drawn = switched(&mut app, &probes, RsmSource::Meshes);
+    let missed = switched(&mut app, &probes, RsmSource::Triangles);
+    app.world_mut().entity_mut(red_box).insert(Mesh3d(readable));
+    let readable = switched(&mut app, &probes, RsmSource::Triangles);
+    let error = meshes_against_triangles("a render-world mesh", &drawn[0], &readable[0]);
+    let missing = compare(&missed[0], &readable[0]);
+    let added = compare(&meshes[0], &readable[0]);
+    println!(
+        "the box missed by the triangles' RSM: {missing:?}; the box's bounce (its light and its \
+         shade) against the floor's alone: {added:?}"
+    );
+    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
+    assert!(missing.rel_l1 > 0.01, "{missing:?}");
 }
 
 /// A camera without `IndirectLight` beside one with it: its picture is an app's without the

@@ -5,6 +5,7 @@
 mod common;
 mod gi;
 mod gi_displaced;
+mod gi_meshes;
 mod gi_scene;
 mod gi_skinned;
 mod hits;

@@ -24,7 +24,9 @@
 //! WxH` (default 256x256) and `--rsm-size N` (default 128) size the off-screen picture and the
 //! RSM. `--ev100 EV` sets the camera's exposure (Bevy's `Exposure`; default 9.7, Bevy's): about
 //! 15 for a glTF lit by a physical sun, 2 for a 4-lux sun or a dim lamp. `--indirect-shadows`
-//! tests each cluster's view on the scene's occupancy grid. At the scale of games:
+//! tests each cluster's view on the scene's occupancy grid. `--rsm-source meshes` draws the
+//! lights' RSMs from Bevy's meshes on the GPU instead of the scene's triangles made on the CPU.
+//! At the scale of games:
 //! `--large-scene SEED` makes and shows a scene of about a million triangles in hundreds of
 //! meshes (`large_scene.rs`), `--move-node NAME` moves a node of the scene every frame (the
 //! large scene's `mover`), `--bend-node NAME` bends a node to and fro every frame (the large
@@ -44,7 +46,7 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy::world_serialization::WorldAssetRoot;
 use clap::Parser;
-use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource};
+use quadray_bevy::gi::{IndirectLight, IndirectLightPlugin, IndirectLightSource, RsmSource};
 use quadray_bevy::{PyramidDisplacementPlugin, PyramidExtension, PyramidMaterial};
 use quadray_bevy_programs::{Offscreen, add_default_plugins, repository_assets, set_title};
 use quadray_indirect::{Method, Settings, Size};
@@ -65,8 +67,8 @@ const TURN: f32 = 0.25;
 type FileCamera = (Added<Camera3d>, Without<IndirectLight>);
 
 /// What the first frame shows (`--no-gi`, `--method`, `--cut-view`), at what size (`--size`,
-/// `--rsm-size`), interleaving (`--interleave`), indirect shadows (`--indirect-shadows`) and
-/// exposure (`--ev100`).
+/// `--rsm-size`), interleaving (`--interleave`), indirect shadows (`--indirect-shadows`), the
+/// RSM's source (`--rsm-source`) and exposure (`--ev100`).
 #[derive(Resource, Clone, Copy)]
 struct Shown {
     gi: bool,
@@ -77,6 +79,7 @@ struct Shown {
     rsm_size: u32,
     interleave: u32,
     indirect_shadows: bool,
+    rsm_source: RsmSource,
     ev100: f32,
 }
 
@@ -165,6 +168,10 @@ struct Args {
     /// direct light's shade, where the bounce is all the light there is (a sunlit scene's).
     #[arg(long, conflicts_with = "displaced")]
     shadows: bool,
+    /// What the lights' RSMs are drawn from: the scene's triangles made on the CPU, or Bevy's
+    /// meshes on the GPU (`IndirectLight::rsm_source`, whose documentation says what each does).
+    #[arg(long, default_value_t = RsmSource::default())]
+    rsm_source: RsmSource,
 }
 
 /// A kind of light `--gi-lights` names.
@@ -250,6 +257,7 @@ fn main() {
         rsm_size: args.rsm_size,
         interleave: args.interleave,
         indirect_shadows: args.indirect_shadows,
+        rsm_source: args.rsm_source,
         ev100: args.ev100,
     };
     let mut app = App::new();
@@ -608,6 +616,7 @@ fn configure(
                 method: shown.method,
                 enabled: shown.gi,
                 cut_view: shown.cut_view,
+                rsm_source: shown.rsm_source,
                 ..default()
             },
         ));

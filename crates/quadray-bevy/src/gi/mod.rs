@@ -32,7 +32,10 @@
 //! The passes are `quadray_indirect`'s own, recorded into Bevy's command encoder on Bevy's
 //! device (quadray builds on the wgpu Bevy 0.19 uses); the plugin adds only the translation of
 //! Bevy's packed G-buffer (`gbuffer.wgsl`, with Bevy's unpacking functions) and the additive
-//! composite (`composite.wgsl`). The light's RSM is rasterised from the scene's triangles,
+//! composite (`composite.wgsl`). With [`RsmSource::Meshes`] the lights' RSMs are drawn from
+//! Bevy's meshes on the GPU by the plugin's mesh pipeline (`render/meshes.rs`; the variant
+//! says what it draws and what not). By default the light's RSM is rasterised
+//! from the scene's triangles,
 //! made on the CPU per visible `Mesh3d` entity: a `StandardMaterial`'s polygons in its base
 //! colour times its `base_color_texture`, sampled per texel (the distinct images, read on the
 //! CPU where they keep their data, are the layers of quadray's texture array, uploaded when that
@@ -86,14 +89,14 @@ pub use cpu_time::{MAIN_WORLD_CPU, RENDER_WORLD_CPU};
 pub use displaced::DISPLACED_TRIANGLES_MAX;
 pub use render::{SceneWork, ViewPasses};
 pub use scene::{
-    IndirectLight, IndirectLightScene, IndirectLightSource, ObjectTriangles, quadray_directional,
-    quadray_point, quadray_spot,
+    IndirectLight, IndirectLightScene, IndirectLightSource, ObjectTriangles, RsmSource,
+    quadray_directional, quadray_point, quadray_spot,
 };
 
 use bevy::diagnostic::DiagnosticPath;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
-use scene::{collect_lights, collect_triangles};
+use scene::{collect_lights, collect_meshes, collect_triangles};
 
 /// Adds [`IndirectLight`] to the cameras that carry it, from the lights marked
 /// [`IndirectLightSource`]. Add it after `DefaultPlugins`; the cameras need deferred rendering
@@ -113,6 +116,10 @@ impl Plugin for IndirectLightPlugin {
                     // this frame's asset events read this frame: an entity's triangles made once
                     .after(bevy::asset::AssetEventSystems),
             );
+        app.add_systems(
+            PostUpdate,
+            collect_meshes.in_set(bevy::camera::visibility::VisibilitySystems::CheckVisibility),
+        );
         render::build(app);
         cpu_time::build(app);
     }

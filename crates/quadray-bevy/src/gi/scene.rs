@@ -6,7 +6,7 @@ use super::displaced::{Albedo, ColourMap, Displacement, append_displaced};
 use super::posed::Poses;
 use super::textures::BaseColours;
 use crate::{PyramidMaterial, Pyramids};
-use bevy::asset::AssetEvent;
+use bevy::asset::{AssetEvent, RenderAssetUsages};
 use bevy::camera::Hdr;
 use bevy::core_pipeline::prepass::{DeferredPrepass, DepthPrepass};
 use bevy::math::Affine2;
@@ -43,6 +43,8 @@ pub struct IndirectLight {
     /// single VPLs, then red, yellow, green, blue, violet going up), the picture `quadray
     /// indirect` writes as `*.cut.png`. The per-tile cuts refine this cut tile by tile.
     pub cut_view: bool,
+    /// What each light's RSM is drawn from (the first camera's choice holds for every camera).
+    pub rsm_source: RsmSource,
     /// Debug output: each frame's indirect radiance (`[f32; 4]` a pixel, row-major, before the
     /// exposure) copied into this buffer, when it has room.
     pub debug_indirect: Option<Handle<ShaderBuffer>>,
@@ -56,9 +58,29 @@ impl Default for IndirectLight {
             r_min: quadray_indirect::scene::DEFAULT_R_MIN,
             enabled: true,
             cut_view: false,
+            rsm_source: RsmSource::default(),
             debug_indirect: None,
         }
     }
+}
+
+/// What the lights' reflective shadow maps are drawn from ([`IndirectLight::rsm_source`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RsmSource {
+    /// The scene's triangles made on the CPU ([`IndirectLightScene`]): every visible `Mesh3d`
+    /// whose mesh keeps its data in the main world, displaced surfaces displaced, skinned and
+    /// morphed meshes posed on the CPU. The RSM is redrawn when the scene or a light changes.
+    #[default]
+    Triangles,
+    /// Bevy's meshes on the GPU, drawn by the plugin's mesh pipeline from Bevy's mesh allocator
+    /// (a mesh kept only in the render world, `RenderAssetUsages::RENDER_WORLD`, included),
+    /// skinned in the vertex stage by Bevy's skinning: every mesh Bevy extracts (one some
+    /// camera or shadow-casting light sees) in its `StandardMaterial`'s base colour times
+    /// 1 - metallic, times its base colour texture sampled as Bevy samples it (another material:
+    /// grey 0.5). Morph targets are not applied and displaced surfaces are drawn flat. The RSM is
+    /// redrawn every frame. Without indirect shadows no triangle is made on the CPU; with them
+    /// the occupancy grid is still made of [`IndirectLightScene`]'s triangles.
+    Meshes,
 }
 
 /// On a `DirectionalLight`, `PointLight` or `SpotLight`: a light whose first bounce
@@ -90,6 +112,9 @@ pub struct IndirectLightScene {
     pub(super) lights: Vec<Light>,
     /// The `StandardMaterial`s' base colour textures the triangles sample.
     pub(super) base_colours: BaseColours,
+    /// The bounds (min, max) of the visible meshes' boxes in world space, kept while a camera
+    /// draws its RSMs from Bevy's meshes ([`RsmSource::Meshes`]).
+    pub(super) mesh_bounds: (Vec3, Vec3),
 }
 
 /// One entity's triangles in world space and their bounds, shared with the render world.
@@ -175,6 +200,32 @@ impl IndirectLightScene {
 fn coloured(color: Color, strength: f32) -> Intensity {
     let c = LinearRgba::from(color);
     Intensity::Native(Vec3::new(c.red, c.green, c.blue) * strength)
+}
+
+impl RsmSource {
+    /// Every source, by its name (the default first).
+    pub const ALL: [Self; 2] = [Self::Triangles, Self::Meshes];
+
+    /// Its name, as a command line writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Triangles => "triangles",
+            Self::Meshes => "meshes",
+        }
+    }
+}
+
+impl std::str::FromStr for RsmSource {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        quadray_core::parse_named(s, &Self::ALL, Self::name, "RSM source")
+    }
+}
+
+impl std::fmt::Display for RsmSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// Bevy's directional light as quadray's: its illuminance along the transform's forward.
@@ -337,21 +388,104 @@ pub(super) struct Sources<'w, 's> {
     image_events: MessageReader<'w, 's, AssetEvent<Image>>,
     /// Each colour texture as the RSM reads it (`None`: not readable on the CPU, warned once).
     colours: Local<'s, HashMap<AssetId<Image>, Option<Arc<ColourMap>>>>,
+    /// The meshes kept only in the render world, warned once.
+    gpu_only: Local<'s, HashSet<AssetId<Mesh>>>,
+}
+
+/// Whether the scene's triangles are made: unless every [`IndirectLight`] camera draws its RSMs
+/// from Bevy's meshes without indirect shadows (whose occupancy grid needs them).
+fn triangles_needed(cameras: &Query<&IndirectLight>) -> bool {
+    cameras.is_empty()
+        || cameras
+            .iter()
+            .any(|c| c.rsm_source == RsmSource::Triangles || c.settings.indirect_shadows)
+}
+
+/// While a camera draws its RSMs from Bevy's meshes: every visible mesh marked seen (so that Bevy
+/// extracts it to the render world, where the RSM draws it, though no camera or shadow-casting
+/// light sees it), and the bounds of their boxes in world space, which the lights' views frame
+/// without the triangles. In Bevy's visibility check, after the boxes are computed.
+pub(super) fn collect_meshes(
+    mut meshes: Query<
+        (
+            &bevy::camera::primitives::Aabb,
+            &GlobalTransform,
+            &InheritedVisibility,
+            &mut ViewVisibility,
+        ),
+        With<Mesh3d>,
+    >,
+    cameras: Query<&IndirectLight>,
+    mut scene: ResMut<IndirectLightScene>,
+    times: Res<CpuTimes>,
+) {
+    use bevy::camera::visibility::SetViewVisibility;
+    let _span = times.main();
+    if !cameras.iter().any(|c| c.rsm_source == RsmSource::Meshes) {
+        return;
+    }
+    let mut bounds = (Vec3::MAX, Vec3::MIN);
+    for (aabb, transform, visible, mut seen) in &mut meshes {
+        if !visible.get() {
+            continue;
+        }
+        seen.set_visible();
+        let affine = transform.affine();
+        let centre = affine.transform_point3a(aabb.center);
+        let half = affine.matrix3.abs() * aabb.half_extents;
+        bounds = (
+            bounds.0.min((centre - half).into()),
+            bounds.1.max((centre + half).into()),
+        );
+    }
+    if scene.mesh_bounds != bounds {
+        scene.mesh_bounds = bounds;
+    }
+}
+
+/// Whether the triangles are made ([`triangles_needed`]), and every mesh entity, all made anew
+/// when they are made again.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct Pause<'w, 's> {
+    cameras: Query<'w, 's, &'static IndirectLight>,
+    mesh_entities: Query<'w, 's, Entity, With<Mesh3d>>,
+    /// None was made last frame.
+    paused: Local<'s, bool>,
 }
 
 /// Makes anew the triangles of the entities that changed (their transform, mesh, material or
 /// visibility, their skin's joints or morph weights, or the assets they use) and hands them to
 /// the render world; in a frame where nothing changed it does nothing more than find that out.
 pub(super) fn collect_triangles(
-    objects: Objects,
-    changed: Changed3d,
+    (objects, changed): (Objects, Changed3d),
     sources: Sources,
     mut poses: Poses,
     mut removed: Removed,
     mut scene: ResMut<IndirectLightScene>,
+    mut pause: Pause,
     times: Res<CpuTimes>,
 ) {
     let _span = times.main();
+    let Pause {
+        cameras,
+        mesh_entities,
+        paused,
+    } = &mut pause;
+    if !triangles_needed(cameras) {
+        if !**paused {
+            // none made while paused: the render world drops the scene's
+            **paused = true;
+            let changes: Vec<_> = scene.objects().map(|(e, _)| (e, None)).collect();
+            scene.objects.clear();
+            if !changes.is_empty() {
+                scene.since = scene.generation;
+                scene.generation += 1;
+                scene.changes = changes;
+            }
+        }
+        return;
+    }
+    let resumed = std::mem::take(&mut **paused);
     let Sources {
         meshes,
         materials,
@@ -364,9 +498,14 @@ pub(super) fn collect_triangles(
         mut displaced_events,
         mut image_events,
         mut colours,
+        mut gpu_only,
     } = sources;
     let displaced = displaced.as_deref();
-    let mut dirty: BTreeSet<Entity> = changed.iter().collect();
+    let mut dirty: BTreeSet<Entity> = if resumed {
+        mesh_entities.iter().collect()
+    } else {
+        changed.iter().collect()
+    };
     dirty.extend(removed.meshes.read());
     dirty.extend(removed.materials.read());
     dirty.extend(removed.displaced.read());
@@ -418,7 +557,19 @@ pub(super) fn collect_triangles(
         let standard = material.and_then(|m| materials.get(&m.0));
         let image = standard.and_then(|m| m.base_color_texture.as_ref());
         let mut texture = None;
-        if let Some(mesh) = meshes.get(&mesh.0).filter(|_| visible.get()) {
+        let readable = meshes.get(&mesh.0).filter(|m| {
+            let kept = m.asset_usage.contains(RenderAssetUsages::MAIN_WORLD);
+            if !kept && gpu_only.insert(mesh.id()) {
+                warn!(
+                    "quadray indirect light: a mesh ({:?}) is kept only in the render world \
+                     (RenderAssetUsages::RENDER_WORLD): the RSM from the scene's triangles \
+                     leaves it out; RsmSource::Meshes draws it",
+                    mesh.id()
+                );
+            }
+            kept
+        });
+        if let Some(mesh) = readable.filter(|_| visible.get()) {
             let posed = poses.posed(entity, mesh);
             let (mesh, transform) = match &posed {
                 Some(posed) if posed.in_world => (&posed.mesh, &GlobalTransform::IDENTITY),
@@ -580,7 +731,7 @@ fn read_colours(
 }
 
 /// A standard material's diffuse albedo: its base colour times 1 - metallic.
-fn base_albedo(m: &StandardMaterial) -> Vec3 {
+pub(super) fn base_albedo(m: &StandardMaterial) -> Vec3 {
     let c = LinearRgba::from(m.base_color);
     Vec3::new(c.red, c.green, c.blue) * (1.0 - m.metallic)
 }

@@ -5,7 +5,7 @@
 //! ([`TextureArray`]).
 
 use crate::contract::{
-    LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module,
+    LightUniform, RasterUniform, bind_group, layout, pipeline_layout, shader_module, shader_source,
     uniform_buffer, uniform_entry, whole,
 };
 use crate::light::view::LightView;
@@ -92,8 +92,10 @@ pub(crate) const SOURCES: [&str; 5] = [
     RASTER_WGSL[0],
     RASTER_WGSL[1],
     BASE_COLOUR_WGSL,
-    include_str!("rsm.wgsl"),
+    RSM_WGSL,
 ];
+/// The RSM's fragment stage (`rsm_wide`, `rsm_compact`).
+const RSM_WGSL: &str = include_str!("rsm.wgsl");
 
 /// The scene's base colour textures on the GPU ([`SceneTextures`]): one `Rgba8UnormSrgb` 2D
 /// array, whose texels the RSM and G-buffer passes read per fragment (the format decodes sRGB)
@@ -357,24 +359,19 @@ pub(crate) fn fragment_entry(name: &str, layout: GBufferLayout) -> String {
     format!("{name}_{}", layout.name())
 }
 
-/// Clears `targets` and draws `vertex_count` vertices of `vertices` into them, binding `groups`.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn record_raster(
-    encoder: &mut wgpu::CommandEncoder,
+/// A render pass over `targets`, cleared (the depth to 0: depths are reversed).
+fn begin_cleared<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
     label: &str,
     targets: &RasterTargets,
-    pipeline: &wgpu::RenderPipeline,
-    groups: &[&wgpu::BindGroup],
-    vertices: wgpu::BufferSlice,
-    vertex_count: u32,
     timestamps: Option<wgpu::RenderPassTimestampWrites>,
-) {
+) -> wgpu::RenderPass<'e> {
     let attachments: Vec<_> = targets
         .views
         .iter()
         .map(|v| cleared_attachment(v, wgpu::Color::TRANSPARENT))
         .collect();
-    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &attachments,
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -387,7 +384,22 @@ pub(crate) fn record_raster(
         }),
         timestamp_writes: timestamps,
         ..Default::default()
-    });
+    })
+}
+
+/// Clears `targets` and draws `vertex_count` vertices of `vertices` into them, binding `groups`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record_raster(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    targets: &RasterTargets,
+    pipeline: &wgpu::RenderPipeline,
+    groups: &[&wgpu::BindGroup],
+    vertices: wgpu::BufferSlice,
+    vertex_count: u32,
+    timestamps: Option<wgpu::RenderPassTimestampWrites>,
+) {
+    let mut pass = begin_cleared(encoder, label, targets, timestamps);
     pass.set_pipeline(pipeline);
     for (index, group) in groups.iter().enumerate() {
         pass.set_bind_group(index as u32, *group, &[]);
@@ -479,6 +491,46 @@ impl RsmPass {
             vertex_count,
             timer.and_then(|(t, slot)| t.render_pass(slot)),
         );
+    }
+
+    /// For a renderer that draws the light view's geometry itself (an engine's own meshes) into
+    /// this RSM: a render pass over its targets, cleared, in which to draw with a pipeline whose
+    /// fragment stage is [`RsmPass::fragment_source`]'s entry [`RsmPass::fragment_entry`] into
+    /// [`RsmPass::target_formats`] and a depth test as this pass's own (`depth32float`, the
+    /// `Greater` compare: the raster uniform's projection reverses depth), binding
+    /// [`RsmPass::uniforms`] as its group 0. The quadtree then builds from it as from
+    /// [`RsmPass::record`].
+    pub fn begin<'e>(&self, encoder: &'e mut wgpu::CommandEncoder) -> wgpu::RenderPass<'e> {
+        begin_cleared(encoder, "rsm", &self.targets, None)
+    }
+
+    /// The uniforms [`RsmPass::set_light`] writes, as the RSM's shaders bind them (group 0):
+    /// the raster uniform (binding 0: the light view's projection, depth reversed, and its eye)
+    /// and the light (binding 1).
+    pub fn uniforms(&self) -> [&wgpu::Buffer; 2] {
+        [&self.raster, &self.light]
+    }
+
+    /// The colour targets' formats in `layout`, in the order of the fragment stage's outputs.
+    pub fn target_formats(layout: GBufferLayout) -> Vec<wgpu::TextureFormat> {
+        rsm_targets(layout).iter().map(|&(_, f)| f).collect()
+    }
+
+    /// The depth buffer's format.
+    pub const DEPTH_FORMAT: wgpu::TextureFormat = DEPTH_FORMAT;
+
+    /// The RSM's fragment stage as WGSL, the prelude first, for a renderer with its own vertex
+    /// stage ([`RsmPass::begin`]): the entry points `rsm_wide` and `rsm_compact` take
+    /// `raster.wgsl`'s `VertexOut` (clip position, world position, normal, albedo, uv, a flat
+    /// `texture` word); the including shader adds its vertex stage and
+    /// `fn surface_albedo(v: VertexOut) -> vec3<f32>`, the texel's albedo.
+    pub fn fragment_source() -> String {
+        shader_source(&[wgsl::LIGHT, RASTER_WGSL[0], RASTER_WGSL[1], RSM_WGSL])
+    }
+
+    /// The fragment entry point of [`RsmPass::fragment_source`] that writes `layout`.
+    pub fn fragment_entry(layout: GBufferLayout) -> String {
+        fragment_entry("rsm", layout)
     }
 
     /// The RSM's textures, for the quadtree and the gather.

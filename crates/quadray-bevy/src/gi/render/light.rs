@@ -3,7 +3,7 @@
 
 use super::triangles::{SceneBuffer, SceneChanges, SceneGrid, SceneMirror, SceneWork};
 use crate::gi::cpu_time::CpuTimes;
-use crate::gi::scene::IndirectLight;
+use crate::gi::scene::{IndirectLight, RsmSource};
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
@@ -37,7 +37,10 @@ pub(super) struct LightPasses {
     pub(super) scene: SceneBuffer,
     /// The base colour textures the triangles sample, which every RSM binds.
     pub(super) textures: TextureArray,
-    /// The scene's bounds, which the lights' views frame.
+    /// What the RSMs are drawn from (the first camera's [`IndirectLight::rsm_source`]).
+    pub(super) source: RsmSource,
+    /// The scene's bounds, which the lights' views frame: its triangles', or its meshes' (their
+    /// boxes in world space) with [`RsmSource::Meshes`].
     pub(super) bounds: (Vec3, Vec3),
     pub(super) lights: Vec<Light>,
     /// The lights' RSM views, one a `views` entry.
@@ -143,7 +146,8 @@ pub(super) fn prepare_light(
             rsm_layout: settings.gbuffer_layout,
             max_lights: settings.max_lights,
             scene: SceneBuffer::new(device, &queue, &mirror, work),
-            bounds: mirror.bounds(),
+            source: camera.rsm_source,
+            bounds: mirror.bounds_of(camera.rsm_source),
             lights: Vec::new(),
             light_views: Vec::new(),
             stale: true,
@@ -186,10 +190,16 @@ pub(super) fn prepare_light(
         }
         l.stale = true;
     }
-    if !matches!(changes, SceneChanges::None) {
+    if l.source != camera.rsm_source {
+        l.source = camera.rsm_source;
+        l.stale = true;
+    }
+    // Bevy's meshes may move on the GPU alone (skinning): their RSMs are drawn every frame
+    let meshes = l.source == RsmSource::Meshes;
+    if !matches!(changes, SceneChanges::None) || meshes {
         // the RSMs are drawn anew; the maps' projections follow the scene's bounds
         l.stale = true;
-        let bounds = mirror.bounds();
+        let bounds = mirror.bounds_of(l.source);
         if bounds != l.bounds {
             l.bounds = bounds;
             l.lights.clear();

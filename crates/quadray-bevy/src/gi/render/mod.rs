@@ -8,12 +8,17 @@
 //! each camera's passes) and `passes.rs` (the `Core3d` systems that record them).
 
 mod light;
+mod meshes;
 mod passes;
 mod pipelines;
 mod triangles;
 pub(super) mod views;
 
 use light::{LightState, prepare_light};
+use meshes::{
+    MeshDraws, RSM_MESH_SHADER, RsmMaterials, RsmMeshPipeline, extract_materials,
+    init_rsm_mesh_pipeline, prepare_mesh_rsm, rsm_mesh_source,
+};
 pub(super) use passes::camera_diagnostics;
 use passes::{cut_view_pass, indirect_light_pass};
 use pipelines::{
@@ -27,8 +32,9 @@ use views::{drop_unused_views, prepare_views};
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::core_pipeline::tonemapping::tonemapping;
+use bevy::pbr::MeshPipelineSystems;
 use bevy::prelude::*;
-use bevy::render::render_resource::SpecializedRenderPipelines;
+use bevy::render::render_resource::{SpecializedMeshPipelines, SpecializedRenderPipelines};
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderStartup, RenderSystems};
 use bevy::shader::Shader;
 
@@ -46,6 +52,10 @@ pub(super) fn build(app: &mut App) {
         &COUNTS_SHADER,
         Shader::from_wgsl(include_str!("counts.wgsl"), "quadray/gi_counts.wgsl"),
     );
+    let _ = shaders.insert(
+        &RSM_MESH_SHADER,
+        Shader::from_wgsl(rsm_mesh_source(), "quadray/gi_rsm_meshes.wgsl"),
+    );
     let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
         return;
     };
@@ -54,11 +64,25 @@ pub(super) fn build(app: &mut App) {
         .init_resource::<SceneMirror>()
         .init_resource::<SceneWork>()
         .init_resource::<SpecializedRenderPipelines<Pipelines>>()
-        .add_systems(RenderStartup, init_pipelines)
-        .add_systems(ExtractSchedule, extract_scene)
+        .init_resource::<RsmMaterials>()
+        .init_resource::<MeshDraws>()
+        .init_resource::<SpecializedMeshPipelines<RsmMeshPipeline>>()
+        .add_systems(
+            RenderStartup,
+            (
+                init_pipelines,
+                init_rsm_mesh_pipeline.after(MeshPipelineSystems),
+            ),
+        )
+        .add_systems(ExtractSchedule, (extract_scene, extract_materials))
         .add_systems(
             Render,
-            (drop_unused_views, prepare_light, prepare_views)
+            (
+                drop_unused_views,
+                prepare_light,
+                prepare_mesh_rsm,
+                prepare_views,
+            )
                 .chain()
                 .in_set(RenderSystems::PrepareBindGroups),
         )

@@ -2,10 +2,12 @@
 //! cut view drawn after tone mapping.
 
 use super::light::LightState;
+use super::meshes::{MeshDraws, record_mesh_rsm};
 use super::pipelines::Pipelines;
+use super::triangles::SceneWork;
 use super::views::{ViewPasses, cut_view_zoom};
 use crate::gi::cpu_time::CpuTimes;
-use crate::gi::scene::IndirectLight;
+use crate::gi::scene::{IndirectLight, RsmSource};
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RecordDiagnostics;
@@ -28,9 +30,9 @@ pub(super) fn indirect_light_pass(
         &MainEntity,
     )>,
     mut light: ResMut<LightState>,
-    pipelines: Res<Pipelines>,
-    pipeline_cache: Res<PipelineCache>,
+    (pipelines, pipeline_cache): (Res<Pipelines>, Res<PipelineCache>),
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    (mesh_draws, mut work): (Res<MeshDraws>, ResMut<SceneWork>),
     times: Res<CpuTimes>,
     mut ctx: RenderContext,
 ) {
@@ -39,9 +41,11 @@ pub(super) fn indirect_light_pass(
     let Some(l) = light.0.as_mut().filter(|_| gi.enabled) else {
         return;
     };
-    let (Some((vertices, vertex_count)), Some(_)) = (l.scene.vertices(), l.views.first()) else {
+    let meshes = l.source == RsmSource::Meshes;
+    let vertices = l.scene.vertices();
+    if l.views.is_empty() || (vertices.is_none() && !meshes) {
         return;
-    };
+    }
     let Some(translate) = pipeline_cache.get_compute_pipeline(pipelines.gbuffer) else {
         return;
     };
@@ -61,9 +65,20 @@ pub(super) fn indirect_light_pass(
     let whole = diagnostics.time_span(encoder, camera_path.clone());
     if l.stale {
         let span = diagnostics.time_span(encoder, "light");
-        for view in &l.views {
-            view.rsm
-                .record(encoder, vertices.slice(..), vertex_count, None);
+        for (i, view) in l.views.iter().enumerate() {
+            match vertices.filter(|_| !meshes) {
+                Some((vertices, vertex_count)) => {
+                    view.rsm
+                        .record(encoder, vertices.slice(..), vertex_count, None);
+                }
+                None => record_mesh_rsm(
+                    encoder,
+                    (&view.rsm, i),
+                    &mesh_draws,
+                    &pipeline_cache,
+                    &mut work,
+                ),
+            }
             view.quadtree.record_build(encoder, None);
             view.quadtree.record_cut(encoder, None);
         }

@@ -3,7 +3,7 @@
 //! ([`SceneBuffer`]) and the occupancy grid, both updated by the entities that changed.
 
 use crate::gi::cpu_time::CpuTimes;
-use crate::gi::scene::{IndirectLightScene, ObjectTriangles};
+use crate::gi::scene::{IndirectLightScene, ObjectTriangles, RsmSource};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::Extract;
@@ -24,6 +24,8 @@ pub(super) struct SceneMirror {
     /// Every entity is to be taken anew (an update was missed).
     replaced: bool,
     pub(super) lights: Vec<Light>,
+    /// The bounds of the visible meshes' boxes in world space ([`IndirectLightScene`]'s).
+    mesh_bounds: (Vec3, Vec3),
     /// The base colour textures, the main world's count of their changes last extracted, and
     /// whether they changed since the lights' side last took them.
     pub(super) textures: Arc<SceneTextures>,
@@ -53,6 +55,15 @@ impl SceneMirror {
         }
     }
 
+    /// The bounds the lights' views frame with `source`: the triangles' ([`Self::bounds`]) or
+    /// the meshes' boxes'.
+    pub(super) fn bounds_of(&self, source: RsmSource) -> (Vec3, Vec3) {
+        match source {
+            RsmSource::Triangles => self.bounds(),
+            RsmSource::Meshes => self.mesh_bounds,
+        }
+    }
+
     /// The scene's bounds, from its entities' (min above max without triangles).
     pub(super) fn bounds(&self) -> (Vec3, Vec3) {
         self.objects
@@ -76,6 +87,7 @@ pub(super) fn extract_scene(
     if scene.lights != mirror.lights {
         mirror.lights.clone_from(&scene.lights);
     }
+    mirror.mesh_bounds = scene.mesh_bounds;
     let textures = &scene.base_colours;
     if textures.generation != mirror.textures_generation {
         mirror.textures = textures.textures.clone();
@@ -126,8 +138,9 @@ pub(super) struct SceneBuffer {
     free: Vec<Range<u32>>,
 }
 
-/// Counts of the render world's work on the scene's triangles, every frame together: what a
-/// frame in which nothing moved adds nothing to. A resource of the render world.
+/// Counts of the render world's work on the scene, every frame together: what a frame in which
+/// nothing moved adds nothing to (but [`SceneWork::meshes_drawn`]). A resource of the render
+/// world.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SceneWork {
     /// Triangles written to the vertex buffer.
@@ -142,6 +155,9 @@ pub struct SceneWork {
     /// Times the base colour textures were uploaded (the first time, and when the set of
     /// textures changed).
     pub textures_uploaded: u64,
+    /// Meshes drawn into the lights' RSMs from Bevy's meshes ([`RsmSource::Meshes`]: every
+    /// frame, each mesh once a light view).
+    pub meshes_drawn: u64,
 }
 
 impl SceneBuffer {
