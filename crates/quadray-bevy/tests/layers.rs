@@ -14,6 +14,7 @@ const LAYERS: &[&[&str]] = &[
     &[""],
     &["gi::cpu_time", "gi::displaced", "gi::textures", "gi::posed"],
     &["gi::scene"],
+    &["gi::lights"],
     &["gi::render::pipelines"],
     &["gi::render::triangles"],
     &["gi::render::light"],

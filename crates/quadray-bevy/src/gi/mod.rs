@@ -80,6 +80,7 @@
 
 mod cpu_time;
 mod displaced;
+mod lights;
 mod posed;
 mod render;
 mod scene;
@@ -87,16 +88,17 @@ mod textures;
 
 pub use cpu_time::{MAIN_WORLD_CPU, RENDER_WORLD_CPU};
 pub use displaced::DISPLACED_TRIANGLES_MAX;
+pub use lights::{quadray_directional, quadray_point, quadray_spot};
 pub use render::{SceneWork, ViewPasses};
 pub use scene::{
     IndirectLight, IndirectLightScene, IndirectLightSource, ObjectTriangles, RsmSource,
-    quadray_directional, quadray_point, quadray_spot,
 };
 
 use bevy::diagnostic::DiagnosticPath;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
-use scene::{collect_lights, collect_meshes, collect_triangles};
+use lights::collect_lights;
+use scene::{collect_meshes, collect_triangles};
 
 /// Adds [`IndirectLight`] to the cameras that carry it, from the lights marked
 /// [`IndirectLightSource`]. Add it after `DefaultPlugins`; the cameras need deferred rendering
