@@ -11,7 +11,7 @@ const LAYERS: &[&[&str]] = &[
     // the crate's error, defined in lib.rs but naming nothing of the crate
     &["IndirectError", "shader_struct"],
     &["method", "frame"],
-    &["settings", "settings::cluster", "settings::shade"],
+    &["settings", "settings::cluster", "settings::sizes"],
     &["scene", "scene::builtin", "scene::textures"],
     &[
         "light",
