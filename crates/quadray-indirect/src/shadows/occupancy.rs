@@ -12,8 +12,10 @@
 
 use crate::scene::Vertex;
 use glam::{IVec3, UVec3, Vec3};
-use std::cell::OnceCell;
 use std::collections::HashMap;
+use triangle_box::{TriangleBoxTest, count_subcells, floor};
+
+mod triangle_box;
 
 /// Cells a segment's ends are moved off their surfaces along the normals: past every cell a
 /// plane through the end may overlap (a cell's diagonal is sqrt(3) sides).
@@ -79,11 +81,56 @@ pub struct OccupancyGrid {
     counts: Counts,
 }
 
-/// What [`OccupancyGrid::add_tracked`] counted: per cell (by its bit index) and, with two
-/// levels, per sub-cell (its bit in the cell's masks), how many of the triangles overlap it.
+/// What [`OccupancyGrid::add_tracked`] counted: per cell (by its bit index) its count and, with
+/// two levels, per sub-cell (its bit in the cell's masks), how many of the triangles overlap it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Footprint {
-    counts: Vec<(usize, u8, u32)>,
+    /// The cells, in the order the triangles first overlapped them.
+    cells: Vec<usize>,
+    /// [`Self::per_cell`] counts a cell, in the order of `cells`.
+    counts: Vec<u32>,
+    /// Counts a cell: one (one level) or [`SUBCELL_COUNT`] (two).
+    per_cell: usize,
+}
+
+/// A [`Footprint`] being counted: where each cell's counts are, and the cell last counted in
+/// (a mesh's next triangle is most often in its last one's cell).
+struct Tally {
+    footprint: Footprint,
+    slots: HashMap<usize, usize, CellHash>,
+    last: Option<(usize, usize)>,
+}
+
+impl Tally {
+    fn new(per_cell: usize) -> Self {
+        Self {
+            footprint: Footprint {
+                per_cell,
+                ..Footprint::default()
+            },
+            slots: HashMap::default(),
+            last: None,
+        }
+    }
+
+    /// The counts of cell `index` (zeros where it was not counted in yet).
+    fn cell(&mut self, index: usize) -> &mut [u32] {
+        let slot = match self.last {
+            Some((cell, slot)) if cell == index => slot,
+            _ => {
+                let f = &mut self.footprint;
+                let slot = *self.slots.entry(index).or_insert_with(|| {
+                    f.cells.push(index);
+                    f.counts.resize(f.counts.len() + f.per_cell, 0);
+                    f.cells.len() - 1
+                });
+                self.last = Some((index, slot));
+                slot
+            }
+        };
+        let n = self.footprint.per_cell;
+        &mut self.footprint.counts[slot * n..(slot + 1) * n]
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -211,16 +258,8 @@ impl OccupancyGrid {
     /// sub-cell), so that [`Self::remove_footprint`] takes them out again without testing them
     /// against the cells anew: an object that moves costs its new triangles' tests alone.
     pub fn add_tracked(&mut self, triangles: &[[Vertex; 3]]) -> Footprint {
-        let mut hits = Vec::new();
-        self.counted(triangles, true, Some(&mut hits));
-        hits.sort_unstable();
-        let mut footprint = Footprint::default();
-        for hit in hits {
-            match footprint.counts.last_mut() {
-                Some((cell, sub, n)) if (*cell, *sub) == hit => *n += 1,
-                _ => footprint.counts.push((hit.0, hit.1, 1)),
-            }
-        }
+        let footprint = self.tally(triangles);
+        self.count(&footprint, true);
         footprint
     }
 
@@ -228,23 +267,68 @@ impl OccupancyGrid {
     /// `footprint` for: a cell (a sub-cell) no other triangle overlaps is cleared, as
     /// [`Self::remove`] of those triangles would.
     pub fn remove_footprint(&mut self, footprint: &Footprint) {
+        self.count(footprint, false);
+    }
+
+    /// Counts `triangles` in or out, and sets and clears the cells that gained their first or
+    /// lost their last triangle.
+    fn update(&mut self, triangles: &[[Vertex; 3]], added: bool) {
+        let footprint = self.tally(triangles);
+        self.count(&footprint, added);
+    }
+
+    /// What `triangles` count in each cell and sub-cell they overlap.
+    fn tally(&self, triangles: &[[Vertex; 3]]) -> Footprint {
+        let per_cell = match self.counts {
+            Counts::Cells(_) => 1,
+            Counts::SubCells(_) => SUBCELL_COUNT,
+        };
+        let mut tally = Tally::new(per_cell);
+        let to_grid = |v: &Vertex| (Vec3::from(v.position) - self.origin) / self.cell;
+        for t in triangles {
+            self.tally_triangle([to_grid(&t[0]), to_grid(&t[1]), to_grid(&t[2])], &mut tally);
+        }
+        tally.footprint
+    }
+
+    /// Counts `footprint` in (`added`) or out, cell by cell, and sets and clears the cells
+    /// that gained their first or lost their last triangle. The sub-cells' words follow each
+    /// change (a set cell's words inserted at its place, the bricks after it moved on by one)
+    /// while few cells are set or cleared; past [`FOLLOWED_FLIPS`] they are compacted anew
+    /// once, at the end.
+    fn count(&mut self, footprint: &Footprint, added: bool) {
         let mut flips = 0;
-        for same_cell in footprint.counts.chunk_by(|a, b| a.0 == b.0) {
-            let index = same_cell[0].0;
+        // (a default footprint has no cells and no counts a cell)
+        let per_cell = footprint.per_cell.max(1);
+        for (&index, n) in footprint
+            .cells
+            .iter()
+            .zip(footprint.counts.chunks_exact(per_cell))
+        {
+            // (a cell a triangle overlapped in none of its sub-cells is as it was)
+            if n.iter().all(|&n| n == 0) {
+                continue;
+            }
             let (word, bit) = (index / 32, (index % 32) as u32);
+            let step = |count: u32, n: u32| {
+                if added {
+                    count + n
+                } else {
+                    count.saturating_sub(n)
+                }
+            };
             let (set, masks_changed) = match &mut self.counts {
                 Counts::Cells(counts) => {
                     let count = counts.entry(index).or_insert(0);
-                    *count = count.saturating_sub(same_cell.iter().map(|h| h.2).sum());
+                    *count = step(*count, n[0]);
                     (*count > 0, false)
                 }
                 Counts::SubCells(counts) => {
                     let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
                     let mut changed = false;
-                    for &(_, sub, n) in same_cell {
-                        let count = &mut cell[usize::from(sub)];
+                    for (count, &n) in cell.iter_mut().zip(n).filter(|(_, n)| **n > 0) {
                         let was = *count > 0;
-                        *count = count.saturating_sub(n);
+                        *count = step(*count, n);
                         changed |= was != (*count > 0);
                     }
                     let set = still_set(cell, changed, self.bits[word] >> bit & 1 == 1);
@@ -255,37 +339,6 @@ impl OccupancyGrid {
                 self.forget(index);
             }
             self.follow(index, set, masks_changed, &mut flips);
-        }
-        if flips > FOLLOWED_FLIPS {
-            self.compact();
-        }
-    }
-
-    /// Counts `triangles` in or out, and sets and clears the cells that gained their first or
-    /// lost their last triangle. The sub-cells' words follow each change (a set cell's words
-    /// inserted at its place, the bricks after it moved on by one) while few cells are set or
-    /// cleared; past [`FOLLOWED_FLIPS`] they are compacted anew once, at the end.
-    fn update(&mut self, triangles: &[[Vertex; 3]], added: bool) {
-        self.counted(triangles, added, None);
-    }
-
-    /// [`Self::update`], noting in `hits` each cell (one level) or sub-cell (two levels, its
-    /// bit in the cell's masks) each triangle was counted in.
-    fn counted(
-        &mut self,
-        triangles: &[[Vertex; 3]],
-        added: bool,
-        mut hits: Option<&mut Vec<(usize, u8)>>,
-    ) {
-        let mut cells = Vec::new();
-        let mut flips = 0;
-        for t in triangles {
-            let t = t.map(|v| (Vec3::from(v.position) - self.origin) / self.cell);
-            self.count_triangle(t, added, &mut cells, hits.as_deref_mut());
-            for &(index, set, masks_changed) in &cells {
-                self.follow(index, set, masks_changed, &mut flips);
-            }
-            cells.clear();
         }
         if flips > FOLLOWED_FLIPS {
             self.compact();
@@ -541,28 +594,15 @@ impl OccupancyGrid {
         Some((word as usize, l.x + BRICK.x * (l.y + BRICK.y * l.z)))
     }
 
-    /// Counts the triangle (in grid units) in or out of every cell it overlaps (with two
-    /// levels, of every sub-cell of those); notes in `cells` each such cell, whether it is now
-    /// set (a triangle over it) and whether its sub-cells were set or cleared; and in `hits`
-    /// each cell (sub-cell) counted.
-    fn count_triangle(
-        &mut self,
-        t: [Vec3; 3],
-        added: bool,
-        cells: &mut Vec<(usize, bool, bool)>,
-        mut hits: Option<&mut Vec<(usize, u8)>>,
-    ) {
+    /// Counts the triangle (in grid units) in `tally`'s every cell it overlaps (with two
+    /// levels, in every sub-cell of those).
+    fn tally_triangle(&self, t: [Vec3; 3], tally: &mut Tally) {
         if !t.iter().all(|v| v.is_finite()) {
             return;
         }
         let test = TriangleBoxTest::new(t);
-        let lo = t[0].min(t[1]).min(t[2]).floor().as_ivec3().max(IVec3::ZERO);
-        let hi = t[0]
-            .max(t[1])
-            .max(t[2])
-            .floor()
-            .as_ivec3()
-            .min(self.dims.as_ivec3() - 1);
+        let lo = floor(t[0].min(t[1]).min(t[2])).max(IVec3::ZERO);
+        let hi = floor(t[0].max(t[1]).max(t[2])).min(self.dims.as_ivec3() - 1);
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for x in lo.x..=hi.x {
@@ -573,32 +613,12 @@ impl OccupancyGrid {
                         continue;
                     }
                     let (word, bit) = self.index(c).expect("clamped to the grid");
-                    let index = word * 32 + bit as usize;
-                    let (set, masks_changed) = match &mut self.counts {
-                        Counts::Cells(counts) => {
-                            let count = counts.entry(index).or_insert(0);
-                            *count = step(*count, added);
-                            if let Some(hits) = hits.as_deref_mut() {
-                                hits.push((index, 0));
-                            }
-                            (*count > 0, false)
-                        }
-                        Counts::SubCells(counts) => {
-                            let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
-                            let counted = |sub: usize| {
-                                if let Some(hits) = hits.as_deref_mut() {
-                                    hits.push((index, sub as u8));
-                                }
-                            };
-                            let changed = count_subcells(t, &test, c, cell, added, counted);
-                            let set = still_set(cell, changed, self.bits[word] >> bit & 1 == 1);
-                            (set, changed)
-                        }
-                    };
-                    if !set {
-                        self.forget(index);
+                    let counts = tally.cell(word * 32 + bit as usize);
+                    if self.sub.is_some() {
+                        count_subcells(&test, c, counts);
+                    } else {
+                        counts[0] += 1;
                     }
-                    cells.push((index, set, masks_changed));
                 }
             }
         }
@@ -613,55 +633,6 @@ fn still_set(cell: &[u32; SUBCELL_COUNT], changed: bool, was: bool) -> bool {
     } else {
         was
     }
-}
-
-/// A count one up (`added`) or down.
-fn step(count: u32, added: bool) -> u32 {
-    if added {
-        count + 1
-    } else {
-        count.saturating_sub(1)
-    }
-}
-
-/// Counts the triangle (in grid units) in or out of the sub-cells of cell `c` it overlaps;
-/// whether a sub-cell was set or cleared.
-fn count_subcells(
-    t: [Vec3; 3],
-    test: &TriangleBoxTest,
-    c: IVec3,
-    cell: &mut [u32; SUBCELL_COUNT],
-    added: bool,
-    mut counted: impl FnMut(usize),
-) -> bool {
-    let k = SUBCELLS as f32;
-    let first = c * SUBCELLS as i32;
-    let lo = (t[0].min(t[1]).min(t[2]) * k).floor().as_ivec3().max(first);
-    let hi = (t[0].max(t[1]).max(t[2]) * k)
-        .floor()
-        .as_ivec3()
-        .min(first + SUBCELLS as i32 - 1);
-    let mut changed = false;
-    for z in lo.z..=hi.z {
-        for y in lo.y..=hi.y {
-            for x in lo.x..=hi.x {
-                let s = IVec3::new(x, y, z);
-                // the cell's box's rule (a plane at a face in, one at the next out): the
-                // sub-cells at the cell's faces end where the cell's box does
-                let low = s.as_vec3() / k - Vec3::splat(1e-5);
-                let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
-                if test.overlaps((low + high) * 0.5, (high - low) * 0.5) {
-                    let (w, b) = sub_bit(sub_cell(s));
-                    counted(w * 32 + b as usize);
-                    let count = &mut cell[w * 32 + b as usize];
-                    let was = *count > 0;
-                    *count = step(*count, added);
-                    changed |= was != (*count > 0);
-                }
-            }
-        }
-    }
-    changed
 }
 
 /// A set cell's [`MASK_WORDS`] words of sub-cells from its counts.
@@ -829,79 +800,6 @@ const BRICK_SHIFT: UVec3 = UVec3::new(
     BRICK.y.trailing_zeros() + SUBCELLS.trailing_zeros(),
     BRICK.z.trailing_zeros() + SUBCELLS.trailing_zeros(),
 );
-
-/// A triangle's separating-axis test against boxes (Akenine-Möller's: the box's axes, the
-/// triangle's normal, and the nine cross products of their edges), its axes and the triangle's
-/// extent along each found once for all the cells and sub-cells it is tested against. Lengths
-/// are taken from its first vertex, so that rounding follows the box's distance from the
-/// triangle, not the grid's coordinates.
-struct TriangleBoxTest {
-    origin: Vec3,
-    /// The triangle's vertices from `origin`, and their bounds.
-    vertices: [Vec3; 3],
-    lo: Vec3,
-    hi: Vec3,
-    /// The normal and the edges' nine axes (a zero one separates nothing), each with the
-    /// triangle's least and greatest projection; made only where a box needs them.
-    axes: OnceCell<[(Vec3, f32, f32); 10]>,
-}
-
-impl TriangleBoxTest {
-    fn new(t: [Vec3; 3]) -> Self {
-        let origin = t[0];
-        let v = t.map(|p| p - origin);
-        Self {
-            origin,
-            vertices: v,
-            lo: v[0].min(v[1]).min(v[2]),
-            hi: v[0].max(v[1]).max(v[2]),
-            axes: OnceCell::new(),
-        }
-    }
-
-    /// The normal and the edges' nine axes, made at the first box the bounds do not decide.
-    fn axes(&self) -> &[(Vec3, f32, f32); 10] {
-        self.axes.get_or_init(|| {
-            let v = self.vertices;
-            let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
-            let mut axes = [(Vec3::ZERO, 0.0, 0.0); 10];
-            let directions = std::iter::once(edges[0].cross(edges[1])).chain(
-                edges
-                    .into_iter()
-                    .flat_map(|e| [Vec3::X.cross(e), Vec3::Y.cross(e), Vec3::Z.cross(e)]),
-            );
-            for (slot, axis) in axes.iter_mut().zip(directions) {
-                if axis.length_squared() >= 1e-12 {
-                    let p = v.map(|v| v.dot(axis));
-                    *slot = (axis, p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-                }
-            }
-            axes
-        })
-    }
-
-    /// Whether the triangle overlaps the box of `centre` and `half` extents.
-    fn overlaps(&self, centre: Vec3, half: Vec3) -> bool {
-        let d = centre - self.origin;
-        // the box's axes: the triangle's bounds
-        let (lo, hi) = (self.lo - d, self.hi - d);
-        if lo.cmpgt(half).any() || hi.cmplt(-half).any() {
-            return false;
-        }
-        // a triangle well inside the box overlaps it whatever the other axes say (most of a
-        // small triangle's cells and sub-cells)
-        let inner = half * (1.0 - 1e-5);
-        if lo.cmpgt(-inner).all() && hi.cmplt(inner).all() {
-            return true;
-        }
-        // the normal first: most boxes of the triangle's bounds lie off its plane
-        self.axes().iter().all(|&(axis, least, most)| {
-            let c = d.dot(axis);
-            let r = half.dot(axis.abs());
-            !(least - c > r || most - c < -r)
-        })
-    }
-}
 
 #[cfg(test)]
 mod tests {
