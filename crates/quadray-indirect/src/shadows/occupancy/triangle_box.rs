@@ -3,7 +3,7 @@
 //! ([`count_subcells`]).
 
 use super::{SUBCELLS, sub_bit, sub_cell};
-use glam::{IVec3, Vec3, Vec4};
+use glam::{IVec3, Mat4, Vec3, Vec4};
 use std::cell::OnceCell;
 
 /// A triangle's separating-axis test against boxes (Akenine-Möller's: the box's axes, the
@@ -44,6 +44,7 @@ const AXIS_GROUPS: usize = 3;
 
 impl TriangleBoxTest {
     /// The test of triangle `t` (grid units).
+    #[inline]
     pub(super) fn new(t: [Vec3; 3]) -> Self {
         let origin = t[0];
         let v = t.map(|p| p - origin);
@@ -65,13 +66,13 @@ impl TriangleBoxTest {
         self.axes.get_or_init(|| {
             let v = self.vertices;
             let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
-            let mut directions = [Vec3::ZERO; 4 * AXIS_GROUPS];
-            directions[0] = edges[0].cross(edges[1]);
-            for (i, e) in edges.into_iter().enumerate() {
-                directions[1 + 3 * i] = Vec3::X.cross(e);
-                directions[2 + 3 * i] = Vec3::Y.cross(e);
-                directions[3 + 3 * i] = Vec3::Z.cross(e);
-            }
+            let [c0, c1, c2] =
+                edges.map(|e| [Vec3::X.cross(e), Vec3::Y.cross(e), Vec3::Z.cross(e)]);
+            let groups = [
+                [edges[0].cross(edges[1]), c0[0], c0[1], c0[2]],
+                [c1[0], c1[1], c1[2], c2[0]],
+                [c2[1], c2[2], Vec3::ZERO, Vec3::ZERO],
+            ];
             let mut axes = Axes {
                 x: [Vec4::ZERO; AXIS_GROUPS],
                 y: [Vec4::ZERO; AXIS_GROUPS],
@@ -83,10 +84,10 @@ impl TriangleBoxTest {
                 most: [Vec4::ZERO; AXIS_GROUPS],
             };
             for g in 0..AXIS_GROUPS {
-                let lanes = |f: fn(Vec3) -> f32| {
-                    Vec4::from_array(std::array::from_fn(|l| f(directions[4 * g + l])))
-                };
-                let (x, y, z) = (lanes(|a| a.x), lanes(|a| a.y), lanes(|a| a.z));
+                // (a transpose: the four axes' x, y and z)
+                let [a, b, c, d] = groups[g].map(|a| a.extend(0.0));
+                let lanes = Mat4::from_cols(a, b, c, d).transpose();
+                let (x, y, z) = (lanes.x_axis, lanes.y_axis, lanes.z_axis);
                 let kept = (x * x + y * y + z * z).cmpge(Vec4::splat(1e-12));
                 let p =
                     v.map(|v| Vec4::splat(v.x) * x + Vec4::splat(v.y) * y + Vec4::splat(v.z) * z);
