@@ -440,7 +440,19 @@ impl OccupancyGrid {
     /// of its first set cell's sub-cells, and [`MASK_WORDS`] words a set cell, its sub-cell
     /// (x, y, z) in word `z / 2` at bit `x + 4 * (y + 4 * (z % 2))`.
     pub fn gpu_words(&self) -> Vec<u32> {
-        let mut words = vec![
+        let (header, parts) = self.gpu_word_parts();
+        let mut words = header.to_vec();
+        for part in parts {
+            words.extend_from_slice(part);
+        }
+        words
+    }
+
+    /// [`Self::gpu_words`] in its parts, in order, without copying them into one: the header,
+    /// the bricks' bits, and with two levels the bricks' first sub-cells and the masks (empty
+    /// with one level).
+    pub fn gpu_word_parts(&self) -> ([u32; HEADER_WORDS], [&[u32]; 3]) {
+        let header = [
             self.dims.x,
             self.dims.y,
             self.dims.z,
@@ -450,12 +462,11 @@ impl OccupancyGrid {
             self.origin.z.to_bits(),
             self.cell.to_bits(),
         ];
-        words.extend_from_slice(&self.bits);
-        if let Some(sub) = &self.sub {
-            words.extend_from_slice(&sub.first);
-            words.extend_from_slice(&sub.masks);
-        }
-        words
+        let (first, masks) = self
+            .sub
+            .as_ref()
+            .map_or((&[][..], &[][..]), |sub| (&sub.first[..], &sub.masks[..]));
+        (header, [&self.bits, first, masks])
     }
 
     /// Cell `c`'s word and bit (outside the grid: none).
