@@ -83,9 +83,9 @@ impl TriangleBoxTest {
                 least: [Vec4::ZERO; AXIS_GROUPS],
                 most: [Vec4::ZERO; AXIS_GROUPS],
             };
-            for g in 0..AXIS_GROUPS {
+            for (g, group) in groups.into_iter().enumerate() {
                 // (a transpose: the four axes' x, y and z)
-                let [a, b, c, d] = groups[g].map(|a| a.extend(0.0));
+                let [a, b, c, d] = group.map(|a| a.extend(0.0));
                 let lanes = Mat4::from_cols(a, b, c, d).transpose();
                 let (x, y, z) = (lanes.x_axis, lanes.y_axis, lanes.z_axis);
                 let kept = (x * x + y * y + z * z).cmpge(Vec4::splat(1e-12));
