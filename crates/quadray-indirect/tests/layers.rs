@@ -22,7 +22,11 @@ const LAYERS: &[&[&str]] = &[
         "direct",
         "output",
     ],
-    &["shadows::occupancy"],
+    &[
+        "shadows::occupancy",
+        "shadows::occupancy::triangle_box",
+        "shadows::occupancy::walk",
+    ],
     &["gathers::samples"],
     &[
         "reference",

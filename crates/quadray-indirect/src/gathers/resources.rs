@@ -190,35 +190,55 @@ impl OccupancyTexture {
         }
     }
 
-    /// Holds `words` from now on: writes the rows from the first changed word to the last, in
-    /// the texture there is, or makes a larger one (with an eighth more rows, for the grid to
-    /// grow into); whether it made one (the frame's group is then to be made anew).
-    fn write(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, words: &[u32]) -> bool {
+    /// Holds `parts`' words, one after the other, from now on: writes the rows from the first
+    /// changed word to the last, in the texture there is, or makes a larger one (with an eighth
+    /// more rows, for the grid to grow into); whether it made one (the frame's group is then to
+    /// be made anew). The words are compared and copied in place, part by part, without being
+    /// gathered into one.
+    fn write(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, parts: &[&[u32]]) -> bool {
         let row = OCCUPANCY_ROW as usize;
-        let made = words.len() > self.held.len();
+        let len: usize = parts.iter().map(|p| p.len()).sum();
+        let made = len > self.held.len();
         if made {
-            let rows = words.len().div_ceil(row) as u32;
+            let rows = len.div_ceil(row) as u32;
             *self = Self::new(device, rows + rows / 8);
         }
-        let changed = |(i, (a, b)): (usize, (&u32, &u32))| (a != b).then_some(i);
-        let tail = std::iter::repeat(&0);
-        let mut differences = words
-            .iter()
-            .chain(tail)
-            .zip(&self.held)
-            .enumerate()
-            .filter_map(changed);
-        let Some(first) = differences.next() else {
+        // the first and last word changed, each part's changed words copied in
+        let mut changed: Option<(usize, usize)> = None;
+        let mut note = |first: usize, last: usize| {
+            changed = Some((changed.map_or(first, |c| c.0), last));
+        };
+        let mut at = 0;
+        for &part in parts {
+            let held = &mut self.held[at..at + part.len()];
+            if held != part {
+                let differs = |(h, w): (&u32, &u32)| h != w;
+                let first = held
+                    .iter()
+                    .zip(part)
+                    .position(differs)
+                    .expect("they differ");
+                let last = held
+                    .iter()
+                    .zip(part)
+                    .rposition(differs)
+                    .expect("they differ");
+                held[first..=last].copy_from_slice(&part[first..=last]);
+                note(at + first, at + last);
+            }
+            at += part.len();
+        }
+        // zeros after the last word, where a longer grid's words were
+        let tail = &mut self.held[at..];
+        if let Some(first) = tail.iter().position(|&w| w != 0) {
+            let last = tail.iter().rposition(|&w| w != 0).expect("one is not zero");
+            tail[first..=last].fill(0);
+            note(at + first, at + last);
+        }
+        let Some((first, last)) = changed else {
             return made;
         };
-        let last = differences.last().unwrap_or(first);
         let (first_row, end_row) = (first / row, last / row + 1);
-        for (i, held) in self.held[first_row * row..end_row * row]
-            .iter_mut()
-            .enumerate()
-        {
-            *held = words.get(first_row * row + i).copied().unwrap_or(0);
-        }
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &self.texture,
@@ -424,11 +444,9 @@ impl Resources {
         grid: &OccupancyGrid,
         gbuffer: GBufferViews,
     ) {
-        if self
-            .outputs
-            .occupancy
-            .write(device, queue, &grid.gpu_words())
-        {
+        let (header, [bits, first, masks]) = grid.gpu_word_parts();
+        let parts = [&header[..], bits, first, masks];
+        if self.outputs.occupancy.write(device, queue, &parts) {
             self.bind_gbuffer(device, gbuffer);
         }
     }
@@ -575,7 +593,7 @@ mod tests {
         let first: Vec<u32> = (1..=5 * row as u32 / 2).collect();
         let mut occupancy = OccupancyTexture::new(d, 0);
         assert!(
-            occupancy.write(d, q, &first),
+            occupancy.write(d, q, &[&first]),
             "a grid larger than the texture"
         );
         // two words changed a row apart, and the last half row gone: rows 1 to 2 written
@@ -586,7 +604,9 @@ mod tests {
         let rows = occupancy.held.len() / row;
         let longer: Vec<u32> = (0..(rows * row + 3) as u32).map(|i| i * 7).collect();
         for (words, made) in [(&shorter, false), (&first, false), (&longer, true)] {
-            assert_eq!(occupancy.write(d, q, words), made);
+            // in two parts, split between the changed words (as a grid's bits and masks are)
+            let (a, b) = words.split_at(row + 5);
+            assert_eq!(occupancy.write(d, q, &[a, b]), made);
             let mut expected = words.clone();
             expected.resize(occupancy.held.len(), 0);
             assert_eq!(texels(&gpu, &occupancy), expected);

@@ -8,12 +8,18 @@
 //! of two levels ([`OccupancyGrid::two_level`]) also holds, for each set cell, which of its
 //! [`SUBCELLS`]^3 sub-cells a triangle overlaps: the walk crosses the set cells sub-cell by
 //! sub-cell, so an opening is narrowed by a sub-cell, not a cell, on each side, at the cost of
-//! the cells in empty space.
+//! the cells in empty space. The walk is in `occupancy/walk.rs`; which cells and sub-cells a
+//! triangle overlaps, in `occupancy/triangle_box.rs`.
 
 use crate::scene::Vertex;
 use glam::{IVec3, UVec3, Vec3};
-use std::cell::OnceCell;
 use std::collections::HashMap;
+use triangle_box::{TriangleBoxTest, count_subcells, floor};
+
+mod triangle_box;
+mod walk;
+
+pub use walk::Walk;
 
 /// Cells a segment's ends are moved off their surfaces along the normals: past every cell a
 /// plane through the end may overlap (a cell's diagonal is sqrt(3) sides).
@@ -42,24 +48,6 @@ pub const SUBCELLS: u32 = 4;
 /// Words a set cell's sub-cells take in a grid of two levels.
 pub const MASK_WORDS: usize = 2;
 
-/// What a walk between two points found, and the words it fetched.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Walk {
-    /// Visible, blocked, or `None`: a moved end lies in a set cell.
-    pub visible: Option<bool>,
-    /// Words fetched: one each time the walk enters a brick it has not just read (and in a
-    /// grid of two levels, one for where a brick's sub-cells start, the first time the walk
-    /// enters a set cell of the brick, and one each time it enters a half of a set cell's
-    /// sub-cells it has not just read).
-    pub fetches: u32,
-    /// Cells and sub-cells the segment crossed up to the answer (what a grid of a word a cell
-    /// would have fetched).
-    pub cells: u32,
-    /// Steps of the walk's loop: a box crossed (an empty brick, a cell, a sub-cell), or a word
-    /// read that the next step needs (its work on a GPU, beside the fetches).
-    pub steps: u32,
-}
-
 /// Cubic cells over a box, one bit a cell: set where a triangle overlaps the cell; in a grid of
 /// two levels, with the same for the [`SUBCELLS`]^3 sub-cells of each set cell. The grid counts
 /// the triangles over each set cell (each set sub-cell), so that triangles are added and
@@ -79,11 +67,56 @@ pub struct OccupancyGrid {
     counts: Counts,
 }
 
-/// What [`OccupancyGrid::add_tracked`] counted: per cell (by its bit index) and, with two
-/// levels, per sub-cell (its bit in the cell's masks), how many of the triangles overlap it.
+/// What [`OccupancyGrid::add_tracked`] counted: per cell (by its bit index) its count and, with
+/// two levels, per sub-cell (its bit in the cell's masks), how many of the triangles overlap it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Footprint {
-    counts: Vec<(usize, u8, u32)>,
+    /// The cells, in the order the triangles first overlapped them.
+    cells: Vec<usize>,
+    /// [`Self::per_cell`] counts a cell, in the order of `cells`.
+    counts: Vec<u32>,
+    /// Counts a cell: one (one level) or [`SUBCELL_COUNT`] (two).
+    per_cell: usize,
+}
+
+/// A [`Footprint`] being counted: where each cell's counts are, and the cell last counted in
+/// (a mesh's next triangle is most often in its last one's cell).
+struct Tally {
+    footprint: Footprint,
+    slots: HashMap<usize, usize, CellHash>,
+    last: Option<(usize, usize)>,
+}
+
+impl Tally {
+    fn new(per_cell: usize) -> Self {
+        Self {
+            footprint: Footprint {
+                per_cell,
+                ..Footprint::default()
+            },
+            slots: HashMap::default(),
+            last: None,
+        }
+    }
+
+    /// The counts of cell `index` (zeros where it was not counted in yet).
+    fn cell(&mut self, index: usize) -> &mut [u32] {
+        let slot = match self.last {
+            Some((cell, slot)) if cell == index => slot,
+            _ => {
+                let f = &mut self.footprint;
+                let slot = *self.slots.entry(index).or_insert_with(|| {
+                    f.cells.push(index);
+                    f.counts.resize(f.counts.len() + f.per_cell, 0);
+                    f.cells.len() - 1
+                });
+                self.last = Some((index, slot));
+                slot
+            }
+        };
+        let n = self.footprint.per_cell;
+        &mut self.footprint.counts[slot * n..(slot + 1) * n]
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -211,16 +244,8 @@ impl OccupancyGrid {
     /// sub-cell), so that [`Self::remove_footprint`] takes them out again without testing them
     /// against the cells anew: an object that moves costs its new triangles' tests alone.
     pub fn add_tracked(&mut self, triangles: &[[Vertex; 3]]) -> Footprint {
-        let mut hits = Vec::new();
-        self.counted(triangles, true, Some(&mut hits));
-        hits.sort_unstable();
-        let mut footprint = Footprint::default();
-        for hit in hits {
-            match footprint.counts.last_mut() {
-                Some((cell, sub, n)) if (*cell, *sub) == hit => *n += 1,
-                _ => footprint.counts.push((hit.0, hit.1, 1)),
-            }
-        }
+        let footprint = self.tally(triangles);
+        self.count(&footprint, true);
         footprint
     }
 
@@ -228,23 +253,68 @@ impl OccupancyGrid {
     /// `footprint` for: a cell (a sub-cell) no other triangle overlaps is cleared, as
     /// [`Self::remove`] of those triangles would.
     pub fn remove_footprint(&mut self, footprint: &Footprint) {
+        self.count(footprint, false);
+    }
+
+    /// Counts `triangles` in or out, and sets and clears the cells that gained their first or
+    /// lost their last triangle.
+    fn update(&mut self, triangles: &[[Vertex; 3]], added: bool) {
+        let footprint = self.tally(triangles);
+        self.count(&footprint, added);
+    }
+
+    /// What `triangles` count in each cell and sub-cell they overlap.
+    fn tally(&self, triangles: &[[Vertex; 3]]) -> Footprint {
+        let per_cell = match self.counts {
+            Counts::Cells(_) => 1,
+            Counts::SubCells(_) => SUBCELL_COUNT,
+        };
+        let mut tally = Tally::new(per_cell);
+        let to_grid = |v: &Vertex| (Vec3::from(v.position) - self.origin) / self.cell;
+        for t in triangles {
+            self.tally_triangle([to_grid(&t[0]), to_grid(&t[1]), to_grid(&t[2])], &mut tally);
+        }
+        tally.footprint
+    }
+
+    /// Counts `footprint` in (`added`) or out, cell by cell, and sets and clears the cells
+    /// that gained their first or lost their last triangle. The sub-cells' words follow each
+    /// change (a set cell's words inserted at its place, the bricks after it moved on by one)
+    /// while few cells are set or cleared; past [`FOLLOWED_FLIPS`] they are compacted anew
+    /// once, at the end.
+    fn count(&mut self, footprint: &Footprint, added: bool) {
         let mut flips = 0;
-        for same_cell in footprint.counts.chunk_by(|a, b| a.0 == b.0) {
-            let index = same_cell[0].0;
+        // (a default footprint has no cells and no counts a cell)
+        let per_cell = footprint.per_cell.max(1);
+        for (&index, n) in footprint
+            .cells
+            .iter()
+            .zip(footprint.counts.chunks_exact(per_cell))
+        {
+            // (a cell a triangle overlapped in none of its sub-cells is as it was)
+            if n.iter().all(|&n| n == 0) {
+                continue;
+            }
             let (word, bit) = (index / 32, (index % 32) as u32);
+            let step = |count: u32, n: u32| {
+                if added {
+                    count + n
+                } else {
+                    count.saturating_sub(n)
+                }
+            };
             let (set, masks_changed) = match &mut self.counts {
                 Counts::Cells(counts) => {
                     let count = counts.entry(index).or_insert(0);
-                    *count = count.saturating_sub(same_cell.iter().map(|h| h.2).sum());
+                    *count = step(*count, n[0]);
                     (*count > 0, false)
                 }
                 Counts::SubCells(counts) => {
                     let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
                     let mut changed = false;
-                    for &(_, sub, n) in same_cell {
-                        let count = &mut cell[usize::from(sub)];
+                    for (count, &n) in cell.iter_mut().zip(n).filter(|(_, n)| **n > 0) {
                         let was = *count > 0;
-                        *count = count.saturating_sub(n);
+                        *count = step(*count, n);
                         changed |= was != (*count > 0);
                     }
                     let set = still_set(cell, changed, self.bits[word] >> bit & 1 == 1);
@@ -255,37 +325,6 @@ impl OccupancyGrid {
                 self.forget(index);
             }
             self.follow(index, set, masks_changed, &mut flips);
-        }
-        if flips > FOLLOWED_FLIPS {
-            self.compact();
-        }
-    }
-
-    /// Counts `triangles` in or out, and sets and clears the cells that gained their first or
-    /// lost their last triangle. The sub-cells' words follow each change (a set cell's words
-    /// inserted at its place, the bricks after it moved on by one) while few cells are set or
-    /// cleared; past [`FOLLOWED_FLIPS`] they are compacted anew once, at the end.
-    fn update(&mut self, triangles: &[[Vertex; 3]], added: bool) {
-        self.counted(triangles, added, None);
-    }
-
-    /// [`Self::update`], noting in `hits` each cell (one level) or sub-cell (two levels, its
-    /// bit in the cell's masks) each triangle was counted in.
-    fn counted(
-        &mut self,
-        triangles: &[[Vertex; 3]],
-        added: bool,
-        mut hits: Option<&mut Vec<(usize, u8)>>,
-    ) {
-        let mut cells = Vec::new();
-        let mut flips = 0;
-        for t in triangles {
-            let t = t.map(|v| (Vec3::from(v.position) - self.origin) / self.cell);
-            self.count_triangle(t, added, &mut cells, hits.as_deref_mut());
-            for &(index, set, masks_changed) in &cells {
-                self.follow(index, set, masks_changed, &mut flips);
-            }
-            cells.clear();
         }
         if flips > FOLLOWED_FLIPS {
             self.compact();
@@ -395,114 +434,25 @@ impl OccupancyGrid {
         self.bits.iter().map(|w| w.count_ones()).sum()
     }
 
-    /// Whether sub-cell `s` (in sub-cell units, [`SUBCELLS`] a cell) holds a piece of a
-    /// triangle: its cell's, in a grid of one level.
-    pub fn subcell_occupied(&self, s: IVec3) -> bool {
-        let mut reader = WordReader::new(self);
-        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
-        reader.occupied(c) && (self.sub.is_none() || reader.sub_occupied(s))
-    }
-
-    /// Whether the segment from `x` (a receiver, normal `n`) to `xp` (a VPL or cluster, normal
-    /// `np`, of any length: a cluster's mean normal is shorter) crosses no set cell, its ends
-    /// moved [`END_OFFSET_CELLS`] off their surfaces (an end whose normal is shorter than 0.1
-    /// stays); `None` where a moved end lies in a set cell (another surface within two cells
-    /// of it: in a corner, under a box) or the walk enters a set cell within
-    /// [`END_CLEARANCE_CELLS`] of an end, which the grid cannot judge. Crosses the boxes the
-    /// segment passes through, in order: a brick whose word is zero, a cell whose bit is not
-    /// set, or a sub-cell of a set one, a box a step.
-    pub fn visible(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Option<bool> {
-        self.walk(x, n, xp, np).visible
-    }
-
-    /// [`Self::visible`] with the words the walk fetched, as the GPU's walk counts them: the
-    /// word last read is kept, so a brick costs one fetch however many of its cells are crossed.
-    pub fn walk(&self, x: Vec3, n: Vec3, xp: Vec3, np: Vec3) -> Walk {
-        let mut reader = WordReader::new(self);
-        let visible = self.walk_cells(x, n, xp, np, &mut reader);
-        Walk {
-            visible,
-            fetches: reader.fetches,
-            cells: reader.cells,
-            steps: reader.steps,
-        }
-    }
-
-    fn walk_cells(
-        &self,
-        x: Vec3,
-        n: Vec3,
-        xp: Vec3,
-        np: Vec3,
-        reader: &mut WordReader,
-    ) -> Option<bool> {
-        let a_cells = self.to_grid(x, n);
-        let b_cells = self.to_grid(xp, np);
-        // the end first: the walk goes on from its word
-        if reader.occupied_at(b_cells) {
-            return None;
-        }
-        let a = a_cells * SUBCELLS as f32;
-        let d = (b_cells - a_cells) * SUBCELLS as f32;
-        let forward = d.cmpgt(Vec3::ZERO);
-        let still = d.cmpeq(Vec3::ZERO);
-        let inverse = Vec3::ONE / Vec3::select(still, Vec3::ONE, d);
-        // the segment parameter of the clearance at each end
-        let clearance = END_CLEARANCE_CELLS / (b_cells - a_cells).length().max(1e-6);
-        let blocked_at = |entered: f32| clearance < entered && entered < 1.0 - clearance;
-        // a step a sub-cell face crossed (the ends lie within two cells of the grid), and two
-        // reads a cell at most
-        let bound = 3 * SUBCELLS * (self.dims.element_sum() + 6);
-        let mut s = a.floor().as_ivec3();
-        let mut entered = 0.0;
-        reader.cells += 1;
-        for _ in 0..bound {
-            reader.steps += 1;
-            let shift = match reader.step_box(s) {
-                StepBox::Read => continue,
-                StepBox::Set => return blocked_at(entered).then_some(false),
-                StepBox::Free(shift) => shift,
-            };
-            let lo = (s >> shift) << shift;
-            let hi = lo + (IVec3::ONE << shift);
-            let exit = Vec3::select(
-                still,
-                Vec3::INFINITY,
-                (IVec3::select(forward, hi, lo).as_vec3() - a) * inverse,
-            );
-            let t = exit.min_element();
-            if t > 1.0 {
-                // the end is in the box
-                break;
-            }
-            // the box across the face the segment leaves by (ties: x, then y), kept beside the
-            // box against rounding
-            let mut next = (a + d * t).floor().as_ivec3().clamp(lo, hi - 1);
-            let across = IVec3::select(forward, hi, lo - 1);
-            let axis = if exit.x <= exit.y && exit.x <= exit.z {
-                0
-            } else if exit.y <= exit.z {
-                1
-            } else {
-                2
-            };
-            next[axis] = across[axis];
-            // the cells entered (a walk of a cell a step would have tested each)
-            let cells = |s: IVec3| s.div_euclid(IVec3::splat(SUBCELLS as i32));
-            reader.cells += (cells(next) - cells(s)).abs().element_sum() as u32;
-            s = next;
-            entered = t;
-        }
-        Some(true)
-    }
-
     /// The grid as the gather reads it: [`HEADER_WORDS`] words (the dimensions, the levels, the
     /// origin and the cell's side as `f32` bits), then a word a [`BRICK`], brick (x, y, z) at
     /// word `x + bricks.x * (y + bricks.y * z)`; with two levels then a word a brick, the index
     /// of its first set cell's sub-cells, and [`MASK_WORDS`] words a set cell, its sub-cell
     /// (x, y, z) in word `z / 2` at bit `x + 4 * (y + 4 * (z % 2))`.
     pub fn gpu_words(&self) -> Vec<u32> {
-        let mut words = vec![
+        let (header, parts) = self.gpu_word_parts();
+        let mut words = header.to_vec();
+        for part in parts {
+            words.extend_from_slice(part);
+        }
+        words
+    }
+
+    /// [`Self::gpu_words`] in its parts, in order, without copying them into one: the header,
+    /// the bricks' bits, and with two levels the bricks' first sub-cells and the masks (empty
+    /// with one level).
+    pub fn gpu_word_parts(&self) -> ([u32; HEADER_WORDS], [&[u32]; 3]) {
+        let header = [
             self.dims.x,
             self.dims.y,
             self.dims.z,
@@ -512,22 +462,11 @@ impl OccupancyGrid {
             self.origin.z.to_bits(),
             self.cell.to_bits(),
         ];
-        words.extend_from_slice(&self.bits);
-        if let Some(sub) = &self.sub {
-            words.extend_from_slice(&sub.first);
-            words.extend_from_slice(&sub.masks);
-        }
-        words
-    }
-
-    /// A segment's end in grid units, moved off its surface.
-    fn to_grid(&self, p: Vec3, n: Vec3) -> Vec3 {
-        let off = if n.length() > 0.1 {
-            n.normalize() * END_OFFSET_CELLS
-        } else {
-            Vec3::ZERO
-        };
-        (p - self.origin) / self.cell + off
+        let (first, masks) = self
+            .sub
+            .as_ref()
+            .map_or((&[][..], &[][..]), |sub| (&sub.first[..], &sub.masks[..]));
+        (header, [&self.bits, first, masks])
     }
 
     /// Cell `c`'s word and bit (outside the grid: none).
@@ -541,28 +480,15 @@ impl OccupancyGrid {
         Some((word as usize, l.x + BRICK.x * (l.y + BRICK.y * l.z)))
     }
 
-    /// Counts the triangle (in grid units) in or out of every cell it overlaps (with two
-    /// levels, of every sub-cell of those); notes in `cells` each such cell, whether it is now
-    /// set (a triangle over it) and whether its sub-cells were set or cleared; and in `hits`
-    /// each cell (sub-cell) counted.
-    fn count_triangle(
-        &mut self,
-        t: [Vec3; 3],
-        added: bool,
-        cells: &mut Vec<(usize, bool, bool)>,
-        mut hits: Option<&mut Vec<(usize, u8)>>,
-    ) {
+    /// Counts the triangle (in grid units) in `tally`'s every cell it overlaps (with two
+    /// levels, in every sub-cell of those).
+    fn tally_triangle(&self, t: [Vec3; 3], tally: &mut Tally) {
         if !t.iter().all(|v| v.is_finite()) {
             return;
         }
         let test = TriangleBoxTest::new(t);
-        let lo = t[0].min(t[1]).min(t[2]).floor().as_ivec3().max(IVec3::ZERO);
-        let hi = t[0]
-            .max(t[1])
-            .max(t[2])
-            .floor()
-            .as_ivec3()
-            .min(self.dims.as_ivec3() - 1);
+        let lo = floor(t[0].min(t[1]).min(t[2])).max(IVec3::ZERO);
+        let hi = floor(t[0].max(t[1]).max(t[2])).min(self.dims.as_ivec3() - 1);
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for x in lo.x..=hi.x {
@@ -573,32 +499,12 @@ impl OccupancyGrid {
                         continue;
                     }
                     let (word, bit) = self.index(c).expect("clamped to the grid");
-                    let index = word * 32 + bit as usize;
-                    let (set, masks_changed) = match &mut self.counts {
-                        Counts::Cells(counts) => {
-                            let count = counts.entry(index).or_insert(0);
-                            *count = step(*count, added);
-                            if let Some(hits) = hits.as_deref_mut() {
-                                hits.push((index, 0));
-                            }
-                            (*count > 0, false)
-                        }
-                        Counts::SubCells(counts) => {
-                            let cell = counts.entry(index).or_insert([0; SUBCELL_COUNT]);
-                            let counted = |sub: usize| {
-                                if let Some(hits) = hits.as_deref_mut() {
-                                    hits.push((index, sub as u8));
-                                }
-                            };
-                            let changed = count_subcells(t, &test, c, cell, added, counted);
-                            let set = still_set(cell, changed, self.bits[word] >> bit & 1 == 1);
-                            (set, changed)
-                        }
-                    };
-                    if !set {
-                        self.forget(index);
+                    let counts = tally.cell(word * 32 + bit as usize);
+                    if self.sub.is_some() {
+                        count_subcells(&test, c, counts);
+                    } else {
+                        counts[0] += 1;
                     }
-                    cells.push((index, set, masks_changed));
                 }
             }
         }
@@ -613,55 +519,6 @@ fn still_set(cell: &[u32; SUBCELL_COUNT], changed: bool, was: bool) -> bool {
     } else {
         was
     }
-}
-
-/// A count one up (`added`) or down.
-fn step(count: u32, added: bool) -> u32 {
-    if added {
-        count + 1
-    } else {
-        count.saturating_sub(1)
-    }
-}
-
-/// Counts the triangle (in grid units) in or out of the sub-cells of cell `c` it overlaps;
-/// whether a sub-cell was set or cleared.
-fn count_subcells(
-    t: [Vec3; 3],
-    test: &TriangleBoxTest,
-    c: IVec3,
-    cell: &mut [u32; SUBCELL_COUNT],
-    added: bool,
-    mut counted: impl FnMut(usize),
-) -> bool {
-    let k = SUBCELLS as f32;
-    let first = c * SUBCELLS as i32;
-    let lo = (t[0].min(t[1]).min(t[2]) * k).floor().as_ivec3().max(first);
-    let hi = (t[0].max(t[1]).max(t[2]) * k)
-        .floor()
-        .as_ivec3()
-        .min(first + SUBCELLS as i32 - 1);
-    let mut changed = false;
-    for z in lo.z..=hi.z {
-        for y in lo.y..=hi.y {
-            for x in lo.x..=hi.x {
-                let s = IVec3::new(x, y, z);
-                // the cell's box's rule (a plane at a face in, one at the next out): the
-                // sub-cells at the cell's faces end where the cell's box does
-                let low = s.as_vec3() / k - Vec3::splat(1e-5);
-                let high = (s + 1).as_vec3() / k - Vec3::splat(1e-4);
-                if test.overlaps((low + high) * 0.5, (high - low) * 0.5) {
-                    let (w, b) = sub_bit(sub_cell(s));
-                    counted(w * 32 + b as usize);
-                    let count = &mut cell[w * 32 + b as usize];
-                    let was = *count > 0;
-                    *count = step(*count, added);
-                    changed |= was != (*count > 0);
-                }
-            }
-        }
-    }
-    changed
 }
 
 /// A set cell's [`MASK_WORDS`] words of sub-cells from its counts.
@@ -682,238 +539,17 @@ fn sub_cell(s: IVec3) -> UVec3 {
     s.rem_euclid(IVec3::splat(SUBCELLS as i32)).as_uvec3()
 }
 
-/// A walk's reads of the grid: the last word fetched, how many were, and the cells tested.
-struct WordReader<'a> {
-    grid: &'a OccupancyGrid,
-    word: Option<(usize, u32)>,
-    /// The held brick's first sub-cells, once read.
-    first: Option<u32>,
-    /// The last word of sub-cells fetched.
-    sub_word: Option<(usize, u32)>,
-    fetches: u32,
-    cells: u32,
-    steps: u32,
-}
-
-impl WordReader<'_> {
-    fn new(grid: &OccupancyGrid) -> WordReader<'_> {
-        WordReader {
-            grid,
-            word: None,
-            first: None,
-            sub_word: None,
-            fetches: 0,
-            cells: 0,
-            steps: 0,
-        }
-    }
-
-    /// Whether the point `p` (grid units) lies in a set cell, and with two levels in a set
-    /// sub-cell of it.
-    fn occupied_at(&mut self, p: Vec3) -> bool {
-        self.occupied(p.floor().as_ivec3())
-            && (self.grid.sub.is_none()
-                || self.sub_occupied((p * SUBCELLS as f32).floor().as_ivec3()))
-    }
-
-    /// Whether sub-cell `s` (sub-cell units) is set, its cell being set (the word of the cell
-    /// held).
-    fn sub_occupied(&mut self, s: IVec3) -> bool {
-        self.cells += 1;
-        if self.first.is_none() {
-            self.read_first();
-        }
-        self.read_sub_word(s) >> sub_bit(sub_cell(s)).1 & 1 == 1
-    }
-
-    /// The box the walk at sub-cell `s` may cross in one step, reading at most one word, as the
-    /// GPU's walk does (its loop has one read): the brick's where another is held; in a set
-    /// cell of a grid of two levels, where the brick's sub-cells start, then the half of the
-    /// cell's sub-cells, each at a step of its own where not held.
-    fn step_box(&mut self, s: IVec3) -> StepBox {
-        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
-        let Some((index, bit)) = self.grid.index(c) else {
-            return StepBox::Free(CELL_SHIFT);
-        };
-        let two_levels = self.grid.sub.is_some();
-        if self.word.is_none_or(|(held, _)| held != index) {
-            let bits = self.read_brick(index);
-            if two_levels && bits >> bit & 1 == 1 {
-                return StepBox::Read;
-            }
-        }
-        let bits = self.word.expect("the brick is held").1;
-        if bits >> bit & 1 == 0 {
-            return StepBox::Free(if bits == 0 { BRICK_SHIFT } else { CELL_SHIFT });
-        }
-        if !two_levels {
-            return StepBox::Set;
-        }
-        if self.first.is_none() {
-            self.read_first();
-            return StepBox::Read;
-        }
-        if self.sub_occupied(s) {
-            StepBox::Set
-        } else {
-            StepBox::Free(UVec3::ZERO)
-        }
-    }
-
-    /// Reads the word of the brick at `index`.
-    fn read_brick(&mut self, index: usize) -> u32 {
-        self.fetches += 1;
-        let bits = self.grid.bits[index];
-        self.word = Some((index, bits));
-        self.first = None;
-        bits
-    }
-
-    /// Reads where the held brick's sub-cells start.
-    fn read_first(&mut self) {
-        let (index, _) = self.word.expect("the brick is held");
-        self.fetches += 1;
-        self.first = Some(self.sub_cells().first[index]);
-    }
-
-    /// The word of sub-cell `s` of a set cell of the held brick (read where another is held).
-    fn read_sub_word(&mut self, s: IVec3) -> u32 {
-        let (_, bits) = self.word.expect("the brick is held");
-        let first = self.first.expect("the brick's first sub-cells are read");
-        let c = s.div_euclid(IVec3::splat(SUBCELLS as i32));
-        let (_, bit) = self.grid.index(c).expect("a set cell is in the grid");
-        let rank = first + (bits & ((1u32 << bit) - 1)).count_ones();
-        let word = rank as usize * MASK_WORDS + sub_bit(sub_cell(s)).0;
-        match self.sub_word {
-            Some((held, mask)) if held == word => mask,
-            _ => {
-                self.fetches += 1;
-                let mask = self.sub_cells().masks[word];
-                self.sub_word = Some((word, mask));
-                mask
-            }
-        }
-    }
-
-    fn sub_cells(&self) -> &SubCells {
-        self.grid.sub.as_ref().expect("a grid of two levels")
-    }
-
-    fn occupied(&mut self, c: IVec3) -> bool {
-        self.cells += 1;
-        let Some((index, bit)) = self.grid.index(c) else {
-            return false;
-        };
-        let bits = match self.word {
-            Some((held, bits)) if held == index => bits,
-            _ => self.read_brick(index),
-        };
-        bits >> bit & 1 == 1
-    }
-}
-
-/// What a step of the walk may cross from its sub-cell ([`WordReader::step_box`]).
-enum StepBox {
-    /// Nothing: the step read a word that the sub-cell's verdict needs before the next one.
-    Read,
-    /// The sub-cell (with one level, the cell) is set.
-    Set,
-    /// The box around the sub-cell, its side 2^shift sub-cells along each axis, is free.
-    Free(UVec3),
-}
-
-/// A step's box in sub-cells: a cell's, a brick's (powers of two).
-const CELL_SHIFT: UVec3 = UVec3::splat(SUBCELLS.trailing_zeros());
-const BRICK_SHIFT: UVec3 = UVec3::new(
-    BRICK.x.trailing_zeros() + SUBCELLS.trailing_zeros(),
-    BRICK.y.trailing_zeros() + SUBCELLS.trailing_zeros(),
-    BRICK.z.trailing_zeros() + SUBCELLS.trailing_zeros(),
-);
-
-/// A triangle's separating-axis test against boxes (Akenine-Möller's: the box's axes, the
-/// triangle's normal, and the nine cross products of their edges), its axes and the triangle's
-/// extent along each found once for all the cells and sub-cells it is tested against. Lengths
-/// are taken from its first vertex, so that rounding follows the box's distance from the
-/// triangle, not the grid's coordinates.
-struct TriangleBoxTest {
-    origin: Vec3,
-    /// The triangle's vertices from `origin`, and their bounds.
-    vertices: [Vec3; 3],
-    lo: Vec3,
-    hi: Vec3,
-    /// The normal and the edges' nine axes (a zero one separates nothing), each with the
-    /// triangle's least and greatest projection; made only where a box needs them.
-    axes: OnceCell<[(Vec3, f32, f32); 10]>,
-}
-
-impl TriangleBoxTest {
-    fn new(t: [Vec3; 3]) -> Self {
-        let origin = t[0];
-        let v = t.map(|p| p - origin);
-        Self {
-            origin,
-            vertices: v,
-            lo: v[0].min(v[1]).min(v[2]),
-            hi: v[0].max(v[1]).max(v[2]),
-            axes: OnceCell::new(),
-        }
-    }
-
-    /// The normal and the edges' nine axes, made at the first box the bounds do not decide.
-    fn axes(&self) -> &[(Vec3, f32, f32); 10] {
-        self.axes.get_or_init(|| {
-            let v = self.vertices;
-            let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
-            let mut axes = [(Vec3::ZERO, 0.0, 0.0); 10];
-            let directions = std::iter::once(edges[0].cross(edges[1])).chain(
-                edges
-                    .into_iter()
-                    .flat_map(|e| [Vec3::X.cross(e), Vec3::Y.cross(e), Vec3::Z.cross(e)]),
-            );
-            for (slot, axis) in axes.iter_mut().zip(directions) {
-                if axis.length_squared() >= 1e-12 {
-                    let p = v.map(|v| v.dot(axis));
-                    *slot = (axis, p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-                }
-            }
-            axes
-        })
-    }
-
-    /// Whether the triangle overlaps the box of `centre` and `half` extents.
-    fn overlaps(&self, centre: Vec3, half: Vec3) -> bool {
-        let d = centre - self.origin;
-        // the box's axes: the triangle's bounds
-        let (lo, hi) = (self.lo - d, self.hi - d);
-        if lo.cmpgt(half).any() || hi.cmplt(-half).any() {
-            return false;
-        }
-        // a triangle well inside the box overlaps it whatever the other axes say (most of a
-        // small triangle's cells and sub-cells)
-        let inner = half * (1.0 - 1e-5);
-        if lo.cmpgt(-inner).all() && hi.cmplt(inner).all() {
-            return true;
-        }
-        // the normal first: most boxes of the triangle's bounds lie off its plane
-        self.axes().iter().all(|&(axis, least, most)| {
-            let c = d.dot(axis);
-            let r = half.dot(axis.abs());
-            !(least - c > r || most - c < -r)
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn quad(corners: [[f32; 3]; 4]) -> [[Vertex; 3]; 2] {
+    pub(super) fn quad(corners: [[f32; 3]; 4]) -> [[Vertex; 3]; 2] {
         let v = corners.map(|position| Vertex::untextured(position, [0.0, 0.0, 1.0], [0.5; 3]));
         [[v[0], v[1], v[2]], [v[0], v[2], v[3]]]
     }
 
     /// A floor (y = 0, 0..1 in x and z) and a thin wall at x = 0.5 up to `wall_top`.
-    fn floor_and_wall(wall_top: f32) -> Vec<[Vertex; 3]> {
+    pub(super) fn floor_and_wall(wall_top: f32) -> Vec<[Vertex; 3]> {
         let mut t = quad([
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
@@ -928,88 +564,6 @@ mod tests {
             [0.5, 0.0, 1.0],
         ]));
         t
-    }
-
-    #[test]
-    fn a_wall_blocks_and_the_gap_above_it_does_not() {
-        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 32);
-        let up = Vec3::Y;
-        let left = Vec3::new(0.2, 0.0, 0.5);
-        let right = Vec3::new(0.8, 0.0, 0.5);
-        assert_eq!(
-            grid.visible(left, up, right, up),
-            Some(false),
-            "through the wall"
-        );
-        let above = grid.visible(left + 0.8 * up, up, right + 0.8 * up, up);
-        assert_eq!(above, Some(true), "above it");
-        let beside = grid.visible(left, up, left + Vec3::new(0.1, 0.3, 0.2), up);
-        assert_eq!(beside, Some(true), "same side");
-        // a plane sets the cells it passes through on its right: a point just right of it
-        // starts in a set cell
-        let corner = grid.visible(Vec3::new(0.51, 0.0, 0.5), up, right, up);
-        assert_eq!(corner, None, "at the wall's foot");
-    }
-
-    #[test]
-    fn a_walk_crosses_an_empty_brick_in_one_step() {
-        for levels in [1, 2] {
-            let grid = OccupancyGrid::with_levels(&floor_and_wall(0.5), 32, levels);
-            // above the floor and left of the wall, through empty bricks only
-            let (from, to) = (Vec3::new(0.02, 0.3, 0.4), Vec3::new(0.45, 0.4, 0.5));
-            let free = grid.walk(from, Vec3::ZERO, to, Vec3::ZERO);
-            assert_eq!(free.visible, Some(true), "{levels} levels");
-            // a brick spans 4 cells along x and y and 2 along z
-            assert!(free.steps * 2 <= free.cells, "{levels} levels: {free:?}");
-            // on through the wall: blocked
-            let across = grid.walk(from, Vec3::ZERO, to + Vec3::X * 0.5, Vec3::ZERO);
-            assert_eq!(across.visible, Some(false), "{levels} levels");
-        }
-    }
-
-    #[test]
-    fn a_point_on_the_edge_of_two_surfaces_is_not_hidden_by_the_other() {
-        // the wall's plane lies on a cell boundary (x = 0.5 with 32 cells) and sets the cells to
-        // its right; a floor point of the right room on the edge, rounded to the wall's left,
-        // starts in the free cell beside the wall's and crosses the wall's at once
-        let grid = OccupancyGrid::of_triangles(&floor_and_wall(0.5), 32);
-        let up = Vec3::Y;
-        let edge = Vec3::new(0.5 - 1e-7, 0.0, 0.5);
-        let across = Vec3::new(0.8, 0.0, 0.5);
-        assert_eq!(
-            grid.visible(edge, up, across, up),
-            None,
-            "undecided, not blocked"
-        );
-        // a real wall a few cells along the way still blocks
-        let left = Vec3::new(0.3, 0.0, 0.5);
-        assert_eq!(grid.visible(left, up, across, up), Some(false));
-    }
-
-    #[test]
-    fn a_surface_does_not_hide_its_own_points_at_any_slope() {
-        for deg in [0.0f32, 10.0, 33.0, 45.0, 71.0] {
-            let (s, c) = deg.to_radians().sin_cos();
-            // a plane through the origin, tilted about z; normal (-s, c, 0)
-            let n = Vec3::new(-s, c, 0.0);
-            let along = Vec3::new(c, s, 0.0);
-            let t = quad([
-                (-along - Vec3::Z).to_array(),
-                (along - Vec3::Z).to_array(),
-                (along + Vec3::Z).to_array(),
-                (-along + Vec3::Z).to_array(),
-            ]);
-            let grid = OccupancyGrid::of_triangles(&t, 40);
-            for k in -4..=4 {
-                let x = along * (k as f32 * 0.1) + Vec3::Z * 0.13;
-                let xp = -along * 0.3 + n * 0.5;
-                assert_eq!(
-                    grid.visible(x, n, xp, -n),
-                    Some(true),
-                    "{deg} deg, point {k}"
-                );
-            }
-        }
     }
 
     #[test]
@@ -1156,15 +710,5 @@ mod tests {
             tracked.add(&before);
             assert_eq!(tracked.gpu_words(), old, "{levels} levels: back");
         }
-    }
-
-    #[test]
-    fn no_triangles_make_a_grid_that_blocks_nothing() {
-        let grid = OccupancyGrid::of_triangles(&[], 8);
-        assert_eq!(grid.occupied_count(), 0);
-        assert_eq!(
-            grid.visible(Vec3::ZERO, Vec3::Y, Vec3::ONE, Vec3::Y),
-            Some(true)
-        );
     }
 }
