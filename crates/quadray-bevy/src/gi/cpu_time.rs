@@ -1,12 +1,14 @@
 //! The plugin's CPU time in each world, reported to Bevy's `DiagnosticsStore` as
 //! [`MAIN_WORLD_CPU`] and [`RENDER_WORLD_CPU`]: what its systems cost a frame besides the GPU's
-//! passes.
+//! passes. A system's span reads its thread's CPU clock (each system runs on one thread), so a
+//! thread preempted by another program's, or by the renderer's, costs the plugin nothing: the
+//! figure does not grow with the machine's load as a wall clock's would.
 
+use ::cpu_time::ThreadTime;
 use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics, RegisterDiagnostic};
 use bevy::prelude::*;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
 /// Milliseconds a frame in the plugin's main-world systems (gathering the scene's triangles and
 /// lights).
@@ -23,25 +25,34 @@ pub const RENDER_WORLD_CPU: DiagnosticPath =
 #[derive(Resource, Clone, Default)]
 pub(crate) struct CpuTimes(Arc<[AtomicU64; 2]>);
 
-/// Adds the time from its making to its drop to one world's total.
-pub(crate) struct Span<'a>(&'a AtomicU64, Instant);
+/// Adds its thread's CPU time from its making to its drop to one world's total (none where the
+/// thread's clock cannot be read).
+pub(crate) struct Span<'a>(&'a AtomicU64, Option<ThreadTime>);
+
+impl Span<'_> {
+    fn start(total: &AtomicU64) -> Span<'_> {
+        Span(total, ThreadTime::try_now().ok())
+    }
+}
 
 impl Drop for Span<'_> {
     fn drop(&mut self) {
-        let nanos = u64::try_from(self.1.elapsed().as_nanos()).unwrap_or(u64::MAX);
-        self.0.fetch_add(nanos, Ordering::Relaxed);
+        if let Some(elapsed) = self.1.as_ref().and_then(|t| t.try_elapsed().ok()) {
+            let nanos = u64::try_from(elapsed.as_nanos()).unwrap_or(u64::MAX);
+            self.0.fetch_add(nanos, Ordering::Relaxed);
+        }
     }
 }
 
 impl CpuTimes {
     /// Times a main-world system until the span is dropped.
     pub(crate) fn main(&self) -> Span<'_> {
-        Span(&self.0[0], Instant::now())
+        Span::start(&self.0[0])
     }
 
     /// Times a render-world system until the span is dropped.
     pub(crate) fn render(&self) -> Span<'_> {
-        Span(&self.0[1], Instant::now())
+        Span::start(&self.0[1])
     }
 }
 
