@@ -232,15 +232,13 @@ impl Plane {
             .filter(|tile| {
                 let corner =
                     self.origin + self.u * (tile % tiles) as f32 + self.v * (tile / tiles) as f32;
-                let clip: Vec<glam::Vec4> = (0..8)
-                    .map(|k| {
-                        let p = corner
-                            + self.u * (k & 1) as f32
-                            + self.v * ((k >> 1) & 1) as f32
-                            + below * (k >> 2) as f32;
-                        view_proj * p.extend(1.0)
-                    })
-                    .collect();
+                let clip: [glam::Vec4; 8] = std::array::from_fn(|k| {
+                    let p = corner
+                        + self.u * (k & 1) as f32
+                        + self.v * ((k >> 1) & 1) as f32
+                        + below * (k >> 2) as f32;
+                    view_proj * p.extend(1.0)
+                });
                 let outside = |plane: fn(glam::Vec4) -> bool| clip.iter().all(|&c| plane(c));
                 !(outside(|c| c.x < -c.w)
                     || outside(|c| c.x > c.w)
