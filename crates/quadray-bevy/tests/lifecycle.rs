@@ -508,7 +508,9 @@ fn a_camera_without_the_plugin_for_a_while_or_respawned_gathers_as_a_fresh_app()
 /// and green by its texture alone; `configure` marks its light and gives the cameras its
 /// projection): once the new scene has loaded, the bounce is a fresh app's on it, far from the
 /// first scene's; the fresh app's is quadray's, the floor's texture in it
-/// ([`check_textured_floor`]).
+/// ([`check_textured_floor`]). Then the RSM drawn from Bevy's meshes on it: as the triangles'
+/// RSM, with a box whose mesh only the render world keeps, and after the floor's texture is
+/// edited in place.
 #[test]
 fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     let expected = fresh(TEXTURED_SCENE, SIZE, SIZE);
@@ -572,6 +574,44 @@ fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     );
     assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
     assert!(missing.rel_l1 > 0.01, "{missing:?}");
+
+    // the floor's texture edited in place, mirrored and twice as wide (Bevy makes a new texture
+    // for the new size): both RSMs sample the new one
+    mirror_floor_texture(&mut app);
+    let edited = switched(&mut app, &probes, RsmSource::Meshes);
+    let edited_triangles = switched(&mut app, &probes, RsmSource::Triangles);
+    let error = meshes_against_triangles("an edited texture", &edited[0], &edited_triangles[0]);
+    let changed = compare(&edited_triangles[0], &readable[0]);
+    println!("the floor's texture mirrored: {changed:?} from the bounce before");
+    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
+    assert!(changed.rel_l1 > 0.05, "{changed:?}");
+}
+
+/// Mirrors the one base colour texture of the app's materials left to right in place, each
+/// texel twice as wide.
+fn mirror_floor_texture(app: &mut App) {
+    let world = app.world_mut();
+    let textures: Vec<AssetId<Image>> = world
+        .resource::<Assets<StandardMaterial>>()
+        .iter()
+        .filter_map(|(_, m)| m.base_color_texture.as_ref().map(Handle::id))
+        .collect();
+    assert_eq!(textures.len(), 1, "the textured room has one texture");
+    let mut images = world.resource_mut::<Assets<Image>>();
+    let mut image = images.get_mut(textures[0]).unwrap();
+    let (width, height) = (image.width() as usize, image.height() as usize);
+    let old = image.data.clone().expect("the texture on the CPU");
+    assert_eq!(old.len(), width * height * 4, "four bytes a texel");
+    let texel = |x: usize, y: usize| &old[(y * width + x) * 4..][..4];
+    let data = (0..height)
+        .flat_map(|y| (0..2 * width).flat_map(move |x| texel(width - 1 - x / 2, y).to_vec()))
+        .collect();
+    image.resize(Extent3d {
+        width: 2 * width as u32,
+        height: height as u32,
+        depth_or_array_layers: 1,
+    });
+    image.data = Some(data);
 }
 
 /// A camera without `IndirectLight` beside one with it: its picture is an app's without the

@@ -392,6 +392,11 @@ pub(super) fn collect_triangles(
         mut gpu_only,
     } = sources;
     let displaced = displaced.as_deref();
+    if resumed {
+        // the images' events while paused were not read: every image read again
+        colours.clear();
+        scene.base_colours.forget_all();
+    }
     let mut dirty: BTreeSet<Entity> = if resumed {
         mesh_entities.iter().collect()
     } else {

@@ -53,6 +53,12 @@ impl BaseColours {
         self.read.remove(&id);
     }
 
+    /// Forgets every image: each read again when next asked for (after a pause in which their
+    /// events went unread).
+    pub fn forget_all(&mut self) {
+        self.read.clear();
+    }
+
     /// The packed texture ([`Vertex::texture`]) of `texture`, read the first time it is asked
     /// for once loaded; `None` until it loads, and where it cannot be read on the CPU or is over
     /// quadray's limits (with a warning naming it, once).

@@ -31,6 +31,7 @@ use bevy::render::render_resource::{
     SamplerBindingType, ShaderStages, SpecializedMeshPipeline, SpecializedMeshPipelineError,
     SpecializedMeshPipelines, StorageBuffer, TextureSampleType, VertexState,
 };
+use bevy::render::render_resource::{SamplerId, TextureId};
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::sync_world::MainEntity;
 use bevy::render::texture::{FallbackImage, GpuImage};
@@ -101,8 +102,9 @@ impl RsmMaterial {
 #[derive(Resource, Default)]
 pub(super) struct RsmMaterials {
     materials: HashMap<AssetId<StandardMaterial>, RsmMaterial>,
-    /// Each material's group and whether its texture was bound (not the fallback's white).
-    groups: HashMap<AssetId<StandardMaterial>, (BindGroup, bool)>,
+    /// Each material's group and what it bound: its texture and sampler, or `None` for the
+    /// fallback's white while the texture is not on the GPU.
+    groups: HashMap<AssetId<StandardMaterial>, (BindGroup, Option<BoundImage>)>,
     grey: Option<BindGroup>,
 }
 
@@ -513,7 +515,13 @@ fn mesh_uniforms(sources: &MeshSources) -> Vec<(MainEntity, MeshUniform)> {
     out
 }
 
-/// A material's group: made once, again while its texture is not loaded.
+/// The texture and sampler a material's group binds. Bevy writes an edited image of the same
+/// size into its texture, but makes a new texture for a new size and a new sampler for a new
+/// sampler descriptor: a group that bound the old ones is made again.
+type BoundImage = (TextureId, SamplerId);
+
+/// A material's group: made once, again while its texture is not loaded and when its image's
+/// texture or sampler is replaced.
 fn material_group(
     materials: &mut RsmMaterials,
     material: Option<(AssetId<StandardMaterial>, RsmMaterial)>,
@@ -521,9 +529,14 @@ fn material_group(
     device: &RenderDevice,
     layout: &bevy::render::render_resource::BindGroupLayout,
 ) -> BindGroup {
+    let bound_image = |m: &RsmMaterial| {
+        let image = m
+            .texture
+            .map_or(Some(&sources.fallback.d2), |id| sources.images.get(id));
+        image.map(|image| (image.texture.id(), image.sampler.id()))
+    };
     let make = |m: &RsmMaterial| {
         let image = m.texture.and_then(|id| sources.images.get(id));
-        let bound = m.texture.is_none() || image.is_some();
         let image = image.unwrap_or(&sources.fallback.d2);
         let buffer = device.create_buffer_with_data(&BufferInitDescriptor {
             label: Some("quadray gi rsm material"),
@@ -539,7 +552,7 @@ fn material_group(
                 &image.sampler,
             )),
         );
-        (group, bound)
+        (group, bound_image(m))
     };
     let Some((id, material)) = material else {
         return materials
@@ -547,7 +560,9 @@ fn material_group(
             .get_or_insert_with(|| make(&RsmMaterial::GREY).0)
             .clone();
     };
-    if let Some((group, true)) = materials.groups.get(&id) {
+    if let Some((group, Some(bound))) = materials.groups.get(&id)
+        && bound_image(&material) == Some(*bound)
+    {
         return group.clone();
     }
     let made = make(&material);
