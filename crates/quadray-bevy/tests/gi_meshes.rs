@@ -40,22 +40,26 @@ pub(crate) fn switched(app: &mut App, probes: &[Probe], source: RsmSource) -> Ve
             break;
         }
     }
+    bounce_settled(app, probes, MAX_FRAMES - frames)
+}
+
+/// Frames (at most `frames`) until every probe's bounce holds still for three frames: each
+/// probe's last bounce.
+pub(crate) fn bounce_settled(app: &mut App, probes: &[Probe], frames: u32) -> Vec<Vec<[f32; 3]>> {
     let read = |p: &Probe| floats(p.read_indirect.lock().unwrap().as_ref().unwrap());
     let mut last: Vec<_> = probes.iter().map(read).collect();
-    // the readbacks of the frames before the switch arrive after it
+    // the readbacks of the frames before the change arrive after it
     let mut still = -3;
-    while still < 3 {
-        assert!(
-            frames < MAX_FRAMES,
-            "the bounce never settled from {source:?}"
-        );
+    for _ in 0..frames {
         app.update();
-        frames += 1;
         let now: Vec<_> = probes.iter().map(read).collect();
         still = if now == last { still + 1 } else { still.min(0) };
         last = now;
+        if still == 3 {
+            return last;
+        }
     }
-    last
+    panic!("the bounce never settled in {frames} frames");
 }
 
 /// The bounce of `meshes` (drawn from Bevy's meshes) against `triangles` (from the CPU's

@@ -23,9 +23,9 @@ use std::sync::{Arc, Mutex};
 
 use crate::gi::{
     Case, Probe, Probes, RSM, SCENE, SIZE, TEXTURED_SCENE, app, app_with, app_without_plugin,
-    cameras_with_passes, check_textured_floor, compiling, floats, gathered,
+    cameras_with_passes, check_textured_floor, compiling, floats, gathered, meshes_drawn,
 };
-use crate::gi_meshes::{MESHES_RSM_TOLERANCE, meshes_against_triangles, switched};
+use crate::gi_meshes::{MESHES_RSM_TOLERANCE, bounce_settled, meshes_against_triangles, switched};
 
 /// A picture read back every frame, the latest kept.
 type Read = Arc<Mutex<Option<Vec<u8>>>>;
@@ -509,8 +509,8 @@ fn a_camera_without_the_plugin_for_a_while_or_respawned_gathers_as_a_fresh_app()
 /// projection): once the new scene has loaded, the bounce is a fresh app's on it, far from the
 /// first scene's; the fresh app's is quadray's, the floor's texture in it
 /// ([`check_textured_floor`]). Then the RSM drawn from Bevy's meshes on it: as the triangles'
-/// RSM, with a box whose mesh only the render world keeps, and after the floor's texture is
-/// edited in place.
+/// RSM, with a box whose mesh only the render world keeps, after the floor's texture is edited
+/// in place and after the box moves; not drawn again while nothing moves.
 #[test]
 fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     let expected = fresh(TEXTURED_SCENE, SIZE, SIZE);
@@ -585,6 +585,28 @@ fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     println!("the floor's texture mirrored: {changed:?} from the bounce before");
     assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
     assert!(changed.rel_l1 > 0.05, "{changed:?}");
+
+    // the box moved while the RSM is drawn from Bevy's meshes: its kept draw takes the new
+    // transform; then, with nothing moving, the RSM is not drawn again
+    switched(&mut app, &probes, RsmSource::Meshes);
+    let moved_place = Transform::from_xyz(-0.4, 0.15, 0.3);
+    app.world_mut().entity_mut(red_box).insert(moved_place);
+    let moved = bounce_settled(&mut app, &probes, 100);
+    let drawn = meshes_drawn(&app);
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(
+        meshes_drawn(&app),
+        drawn,
+        "the RSM drawn again with nothing moving"
+    );
+    let moved_triangles = switched(&mut app, &probes, RsmSource::Triangles);
+    let error = meshes_against_triangles("a moved box", &moved[0], &moved_triangles[0]);
+    let changed = compare(&moved_triangles[0], &edited_triangles[0]);
+    println!("the box moved: {changed:?} from the bounce before");
+    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
+    assert!(changed.rel_l1 > 0.01, "{changed:?}");
 }
 
 /// Mirrors the one base colour texture of the app's materials left to right in place, each

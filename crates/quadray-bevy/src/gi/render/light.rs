@@ -194,11 +194,12 @@ pub(super) fn prepare_light(
         l.source = camera.rsm_source;
         l.stale = true;
     }
-    // Bevy's meshes may move on the GPU alone (skinning): their RSMs are drawn every frame
+    // the triangles' RSMs are drawn anew when the scene changed, the meshes' when their draws
+    // do (`prepare_mesh_rsm`); the maps' projections follow the scene's bounds
     let meshes = l.source == RsmSource::Meshes;
-    if !matches!(changes, SceneChanges::None) || meshes {
-        // the RSMs are drawn anew; the maps' projections follow the scene's bounds
-        l.stale = true;
+    let changed = !matches!(changes, SceneChanges::None);
+    l.stale |= changed && !meshes;
+    if changed || meshes {
         let bounds = mirror.bounds_of(l.source);
         if bounds != l.bounds {
             l.bounds = bounds;

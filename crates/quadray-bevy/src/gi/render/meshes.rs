@@ -22,7 +22,7 @@ use bevy::render::Extract;
 use bevy::render::batching::gpu_preprocessing::BatchedInstanceBuffers;
 use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::mesh::{RenderMesh, RenderMeshBufferInfo};
-use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_asset::{ExtractedAssets, RenderAssets};
 use bevy::render::render_resource::binding_types::{sampler, texture_2d, uniform_buffer_sized};
 use bevy::render::render_resource::{
     BindGroup, BindGroupEntries, BindGroupLayoutDescriptor, BindGroupLayoutEntries,
@@ -31,7 +31,7 @@ use bevy::render::render_resource::{
     SamplerBindingType, ShaderStages, SpecializedMeshPipeline, SpecializedMeshPipelineError,
     SpecializedMeshPipelines, StorageBuffer, TextureSampleType, VertexState,
 };
-use bevy::render::render_resource::{SamplerId, TextureId};
+use bevy::render::render_resource::{BindGroupId, SamplerId, TextureId};
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::sync_world::MainEntity;
 use bevy::render::texture::{FallbackImage, GpuImage};
@@ -106,6 +106,8 @@ pub(super) struct RsmMaterials {
     /// fallback's white while the texture is not on the GPU.
     groups: HashMap<AssetId<StandardMaterial>, (BindGroup, Option<BoundImage>)>,
     grey: Option<BindGroup>,
+    /// Counts the frames in which a material changed.
+    generation: u64,
 }
 
 pub(super) fn extract_materials(
@@ -116,6 +118,9 @@ pub(super) fn extract_materials(
 ) {
     let _span = times.render();
     for event in events.read() {
+        if !matches!(event, AssetEvent::Unused { .. }) {
+            materials.generation += 1;
+        }
         match *event {
             AssetEvent::Added { id }
             | AssetEvent::Modified { id }
@@ -282,9 +287,61 @@ struct MeshDraw {
     )>,
 }
 
-/// This frame's draws of the meshes into the RSMs ([`record_mesh_rsm`]): their mesh uniforms
-/// (the draw's instance index is its place), Bevy's mesh bind groups over them, each light
-/// view's group 0.
+/// What an entity's mesh uniform is made from: its transform (Bevy's transposed affine), its
+/// flags, its first vertex in its slab and its skin (`u32::MAX`: none).
+#[derive(Clone, Copy, PartialEq)]
+struct UniformInput {
+    world_from_local: [Vec4; 3],
+    flags: u32,
+    first_vertex: u32,
+    skin: u32,
+}
+
+impl UniformInput {
+    /// The mesh uniform as Bevy's mesh shaders read it.
+    fn uniform(&self) -> MeshUniform {
+        let world_from_local = Affine3::from_transpose(self.world_from_local);
+        let (local_from_world_transpose_a, local_from_world_transpose_b) =
+            world_from_local.inverse_transpose_3x3();
+        MeshUniform {
+            world_from_local: self.world_from_local,
+            previous_world_from_local: self.world_from_local,
+            lightmap_uv_rect: UVec2::ZERO,
+            local_from_world_transpose_a,
+            local_from_world_transpose_b,
+            flags: self.flags,
+            first_vertex_index: self.first_vertex,
+            current_skin_index: self.skin,
+            material_and_lightmap_bind_group_slot: 0,
+            tag: 0,
+            morph_descriptor_index: u32::MAX,
+        }
+    }
+}
+
+/// An entity's draw as last prepared, kept while its mesh and material are the same and no mesh
+/// was uploaded or freed (which may move a mesh in Bevy's slabs).
+struct CachedDraw {
+    mesh: AssetId<Mesh>,
+    material: Option<AssetId<StandardMaterial>>,
+    /// The draw's pipeline, slabs and skinning (its material's group is looked up each frame:
+    /// it is made again when its texture loads or is replaced).
+    pipeline: CachedRenderPipelineId,
+    skinned: bool,
+    vertices: (bevy::render::render_resource::Buffer, Range<u32>),
+    indices: Option<(
+        bevy::render::render_resource::Buffer,
+        Range<u32>,
+        IndexFormat,
+    )>,
+    input: UniformInput,
+    uniform: MeshUniform,
+}
+
+/// The meshes' draws into the RSMs ([`record_mesh_rsm`]): their mesh uniforms (the draw's
+/// instance index is its place), Bevy's mesh bind groups over them, each light view's group 0;
+/// and each entity's draw kept across frames, so that a frame in which nothing moved makes no
+/// draw and sets no RSM to be drawn again.
 #[derive(Resource, Default)]
 pub(super) struct MeshDraws {
     draws: Vec<MeshDraw>,
@@ -292,6 +349,13 @@ pub(super) struct MeshDraws {
     model_only: Option<BindGroup>,
     skinned: Option<BindGroup>,
     views: Vec<BindGroup>,
+    /// Each entity's draw, and what it was prepared under: the RSM layout, the materials'
+    /// generation, the count of meshes on the GPU.
+    cache: HashMap<MainEntity, CachedDraw>,
+    prepared_for: (bool, u64, usize),
+    /// Last frame's draws: entity, pipeline, material group (the RSMs are drawn again when
+    /// they differ).
+    last: Vec<(MainEntity, CachedRenderPipelineId, BindGroupId)>,
 }
 
 /// The Bevy resources the draws are made from.
@@ -300,6 +364,7 @@ pub(super) struct MeshSources<'w> {
     instances: Res<'w, RenderMeshInstances>,
     material_instances: Res<'w, RenderMaterialInstances>,
     meshes: Res<'w, RenderAssets<RenderMesh>>,
+    uploaded: Res<'w, ExtractedAssets<RenderMesh>>,
     allocator: Res<'w, MeshAllocator>,
     images: Res<'w, RenderAssets<GpuImage>>,
     fallback: Res<'w, FallbackImage>,
@@ -308,10 +373,12 @@ pub(super) struct MeshSources<'w> {
 }
 
 /// Specialises the pipelines and prepares this frame's draws, when the lights' RSMs are drawn
-/// from Bevy's meshes.
+/// from Bevy's meshes; sets the RSMs to be drawn again when the draws changed (an entity moved,
+/// came or went, its mesh or material changed, a skinned mesh is drawn, or a pipeline is still
+/// compiling).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn prepare_mesh_rsm(
-    light: Res<LightState>,
+    mut light: ResMut<LightState>,
     sources: MeshSources,
     mut materials: ResMut<RsmMaterials>,
     pipeline: Res<RsmMeshPipeline>,
@@ -323,9 +390,10 @@ pub(super) fn prepare_mesh_rsm(
 ) {
     let _span = times.render();
     let draws = &mut *draws;
-    draws.draws.clear();
-    draws.views.clear();
-    let Some(l) = light.0.as_ref().filter(|l| l.source == RsmSource::Meshes) else {
+    let Some(l) = light.0.as_mut().filter(|l| l.source == RsmSource::Meshes) else {
+        draws.draws.clear();
+        draws.cache.clear();
+        draws.last.clear();
         return;
     };
     if !pipeline.storage_buffers {
@@ -338,27 +406,21 @@ pub(super) fn prepare_mesh_rsm(
         return;
     }
     let compact = l.rsm_layout == GBufferLayout::Compact;
+    // (a mesh freed changes the count)
+    let prepared_for = (compact, materials.generation, sources.meshes.iter().count());
+    // a mesh uploaded may grow a slab, so move the meshes in it
+    let uploaded = !sources.uploaded.added.is_empty() || !sources.uploaded.modified.is_empty();
+    if uploaded || draws.prepared_for != prepared_for {
+        draws.cache.clear();
+        draws.prepared_for = prepared_for;
+    }
     let material_layout = pipeline_cache.get_bind_group_layout(&pipeline.material_layout);
+    let mut seen = bevy::platform::collections::HashSet::new();
+    let (mut uniforms_changed, mut redraw) = (false, false);
+    draws.draws.clear();
     let mut uniforms = Vec::new();
-    let entities: Vec<(MainEntity, MeshUniform)> = mesh_uniforms(&sources);
-    for (entity, uniform) in entities {
-        let Some(mesh_id) = sources.instances.mesh_asset_id(entity) else {
-            continue;
-        };
-        let Some(mesh) = sources.meshes.get(mesh_id) else {
-            continue;
-        };
-        let Some(vertices) = sources.allocator.mesh_vertex_slice(&mesh_id) else {
-            continue;
-        };
-        // triangles with normals, as the triangles' RSM takes them
-        let triangles = matches!(
-            mesh.primitive_topology(),
-            PrimitiveTopology::TriangleList | PrimitiveTopology::TriangleStrip
-        );
-        if !triangles || !mesh.layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
-            continue;
-        }
+    let mut now = Vec::new();
+    for (entity, mesh_id, input) in uniform_inputs(&sources) {
         let material_id = sources
             .material_instances
             .instances
@@ -372,27 +434,44 @@ pub(super) fn prepare_mesh_rsm(
             },
             None => None,
         };
-        // (laid out as Bevy's mesh pipeline lays the mesh out: skinned where it has joints)
-        let skinned = mesh.layout.0.contains(Mesh::ATTRIBUTE_JOINT_INDEX)
-            && mesh.layout.0.contains(Mesh::ATTRIBUTE_JOINT_WEIGHT);
-        if skinned && uniform.current_skin_index == u32::MAX {
-            continue;
-        }
-        let key = RsmMeshKey {
-            mesh: MeshPipelineKey::from_primitive_topology_and_strip_index(
-                mesh.primitive_topology(),
-                mesh.index_format(),
-            ),
-            compact,
-            uv1: material.is_some_and(|(_, m)| m.uv1),
-        };
-        let id = match pipelines.specialize(&pipeline_cache, &pipeline, key, &mesh.layout) {
-            Ok(id) => id,
-            Err(e) => {
-                error!("quadray indirect light: no RSM pipeline for a mesh: {e}");
-                continue;
+        let cached = draws
+            .cache
+            .get_mut(&entity)
+            .filter(|c| c.mesh == mesh_id && c.material == material_id);
+        let cached = match cached {
+            Some(c) => {
+                if c.input != input {
+                    c.input = input;
+                    c.uniform = input.uniform();
+                    uniforms_changed = true;
+                }
+                c
+            }
+            None => {
+                let Some(made) = prepare_draw(
+                    &sources,
+                    (mesh_id, material.map(|(_, m)| m.uv1)),
+                    compact,
+                    input,
+                    (&pipeline, &mut pipelines, &pipeline_cache),
+                ) else {
+                    continue;
+                };
+                uniforms_changed = true;
+                draws
+                    .cache
+                    .entry(entity)
+                    .insert(CachedDraw {
+                        material: material_id,
+                        ..made
+                    })
+                    .into_mut()
             }
         };
+        if cached.skinned && input.skin == u32::MAX {
+            continue;
+        }
+        seen.insert(entity);
         let group = material_group(
             &mut materials,
             material,
@@ -400,27 +479,27 @@ pub(super) fn prepare_mesh_rsm(
             &device,
             &material_layout,
         );
-        let indices = match &mesh.buffer_info {
-            RenderMeshBufferInfo::Indexed {
-                count,
-                index_format,
-            } => {
-                let Some(slice) = sources.allocator.mesh_index_slice(&mesh_id) else {
-                    continue;
-                };
-                let start = slice.range.start;
-                Some((slice.buffer.clone(), start..start + count, *index_format))
-            }
-            RenderMeshBufferInfo::NonIndexed => None,
-        };
+        // skinned meshes move with their joints, which Bevy poses on the GPU
+        redraw |= cached.skinned
+            || pipeline_cache
+                .get_render_pipeline(cached.pipeline)
+                .is_none();
+        now.push((entity, cached.pipeline, group.id()));
         draws.draws.push(MeshDraw {
-            pipeline: id,
+            pipeline: cached.pipeline,
             material: group,
-            skinned,
-            vertices: (vertices.buffer.clone(), vertices.range.clone()),
-            indices,
+            skinned: cached.skinned,
+            vertices: cached.vertices.clone(),
+            indices: cached.indices.clone(),
         });
-        uniforms.push(uniform);
+        uniforms.push(cached.uniform.clone());
+    }
+    draws.cache.retain(|entity, _| seen.contains(entity));
+    redraw |= uniforms_changed || now != draws.last;
+    draws.last = now;
+    l.stale |= redraw;
+    if !l.stale || draws.draws.is_empty() {
+        return;
     }
     let uniforms_layout = pipeline_cache.get_bind_group_layout(&pipeline.uniforms_layout);
     draws.views = l
@@ -438,9 +517,6 @@ pub(super) fn prepare_mesh_rsm(
             )
         })
         .collect();
-    if draws.draws.is_empty() {
-        return;
-    }
     draws.uniforms.set(uniforms);
     draws.uniforms.write_buffer(&device, &queue);
     let Some(model) = draws.uniforms.binding() else {
@@ -456,27 +532,71 @@ pub(super) fn prepare_mesh_rsm(
     ));
 }
 
-/// Every mesh entity Bevy extracted and its mesh uniform as Bevy's mesh shaders read it (its
-/// transform, first vertex and skin), by entity.
-fn mesh_uniforms(sources: &MeshSources) -> Vec<(MainEntity, MeshUniform)> {
-    let uniform = |world_from_local: Affine3, flags, first_vertex_index, skin: Option<u32>| {
-        let (local_from_world_transpose_a, local_from_world_transpose_b) =
-            world_from_local.inverse_transpose_3x3();
-        MeshUniform {
-            world_from_local: world_from_local.to_transpose(),
-            previous_world_from_local: world_from_local.to_transpose(),
-            lightmap_uv_rect: UVec2::ZERO,
-            local_from_world_transpose_a,
-            local_from_world_transpose_b,
-            flags,
-            first_vertex_index,
-            current_skin_index: skin.unwrap_or(u32::MAX),
-            material_and_lightmap_bind_group_slot: 0,
-            tag: 0,
-            morph_descriptor_index: u32::MAX,
-        }
+/// Entity `mesh`'s draw: its pipeline (specialised for its layout and whether its material reads
+/// the second uv channel), its slabs; `None` for a mesh not drawn (not uploaded yet, not
+/// triangles with normals, no pipeline).
+fn prepare_draw(
+    sources: &MeshSources,
+    (mesh_id, uv1): (AssetId<Mesh>, Option<bool>),
+    compact: bool,
+    input: UniformInput,
+    (pipeline, pipelines, pipeline_cache): (
+        &RsmMeshPipeline,
+        &mut SpecializedMeshPipelines<RsmMeshPipeline>,
+        &PipelineCache,
+    ),
+) -> Option<CachedDraw> {
+    let mesh = sources.meshes.get(mesh_id)?;
+    let vertices = sources.allocator.mesh_vertex_slice(&mesh_id)?;
+    // triangles with normals, as the triangles' RSM takes them
+    let triangles = matches!(
+        mesh.primitive_topology(),
+        PrimitiveTopology::TriangleList | PrimitiveTopology::TriangleStrip
+    );
+    if !triangles || !mesh.layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
+        return None;
+    }
+    // (laid out as Bevy's mesh pipeline lays the mesh out: skinned where it has joints)
+    let skinned = mesh.layout.0.contains(Mesh::ATTRIBUTE_JOINT_INDEX)
+        && mesh.layout.0.contains(Mesh::ATTRIBUTE_JOINT_WEIGHT);
+    let key = RsmMeshKey {
+        mesh: MeshPipelineKey::from_primitive_topology_and_strip_index(
+            mesh.primitive_topology(),
+            mesh.index_format(),
+        ),
+        compact,
+        uv1: uv1.unwrap_or(false),
     };
-    let mut out: Vec<(MainEntity, MeshUniform)> = match &*sources.instances {
+    let id = pipelines
+        .specialize(pipeline_cache, pipeline, key, &mesh.layout)
+        .inspect_err(|e| error!("quadray indirect light: no RSM pipeline for a mesh: {e}"))
+        .ok()?;
+    let indices = match &mesh.buffer_info {
+        RenderMeshBufferInfo::Indexed {
+            count,
+            index_format,
+        } => {
+            let slice = sources.allocator.mesh_index_slice(&mesh_id)?;
+            let start = slice.range.start;
+            Some((slice.buffer.clone(), start..start + count, *index_format))
+        }
+        RenderMeshBufferInfo::NonIndexed => None,
+    };
+    Some(CachedDraw {
+        mesh: mesh_id,
+        material: None,
+        pipeline: id,
+        skinned,
+        vertices: (vertices.buffer.clone(), vertices.range.clone()),
+        indices,
+        input,
+        uniform: input.uniform(),
+    })
+}
+
+/// Every mesh entity Bevy extracted, its mesh and what its mesh uniform is made from, by entity.
+fn uniform_inputs(sources: &MeshSources) -> Vec<(MainEntity, AssetId<Mesh>, UniformInput)> {
+    let mut out: Vec<(MainEntity, AssetId<Mesh>, UniformInput)> = match &*sources.instances {
         RenderMeshInstances::GpuBuilding(instances) => {
             let Some(batched) = sources.batched.as_ref() else {
                 return Vec::new();
@@ -486,32 +606,37 @@ fn mesh_uniforms(sources: &MeshSources) -> Vec<(MainEntity, MeshUniform)> {
                 .filter_map(|(entity, instance)| {
                     let index = instance.gpu_specific.current_uniform_index();
                     let input = batched.current_input_buffer.get(index)?;
-                    let skin =
-                        (input.current_skin_index != u32::MAX).then_some(input.current_skin_index);
-                    let transform = Affine3::from_transpose(input.world_from_local);
-                    let u = uniform(transform, input.flags, input.first_vertex_index, skin);
-                    Some((*entity, u))
+                    let uniform = UniformInput {
+                        world_from_local: input.world_from_local,
+                        flags: input.flags,
+                        first_vertex: input.first_vertex_index,
+                        skin: input.current_skin_index,
+                    };
+                    Some((*entity, instance.mesh_asset_id(), uniform))
                 })
                 .collect()
         }
         RenderMeshInstances::CpuBuilding(instances) => instances
             .iter()
             .map(|(entity, instance)| {
+                let mesh = instance.mesh_asset_id();
                 let first_vertex = sources
                     .allocator
-                    .mesh_vertex_slice(&instance.mesh_asset_id())
+                    .mesh_vertex_slice(&mesh)
                     .map_or(0, |s| s.range.start);
                 let t = &instance.transforms;
-                let skin = sources.skins.skin_index(*entity);
-                (
-                    *entity,
-                    uniform(t.world_from_local, t.flags, first_vertex, skin),
-                )
+                let uniform = UniformInput {
+                    world_from_local: t.world_from_local.to_transpose(),
+                    flags: t.flags,
+                    first_vertex,
+                    skin: sources.skins.skin_index(*entity).unwrap_or(u32::MAX),
+                };
+                (*entity, mesh, uniform)
             })
             .collect(),
     };
     // one order a frame, whatever the map's
-    out.sort_by_key(|(entity, _)| *entity);
+    out.sort_by_key(|(entity, ..)| *entity);
     out
 }
 
