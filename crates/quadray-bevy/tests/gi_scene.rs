@@ -3,7 +3,8 @@
 //! costs no scene work in either world; a moved mesh makes its own triangles anew, writes them
 //! alone to the vertex buffer and moves them alone in the occupancy grid (the floor's texture
 //! uploaded once), and the scene equals a fresh app's gather of the new places; the floor's
-//! texture swapped for a flat colour drops its layer. The ball's texture has no CPU-side data:
+//! texture swapped for a flat colour drops its layer; a texture refused while the layers were full
+//! is taken once one is free. The ball's texture has no CPU-side data:
 //! it takes its flat colour. The app's default sampler is nearest, and the floor's texture
 //! (`ImageSampler::Default`) is read through it.
 
@@ -307,4 +308,73 @@ fn app_fresh(places: [Transform; 5]) -> (App, Vec<Entity>) {
     let (mut app, entities) = app(places, false);
     settle(&mut app);
     (app, entities)
+}
+
+/// Quads with as many distinct 1x1 textures as the layers hold, beside the floor's: the last
+/// made is refused (its triangles untextured); once a textured quad is despawned, its layer
+/// dropped, the refused texture is read again and its quad's triangles sample it.
+#[test]
+fn a_texture_refused_while_the_layers_are_full_is_taken_once_one_is_free() {
+    use bevy::render::render_resource::{Extent3d, TextureDimension};
+    use quadray_indirect::scene::MAX_TEXTURES;
+    let (mut app, _) = app_fresh(places());
+    let textured = |app: &App| {
+        scene(app)
+            .triangles()
+            .filter(|t| t[0].texture != Vertex::UNTEXTURED)
+            .count()
+    };
+    let floor = textured(&app);
+    // the quads one a metre apart, below the floor: which is untextured
+    let refused = |app: &App| {
+        let mut quads = scene(app)
+            .triangles()
+            .filter(|t| t[0].position[1] == -1.0 && t[0].texture == Vertex::UNTEXTURED);
+        quads.next().map(|t| t[0].position[0].round() as usize)
+    };
+    let world = app.world_mut();
+    let quad = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Plane3d::new(Vec3::Y, Vec2::splat(0.1)));
+    let quads: Vec<Entity> = (0..MAX_TEXTURES)
+        .map(|i| {
+            let colour = [(i % 256) as u8, (i / 256) as u8, 9, 255];
+            let image = world.resource_mut::<Assets<Image>>().add(Image::new(
+                Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+                TextureDimension::D2,
+                colour.to_vec(),
+                TextureFormat::Rgba8UnormSrgb,
+                RenderAssetUsages::default(),
+            ));
+            let material = world
+                .resource_mut::<Assets<StandardMaterial>>()
+                .add(StandardMaterial {
+                    base_color_texture: Some(image),
+                    ..default()
+                });
+            let place = Transform::from_xyz(i as f32, -1.0, 0.0);
+            world
+                .spawn((Mesh3d(quad.clone()), MeshMaterial3d(material), place))
+                .id()
+        })
+        .collect();
+    settle(&mut app);
+    let layers = scene(&app).textures().layers.len();
+    assert_eq!(layers, MAX_TEXTURES, "the layers full");
+    let full = textured(&app);
+    assert_eq!(full, floor + 2 * (MAX_TEXTURES - 1), "one quad refused");
+    let refused_quad = refused(&app).expect("a quad refused");
+    app.world_mut()
+        .despawn(quads[(refused_quad + 1) % MAX_TEXTURES]);
+    settle(&mut app);
+    assert_eq!(
+        (refused(&app), textured(&app)),
+        (None, full),
+        "quad {refused_quad}'s texture not taken once a layer was free"
+    );
+    assert_eq!(scene(&app).textures().layers.len(), MAX_TEXTURES);
 }

@@ -78,8 +78,10 @@ pub enum RsmSource {
     /// skinned in the vertex stage by Bevy's skinning: every mesh Bevy extracts (one some
     /// camera or shadow-casting light sees) in its `StandardMaterial`'s base colour times
     /// 1 - metallic, times its base colour texture sampled as Bevy samples it (another material:
-    /// grey 0.5). Morph targets are not applied and displaced surfaces are drawn flat. The RSM is
-    /// redrawn every frame. Without indirect shadows no triangle is made on the CPU; with them
+    /// grey 0.5). Morph targets are not applied and displaced surfaces are drawn flat. Each
+    /// entity's draw is kept across frames; the RSM is redrawn when a light or the draws change
+    /// (an entity moved, came or went, its material changed) and every frame while a skinned mesh
+    /// is drawn. Without indirect shadows no triangle is made on the CPU; with them
     /// the occupancy grid is still made of [`IndirectLightScene`]'s triangles.
     Meshes,
 }
@@ -113,6 +115,9 @@ pub struct IndirectLightScene {
     pub(super) lights: Vec<Light>,
     /// The `StandardMaterial`s' base colour textures the triangles sample.
     pub(super) base_colours: BaseColours,
+    /// Entities to make again next frame: their texture was refused while the layers were full,
+    /// and layers were dropped since.
+    retry: Vec<Entity>,
     /// The bounds (min, max) of the visible meshes' boxes in world space, kept while a camera
     /// draws its RSMs from Bevy's meshes ([`RsmSource::Meshes`]).
     pub(super) mesh_bounds: (Vec3, Vec3),
@@ -402,6 +407,7 @@ pub(super) fn collect_triangles(
     } else {
         changed.iter().collect()
     };
+    dirty.extend(std::mem::take(&mut scene.retry));
     dirty.extend(removed.meshes.read());
     dirty.extend(removed.materials.read());
     dirty.extend(removed.displaced.read());
@@ -547,9 +553,17 @@ fn relayer_unused(
     changes: &mut Vec<(Entity, Option<Arc<ObjectTriangles>>)>,
 ) {
     let used: Vec<u32> = scene.objects.values().filter_map(|o| o.texture).collect();
-    let Some(moved) = scene.base_colours.drop_unused(used) else {
+    let Some((moved, refused)) = scene.base_colours.drop_unused(used) else {
         return;
     };
+    // the entities whose texture was refused while the layers were full: made again next frame
+    scene.retry.extend(
+        scene
+            .objects
+            .iter()
+            .filter(|(_, o)| o.texture.is_none() && o.image.is_some_and(|i| refused.contains(&i)))
+            .map(|(e, _)| *e),
+    );
     for (entity, object) in &mut scene.objects {
         let Some(before) = object.texture else {
             continue;

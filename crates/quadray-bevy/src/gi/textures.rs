@@ -6,7 +6,7 @@
 
 use bevy::asset::RenderAssetUsages;
 use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
-use bevy::platform::collections::HashMap;
+use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use bevy::render::render_resource::TextureFormat;
 use quadray_core::image_in::MAX_SIDE;
@@ -23,6 +23,9 @@ pub(super) struct BaseColours {
     /// Each image asked for: its packed texture, or `None` (not loaded yet; or not readable on
     /// the CPU, or over the limits, which was warned once).
     read: HashMap<AssetId<Image>, Option<u32>>,
+    /// The images refused because the layers were full (their count or bytes): read again once
+    /// layers are dropped.
+    refused_full: HashSet<AssetId<Image>>,
     /// The layers changed since [`BaseColours::publish`].
     changed: bool,
     /// The layers the render world uploads.
@@ -39,6 +42,7 @@ impl Default for BaseColours {
         Self {
             collector: TextureCollector::default(),
             read: HashMap::default(),
+            refused_full: HashSet::default(),
             changed: false,
             textures: Arc::default(),
             generation: 0,
@@ -98,6 +102,9 @@ impl BaseColours {
                 &name(),
             );
             self.changed |= self.collector.len() != before;
+            if packed.is_err() {
+                self.refused_full.insert(texture.id());
+            }
             packed
         } else {
             Err(
@@ -120,9 +127,17 @@ impl BaseColours {
     }
 
     /// Drops the layers that no packed texture of `used` (every object's) reads; returns what
-    /// the packed textures kept become, where one was dropped.
-    pub fn drop_unused(&mut self, used: impl IntoIterator<Item = u32>) -> Option<Relayering> {
+    /// the packed textures kept become, where one was dropped, and the images refused while the
+    /// layers were full, forgotten so that they are read again when next asked for.
+    pub fn drop_unused(
+        &mut self,
+        used: impl IntoIterator<Item = u32>,
+    ) -> Option<(Relayering, HashSet<AssetId<Image>>)> {
         let moved = self.collector.retain_used(used)?;
+        let refused = std::mem::take(&mut self.refused_full);
+        for id in &refused {
+            self.read.remove(id);
+        }
         self.read.retain(|_, packed| match packed {
             Some(p) => {
                 *p = moved.packed(*p);
@@ -131,7 +146,7 @@ impl BaseColours {
             None => true,
         });
         self.changed = true;
-        Some(moved)
+        Some((moved, refused))
     }
 
     /// Ends an update: the textures made anew where the layers changed.
