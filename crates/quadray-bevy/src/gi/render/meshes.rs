@@ -31,7 +31,7 @@ use bevy::render::render_resource::{
     SamplerBindingType, ShaderStages, SpecializedMeshPipeline, SpecializedMeshPipelineError,
     SpecializedMeshPipelines, StorageBuffer, TextureSampleType, VertexState,
 };
-use bevy::render::render_resource::{BindGroupId, SamplerId, TextureId};
+use bevy::render::render_resource::{BindGroupId, BufferId, SamplerId, TextureId};
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::sync_world::MainEntity;
 use bevy::render::texture::{FallbackImage, GpuImage};
@@ -356,6 +356,10 @@ pub(super) struct MeshDraws {
     /// Last frame's draws: entity, pipeline, material group (the RSMs are drawn again when
     /// they differ).
     last: Vec<(MainEntity, CachedRenderPipelineId, BindGroupId)>,
+    /// The light views' uniform buffers that [`Self::views`] bind.
+    view_uniforms: Vec<[wgpu::Buffer; 2]>,
+    /// The mesh uniforms' and Bevy's joints' buffers that the mesh groups bind.
+    mesh_groups_bound: Option<(Option<BufferId>, BufferId)>,
 }
 
 /// The Bevy resources the draws are made from.
@@ -495,41 +499,58 @@ pub(super) fn prepare_mesh_rsm(
         uniforms.push(cached.uniform.clone());
     }
     draws.cache.retain(|entity, _| seen.contains(entity));
-    redraw |= uniforms_changed || now != draws.last;
+    let listed = uniforms_changed || now != draws.last;
+    redraw |= listed;
     draws.last = now;
     l.stale |= redraw;
     if !l.stale || draws.draws.is_empty() {
         return;
     }
-    let uniforms_layout = pipeline_cache.get_bind_group_layout(&pipeline.uniforms_layout);
-    draws.views = l
+    // (the groups and uniforms written again only where what they hold changed)
+    let view_uniforms: Vec<[wgpu::Buffer; 2]> = l
         .views
         .iter()
-        .map(|v| {
-            let [raster, light] = v.rsm.uniforms();
-            device.create_bind_group(
-                "quadray gi rsm uniforms",
-                &uniforms_layout,
-                &BindGroupEntries::sequential((
-                    raster.as_entire_binding(),
-                    light.as_entire_binding(),
-                )),
-            )
-        })
+        .map(|v| v.rsm.uniforms().map(Clone::clone))
         .collect();
-    draws.uniforms.set(uniforms);
-    draws.uniforms.write_buffer(&device, &queue);
+    if view_uniforms != draws.view_uniforms {
+        let uniforms_layout = pipeline_cache.get_bind_group_layout(&pipeline.uniforms_layout);
+        draws.views = view_uniforms
+            .iter()
+            .map(|[raster, light]| {
+                device.create_bind_group(
+                    "quadray gi rsm uniforms",
+                    &uniforms_layout,
+                    &BindGroupEntries::sequential((
+                        raster.as_entire_binding(),
+                        light.as_entire_binding(),
+                    )),
+                )
+            })
+            .collect();
+        draws.view_uniforms = view_uniforms;
+    }
+    if listed || draws.uniforms.buffer().is_none() {
+        draws.uniforms.set(uniforms);
+        draws.uniforms.write_buffer(&device, &queue);
+    }
     let Some(model) = draws.uniforms.binding() else {
         return;
     };
-    let layouts = &pipeline.mesh_layouts;
-    draws.model_only = Some(layouts.model_only(&device, &pipeline_cache, &model));
-    draws.skinned = Some(layouts.skinned(
-        &device,
-        &pipeline_cache,
-        &model,
-        &sources.skins.current_buffer,
-    ));
+    let bound = (
+        draws.uniforms.buffer().map(|b| b.id()),
+        sources.skins.current_buffer.id(),
+    );
+    if draws.mesh_groups_bound != Some(bound) {
+        let layouts = &pipeline.mesh_layouts;
+        draws.model_only = Some(layouts.model_only(&device, &pipeline_cache, &model));
+        draws.skinned = Some(layouts.skinned(
+            &device,
+            &pipeline_cache,
+            &model,
+            &sources.skins.current_buffer,
+        ));
+        draws.mesh_groups_bound = Some(bound);
+    }
 }
 
 /// Entity `mesh`'s draw: its pipeline (specialised for its layout and whether its material reads
