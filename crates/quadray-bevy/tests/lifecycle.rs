@@ -580,11 +580,12 @@ fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     mirror_floor_texture(&mut app);
     let edited = switched(&mut app, &probes, RsmSource::Meshes);
     let edited_triangles = switched(&mut app, &probes, RsmSource::Triangles);
-    let error = meshes_against_triangles("an edited texture", &edited[0], &edited_triangles[0]);
-    let changed = compare(&edited_triangles[0], &readable[0]);
-    println!("the floor's texture mirrored: {changed:?} from the bounce before");
-    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
-    assert!(changed.rel_l1 > 0.05, "{changed:?}");
+    sources_agree_on_a_change(
+        "an edited texture",
+        (&edited[0], &edited_triangles[0]),
+        &readable[0],
+        0.05,
+    );
 
     // the box moved while the RSM is drawn from Bevy's meshes: its kept draw takes the new
     // transform; then, with nothing moving, the RSM is not drawn again
@@ -602,11 +603,27 @@ fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
         "the RSM drawn again with nothing moving"
     );
     let moved_triangles = switched(&mut app, &probes, RsmSource::Triangles);
-    let error = meshes_against_triangles("a moved box", &moved[0], &moved_triangles[0]);
-    let changed = compare(&moved_triangles[0], &edited_triangles[0]);
-    println!("the box moved: {changed:?} from the bounce before");
-    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
-    assert!(changed.rel_l1 > 0.01, "{changed:?}");
+    sources_agree_on_a_change(
+        "a moved box",
+        (&moved[0], &moved_triangles[0]),
+        &edited_triangles[0],
+        0.01,
+    );
+}
+
+/// After a change, the bounce over the RSM drawn from Bevy's meshes is the triangles' (within
+/// [`MESHES_RSM_TOLERANCE`]), which the change moved more than `least` rel. L1 from `before`.
+fn sources_agree_on_a_change(
+    what: &str,
+    (meshes, triangles): (&[[f32; 3]], &[[f32; 3]]),
+    before: &[[f32; 3]],
+    least: f64,
+) {
+    let error = meshes_against_triangles(what, meshes, triangles);
+    let changed = compare(triangles, before);
+    println!("{what}: {changed:?} from the bounce before");
+    assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{what}: {error:?}");
+    assert!(changed.rel_l1 > least, "{what}: {changed:?}");
 }
 
 /// Mirrors the one base colour texture of the app's materials left to right in place, each

@@ -275,8 +275,14 @@ impl SpecializedMeshPipeline for RsmMeshPipeline {
 
 /// One mesh entity's draw into every RSM.
 struct MeshDraw {
-    pipeline: CachedRenderPipelineId,
+    geometry: MeshGeometry,
     material: BindGroup,
+}
+
+/// A mesh's pipeline, slabs and skinning.
+#[derive(Clone)]
+struct MeshGeometry {
+    pipeline: CachedRenderPipelineId,
     skinned: bool,
     vertices: (bevy::render::render_resource::Buffer, Range<u32>),
     /// Indexed: the index buffer, its range and format.
@@ -324,16 +330,9 @@ impl UniformInput {
 struct CachedDraw {
     mesh: AssetId<Mesh>,
     material: Option<AssetId<StandardMaterial>>,
-    /// The draw's pipeline, slabs and skinning (its material's group is looked up each frame:
-    /// it is made again when its texture loads or is replaced).
-    pipeline: CachedRenderPipelineId,
-    skinned: bool,
-    vertices: (bevy::render::render_resource::Buffer, Range<u32>),
-    indices: Option<(
-        bevy::render::render_resource::Buffer,
-        Range<u32>,
-        IndexFormat,
-    )>,
+    /// (its material's group is looked up each frame: it is made again when its texture loads
+    /// or is replaced)
+    geometry: MeshGeometry,
     input: UniformInput,
     uniform: MeshUniform,
 }
@@ -472,7 +471,8 @@ pub(super) fn prepare_mesh_rsm(
                     .into_mut()
             }
         };
-        if cached.skinned && input.skin == u32::MAX {
+        let geometry = &cached.geometry;
+        if geometry.skinned && input.skin == u32::MAX {
             continue;
         }
         seen.insert(entity);
@@ -484,17 +484,14 @@ pub(super) fn prepare_mesh_rsm(
             &material_layout,
         );
         // skinned meshes move with their joints, which Bevy poses on the GPU
-        redraw |= cached.skinned
+        redraw |= geometry.skinned
             || pipeline_cache
-                .get_render_pipeline(cached.pipeline)
+                .get_render_pipeline(geometry.pipeline)
                 .is_none();
-        now.push((entity, cached.pipeline, group.id()));
+        now.push((entity, geometry.pipeline, group.id()));
         draws.draws.push(MeshDraw {
-            pipeline: cached.pipeline,
+            geometry: geometry.clone(),
             material: group,
-            skinned: cached.skinned,
-            vertices: cached.vertices.clone(),
-            indices: cached.indices.clone(),
         });
         uniforms.push(cached.uniform.clone());
     }
@@ -606,10 +603,12 @@ fn prepare_draw(
     Some(CachedDraw {
         mesh: mesh_id,
         material: None,
-        pipeline: id,
-        skinned,
-        vertices: (vertices.buffer.clone(), vertices.range.clone()),
-        indices,
+        geometry: MeshGeometry {
+            pipeline: id,
+            skinned,
+            vertices: (vertices.buffer.clone(), vertices.range.clone()),
+            indices,
+        },
         input,
         uniform: input.uniform(),
     })
@@ -732,17 +731,21 @@ pub(super) fn record_mesh_rsm(
     };
     pass.set_bind_group(0, Some(&**group), &[]);
     for (instance, draw) in (0u32..).zip(&draws.draws) {
-        let Some(pipeline) = pipeline_cache.get_render_pipeline(draw.pipeline) else {
+        let Some(pipeline) = pipeline_cache.get_render_pipeline(draw.geometry.pipeline) else {
             continue;
         };
         pass.set_pipeline(pipeline);
         pass.set_bind_group(1, Some(&*draw.material), &[]);
-        let mesh = if draw.skinned { skinned } else { model_only };
+        let mesh = if draw.geometry.skinned {
+            skinned
+        } else {
+            model_only
+        };
         pass.set_bind_group(2, Some(&**mesh), &[]);
-        let (buffer, range) = &draw.vertices;
+        let (buffer, range) = &draw.geometry.vertices;
         pass.set_vertex_buffer(0, wgpu::Buffer::slice(buffer, ..));
         let instances = instance..instance + 1;
-        match &draw.indices {
+        match &draw.geometry.indices {
             Some((indices, range_of_indices, format)) => {
                 pass.set_index_buffer(wgpu::Buffer::slice(indices, ..), *format);
                 pass.draw_indexed(range_of_indices.clone(), range.start as i32, instances);
