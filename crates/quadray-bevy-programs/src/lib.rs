@@ -42,10 +42,12 @@ pub struct Offscreen {
     /// The camera's target (made by [`Offscreen::make_target`]).
     pub target: Handle<Image>,
     /// Frames before the picture is taken, counted from when Bevy has no pipeline left to compile
-    /// (the scene loaded, the pipelines warm).
+    /// and [`Self::waits_for`] have loaded (the scene loaded, the pipelines warm).
     pub warm_up: u32,
     /// Frames to time after the warm-up, before the picture (0: none).
     pub timed: usize,
+    /// Assets the warm-up waits for (with their dependencies): the scene a program loads.
+    pub waits_for: Vec<UntypedHandle>,
     frames: u32,
     times: Vec<f64>,
 }
@@ -58,6 +60,7 @@ impl Offscreen {
             target: Handle::default(),
             warm_up,
             timed,
+            waits_for: Vec::new(),
             frames: 0,
             times: Vec::new(),
         }
@@ -139,9 +142,17 @@ fn save_when_ready(
     mut exit: MessageWriter<AppExit>,
     time: Res<Time<Real>>,
     mut diagnostics: ResMut<DiagnosticsStore>,
-    compiling: Res<Compiling>,
+    (compiling, assets): (Res<Compiling>, Res<AssetServer>),
 ) {
-    if offscreen.frames <= offscreen.warm_up && compiling.0.load(Ordering::Relaxed) {
+    // (a large scene may take longer to load than the warm-up's frames)
+    let loading = offscreen.waits_for.iter().any(|h| {
+        use bevy::asset::RecursiveDependencyLoadState::{Loading, NotLoaded};
+        matches!(
+            assets.recursive_dependency_load_state(h.id()),
+            Loading | NotLoaded
+        )
+    });
+    if offscreen.frames <= offscreen.warm_up && (compiling.0.load(Ordering::Relaxed) || loading) {
         offscreen.frames = 0;
     }
     offscreen.frames += 1;

@@ -442,15 +442,17 @@ fn setup(
     mut commands: Commands,
     assets: Res<AssetServer>,
     mut images: ResMut<Assets<Image>>,
-    offscreen: Option<ResMut<Offscreen>>,
+    mut offscreen: Option<ResMut<Offscreen>>,
     shown: Res<Shown>,
     scene: Res<Shows>,
 ) {
     match &*scene {
         Shows::File(file, framing) => {
-            commands.spawn(WorldAssetRoot(
-                assets.load(GltfAssetLabel::Scene(0).from_asset(file.clone())),
-            ));
+            let world = assets.load(GltfAssetLabel::Scene(0).from_asset(file.clone()));
+            if let Some(offscreen) = offscreen.as_deref_mut() {
+                offscreen.waits_for.push(world.clone().untyped());
+            }
+            commands.spawn(WorldAssetRoot(world));
             // where the file's camera would be (`configure` gives it the bounce)
             if let Some(c) = framing {
                 commands.spawn((

@@ -15,15 +15,17 @@ use std::sync::atomic::{AtomicU64, Ordering};
 pub const MAIN_WORLD_CPU: DiagnosticPath = DiagnosticPath::const_new("quadray_gi/main_world_cpu");
 
 /// Milliseconds a frame in the plugin's render-world systems (extracting the scene, updating
-/// its vertex buffer and occupancy grid, preparing and recording the passes); the render
-/// world's frame as the main world's next one reports it.
+/// its vertex buffer and occupancy grid, preparing and recording the passes): the last render
+/// frame finished when the main world reports (the render world runs beside the main world's
+/// next frame, so a report may repeat a frame, never split one).
 pub const RENDER_WORLD_CPU: DiagnosticPath =
     DiagnosticPath::const_new("quadray_gi/render_world_cpu");
 
-/// Nanoseconds spent in the plugin's systems since the last report, main world then render
-/// world; one resource shared by both worlds.
+/// Nanoseconds spent in the plugin's systems: the main world's since the last report, the
+/// render world's this render frame, and its last finished frame's; one resource shared by both
+/// worlds.
 #[derive(Resource, Clone, Default)]
-pub(crate) struct CpuTimes(Arc<[AtomicU64; 2]>);
+pub(crate) struct CpuTimes(Arc<[AtomicU64; 3]>);
 
 /// Adds its thread's CPU time from its making to its drop to one world's total (none where the
 /// thread's clock cannot be read).
@@ -64,17 +66,24 @@ pub(super) fn build(app: &mut App) {
         .register_diagnostic(Diagnostic::new(RENDER_WORLD_CPU).with_suffix("ms"))
         .add_systems(Last, report);
     if let Some(render_app) = app.get_sub_app_mut(bevy::render::RenderApp) {
-        render_app.insert_resource(times);
+        render_app.insert_resource(times).add_systems(
+            bevy::render::Render,
+            finish_render_frame.in_set(bevy::render::RenderSystems::Cleanup),
+        );
     }
 }
 
-/// Reports the times since the last report, in milliseconds.
+/// Ends a render frame: its time becomes the last finished frame's.
+fn finish_render_frame(times: Res<CpuTimes>) {
+    let nanos = times.0[1].swap(0, Ordering::Relaxed);
+    times.0[2].store(nanos, Ordering::Relaxed);
+}
+
+/// Reports the main world's time since the last report and the last finished render frame's,
+/// in milliseconds.
 fn report(times: Res<CpuTimes>, mut diagnostics: Diagnostics) {
-    for (path, total) in [
-        (&MAIN_WORLD_CPU, &times.0[0]),
-        (&RENDER_WORLD_CPU, &times.0[1]),
-    ] {
-        let nanos = total.swap(0, Ordering::Relaxed);
-        diagnostics.add_measurement(path, || nanos as f64 * 1e-6);
-    }
+    let main = times.0[0].swap(0, Ordering::Relaxed);
+    let render = times.0[2].load(Ordering::Relaxed);
+    diagnostics.add_measurement(&MAIN_WORLD_CPU, || main as f64 * 1e-6);
+    diagnostics.add_measurement(&RENDER_WORLD_CPU, || render as f64 * 1e-6);
 }
