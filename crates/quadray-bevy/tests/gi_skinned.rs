@@ -15,8 +15,8 @@ use quadray_indirect::reference::compare;
 use quadray_indirect::scene::Vertex;
 use quadray_indirect::{Method, Renderer, Settings};
 
-use crate::gi::{SIZE, app_of, floats, gathered, in_candela, scene_from};
-use crate::gi_meshes::{MESHES_RSM_TOLERANCE, meshes_against_triangles, switched};
+use crate::gi::{SIZE, app_of, floats, gathered, in_candela, meshes_drawn, scene_from};
+use crate::gi_meshes::{MESHES_RSM_TOLERANCE, bounce_settled, meshes_against_triangles, switched};
 
 const SKINNED_SCENE: &str = "scenes/skinned_bar.gltf";
 /// A camera looking at the room's left wall past the bar, which it never sees (standing or bent
@@ -201,6 +201,26 @@ fn a_skinned_mesh_s_bounce_moves_with_its_joints() {
     let meshes = switched(&mut app, &probes, RsmSource::Meshes);
     let error = meshes_against_triangles("the bent bar", &meshes[0], &last);
     assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
+    // with nothing moving the RSM is not drawn again; the joint turned back and bent again, it
+    // is, each pose's bounce as the triangles' was
+    let drawn = meshes_drawn(&app);
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(
+        meshes_drawn(&app),
+        drawn,
+        "the RSM drawn again, nothing moving"
+    );
+    for (rotation, pose, expected) in [
+        (Quat::IDENTITY, "the bind pose", &bind[0]),
+        (turn, "bent again", &last),
+    ] {
+        app.world_mut().get_mut::<Transform>(bend).unwrap().rotation = rotation;
+        let posed = bounce_settled(&mut app, &probes, 100);
+        let error = meshes_against_triangles(pose, &posed[0], expected);
+        assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{pose}: {error:?}");
+    }
     let triangles = switched(&mut app, &probes, RsmSource::Triangles);
     assert_eq!(triangles[0], last);
 

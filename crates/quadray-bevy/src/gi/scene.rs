@@ -80,8 +80,7 @@ pub enum RsmSource {
     /// 1 - metallic, times its base colour texture sampled as Bevy samples it (another material:
     /// grey 0.5). Morph targets are not applied and displaced surfaces are drawn flat. Each
     /// entity's draw is kept across frames; the RSM is redrawn when a light or the draws change
-    /// (an entity moved, came or went, its material changed) and every frame while a skinned mesh
-    /// is drawn. Without indirect shadows no triangle is made on the CPU; with them
+    /// (an entity moved, came or went, its material changed, a skinned mesh's joints moved). Without indirect shadows no triangle is made on the CPU; with them
     /// the occupancy grid is still made of [`IndirectLightScene`]'s triangles.
     Meshes,
 }

@@ -355,6 +355,8 @@ pub(super) struct MeshDraws {
     /// Last frame's draws: entity, pipeline, material group (the RSMs are drawn again when
     /// they differ).
     last: Vec<(MainEntity, CachedRenderPipelineId, BindGroupId)>,
+    /// Bevy's joint matrices when the skinned meshes were last drawn.
+    joints: Vec<Mat4>,
     /// The light views' uniform buffers that [`Self::views`] bind.
     view_uniforms: Vec<[wgpu::Buffer; 2]>,
     /// The mesh uniforms' and Bevy's joints' buffers that the mesh groups bind.
@@ -377,8 +379,8 @@ pub(super) struct MeshSources<'w> {
 
 /// Specialises the pipelines and prepares this frame's draws, when the lights' RSMs are drawn
 /// from Bevy's meshes; sets the RSMs to be drawn again when the draws changed (an entity moved,
-/// came or went, its mesh or material changed, a skinned mesh is drawn, or a pipeline is still
-/// compiling).
+/// came or went, its mesh or material changed, a skinned mesh's joints moved, or a pipeline is
+/// still compiling).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn prepare_mesh_rsm(
     mut light: ResMut<LightState>,
@@ -419,7 +421,7 @@ pub(super) fn prepare_mesh_rsm(
     }
     let material_layout = pipeline_cache.get_bind_group_layout(&pipeline.material_layout);
     let mut seen = bevy::platform::collections::HashSet::new();
-    let (mut uniforms_changed, mut redraw) = (false, false);
+    let (mut uniforms_changed, mut redraw, mut skinned) = (false, false, false);
     draws.draws.clear();
     let mut uniforms = Vec::new();
     let mut now = Vec::new();
@@ -483,11 +485,10 @@ pub(super) fn prepare_mesh_rsm(
             &device,
             &material_layout,
         );
-        // skinned meshes move with their joints, which Bevy poses on the GPU
-        redraw |= geometry.skinned
-            || pipeline_cache
-                .get_render_pipeline(geometry.pipeline)
-                .is_none();
+        skinned |= geometry.skinned;
+        redraw |= pipeline_cache
+            .get_render_pipeline(geometry.pipeline)
+            .is_none();
         now.push((entity, geometry.pipeline, group.id()));
         draws.draws.push(MeshDraw {
             geometry: geometry.clone(),
@@ -497,6 +498,12 @@ pub(super) fn prepare_mesh_rsm(
     }
     draws.cache.retain(|entity, _| seen.contains(entity));
     let listed = uniforms_changed || now != draws.last;
+    // skinned meshes move with their joints, which Bevy poses on the GPU from its joint matrices
+    let joints = &sources.skins.current_staging_buffer;
+    if skinned && *joints != draws.joints {
+        draws.joints.clone_from(joints);
+        redraw = true;
+    }
     redraw |= listed;
     draws.last = now;
     l.stale |= redraw;
