@@ -7,6 +7,7 @@
 
 use crate::light::node::{CONE_SLACK, CUT_CLASS_SIDE, EMPTY_BOX, MAX_LEVELS};
 use crate::method::GBufferLayout;
+use crate::reference::LUMINANCE;
 use crate::settings::{Shade, TILE, TILE_FRONTIER, TILE_SHADOW_HEADER};
 use crate::shader_struct::{Layout, shader_struct};
 use crate::shadows::occupancy::{
@@ -80,7 +81,8 @@ pub(crate) fn prelude() -> String {
          const DEBLOCK_ALBEDO: f32 = {DEBLOCK_ALBEDO:?};\n\
          const MAX_INTERLEAVE: u32 = {}u;\n\
          const CUT_CLASS_SIDE: u32 = {CUT_CLASS_SIDE}u;\n\
-         const SHADOW_CORNER_WORDS: u32 = {}u;\n",
+         const SHADOW_CORNER_WORDS: u32 = {}u;\n\
+         const LUMINANCE = vec3<f32>({:?}, {:?}, {:?});\n",
         std::f32::consts::PI,
         OutputTerm::Indirect as u32,
         OutputTerm::Direct as u32,
@@ -91,6 +93,9 @@ pub(crate) fn prelude() -> String {
         BRICK.z,
         crate::Settings::INTERLEAVE.max,
         crate::Settings::SHADOW_CORNER_CLUSTERS / 32,
+        LUMINANCE[0] as f32,
+        LUMINANCE[1] as f32,
+        LUMINANCE[2] as f32,
     ) + &shared_structs()
         .into_iter()
         .map(|s| s.wgsl)

@@ -26,8 +26,8 @@ pub fn vpl_kernel(d: DVec3, receiver_normal: DVec3, vpl_normal: DVec3, r_min: f6
 /// per-tile cuts' rules (`luminance` in the shaders' kernel), their twin and the studies use.
 pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
 
-/// The luminance of linear RGB `c` in f32, as the shaders weigh it ([`LUMINANCE`]; the weights
-/// round to the same f32 as the shaders' literals).
+/// The luminance of linear RGB `c` in f32, as the shaders weigh it ([`LUMINANCE`] rounded to
+/// f32, which the shaders' prelude declares).
 pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::from(LUMINANCE.map(|w| w as f32)))
 }

@@ -1,8 +1,9 @@
 // The VPL kernel: the irradiance a VPL or cluster gives a receiver, and its vector form.
 // Engine-neutral: no bindings, no accessors (needs node.wgsl's counters).
 
+// (the prelude's LUMINANCE: the Rec. 709 weights, declared in reference.rs)
 fn luminance(c: vec3<f32>) -> f32 {
-    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+    return dot(c, LUMINANCE);
 }
 
 // Whether every component of v is a finite number, read from the exponent bits: WGSL lets a
