@@ -173,13 +173,25 @@ impl std::fmt::Display for ExposureAdvice {
     }
 }
 
+/// The Rec. 709 weights of linear RGB's luminance: the one measure of a colour's size that the
+/// pictures' exposure, the per-tile cuts' rules (the indirect shaders' prelude declares them), their
+/// twin, the studies and the scenes' lighting advice use.
+pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+/// The luminance of linear RGB `rgb` in f32 ([`LUMINANCE`] rounded to f32), as the shaders weigh
+/// it.
+pub fn luminance(rgb: [f32; 3]) -> f32 {
+    let [r, g, b] = LUMINANCE.map(|w| w as f32);
+    r * rgb[0] + g * rgb[1] + b * rgb[2]
+}
+
 /// The picture of linear `radiance` at `exposure` judged by its 99th-percentile and median
 /// luminance: nearly black where 99% of the pixels are below 2% of `white` (the exposed value
 /// the tone map shows as white), nearly white where half of them are at or above `white`.
 pub fn check_exposure(radiance: &[[f32; 3]], exposure: f32, white: f32) -> Option<ExposureAdvice> {
     let mut luminance: Vec<f32> = radiance
         .iter()
-        .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+        .map(|p| luminance(*p))
         .filter(|l| l.is_finite())
         .map(|l| l.max(0.0))
         .collect();

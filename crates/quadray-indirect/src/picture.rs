@@ -54,7 +54,7 @@ pub fn cut_view_zoom(rsm_size: u32) -> u32 {
 /// [`crate::wgsl::CUT_VIEW`] (the Bevy plugin's debug view).
 pub fn cut_view(rsm_size: u32, nodes: &[[[f32; 4]; 3]], cut: &[CutNode], zoom: u32) -> Rgba8Image {
     let side = rsm_size * zoom;
-    let luminance = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let luminance = |p: &[f32; 4]| quadray_core::image_out::luminance([p[0], p[1], p[2]]);
     let root = nodes.last().map_or([0.0; 4], |n| n[0]);
     let sum = luminance(&root);
     let exposure = if sum > 0.0 { root[3] / sum } else { 1.0 };

@@ -22,14 +22,12 @@ pub fn vpl_kernel(d: DVec3, receiver_normal: DVec3, vpl_normal: DVec3, r_min: f6
     emit * receive / (r2 * r2)
 }
 
-/// The Rec. 709 weights of linear RGB's luminance, the one measure of a colour's size that the
-/// per-tile cuts' rules (`luminance` in the shaders' kernel), their twin and the studies use.
-pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+pub use quadray_core::image_out::LUMINANCE;
 
-/// The luminance of linear RGB `c` in f32, as the shaders weigh it ([`LUMINANCE`] rounded to
-/// f32, which the shaders' prelude declares).
+/// The luminance of linear RGB `c` in f32, as the shaders weigh it
+/// ([`quadray_core::image_out::luminance`]).
 pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::from(LUMINANCE.map(|w| w as f32)))
+    quadray_core::image_out::luminance(c.to_array())
 }
 
 /// Indirect radiance albedo/pi * sum_p E_p at every receiver (zero where there is none), with

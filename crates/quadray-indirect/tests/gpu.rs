@@ -953,8 +953,9 @@ fn quadtree_nodes_match_a_cpu_rebuild() {
                     let flux: f32 = children.iter().map(|c| c[0][0]).sum();
                     assert_eq!(node[0][3], count);
                     assert!((node[0][0] - flux).abs() <= 1e-5 * flux.abs() + 1e-12);
-                    let lum =
-                        |c: &[[f32; 4]; 3]| 0.2126 * c[0][0] + 0.7152 * c[0][1] + 0.0722 * c[0][2];
+                    let lum = |c: &[[f32; 4]; 3]| {
+                        quadray_core::image_out::luminance([c[0][0], c[0][1], c[0][2]])
+                    };
                     let weight: f32 = children.iter().map(lum).sum();
                     if weight > 0.0 {
                         let depth: f32 =

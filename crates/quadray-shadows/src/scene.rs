@@ -306,7 +306,7 @@ impl Scene {
     /// ambient term, flat, whatever the exposure. A glTF light's intensity is in candela, so a desk
     /// lamp's few candela in a room-sized scene comes out so.
     pub fn lighting_advice(&self) -> Option<String> {
-        let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let luminance = |c: Vec3| quadray_core::image_out::luminance(c.to_array());
         let ambient = luminance(self.ambient);
         let strongest = self
             .lights
