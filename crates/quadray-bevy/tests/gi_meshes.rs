@@ -62,6 +62,19 @@ pub(crate) fn bounce_settled(app: &mut App, probes: &[Probe], frames: u32) -> Ve
     panic!("the bounce never settled in {frames} frames");
 }
 
+/// Three frames with nothing moving draw no mesh into the RSMs.
+pub(crate) fn assert_still_frames_draw_nothing(app: &mut App, what: &str) {
+    let drawn = meshes_drawn(app);
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(
+        meshes_drawn(app),
+        drawn,
+        "{what}: the RSM drawn again, nothing moving"
+    );
+}
+
 /// The bounce of `meshes` (drawn from Bevy's meshes) against `triangles` (from the CPU's
 /// triangles), printed.
 pub(crate) fn meshes_against_triangles(

@@ -15,8 +15,11 @@ use quadray_indirect::reference::compare;
 use quadray_indirect::scene::Vertex;
 use quadray_indirect::{Method, Renderer, Settings};
 
-use crate::gi::{SIZE, app_of, floats, gathered, in_candela, meshes_drawn, scene_from};
-use crate::gi_meshes::{MESHES_RSM_TOLERANCE, bounce_settled, meshes_against_triangles, switched};
+use crate::gi::{SIZE, app_of, floats, gathered, in_candela, scene_from};
+use crate::gi_meshes::{
+    MESHES_RSM_TOLERANCE, assert_still_frames_draw_nothing, bounce_settled,
+    meshes_against_triangles, switched,
+};
 
 const SKINNED_SCENE: &str = "scenes/skinned_bar.gltf";
 /// A camera looking at the room's left wall past the bar, which it never sees (standing or bent
@@ -203,15 +206,7 @@ fn a_skinned_mesh_s_bounce_moves_with_its_joints() {
     assert!(error.rel_l1 <= MESHES_RSM_TOLERANCE, "{error:?}");
     // with nothing moving the RSM is not drawn again; the joint turned back and bent again, it
     // is, each pose's bounce as the triangles' was
-    let drawn = meshes_drawn(&app);
-    for _ in 0..3 {
-        app.update();
-    }
-    assert_eq!(
-        meshes_drawn(&app),
-        drawn,
-        "the RSM drawn again, nothing moving"
-    );
+    assert_still_frames_draw_nothing(&mut app, "the bent bar");
     for (rotation, pose, expected) in [
         (Quat::IDENTITY, "the bind pose", &bind[0]),
         (turn, "bent again", &last),

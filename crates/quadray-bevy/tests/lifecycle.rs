@@ -23,9 +23,12 @@ use std::sync::{Arc, Mutex};
 
 use crate::gi::{
     Case, Probe, Probes, RSM, SCENE, SIZE, TEXTURED_SCENE, app, app_with, app_without_plugin,
-    cameras_with_passes, check_textured_floor, compiling, floats, gathered, meshes_drawn,
+    cameras_with_passes, check_textured_floor, compiling, floats, gathered,
 };
-use crate::gi_meshes::{MESHES_RSM_TOLERANCE, bounce_settled, meshes_against_triangles, switched};
+use crate::gi_meshes::{
+    MESHES_RSM_TOLERANCE, assert_still_frames_draw_nothing, bounce_settled,
+    meshes_against_triangles, switched,
+};
 
 /// A picture read back every frame, the latest kept.
 type Read = Arc<Mutex<Option<Vec<u8>>>>;
@@ -593,15 +596,7 @@ fn a_replaced_scene_gathers_as_a_fresh_app_on_the_new_one() {
     let moved_place = Transform::from_xyz(-0.4, 0.15, 0.3);
     app.world_mut().entity_mut(red_box).insert(moved_place);
     let moved = bounce_settled(&mut app, &probes, 100);
-    let drawn = meshes_drawn(&app);
-    for _ in 0..3 {
-        app.update();
-    }
-    assert_eq!(
-        meshes_drawn(&app),
-        drawn,
-        "the RSM drawn again with nothing moving"
-    );
+    assert_still_frames_draw_nothing(&mut app, "the moved box");
     let moved_triangles = switched(&mut app, &probes, RsmSource::Triangles);
     sources_agree_on_a_change(
         "a moved box",
