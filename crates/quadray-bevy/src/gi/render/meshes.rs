@@ -335,6 +335,8 @@ struct CachedDraw {
     geometry: MeshGeometry,
     input: UniformInput,
     uniform: MeshUniform,
+    /// The last frame ([`MeshDraws::frame`]) that drew it.
+    frame: u64,
 }
 
 /// The meshes' draws into the RSMs ([`record_mesh_rsm`]): their mesh uniforms (the draw's
@@ -352,6 +354,8 @@ pub(super) struct MeshDraws {
     /// generation, the count of meshes on the GPU.
     cache: HashMap<MainEntity, CachedDraw>,
     prepared_for: (bool, u64, usize),
+    /// Counts the frames prepared (an entity's kept draw not drawn this frame is dropped).
+    frame: u64,
     /// Last frame's draws: entity, pipeline, material group (the RSMs are drawn again when
     /// they differ).
     last: Vec<(MainEntity, CachedRenderPipelineId, BindGroupId)>,
@@ -420,7 +424,8 @@ pub(super) fn prepare_mesh_rsm(
         draws.prepared_for = prepared_for;
     }
     let material_layout = pipeline_cache.get_bind_group_layout(&pipeline.material_layout);
-    let mut seen = bevy::platform::collections::HashSet::new();
+    draws.frame += 1;
+    let frame = draws.frame;
     let (mut uniforms_changed, mut redraw, mut skinned) = (false, false, false);
     draws.draws.clear();
     let mut uniforms = Vec::new();
@@ -477,7 +482,7 @@ pub(super) fn prepare_mesh_rsm(
         if geometry.skinned && input.skin == u32::MAX {
             continue;
         }
-        seen.insert(entity);
+        cached.frame = frame;
         let group = material_group(
             &mut materials,
             material,
@@ -496,7 +501,7 @@ pub(super) fn prepare_mesh_rsm(
         });
         uniforms.push(cached.uniform.clone());
     }
-    draws.cache.retain(|entity, _| seen.contains(entity));
+    draws.cache.retain(|_, c| c.frame == frame);
     let listed = uniforms_changed || now != draws.last;
     // skinned meshes move with their joints, which Bevy poses on the GPU from its joint matrices
     let joints = &sources.skins.current_staging_buffer;
@@ -618,6 +623,7 @@ fn prepare_draw(
         },
         input,
         uniform: input.uniform(),
+        frame: 0,
     })
 }
 
